@@ -1,0 +1,72 @@
+// ffsr/algorithm/effective_mass.hpp -- effective mass m_e (Eq. 4) and integrated effective mass M_ie (Eq. 14).
+#pragma once
+
+#include "ffsr/algorithm/crba.hpp"
+#include "ffsr/model/target.hpp"
+
+namespace ffsr {
+namespace detail {
+
+/// w = J_v^T u for the origin of `frame`: the generalized force that a unit force along u at the
+/// point produces. Reads the kinematics. Writes data.w.
+inline void linear_jacobian_transpose_times(const Model& model, Data& data, int frame, const Vector3& u) {
+  const Vector3 pe = frame_pose(model, data, frame).p;
+  data.w.setZero();
+  data.w.head<3>() = u;
+  data.w.segment<3>(3) = (pe - data.p[0]).cross(u);
+  for (int i = model.frame(frame).body; i > 0; i = model.body(i).parent) {
+    const auto S = data.S.col(i - 1);
+    data.w(5 + i) = model.body(i).joint.type == JointType::Revolute
+                        ? S.tail<3>().dot((pe - data.p[static_cast<size_t>(i)]).cross(u))
+                        : S.head<3>().dot(u);
+  }
+}
+
+inline void check_unit_direction(const Vector3& u, const char* where) {
+  require_finite_all(u, where, "direction u");
+  if (std::abs(u.norm() - 1.0) > 1e-9) throw InputError(str(where, ": direction u must be a unit vector, |u| = ", u.norm()));
+}
+
+}  // namespace detail
+
+/// Inverse effective mass u^T J_v H^-1 J_v^T u (the denominator of Eq. 4) at the configuration of
+/// the last crba. Reads data.H and the kinematics. Writes data.L, data.w, data.y (y = H^-1 w).
+inline double inverse_effective_mass(const Model& model, Data& data, int frame, const Vector3& u) {
+  detail::check_unit_direction(u, "effective_mass");
+  if (frame < 0 || frame >= static_cast<int>(model.frames().size()))
+    throw InputError(detail::str("effective_mass: frame index ", frame, " out of range"));
+  detail::linear_jacobian_transpose_times(model, data, frame, u);
+  detail::cholesky(data.H, data.L, "effective_mass");
+  data.y = data.w;
+  detail::cholesky_solve(data.L, data.y);
+  return data.w.dot(data.y);
+}
+
+/// Effective mass m_e = 1 / (u^T (J_v H^-1 J_v^T) u) of the free-floating robot at the origin of
+/// `frame` along the unit inertial direction u (Eq. 4). Runs crba.
+inline double effective_mass(const Model& model, Data& data, const BasePose& base,
+                             const Eigen::Ref<const Eigen::VectorXd>& theta, int frame, const Vector3& u) {
+  crba(model, data, base, theta);
+  return 1.0 / inverse_effective_mass(model, data, frame, u);
+}
+
+/// Integrated effective mass (Eq. 14) from the robot's effective mass along u = R_t u_n:
+/// M_ie = 1 / (1/m_e + 1/m_t + (r x u)^T I^-1 (r x u)), r = R_t r_tp, I = R_t I_t R_t^T.
+inline double integrated_effective_mass(double m_e, const Target& target) {
+  if (!(m_e > 0) || !std::isfinite(m_e))
+    throw InputError(detail::str("integrated_effective_mass: m_e must be positive and finite, got ", m_e));
+  return 1.0 / (1.0 / m_e + target.inverse_mass_along_normal());
+}
+
+/// Integrated effective mass (Eq. 14) of the robot at (base, theta) with the end-effector `frame`
+/// touching `target` (its attitude gives u = R_t u_n). Runs crba. Does not validate the target on
+/// every call: validate it once (Target::validate) when it is made.
+inline double integrated_effective_mass(const Model& model, Data& data, const BasePose& base,
+                                        const Eigen::Ref<const Eigen::VectorXd>& theta, int frame,
+                                        const Target& target) {
+  crba(model, data, base, theta);
+  const double inv_me = inverse_effective_mass(model, data, frame, target.normal_world());
+  return 1.0 / (inv_me + target.inverse_mass_along_normal());
+}
+
+}  // namespace ffsr

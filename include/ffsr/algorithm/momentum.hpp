@@ -1,0 +1,69 @@
+// ffsr/algorithm/momentum.hpp -- momentum, kinetic energy and base motion from momentum conservation.
+#pragma once
+
+#include "ffsr/algorithm/crba.hpp"
+
+namespace ffsr {
+
+/// Velocity of every body (angular velocity and the velocity of its centre of mass, inertial
+/// frame) by a forward pass over the tree. Reads the kinematics (forward_kinematics) and v.
+/// Calls `visit(i, w_i, vc_i, c_i)` for each body, c_i the centre of mass in o.
+template <class Visit>
+void for_each_body_velocity(const Model& model, const Data& data, const Eigen::Ref<const Eigen::VectorXd>& v,
+                            Visit&& visit) {
+  detail::require_size(v.size(), model.nv(), "body velocities", "v");
+  const int nb = model.n() + 1;
+  // w_i and the velocity of the body point at the base origin, u_i (a spatial velocity about p0)
+  std::vector<Vector6> Vs(static_cast<size_t>(nb));  // small, off the hot path
+  Vs[0] = v.head<6>();
+  for (int i = 1; i < nb; ++i) Vs[static_cast<size_t>(i)] = Vs[static_cast<size_t>(model.body(i).parent)] + data.S.col(i - 1) * v(5 + i);
+  for (int i = 0; i < nb; ++i) {
+    const auto ui = static_cast<size_t>(i);
+    const Vector3 c = data.p[ui] + data.R[ui] * model.body(i).inertia.com;
+    const Vector3 w = Vs[ui].tail<3>();
+    const Vector3 vc = Vs[ui].head<3>() + w.cross(c - data.p[0]);
+    visit(i, w, vc, c);
+  }
+}
+
+/// Total momentum [P; L] of the system: linear momentum and angular momentum about the base frame
+/// origin, inertial frame, summed body by body. Equals the first six rows of H v.
+/// Reads the kinematics (forward_kinematics) and v.
+inline Vector6 momentum(const Model& model, const Data& data, const Eigen::Ref<const Eigen::VectorXd>& v) {
+  Vector6 h = Vector6::Zero();
+  for_each_body_velocity(model, data, v, [&](int i, const Vector3& w, const Vector3& vc, const Vector3& c) {
+    const Inertia& in = model.body(i).inertia;
+    const Matrix3& R = data.R[static_cast<size_t>(i)];
+    h.head<3>() += in.mass * vc;
+    h.tail<3>() += (c - data.p[0]).cross(in.mass * vc) + R * in.I * R.transpose() * w;
+  });
+  return h;
+}
+
+/// Kinetic energy, summed body by body: sum of 1/2 m |v_c|^2 + 1/2 w^T I w.
+/// Reads the kinematics (forward_kinematics) and v.
+inline double kinetic_energy(const Model& model, const Data& data, const Eigen::Ref<const Eigen::VectorXd>& v) {
+  double T = 0;
+  for_each_body_velocity(model, data, v, [&](int i, const Vector3& w, const Vector3& vc, const Vector3&) {
+    const Inertia& in = model.body(i).inertia;
+    const Matrix3& R = data.R[static_cast<size_t>(i)];
+    T += 0.5 * in.mass * vc.squaredNorm() + 0.5 * w.dot(R * in.I * R.transpose() * w);
+  });
+  return T;
+}
+
+/// Base velocity [v0; w0] from momentum conservation: H_b x_b_dot + H_bm theta_dot = h, with h the
+/// total momentum [P; L about the base frame origin] (zero by default).
+/// Reads data.H (crba) and theta_dot.
+inline Vector6 base_velocity_from_momentum(const Model& model, const Data& data,
+                                           const Eigen::Ref<const Eigen::VectorXd>& theta_dot,
+                                           const Vector6& h = Vector6::Zero()) {
+  detail::require_size(theta_dot.size(), model.n(), "base_velocity_from_momentum", "theta_dot");
+  detail::require_finite_all(theta_dot, "base_velocity_from_momentum", "theta_dot");
+  detail::require_finite_all(h, "base_velocity_from_momentum", "momentum");
+  const Eigen::LLT<Matrix6> Hb(data.H.topLeftCorner<6, 6>());
+  if (Hb.info() != Eigen::Success) throw NumericalError("base_velocity_from_momentum: H_b is singular");
+  return Hb.solve(h - data.H.topRightCorner(6, model.n()) * theta_dot);
+}
+
+}  // namespace ffsr

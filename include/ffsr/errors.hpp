@@ -1,0 +1,72 @@
+// ffsr/errors.hpp -- the exception hierarchy of the library.
+//
+// The library never prints and never exits: every failure is thrown as one of these types.
+//   InputError       -- a caller's argument is wrong (size, non-finite value, range, unknown name)
+//   ModelError       -- a URDF file or a programmatically built tree is malformed or unphysical
+//   NumericalError   -- a computation cannot give an answer (singular matrix, no convergence)
+//   IntegrationError -- SUNDIALS CVODE reported a failure (the message names the flag)
+// Messages name the function and the offending argument, what was expected and what came.
+#pragma once
+
+#include <Eigen/Core>
+
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+
+namespace ffsr {
+
+class Error : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+class InputError : public Error {
+ public:
+  using Error::Error;
+};
+class ModelError : public Error {
+ public:
+  using Error::Error;
+};
+class NumericalError : public Error {
+ public:
+  using Error::Error;
+};
+class IntegrationError : public Error {
+ public:
+  using Error::Error;
+};
+
+namespace detail {
+
+/// Joins the arguments into one string with operator<<.
+template <class... Args>
+std::string str(const Args&... args) {
+  std::ostringstream os;
+  os.precision(17);
+  (os << ... << args);
+  return os.str();
+}
+
+/// Throws InputError("<where>: <what> must be finite, got <value>") for NaN or infinity.
+inline void require_finite(double value, const char* where, const char* what) {
+  if (!std::isfinite(value)) throw InputError(str(where, ": ", what, " must be finite, got ", value));
+}
+
+/// Throws InputError unless every coefficient of an Eigen expression is finite.
+template <class Derived>
+void require_finite_all(const Derived& m, const char* where, const char* what) {
+  for (Eigen::Index i = 0; i < m.size(); ++i)
+    if (!std::isfinite(m.data()[i]))
+      throw InputError(str(where, ": ", what, " must be finite, entry ", i, " is ", m.data()[i]));
+}
+
+/// Throws InputError("<where>: <what> has <got> entries, expected <expected>").
+inline void require_size(long got, long expected, const char* where, const char* what) {
+  if (got != expected)
+    throw InputError(str(where, ": ", what, " has ", got, " entries, expected ", expected));
+}
+
+}  // namespace detail
+}  // namespace ffsr

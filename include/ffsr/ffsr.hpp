@@ -1,0 +1,16 @@
+// ffsr/ffsr.hpp -- umbrella header of the dynamics part (Eigen only).
+// The URDF loader (ffsr/io/urdf.hpp, urdfdom) and the CVODE parts (ffsr/simulate/, ffsr/optimize/)
+// are included separately, so that a user who wants the dynamics pulls in only Eigen.
+#pragma once
+
+#include "ffsr/errors.hpp"
+#include "ffsr/spatial/spatial.hpp"
+#include "ffsr/model/model.hpp"
+#include "ffsr/model/data.hpp"
+#include "ffsr/model/target.hpp"
+#include "ffsr/algorithm/kinematics.hpp"
+#include "ffsr/algorithm/crba.hpp"
+#include "ffsr/algorithm/rnea.hpp"
+#include "ffsr/algorithm/jacobian.hpp"
+#include "ffsr/algorithm/momentum.hpp"
+#include "ffsr/algorithm/effective_mass.hpp"

@@ -1,0 +1,60 @@
+// ffsr/model/data.hpp -- the workspace every algorithm writes into.
+//
+// Made once from a Model (all storage is allocated here); the algorithms then run without heap
+// allocation. One Data per thread. Nothing in it is a cache: each algorithm says what it reads
+// and what it writes.
+#pragma once
+
+#include "ffsr/model/model.hpp"
+
+#include <vector>
+
+namespace ffsr {
+
+struct Data {
+  explicit Data(const Model& model)
+      : R(static_cast<size_t>(model.n() + 1)),
+        p(static_cast<size_t>(model.n() + 1)),
+        Ic(static_cast<size_t>(model.n() + 1)),
+        S(6, model.n()),
+        H(model.nv(), model.nv()),
+        L(model.nv(), model.nv()),
+        J(6, model.nv()),
+        Jf(6, model.n()),
+        w(model.nv()),
+        y(model.nv()),
+        V(static_cast<size_t>(model.n() + 1)),
+        A(static_cast<size_t>(model.n() + 1)),
+        F(static_cast<size_t>(model.n() + 1)),
+        Xup(static_cast<size_t>(model.n() + 1)),
+        tau(model.nv()),
+        HbInv_Hbm(6, model.n()) {
+    S.setZero();
+    H.setZero();
+    L.setZero();
+    J.setZero();
+    Jf.setZero();
+  }
+  // --- kinematics (forward_kinematics): world pose of every body frame ---------------------------
+  std::vector<Matrix3> R;   ///< oR_i
+  std::vector<Vector3> p;   ///< origin of body i in o
+  BasePose base;            ///< the base pose the kinematics were computed at
+  /// Joint motion subspace columns in the inertial orientation, about the base frame origin:
+  /// [ (p_k - p_0) x z_k ; z_k ] (revolute) or [ z_k ; 0 ] (prismatic).
+  Eigen::Matrix<double, 6, Eigen::Dynamic> S;
+  // --- CRBA --------------------------------------------------------------------------------------
+  std::vector<SpatialInertia> Ic;  ///< composite inertias about the base origin, inertial axes
+  Eigen::MatrixXd H;               ///< (6+n)x(6+n) joint-space inertia
+  Eigen::MatrixXd L;               ///< Cholesky factor of H (lower), written by the solves
+  // --- Jacobians -------------------------------------------------------------------------------
+  Eigen::MatrixXd J;   ///< 6x(6+n) point Jacobian [J_b J_m] of a frame origin
+  Eigen::MatrixXd Jf;  ///< 6xn generalized Jacobian
+  Eigen::VectorXd w, y;  ///< scratch vectors of size 6+n
+  // --- RNEA (body coordinates) ---------------------------------------------------------------
+  std::vector<Vector6> V, A, F;
+  std::vector<Pose> Xup;  ///< pose of body i in its parent
+  Eigen::VectorXd tau;
+  Eigen::Matrix<double, 6, Eigen::Dynamic> HbInv_Hbm;  ///< H_b^-1 H_bm
+};
+
+}  // namespace ffsr

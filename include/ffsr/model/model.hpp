@@ -1,0 +1,292 @@
+// ffsr/model/model.hpp -- the free-floating robot: a tree of rigid bodies on a 6-DoF base.
+//
+// Coordinates (the one place they are fixed; see also README "Conventions"):
+//  - Configuration: the base pose (position of the base link frame origin and its attitude,
+//    both in the inertial frame o) and the joint positions theta (radians or metres), one per
+//    moving joint, in model order (depth-first from the base; siblings in the order in which
+//    their joints were added -- for URDF, the order of the <joint> elements in the file).
+//  - Generalized velocity (6+n): [v0, w0, theta_dot] with v0 the linear velocity of the base
+//    link frame origin and w0 the angular velocity of the base, both in the inertial frame.
+//  - Generalized acceleration: the time derivative of that vector.
+//  - The first six generalized forces are the force and the moment about the base frame
+//    origin acting on the base, both in the inertial frame.
+//
+// A Model is constant once built. Algorithms write only into a Data (model/data.hpp).
+#pragma once
+
+#include "ffsr/errors.hpp"
+#include "ffsr/spatial/spatial.hpp"
+
+#include <limits>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace ffsr {
+
+/// Pose of a frame b in a frame a: p is the origin of b in a, R = aRb.
+struct Pose {
+  Vector3 p = Vector3::Zero();
+  Matrix3 R = Matrix3::Identity();
+  static Pose from_xyz_rpy(const Vector3& xyz, const Vector3& rpy) { return {xyz, rotation_from_rpy(rpy)}; }
+  Pose operator*(const Pose& b) const { return {p + R * b.p, R * b.R}; }
+};
+
+/// The pose of the base in the inertial frame.
+struct BasePose {
+  Vector3 position = Vector3::Zero();
+  Quaternion orientation = Quaternion::Identity();
+};
+
+/// Mass, centre of mass and inertia about the centre of mass, in the link frame.
+struct Inertia {
+  double mass = 0.0;
+  Vector3 com = Vector3::Zero();
+  Matrix3 I = Matrix3::Zero();
+};
+
+enum class JointType { Revolute, Prismatic };
+
+struct Joint {
+  std::string name;
+  JointType type = JointType::Revolute;
+  Vector3 axis = Vector3::UnitZ();  ///< unit axis in the child (joint) frame
+  double lower = -std::numeric_limits<double>::infinity();
+  double upper = std::numeric_limits<double>::infinity();
+  bool has_limits() const { return std::isfinite(lower) || std::isfinite(upper); }
+};
+
+/// One rigid body. Body 0 is the free-floating base; body i > 0 hangs on joint i - 1.
+struct Body {
+  std::string name;
+  int parent = -1;      ///< index of the parent body, -1 for the base; parent < own index
+  Joint joint;          ///< the joint from the parent (unused for the base)
+  Pose tree;            ///< joint frame in the parent body frame at zero joint position
+  Inertia inertia;      ///< in this body's frame, fixed-joint children merged in
+};
+
+/// A named frame rigidly attached to a body (every link, including those merged by fixed joints).
+struct Frame {
+  std::string name;
+  int body = 0;
+  Pose pose;  ///< in the body frame
+};
+
+/// Checks that an inertia is physical: finite, mass >= 0 (> 0 when `require_positive_mass`),
+/// the rotational inertia symmetric positive semi-definite and satisfying the triangle inequality
+/// (a thin rod's zero axial moment is valid). Throws ModelError naming `what`.
+inline void validate_inertia(const Inertia& in, const std::string& what, bool require_positive_mass) {
+  using detail::str;
+  if (!std::isfinite(in.mass) || !in.com.allFinite() || !in.I.allFinite())
+    throw ModelError(str(what, ": inertial values must be finite"));
+  if (in.mass < 0 || (require_positive_mass && in.mass <= 0))
+    throw ModelError(str(what, ": mass must be positive, got ", in.mass));
+  const double scale = std::max(1.0, in.I.cwiseAbs().maxCoeff());
+  if ((in.I - in.I.transpose()).cwiseAbs().maxCoeff() > 1e-12 * scale)
+    throw ModelError(str(what, ": inertia matrix is not symmetric"));
+  Eigen::SelfAdjointEigenSolver<Matrix3> es(in.I, Eigen::EigenvaluesOnly);
+  const Vector3 e = es.eigenvalues();
+  const double tol = 1e-9 * scale;
+  if (e.minCoeff() < -tol)
+    throw ModelError(str(what, ": inertia matrix is not positive semi-definite (smallest principal moment ",
+                         e.minCoeff(), ")"));
+  if (e(2) > e(0) + e(1) + tol)
+    throw ModelError(str(what, ": principal moments (", e(0), ", ", e(1), ", ", e(2),
+                         ") break the triangle inequality"));
+}
+
+class ModelBuilder;
+
+/// A free-floating multibody tree. Constant after it is built (see ModelBuilder).
+class Model {
+ public:
+  /// Number of moving joints n (the joint-space dimension).
+  int n() const { return static_cast<int>(bodies_.size()) - 1; }
+  /// Dimension of the generalized velocity, 6 + n.
+  int nv() const { return n() + 6; }
+  const std::vector<Body>& bodies() const { return bodies_; }
+  const Body& body(int i) const { return bodies_[static_cast<size_t>(i)]; }
+  const std::vector<Frame>& frames() const { return frames_; }
+  const Frame& frame(int i) const { return frames_[static_cast<size_t>(i)]; }
+  /// The index of a named frame; throws InputError listing the frames when the name is unknown.
+  int frame_index(const std::string& name) const {
+    for (size_t i = 0; i < frames_.size(); ++i)
+      if (frames_[i].name == name) return static_cast<int>(i);
+    std::string list;
+    for (const auto& f : frames_) list += (list.empty() ? "" : ", ") + f.name;
+    throw InputError(detail::str("unknown frame '", name, "'; the model has: ", list));
+  }
+  /// The default end-effector frame (the single leaf, or the one set by the builder).
+  int end_effector() const { return end_effector_; }
+  std::vector<std::string> joint_names() const {
+    std::vector<std::string> names;
+    for (size_t i = 1; i < bodies_.size(); ++i) names.push_back(bodies_[i].joint.name);
+    return names;
+  }
+  double total_mass() const {
+    double m = 0;
+    for (const auto& b : bodies_) m += b.inertia.mass;
+    return m;
+  }
+  /// Gravity in the inertial frame (zero by default: the robot floats freely).
+  Vector3 gravity = Vector3::Zero();
+  /// A label for error messages (the URDF file, or "model").
+  std::string source = "model";
+
+ private:
+  friend class ModelBuilder;
+  std::vector<Body> bodies_;
+  std::vector<Frame> frames_;
+  int end_effector_ = -1;
+};
+
+/// Builds a Model in code, or from a URDF (io/urdf.hpp uses it).
+///
+///   Model m = ModelBuilder("base", {500, {0,0,0}, 200 * Matrix3::Identity()})
+///                 .add_joint("j1", JointType::Revolute, "base", Pose{{0.6,0,0}}, Vector3::UnitZ(),
+///                            "link1", {5, {0.7,0,0}, Vector3(0.01,0.82,0.82).asDiagonal()})
+///                 ...
+///                 .build();
+class ModelBuilder {
+ public:
+  ModelBuilder(const std::string& base_name, const Inertia& base_inertia) {
+    validate_inertia(base_inertia, "base link '" + base_name + "'", false);
+    Body b;
+    b.name = base_name;
+    b.inertia = base_inertia;
+    model_.bodies_.push_back(b);
+    model_.frames_.push_back({base_name, 0, Pose{}});
+  }
+
+  /// Adds a moving joint from the frame `parent` (a link or frame name) to a new link `child`.
+  ModelBuilder& add_joint(const std::string& name, JointType type, const std::string& parent, const Pose& origin,
+                          const Vector3& axis, const std::string& child, const Inertia& inertia,
+                          double lower = -std::numeric_limits<double>::infinity(),
+                          double upper = std::numeric_limits<double>::infinity()) {
+    using detail::str;
+    const Frame pf = find_parent(parent, name);
+    check_new_name(child, name);
+    check_pose(origin, "joint '" + name + "' origin");
+    if (!axis.allFinite() || axis.norm() < 1e-12)
+      throw ModelError(str("joint '", name, "': axis must be a finite non-zero vector"));
+    if (std::isnan(lower) || std::isnan(upper) || lower > upper)
+      throw ModelError(str("joint '", name, "': limits must satisfy lower <= upper, got [", lower, ", ", upper, "]"));
+    validate_inertia(inertia, "link '" + child + "'", false);
+    Body b;
+    b.name = child;
+    b.parent = pf.body;
+    b.joint = Joint{name, type, axis.normalized(), lower, upper};
+    b.tree = pf.pose * origin;
+    b.inertia = inertia;
+    model_.bodies_.push_back(b);
+    frame_parent_.push_back(frame_position(parent));
+    model_.frames_.push_back({child, static_cast<int>(model_.bodies_.size()) - 1, Pose{}});
+    return *this;
+  }
+
+  /// Adds a fixed joint: the link `child` is merged into the body carrying `parent` (its inertia is
+  /// added there) and keeps a named frame.
+  ModelBuilder& add_fixed(const std::string& name, const std::string& parent, const Pose& origin,
+                          const std::string& child, const Inertia& inertia) {
+    const Frame pf = find_parent(parent, name);
+    check_new_name(child, name);
+    check_pose(origin, "joint '" + name + "' origin");
+    validate_inertia(inertia, "link '" + child + "'", false);
+    const Pose pose = pf.pose * origin;
+    Inertia& target = model_.bodies_[static_cast<size_t>(pf.body)].inertia;
+    target = merge(target, transformed(inertia, pose));
+    frame_parent_.push_back(frame_position(parent));
+    model_.frames_.push_back({child, pf.body, pose});
+    return *this;
+  }
+
+  /// Names the end-effector frame (default: the single leaf link).
+  ModelBuilder& set_end_effector(const std::string& frame) {
+    ee_name_ = frame;
+    return *this;
+  }
+
+  /// Validates the tree and returns the model. Throws ModelError (moving link without mass,
+  /// no joint) or InputError (unknown or ambiguous end-effector).
+  Model build() const {
+    using detail::str;
+    Model m = model_;
+    if (m.n() < 1) throw ModelError(str(m.source, ": the robot has no moving joint"));
+    validate_inertia(m.bodies_[0].inertia, "base link '" + m.bodies_[0].name + "'", true);
+    for (int i = 1; i <= m.n(); ++i)
+      validate_inertia(m.body(i).inertia, "link '" + m.body(i).name + "' (moving)", true);
+    if (!ee_name_.empty()) {
+      m.end_effector_ = m.frame_index(ee_name_);
+    } else {
+      std::vector<std::string> leaves = leaf_frames(m);
+      if (leaves.size() != 1) {
+        std::string list;
+        for (const auto& l : leaves) list += (list.empty() ? "" : ", ") + l;
+        throw InputError(str("the end-effector is ambiguous: the tree has ", leaves.size(),
+                             " leaf links (", list, "); name one"));
+      }
+      m.end_effector_ = m.frame_index(leaves.front());
+    }
+    return m;
+  }
+
+  /// Source label for error messages.
+  ModelBuilder& set_source(const std::string& s) {
+    model_.source = s;
+    return *this;
+  }
+  ModelBuilder& set_gravity(const Vector3& g) {
+    if (!g.allFinite()) throw InputError("gravity must be finite");
+    model_.gravity = g;
+    return *this;
+  }
+
+ private:
+  Frame find_parent(const std::string& parent, const std::string& joint) const {
+    for (const auto& f : model_.frames_)
+      if (f.name == parent) return f;
+    throw ModelError(detail::str("joint '", joint, "': unknown parent link '", parent, "'"));
+  }
+  void check_new_name(const std::string& child, const std::string& joint) const {
+    for (const auto& f : model_.frames_)
+      if (f.name == child)
+        throw ModelError(detail::str("joint '", joint, "': link '", child,
+                                     "' already has a parent (closed loop or duplicate link)"));
+  }
+  static void check_pose(const Pose& p, const std::string& what) {
+    if (!p.p.allFinite() || !p.R.allFinite()) throw ModelError(what + ": values must be finite");
+  }
+  static Inertia transformed(const Inertia& in, const Pose& pose) {
+    return {in.mass, pose.p + pose.R * in.com, pose.R * in.I * pose.R.transpose()};
+  }
+  static Inertia merge(const Inertia& a, const Inertia& b) {
+    const double m = a.mass + b.mass;
+    if (m <= 0) return {0.0, Vector3::Zero(), a.I + b.I};
+    const Vector3 c = (a.mass * a.com + b.mass * b.com) / m;
+    auto about_c = [&](const Inertia& x) {
+      const Vector3 d = x.com - c;
+      return Matrix3(x.I + x.mass * (d.squaredNorm() * Matrix3::Identity() - d * d.transpose()));
+    };
+    return {m, c, about_c(a) + about_c(b)};
+  }
+  std::vector<std::string> leaf_frames(const Model& m) const {
+    // A leaf is a link frame that is no other link's parent (fixed children count as children).
+    std::vector<char> is_parent(m.frames_.size(), 0);
+    for (int p : frame_parent_)
+      if (p >= 0) is_parent[static_cast<size_t>(p)] = 1;
+    std::vector<std::string> leaves;
+    for (size_t fi = 0; fi < m.frames_.size(); ++fi)
+      if (!is_parent[fi]) leaves.push_back(m.frames_[fi].name);
+    return leaves;
+  }
+  int frame_position(const std::string& name) const {
+    for (size_t i = 0; i < model_.frames_.size(); ++i)
+      if (model_.frames_[i].name == name) return static_cast<int>(i);
+    return -1;
+  }
+  Model model_;
+  std::vector<int> frame_parent_{-1};  ///< for each frame, the frame it hangs on (-1 for the base)
+  std::string ee_name_;
+};
+
+}  // namespace ffsr

@@ -1,0 +1,66 @@
+// ffsr/model/target.hpp -- the tumbling target: a free rigid body with one contact point.
+#pragma once
+
+#include "ffsr/errors.hpp"
+#include "ffsr/spatial/spatial.hpp"
+
+namespace ffsr {
+
+/// The target of the capture (Section 2.2). Vectors marked (target frame) rotate with it.
+struct Target {
+  double mass = 200.0;                                        ///< m_t, kg
+  Matrix3 inertia = 100.0 * Matrix3::Identity();              ///< I_t about its centre of mass (target frame)
+  Vector3 position = Vector3::Zero();                         ///< centre of mass in o
+  Quaternion attitude = Quaternion::Identity();               ///< oR_t
+  Vector3 velocity = Vector3::Zero();                         ///< v_t, inertial frame
+  Vector3 angular_velocity = Vector3::Zero();                 ///< omega_t (target frame), rad/s
+  Vector3 contact_offset = Vector3(-0.25, 0.15, 0.0);         ///< r_tp (target frame)
+  Vector3 normal = Vector3::UnitX();                          ///< u_n (target frame), unit
+
+  /// Checks every field; throws InputError naming the field. The inertia must be symmetric positive
+  /// definite (Eq. 14 inverts it) and satisfy the triangle inequality.
+  void validate(const char* where = "target") const {
+    using detail::str;
+    if (!std::isfinite(mass) || mass <= 0) throw InputError(str(where, ": mass must be positive and finite, got ", mass));
+    detail::require_finite_all(inertia, where, "inertia");
+    detail::require_finite_all(position, where, "position");
+    detail::require_finite_all(attitude.coeffs(), where, "attitude");
+    detail::require_finite_all(velocity, where, "velocity");
+    detail::require_finite_all(angular_velocity, where, "angular velocity");
+    detail::require_finite_all(contact_offset, where, "contact offset");
+    detail::require_finite_all(normal, where, "normal");
+    if (attitude.norm() < 1e-9) throw InputError(str(where, ": attitude quaternion has zero norm"));
+    if (normal.norm() < 1e-12) throw InputError(str(where, ": normal must be a non-zero vector"));
+    const double scale = inertia.cwiseAbs().maxCoeff();
+    if ((inertia - inertia.transpose()).cwiseAbs().maxCoeff() > 1e-12 * scale)
+      throw InputError(str(where, ": inertia must be symmetric"));
+    Eigen::SelfAdjointEigenSolver<Matrix3> es(inertia, Eigen::EigenvaluesOnly);
+    const Vector3 e = es.eigenvalues();
+    if (!(e(0) > 1e-12 * scale) || !(scale > 0))
+      throw InputError(str(where, ": inertia must be positive definite, principal moments (", e(0), ", ", e(1), ", ",
+                           e(2), ")"));
+    if (e(2) > (e(0) + e(1)) * (1 + 1e-9))
+      throw InputError(str(where, ": principal moments (", e(0), ", ", e(1), ", ", e(2),
+                           ") break the triangle inequality"));
+  }
+  /// oR_t.
+  Matrix3 rotation() const { return attitude.normalized().toRotationMatrix(); }
+  /// Contact normal u = R_t u_n in o (unit).
+  Vector3 normal_world() const { return rotation() * normal.normalized(); }
+  /// Contact point offset r = R_t r_tp in o.
+  Vector3 offset_world() const { return rotation() * contact_offset; }
+  /// Contact point position in o.
+  Vector3 contact_point() const { return position + offset_world(); }
+  /// Angular velocity in o.
+  Vector3 angular_velocity_world() const { return rotation() * angular_velocity; }
+  /// Velocity of the target's material contact point, v_tp = v_t + w_t x r (Eq. 12), in o.
+  Vector3 contact_point_velocity() const { return velocity + angular_velocity_world().cross(offset_world()); }
+  /// The target's inverse mass perceived along the normal at the contact point,
+  /// 1/m_t + (r x u)^T I^-1 (r x u) (the target part of Eq. 14). It does not depend on the attitude.
+  double inverse_mass_along_normal() const {
+    const Vector3 ru = contact_offset.cross(normal.normalized());
+    return 1.0 / mass + ru.dot(inertia.ldlt().solve(ru));
+  }
+};
+
+}  // namespace ffsr

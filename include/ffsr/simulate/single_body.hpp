@@ -1,0 +1,172 @@
+// ffsr/simulate/single_body.hpp -- CVODE integration of the single-body contact model, Eq. 16:
+//     M_ie δ̈ = -F(δ, δ̇),   F the contact law of Eq. 15 (HertzDamped::force, with its clamp),
+// from first touch (δ = 0, δ̇ = δ̇⁻) to separation (δ back to 0), located by CVODE root finding
+// (Zhang et al. 2022, Section 3). It is the time-stepping reference for the closed forms
+// (Eq. 20, 23-25) and for the exact maximum of contact_law.hpp.
+//
+// Scaling: the contact lasts milliseconds and δ is micrometres, so the integration runs in the
+// natural units of the problem: length δ_ref = δ_max (Eq. 20), velocity δ̇⁻, time T = δ_ref/δ̇⁻.
+// The scaled state y = (δ/δ_ref, δ̇/δ̇⁻) is O(1) along the whole contact, so plain relative and
+// absolute tolerances apply; results are returned in SI units.
+//
+// Events (CVODE root functions, all with direction -1, i.e. crossed while decreasing):
+//   dF/dt  -- the force peak. For δ > 0, dF/dt = δ^(α-1) (α δ̇ (K + λ δ̇) + λ δ δ̈); the bracket
+//             is the root function, so the peak is located to CVODE's root tolerance and F there
+//             is F(δ, δ̇) of the integrated state (first order insensitive to the time error);
+//   δ̇      -- the maximum deformation;
+//   δ      -- separation.
+#pragma once
+
+#include <ffsr/contact/contact_law.hpp>
+#include <ffsr/errors.hpp>
+#include <ffsr/simulate/cvode.hpp>
+
+#include <Eigen/Core>
+
+#include <cmath>
+#include <variant>
+#include <vector>
+
+namespace ffsr {
+
+/// Settings of simulate_single_body.
+struct SingleBodyOptions {
+  /// CVODE settings for the scaled state (δ/δ_max, δ̇/δ̇⁻) in the time unit δ_max/δ̇⁻ (file comment).
+  cvode::Options cvode{};
+  /// Record the time series (every internal step plus the events).
+  bool record_series = false;
+  /// Give up (NumericalError) if the bodies have not separated after this many time units
+  /// δ_max/δ̇⁻ (an elastic Hertz contact lasts about 3 of them).
+  double max_scaled_duration = 1e4;
+};
+
+/// The time series of a single-body contact, SI units.
+struct SingleBodySeries {
+  std::vector<double> t;          ///< time since first touch [s]
+  std::vector<double> force;      ///< F [N]
+  std::vector<double> delta;      ///< δ [m]
+  std::vector<double> delta_dot;  ///< δ̇ [m/s]
+};
+
+/// Result of simulate_single_body, SI units.
+struct SingleBodyResult {
+  double f_max = 0;               ///< maximum contact force [N]
+  double t_at_f_max = 0;          ///< time of the force peak [s]
+  double delta_at_f_max = 0;      ///< δ'_max, deformation at the force peak [m]
+  double delta_dot_at_f_max = 0;  ///< δ̇ at the force peak [m/s]
+  double delta_max = 0;           ///< maximum deformation (where δ̇ = 0) [m]
+  double t_at_delta_max = 0;      ///< its time [s]
+  double contact_duration = 0;    ///< time from first touch to separation [s]
+  double separation_velocity = 0; ///< δ̇ at separation [m/s] (negative)
+  double restitution = 0;         ///< realized coefficient of restitution, -δ̇_sep/δ̇⁻
+  long num_steps = 0;             ///< CVODE steps taken
+  SingleBodySeries series;        ///< filled when SingleBodyOptions::record_series
+};
+
+/// Integrates Eq. 16 with `law` and M_ie > 0 from first touch to separation (see the file
+/// comment). InputError for M_ie <= 0 or bad options; IntegrationError from CVODE; NumericalError
+/// if no separation within max_scaled_duration.
+template <class Damping>
+SingleBodyResult simulate_single_body(const HertzDamped<Damping>& law, double M_ie,
+                                      const SingleBodyOptions& opt = {});
+
+/// The same for a law chosen at run time.
+inline SingleBodyResult simulate_single_body(const AnyContactLaw& law, double M_ie,
+                                             const SingleBodyOptions& opt = {}) {
+  return std::visit([&](const auto& l) { return simulate_single_body(l, M_ie, opt); }, law);
+}
+
+// ============================================================================================
+// Implementation
+// ============================================================================================
+
+template <class Damping>
+SingleBodyResult simulate_single_body(const HertzDamped<Damping>& law, double M_ie,
+                                      const SingleBodyOptions& opt) {
+  using detail::str;
+  constexpr const char* where = "simulate_single_body";
+  const double delta_ref = law.max_deformation(M_ie);  // validates M_ie
+  if (!(opt.max_scaled_duration > 0.0) || !std::isfinite(opt.max_scaled_duration))
+    throw InputError(str(where, ": max_scaled_duration must be positive and finite, got ",
+                         opt.max_scaled_duration));
+  const double v0 = law.approach_velocity();
+  const double T = delta_ref / v0;                            // time unit [s]
+  const double accel_scale = delta_ref / (M_ie * v0 * v0);    // scaled accel = -F * accel_scale
+  const double f = law.f();
+  const double alpha = law.params().alpha;
+
+  auto scaled_force = [&law, delta_ref, v0](double x, double v) {
+    return law.force(delta_ref * x, v0 * v);
+  };
+  cvode::Rhs rhs = [scaled_force, accel_scale](double, const Eigen::Ref<const Eigen::VectorXd>& y,
+                                               Eigen::Ref<Eigen::VectorXd> ydot) {
+    ydot[0] = y[1];
+    ydot[1] = -scaled_force(y[0], y[1]) * accel_scale;
+  };
+  // g0 = (dF/dt) / (δ^(α-1) K δ̇⁻) = α v (1 + f v) + f x a; g1 = v; g2 = x.
+  cvode::Roots roots = [scaled_force, accel_scale, alpha, f](
+                           double, const Eigen::Ref<const Eigen::VectorXd>& y,
+                           Eigen::Ref<Eigen::VectorXd> g) {
+    const double x = y[0], v = y[1];
+    const double a = -scaled_force(x, v) * accel_scale;
+    g[0] = alpha * v * (1.0 + f * v) + f * x * a;
+    g[1] = v;
+    g[2] = x;
+  };
+
+  cvode::Integrator integ(rhs, Eigen::Vector2d(0.0, 1.0), 0.0, opt.cvode, 3, roots, {-1, -1, -1});
+
+  SingleBodyResult r;
+  auto record = [&] {
+    const double x = integ.y()[0], v = integ.y()[1];
+    r.series.t.push_back(integ.t() * T);
+    r.series.force.push_back(scaled_force(x, v));
+    r.series.delta.push_back(x * delta_ref);
+    r.series.delta_dot.push_back(v * v0);
+  };
+  if (opt.record_series) record();
+
+  bool peak = false, compressed = false;
+  // advance() returns only at events (three expected) or at the end; step() once per step.
+  const long max_calls = opt.record_series ? opt.cvode.max_num_steps : 64;
+  for (long call = 0; call < max_calls; ++call) {
+    const auto status =
+        opt.record_series ? integ.step(opt.max_scaled_duration) : integ.advance(opt.max_scaled_duration);
+    if (opt.record_series) record();
+    if (status == cvode::Integrator::Status::Reached)
+      throw NumericalError(str(where, ": no separation within ", opt.max_scaled_duration * T,
+                               " s (", opt.max_scaled_duration, " time units delta_max/v0)"));
+    if (status != cvode::Integrator::Status::Root) continue;
+    const std::vector<int> info = integ.roots_found();
+    const double x = integ.y()[0], v = integ.y()[1];
+    if (info[0] != 0) {
+      const double F = scaled_force(x, v);
+      if (!peak || F > r.f_max) {
+        r.f_max = F;
+        r.t_at_f_max = integ.t() * T;
+        r.delta_at_f_max = x * delta_ref;
+        r.delta_dot_at_f_max = v * v0;
+      }
+      peak = true;
+    }
+    if (info[1] != 0 && !compressed) {
+      r.delta_max = x * delta_ref;
+      r.t_at_delta_max = integ.t() * T;
+      compressed = true;
+    }
+    if (info[2] != 0) {
+      if (!peak || !compressed)
+        throw NumericalError(str(where, ": separation at t = ", integ.t() * T,
+                                 " s before the force peak or the maximum deformation was found"));
+      r.contact_duration = integ.t() * T;
+      r.separation_velocity = v * v0;
+      r.restitution = -v;
+      r.num_steps = integ.num_steps();
+      return r;
+    }
+  }
+  throw IntegrationError(str(where, ": no separation after ", max_calls,
+                             " calls of CVODE (max_num_steps = ", opt.cvode.max_num_steps, ")"));
+}
+
+}  // namespace ffsr
