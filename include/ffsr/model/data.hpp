@@ -15,8 +15,8 @@ struct Data {
   explicit Data(const Model& model)
       : R(static_cast<size_t>(model.n() + 1)),
         p(static_cast<size_t>(model.n() + 1)),
-        Ic(static_cast<size_t>(model.n() + 1)),
         S(6, model.n()),
+        Ic(static_cast<size_t>(model.n() + 1)),
         H(model.nv(), model.nv()),
         L(model.nv(), model.nv()),
         J(6, model.nv()),

@@ -1,0 +1,2 @@
+#include "ffsr/ffsr.hpp"
+int main(){}

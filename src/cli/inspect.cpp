@@ -1,0 +1,78 @@
+// ffsr-optimize inspect: evaluate one configuration (H, J_f, m_e, M_ie).
+#include "common.hpp"
+#include "subcommands.hpp"
+
+#include <iomanip>
+#include <iostream>
+#include <memory>
+
+namespace ffsr::cli {
+namespace {
+
+struct InspectOptions {
+  RobotOptions robot;
+  TargetOptions target;
+  bool json = false;
+};
+
+int run_inspect(const InspectOptions& o) {
+  const Robot r = load_robot(o.robot);
+  const Target target = o.target.build();
+  Data data(r.model);
+  const Vector3 u = target.normal_world();
+  const double M_ie = integrated_effective_mass(r.model, data, r.base, r.theta, r.end_effector, target);
+  const double m_e = 1.0 / inverse_effective_mass(r.model, data, r.end_effector, u);
+  frame_jacobian(r.model, data, r.end_effector);
+  const Eigen::MatrixXd Jf = generalized_jacobian(r.model, data);
+  const Pose ee = frame_pose(r.model, data, r.end_effector);
+
+  if (o.json) {
+    nlohmann::json j;
+    j["urdf"] = o.robot.urdf;
+    j["end_effector"] = r.model.frame(r.end_effector).name;
+    j["joint_names"] = r.model.joint_names();
+    j["joints_deg"] = to_json(Eigen::VectorXd(r.theta * (180.0 / M_PI)));
+    j["base_position"] = to_json(Eigen::VectorXd(r.base.position));
+    j["end_effector_position"] = to_json(Eigen::VectorXd(ee.p));
+    j["end_effector_rpy_deg"] = to_json(Eigen::VectorXd(rpy_from_rotation(ee.R) * (180.0 / M_PI)));
+    j["direction"] = to_json(Eigen::VectorXd(u));
+    j["H"] = to_json(data.H);
+    j["J_bm"] = to_json(data.J);
+    j["J_f"] = to_json(Jf);
+    j["total_mass"] = r.model.total_mass();
+    j["effective_mass"] = m_e;
+    j["integrated_effective_mass"] = M_ie;
+    j["version"] = FFSR_VERSION;
+    std::cout << j.dump(2) << "\n";
+    return 0;
+  }
+  std::cout << std::setprecision(6);
+  std::cout << "robot            " << o.robot.urdf << " (" << r.model.n() << " joints, " << r.model.total_mass()
+            << " kg)\n";
+  std::cout << "end-effector     " << r.model.frame(r.end_effector).name << " at [" << ee.p.transpose().format(
+                                                                                              Eigen::IOFormat(6, 0, ", "))
+            << "] m\n";
+  std::cout << "joints           ";
+  const auto names = r.model.joint_names();
+  for (size_t i = 0; i < names.size(); ++i)
+    std::cout << names[i] << "=" << r.theta(static_cast<Eigen::Index>(i)) * 180.0 / M_PI << (i + 1 < names.size() ? ", " : " deg\n");
+  std::cout << "direction u      [" << u.transpose().format(Eigen::IOFormat(6, 0, ", ")) << "]\n";
+  std::cout << "effective mass   m_e  = " << m_e << " kg   (Eq. 4)\n";
+  std::cout << "integrated mass  M_ie = " << M_ie << " kg   (Eq. 14)\n";
+  std::cout << "J_f (generalized Jacobian, 6x" << r.model.n() << ", linear rows first):\n"
+            << Jf.format(Eigen::IOFormat(5, 0, "  ", "\n", "  ")) << "\n";
+  return 0;
+}
+
+}  // namespace
+
+void register_inspect(CLI::App& app, Action& action) {
+  auto opts = std::make_shared<InspectOptions>();
+  CLI::App* sub = app.add_subcommand("inspect", "Evaluate one configuration: H, J_f, effective mass and M_ie");
+  opts->robot.add_to(*sub);
+  opts->target.add_to(*sub);
+  sub->add_flag("--json", opts->json, "Print one JSON object on stdout");
+  sub->callback([opts, &action] { action = [opts] { return run_inspect(*opts); }; });
+}
+
+}  // namespace ffsr::cli

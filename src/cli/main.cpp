@@ -1,0 +1,52 @@
+// ffsr-optimize: plan the capture configuration of a free-floating space robot.
+// Parses the command line, runs the chosen action and maps exceptions to one error line and an exit
+// code (2: bad input, 3: numerical failure). The library itself never prints.
+#include "common.hpp"
+#include "subcommands.hpp"
+
+#include <iostream>
+
+int main(int argc, char** argv) {
+  using namespace ffsr::cli;
+  CLI::App app{"ffsr-optimize: capture-configuration optimization for free-floating space robots (ffsr " FFSR_VERSION ")",
+               "ffsr-optimize"};
+  app.set_version_flag("--version", FFSR_VERSION);
+  Action action;
+  register_inspect(app, action);
+  // register_contact(app, action);
+  app.require_subcommand(0, 1);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::cerr << "ffsr-optimize: error: " << e.what() << "\n";
+    return kExitInput;
+  } catch (const ffsr::Error& e) {
+    std::cerr << "ffsr-optimize: error: " << e.what() << "\n";
+    return kExitInput;
+  }
+  if (!action) {
+    std::cout << app.help();
+    return 0;
+  }
+  try {
+    return action();
+  } catch (const ffsr::InputError& e) {
+    std::cerr << "ffsr-optimize: error: " << e.what() << "\n";
+    return kExitInput;
+  } catch (const ffsr::ModelError& e) {
+    std::cerr << "ffsr-optimize: error: " << e.what() << "\n";
+    return kExitInput;
+  } catch (const ffsr::Error& e) {
+    std::cerr << "ffsr-optimize: error: " << e.what() << "\n";
+    return kExitNumerical;
+  } catch (const std::exception& e) {
+    std::cerr << "ffsr-optimize: error: " << e.what() << "\n";
+    return 1;
+  }
+}
