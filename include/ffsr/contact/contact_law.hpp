@@ -24,6 +24,7 @@
 #include <ffsr/errors.hpp>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>  // cross
 
 #include <algorithm>
 #include <array>

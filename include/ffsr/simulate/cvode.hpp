@@ -94,7 +94,11 @@ class Integrator {
   double t() const;                    ///< time of the last returned solution
   const Eigen::VectorXd& y() const;    ///< the solution at t()
   Eigen::Index size() const;           ///< number of states
-  /// Dense output y(t) (CVodeGetDky, k = 0); t within the last step [t_n - h_u, t_n].
+  /// CVODE's internal time t_n (CVodeGetCurrentTime): the end of the last internal step, >= t()
+  /// (beyond it after a root or in CV_NORMAL mode).
+  double current_time() const;
+  /// Dense output y(t) (CVodeGetDky, k = 0); t within the last step [t_n - h_u, t_n], with
+  /// t_n = current_time() and h_u = last_step(); IntegrationError (CV_BAD_T) outside.
   Eigen::VectorXd interpolate(double t) const;
   /// CVodeGetRootInfo after Status::Root: per root function, +1 / -1 if it crossed increasing /
   /// decreasing, 0 if it did not.
@@ -404,6 +408,11 @@ inline long Integrator::num_root_evals() const {
   long v = 0;
   s_->check(CVodeGetNumGEvals(s_->mem.get(), &v), "CVodeGetNumGEvals");
   return v;
+}
+inline double Integrator::current_time() const {
+  sunrealtype tc = 0;
+  s_->check(CVodeGetCurrentTime(s_->mem.get(), &tc), "CVodeGetCurrentTime");
+  return tc;
 }
 inline double Integrator::last_step() const {
   sunrealtype h = 0;

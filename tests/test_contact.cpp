@@ -1,0 +1,609 @@
+// Tests of the contact laws (Table 1, Eq. 15-27, 32), the CVODE wrapper and the single-body
+// simulation of Eq. 16 (Zhang et al. 2022, Aerospace 9, 69). Every check names its tolerance and
+// where the expected value comes from.
+#include <ffsr/contact/contact_law.hpp>
+#include <ffsr/contact/damping.hpp>
+#include <ffsr/errors.hpp>
+#include <ffsr/simulate/cvode.hpp>
+#include <ffsr/simulate/single_body.hpp>
+
+#include <catch2/catch.hpp>
+
+#include <Eigen/Core>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <tuple>
+#include <utility>
+#include <vector>
+
+using namespace ffsr;
+using Catch::Matchers::Contains;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kDeg = kPi / 180.0;
+
+double rel(double a, double b) { return std::abs(a - b) / std::abs(b); }
+
+// The paper's contact parameters (Sections 5.1.1 and 5.2.1).
+const ContactParams kPaper{1e9, 1.5, 0.9};
+
+// Every law of AnyContactLaw, built by name.
+std::vector<AnyContactLaw> all_laws(const ContactParams& p, double v0) {
+  std::vector<AnyContactLaw> laws;
+  for (std::string_view n : contact_law_names()) laws.push_back(make_contact_law(n, p, v0));
+  return laws;
+}
+
+// Table 1 written out independently of damping.hpp, in the order of contact_law_names().
+double table1_factor(std::size_t i, double c) {
+  switch (i) {
+    case 0: return 1.5 * (1 - c);                                   // Hunt-Crossley
+    case 1: return 6 * (1 - c) / ((2 * c - 1) * (2 * c - 1) + 3);   // Herbert-McWhannell
+    case 2: return 0.75 * (1 - c * c);                              // Lankarani-Nikravesh
+    case 3: return 0.75 * (1 - c);                                  // Lee-Wang
+    case 4: return 8 * (1 - c) / (5 * c);                           // Flores et al.
+    case 5: return (1 - c * c) / c;                                 // Gonthier et al.
+    case 6: return 0.75 * (1 - c * c) * std::exp(2 * (1 - c));      // Zhiying-Qishao
+    case 7: return 1.5 * (1 - c) / c;                               // Hu-Guo
+    default: return std::nan("");
+  }
+}
+
+// F along the single-body contact as a function of s = δ̇/δ̇⁻ (Eq. 19 into Eq. 15).
+double force_at_rate(const AnyContactLaw& law, double M, double s) {
+  const double v0 = approach_velocity(law);
+  return std::visit(
+      [&](const auto& l) { return l.force(l.deformation(M, s * v0), s * v0); }, law);
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// Table 1 and the law itself
+// ---------------------------------------------------------------------------------------------
+
+TEST_CASE("damping factors follow Table 1 and vanish at c_r = 1", "[contact]") {
+  const auto names = contact_law_names();
+  REQUIRE(names.size() == 8);
+  const std::array<std::string_view, 8> expected{"hunt-crossley", "herbert-mcwhannell",
+                                                 "lankarani-nikravesh", "lee-wang", "flores",
+                                                 "gonthier", "zhiying-qishao", "hu-guo"};
+  for (std::size_t i = 0; i < 8; ++i) {
+    CHECK(names[i] == expected[i]);
+    for (double c : {0.1, 0.3, 0.5, 0.9, 0.99, 1.0}) {
+      const auto law = make_contact_law(names[i], ContactParams{1e9, 1.5, c}, 0.2);
+      INFO(names[i] << " c_r = " << c);
+      CHECK(contact_law_name(law) == names[i]);
+      // Table 1 re-typed independently; tolerance 1e-15 relative (rounding of the same formula).
+      CHECK(damping_factor(law) == Approx(table1_factor(i, c)).epsilon(1e-15).margin(0));
+      // Eq. 22: λ = f K / δ̇⁻ (identity, 1e-15).
+      CHECK(lambda(law) == Approx(table1_factor(i, c) * 1e9 / 0.2).epsilon(1e-15).margin(0));
+    }
+  }
+}
+
+TEST_CASE("the force of Eq. 15: zero without contact, clamped at zero, never pulls", "[contact]") {
+  const HertzDamped<HuntCrossley> law({1e9, 1.5, 0.5}, 0.2);  // f = 0.75, λ = 3.75e9
+  // No contact: F = 0 for δ <= 0 whatever δ̇.
+  CHECK(law.force(0.0, 0.2) == 0.0);
+  CHECK(law.force(-1e-6, -0.2) == 0.0);
+  // Eq. 15 by hand: δ = 1e-5, δ̇ = 0.1: K δ^1.5 (1 + λ δ̇ / K); tolerance 1e-14 relative.
+  const double d = 1e-5;
+  CHECK(law.force(d, 0.1) == Approx(1e9 * std::pow(d, 1.5) * (1 + 0.75 * 0.1 / 0.2)).epsilon(1e-14));
+  // K + λ δ̇ < 0 for δ̇ < -K/λ = -0.2667 m/s: clamped to exactly zero (documented choice).
+  CHECK(law.force(d, -0.3) == 0.0);
+  CHECK(law.force(d, -0.26) > 0.0);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Tables 3 and 6: the closed form at the paper's own M_ie values
+// ---------------------------------------------------------------------------------------------
+
+TEST_CASE("Eq. 10-12: the approach velocities of the paper's scenarios", "[contact][paper]") {
+  const Eigen::Vector3d u = Eigen::Vector3d::UnitX();
+  const Eigen::Vector3d v_e = 0.2 * u, v_t = Eigen::Vector3d::Zero();
+  // 3-DOF: ω = [0, 0, 2] deg/s, r = [-0.25, 0.15, 0]; u·(ω × r) = -0.15 ω_z by hand.
+  const double v3 = approach_velocity(u, v_e, v_t, Eigen::Vector3d(0, 0, 2 * kDeg),
+                                      Eigen::Vector3d(-0.25, 0.15, 0));
+  CHECK(v3 == Approx(0.2 + 0.15 * 2 * kDeg).epsilon(1e-15));
+  CHECK(v3 == Approx(0.2052).margin(5e-5));  // the issue's ≈ 0.2052 m/s
+  // 7-DOF: ω = [1, -0.5, 2] deg/s, r = [-0.25, 0.15, 0.1]; (ω × r)_x = ω_y r_z - ω_z r_y.
+  const double v7 = approach_velocity(u, v_e, v_t, Eigen::Vector3d(1, -0.5, 2) * kDeg,
+                                      Eigen::Vector3d(-0.25, 0.15, 0.1));
+  CHECK(v7 == Approx(0.2 - (-0.5 * 0.1 - 2 * 0.15) * kDeg).epsilon(1e-15));
+  CHECK(v7 == Approx(0.2061).margin(5e-5));  // the issue's ≈ 0.2061 m/s
+  // A moving target along u reduces the approach velocity one for one (Eq. 12).
+  CHECK(approach_velocity(u, v_e, 0.05 * u, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()) ==
+        Approx(0.15).epsilon(1e-15));
+  CHECK_THROWS_AS(approach_velocity(2 * u, v_e, v_t, v_t, v_t), InputError);
+  CHECK_THROWS_AS(approach_velocity(u, Eigen::Vector3d(std::nan(""), 0, 0), v_t, v_t, v_t),
+                  InputError);
+}
+
+TEST_CASE("Table 3 (3-DOF): closed-form F_max at the paper's M_ie within 0.3 %", "[contact][paper]") {
+  const double v0 = approach_velocity(Eigen::Vector3d::UnitX(), Eigen::Vector3d(0.2, 0, 0),
+                                      Eigen::Vector3d::Zero(), Eigen::Vector3d(0, 0, 2 * kDeg),
+                                      Eigen::Vector3d(-0.25, 0.15, 0));
+  const auto law = make_contact_law("herbert-mcwhannell", kPaper, v0);
+  // Table 3: integrated effective mass [kg] and "Proposed Method" [kN].
+  const std::array<std::pair<double, double>, 10> rows{{{1.555, 0.834}, {1.648, 0.863},
+                                                        {3.679, 1.397}, {4.299, 1.534},
+                                                        {5.817, 1.840}, {5.926, 1.860},
+                                                        {7.446, 2.133}, {9.635, 2.490},
+                                                        {13.74, 3.081}, {21.093, 3.985}}};
+  for (const auto& [M, paper_kN] : rows) {
+    const double F = max_force_closed_form(law, M);
+    INFO("M_ie = " << M << " kg: ours " << F / 1e3 << " kN, paper " << paper_kN << " kN");
+    CHECK(rel(F / 1e3, paper_kN) < 3e-3);
+  }
+}
+
+TEST_CASE("Table 6 (7-DOF): closed-form F_max at the paper's M_ie within 0.3 %", "[contact][paper]") {
+  const double v0 = approach_velocity(Eigen::Vector3d::UnitX(), Eigen::Vector3d(0.2, 0, 0),
+                                      Eigen::Vector3d::Zero(), Eigen::Vector3d(1, -0.5, 2) * kDeg,
+                                      Eigen::Vector3d(-0.25, 0.15, 0.1));
+  const auto law = make_contact_law("herbert-mcwhannell", kPaper, v0);
+  // Table 6: integrated effective mass [kg] and "Proposed Method" [kN].
+  const std::array<std::pair<double, double>, 10> rows{{{4.875, 1.664}, {7.876, 2.218},
+                                                        {2.848, 1.205}, {3.061, 1.258},
+                                                        {3.167, 1.284}, {5.003, 1.690},
+                                                        {2.513, 1.118}, {1.658, 0.871},
+                                                        {2.677, 1.161}, {1.495, 0.819}}};
+  for (const auto& [M, paper_kN] : rows) {
+    const double F = max_force_closed_form(law, M);
+    INFO("M_ie = " << M << " kg: ours " << F / 1e3 << " kN, paper " << paper_kN << " kN");
+    CHECK(rel(F / 1e3, paper_kN) < 3e-3);
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// The closed forms Eq. 20, 23-25 and their λ -> 0 limit
+// ---------------------------------------------------------------------------------------------
+
+TEST_CASE("closed forms agree: K δ_max^α = F'_max (Eq. 23) = ζ M^(α/(α+1)) (Eq. 24)", "[contact]") {
+  for (double c : {0.1, 0.5, 0.9, 0.999, 1.0}) {
+    for (double alpha : {1.0, 1.5, 2.0}) {
+      for (const auto& law : all_laws({1e9, alpha, c}, 0.2)) {
+        for (double M : {0.1, 1.0, 21.093, 1e3}) {
+          INFO(contact_law_name(law) << " c_r = " << c << " alpha = " << alpha << " M = " << M);
+          const double dmax = max_deformation(law, M);
+          const double est = max_force_estimate(law, M);
+          // Identities; tolerance 1e-14 relative (a few roundings of pow).
+          CHECK(rel(1e9 * std::pow(dmax, alpha), est) < 1e-14);
+          CHECK(rel(zeta(law) * std::pow(M, alpha / (alpha + 1)), est) < 1e-14);
+          CHECK(rel(max_force_closed_form(law, M), est) < 1e-14);
+          // Eq. 27: dF_max/dM = α ζ /(α+1) M^(-1/(α+1)), against a central difference (1e-7).
+          const double h = 1e-4 * M;
+          const double dF = (max_force_closed_form(law, M + h) - max_force_closed_form(law, M - h)) / (2 * h);
+          CHECK(rel(dF, alpha * zeta(law) / (alpha + 1) * std::pow(M, -1 / (alpha + 1))) < 1e-7);
+        }
+      }
+    }
+  }
+}
+
+TEST_CASE("Eq. 20 and Eq. 25 as printed (with λ and ln) agree with the implementation", "[contact]") {
+  // The paper's formulas typed literally; fine where f is not small (no cancellation in the log).
+  const double K = 1e9, a = 1.5, v0 = 0.2, M = 3.0;
+  for (double c : {0.1, 0.3, 0.5, 0.7, 0.9}) {
+    for (const auto& law : all_laws({K, a, c}, v0)) {
+      INFO(contact_law_name(law) << " c_r = " << c);
+      const double lam = lambda(law), f = damping_factor(law);
+      const double d20 = std::pow(M * (a + 1) / (lam * lam) * (lam * v0 + K * std::log(K / (lam * v0 + K))),
+                                  1 / (a + 1));
+      const double z25 = std::pow(K, 1 / (a + 1)) *
+                         std::pow((a + 1) * v0 * v0 / (f * f) * (f + std::log(1 / (f + 1))), a / (a + 1));
+      // Cancellation in λ δ̇⁻ + K ln(...) costs about log10(1/f) digits: tolerance 1e-11.
+      CHECK(rel(max_deformation(law, M), d20) < 1e-11);
+      CHECK(rel(zeta(law), z25) < 1e-11);
+    }
+  }
+}
+
+TEST_CASE("c_r = 1 is the pure Hertz limit, continuous as c_r -> 1", "[contact]") {
+  const double K = 1e9, a = 1.5, v0 = 0.2, M = 5.0;
+  // Pure Hertz (λ = 0): δ_max = (M (α+1) δ̇⁻² / (2K))^(1/(α+1)) from energy conservation.
+  const double d_hertz = std::pow(M * (a + 1) * v0 * v0 / (2 * K), 1 / (a + 1));
+  for (const auto& law : all_laws({K, a, 1.0}, v0)) {
+    INFO(contact_law_name(law));
+    CHECK(damping_factor(law) == 0.0);
+    CHECK(rel(max_deformation(law, M), d_hertz) < 1e-15);
+    CHECK(rel(max_force_exact(law, M), K * std::pow(d_hertz, a)) < 1e-15);
+    CHECK(exact_peak(law, M).deformation_rate == 0.0);
+    CHECK(relative_error(law) == 0.0);
+  }
+  // c_r = 1 - 1e-12 against c_r = 1: relative agreement 1e-9 (the change is O(f) ~ 1e-12).
+  const auto at1 = all_laws({K, a, 1.0}, v0);
+  const auto near1 = all_laws({K, a, 1.0 - 1e-12}, v0);
+  for (std::size_t i = 0; i < at1.size(); ++i) {
+    INFO(contact_law_name(at1[i]));
+    CHECK(damping_factor(near1[i]) > 0.0);
+    CHECK(rel(max_deformation(near1[i], M), max_deformation(at1[i], M)) < 1e-9);
+    CHECK(rel(zeta(near1[i]), zeta(at1[i])) < 1e-9);
+    CHECK(rel(max_force_exact(near1[i], M), max_force_exact(at1[i], M)) < 1e-9);
+    CHECK(rel(exact_peak(near1[i], M).deformation, exact_peak(at1[i], M).deformation) < 1e-9);
+    CHECK(std::abs(relative_error(near1[i])) < 1e-9);  // ξ in percent, -> 0
+  }
+}
+
+TEST_CASE("G(s) = g(s)/f² of Eq. 19: series and log1p branches against long double", "[contact]") {
+  // Reference: g(s) = f(1-s) + ln((1+fs)/(1+f)) in long double, only where f >= 0.05 so that its
+  // own cancellation (about 1/f) leaves ~1e-17 accuracy. Tolerance 1e-13 relative.
+  for (double f : {0.05, 0.2, 0.33, 0.5, 1.0, 3.0, 14.4}) {
+    for (double s = -0.3; s < 0.999; s += 0.0371) {
+      if (1 + f * s <= 0) continue;
+      const long double F = f, S = s;
+      const long double g = F * (1 - S) + std::log1p(F * S) - std::log1p(F);
+      const double G = static_cast<double>(g / (F * F));
+      INFO("f = " << f << " s = " << s);
+      CHECK(rel(detail::contact_G(f, s), G) < 1e-13);
+    }
+  }
+  // Small f: G(s) = (1-s²)/2 - f(1-s³)/3 + f²(1-s⁴)/4 - ... (the series in f of the brief).
+  for (double f : {0.0, 1e-12, 1e-6, 1e-3}) {
+    for (double s : {0.0, 0.3, 0.9, 0.999999}) {
+      const double ref = (1 - s * s) / 2 - f * (1 - s * s * s) / 3 + f * f * (1 - std::pow(s, 4)) / 4 -
+                         f * f * f * (1 - std::pow(s, 5)) / 5;
+      INFO("f = " << f << " s = " << s);
+      CHECK(rel(detail::contact_G(f, s), ref) < 1e-10);  // 1 - s^k loses digits near s = 1
+    }
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Figures 3-6: the exact maximum and the relative error ξ (Eq. 21)
+// ---------------------------------------------------------------------------------------------
+
+TEST_CASE("Figure 3: both points, Gonthier, M = 1 kg, K = 1e9, 0.2 m/s, c_r = 0.5", "[contact][paper]") {
+  const HertzDamped<Gonthier> law({1e9, 1.5, 0.5}, 0.2);
+  const double M = 1.0;
+  const ForcePeak pk = law.exact_peak(M);          // "*" : (δ'_max, F_max)
+  const double d_max = law.max_deformation(M);     // "o" : (δ_max, F'_max)
+  const double F_est = law.max_force_estimate(M);
+  INFO("(delta'_max, F_max) = (" << pk.deformation << " m, " << pk.force << " N), (delta_max, F'_max) = ("
+       << d_max << " m, " << F_est << " N), xi = " << law.relative_error() << " %");
+  CHECK(pk.deformation < d_max);
+  CHECK(pk.force > F_est);
+  CHECK(pk.deformation_rate > 0.0);
+  CHECK(pk.deformation_rate < 0.2);
+  // Each point lies on the law (Eq. 15), tolerance 1e-14 relative.
+  CHECK(rel(law.force(pk.deformation, pk.deformation_rate), pk.force) < 1e-14);
+  CHECK(rel(law.force(d_max, 0.0), F_est) < 1e-14);
+  // The point "*" lies on the trajectory of Eq. 19 (identity, 1e-14).
+  CHECK(rel(law.deformation(M, pk.deformation_rate), pk.deformation) < 1e-14);
+  // Eq. 21 from the two points equals relative_error() (percent; 1e-10 relative).
+  CHECK(rel((pk.force - F_est) / pk.force * 100, law.relative_error()) < 1e-10);
+}
+
+TEST_CASE("Figures 4-5: ξ does not depend on K or on the approach velocity", "[contact][paper]") {
+  for (std::string_view name : contact_law_names()) {
+    const double xi_ref = relative_error(make_contact_law(name, kPaper, 0.2));
+    INFO(name << ": xi(c_r = 0.9) = " << xi_ref << " %");
+    CHECK(xi_ref > 0.0);
+    // Figure 4: K from 1e7 to 1e11 at δ̇⁻ = 0.2; ξ from the two maxima (Eq. 21); < 1e-6 relative.
+    for (double K : {1e7, 1e8, 1e9, 1e10, 1e11}) {
+      const auto law = make_contact_law(name, {K, 1.5, 0.9}, 0.2);
+      const double xi = (max_force_exact(law, 1.0) - max_force_estimate(law, 1.0)) / max_force_exact(law, 1.0) * 100;
+      CHECK(rel(xi, xi_ref) < 1e-6);
+      CHECK(rel(relative_error(law), xi_ref) < 1e-6);
+    }
+    // Figure 5: δ̇⁻ from 0.01 to 1 m/s at K = 1e9; < 1e-6 relative.
+    for (double v0 : {0.01, 0.05, 0.1, 0.5, 1.0}) {
+      const auto law = make_contact_law(name, kPaper, v0);
+      const double xi = (max_force_exact(law, 2.5) - max_force_estimate(law, 2.5)) / max_force_exact(law, 2.5) * 100;
+      CHECK(rel(xi, xi_ref) < 1e-6);
+    }
+  }
+}
+
+TEST_CASE("Figure 6: ξ decreases as c_r grows, for every law", "[contact][paper]") {
+  for (std::string_view name : contact_law_names()) {
+    double previous = std::numeric_limits<double>::infinity();
+    for (double c = 0.1; c < 0.995; c += 0.01) {
+      const double xi = relative_error(make_contact_law(name, {1e9, 1.5, c}, 0.2));
+      INFO(name << " c_r = " << c << " xi = " << xi << " % (previous " << previous << ")");
+      CHECK(xi > 0.0);
+      CHECK(xi < previous);  // strictly decreasing (Figure 6)
+      previous = xi;
+    }
+  }
+}
+
+TEST_CASE("the exact maximum: above the closed form, above a dense scan, stationary", "[contact]") {
+  const double M = 5.0;
+  for (double c : {0.1, 0.3, 0.5, 0.7, 0.9, 0.99, 1.0}) {
+    for (const auto& law : all_laws({1e9, 1.5, c}, 0.2)) {
+      INFO(contact_law_name(law) << " c_r = " << c);
+      const ForcePeak pk = exact_peak(law, M);
+      // F_max >= F'_max (the maximum over the contact includes s = 0); rounding 1e-14.
+      CHECK(pk.force >= max_force_estimate(law, M) * (1 - 1e-14));
+      CHECK(pk.force >= max_force_closed_form(law, M) * (1 - 1e-14));
+      // A dense scan of F(s), s in [0, 1], 1e5 + 1 points, never exceeds F_max beyond rounding.
+      double scan = 0;
+      for (int i = 0; i <= 100000; ++i) scan = std::max(scan, force_at_rate(law, M, i / 100000.0));
+      CHECK(scan <= pk.force * (1 + 1e-14));
+      CHECK(scan >= pk.force * (1 - 1e-8));  // and gets close to it (grid 1e-5, quadratic peak)
+      // Stationarity: central difference of F(s) at s*, step 1e-5: |dF/ds| < 1e-7 F_max, whereas
+      // at s = 0 the slope is f F (Eq. 15), i.e. f F'_max.
+      const double s = pk.deformation_rate / 0.2;
+      if (s > 1e-5) {
+        const double dF = (force_at_rate(law, M, s + 1e-5) - force_at_rate(law, M, s - 1e-5)) / 2e-5;
+        CHECK(std::abs(dF) < 1e-7 * pk.force);
+        // and (α+1) g(s) - α f s = 0 there (the stationarity condition), relative to α f s: 1e-12.
+        const double f = damping_factor(law);
+        const double phi = 2.5 * f * detail::contact_G(f, s) - 1.5 * s;
+        CHECK(std::abs(phi) < 1e-12 * 1.5 * s);
+      }
+    }
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// CVODE integration of the single-body model Eq. 16
+// ---------------------------------------------------------------------------------------------
+
+TEST_CASE("exact maximum vs CVODE integration of Eq. 16, all laws", "[contact][cvode]") {
+  const double M = 5.0, v0 = 0.2;
+  double worst = 0;
+  for (double c : {0.3, 0.5, 0.7, 0.9, 0.99, 1.0}) {
+    for (const auto& law : all_laws({1e9, 1.5, c}, v0)) {
+      INFO(contact_law_name(law) << " c_r = " << c);
+      const SingleBodyResult sim = simulate_single_body(law, M);
+      const ForcePeak pk = exact_peak(law, M);
+      // Tolerance 1e-6 relative (the issue); CVODE runs at rtol 1e-10.
+      CHECK(rel(sim.f_max, pk.force) < 1e-6);
+      worst = std::max(worst, rel(sim.f_max, pk.force));
+      // δ_max of Eq. 20 is exact for Eq. 16: 1e-6 relative.
+      CHECK(rel(sim.delta_max, max_deformation(law, M)) < 1e-6);
+      // Where the peak is: δ'_max to 1e-6 relative, δ̇ there to 1e-6 of δ̇⁻.
+      CHECK(rel(sim.delta_at_f_max, pk.deformation) < 1e-6);
+      CHECK(std::abs(sim.delta_dot_at_f_max - pk.deformation_rate) < 1e-6 * v0);
+      CHECK(sim.t_at_f_max <= sim.t_at_delta_max * (1 + 1e-9));
+      CHECK(sim.contact_duration > sim.t_at_delta_max);
+      CHECK(sim.restitution > 0.0);
+      CHECK(sim.restitution <= 1.0 + 1e-6);
+      // The separation speed is the end of the trajectory Eq. 19: δ(δ̇_sep) = 0, i.e. g(s_sep) = 0.
+      const double f = damping_factor(law), s_sep = sim.separation_velocity / v0;
+      CHECK(std::abs(detail::contact_G(f, s_sep)) < 1e-7);
+    }
+  }
+  INFO("largest relative deviation exact vs CVODE: " << worst);
+  CHECK(worst < 1e-6);
+}
+
+TEST_CASE("c_r = 1: CVODE conserves energy (separation speed = approach speed)", "[contact][cvode]") {
+  for (const auto& law : all_laws({1e9, 1.5, 1.0}, 0.2)) {
+    INFO(contact_law_name(law));
+    const SingleBodyResult sim = simulate_single_body(law, 3.0);
+    // Energy: ½ M δ̇_sep² = ½ M δ̇⁻² (no damping), tolerance 1e-6 relative.
+    CHECK(sim.separation_velocity == Approx(-0.2).epsilon(1e-6));
+    CHECK(sim.restitution == Approx(1.0).epsilon(1e-6));
+    // Elastic Hertz: the impact is symmetric, duration = 2 t(δ_max), 1e-6 relative.
+    CHECK(sim.contact_duration == Approx(2 * sim.t_at_delta_max).epsilon(1e-6));
+    // Known Hertz duration: t_c = 2 (δ_max/δ̇⁻) ∫_0^1 dx/sqrt(1 - x^(5/2)) = 2 · 1.4716 δ_max/δ̇⁻
+    // (the integral is B(2/5, 1/2)/(5/2) = 1.47161...); tolerance 1e-4 relative on the constant.
+    const double d_max = max_deformation(law, 3.0);
+    CHECK(sim.contact_duration / (d_max / 0.2) == Approx(2 * 1.4716).epsilon(1e-4));
+  }
+}
+
+TEST_CASE("single-body time series on request", "[contact][cvode]") {
+  const HertzDamped<HerbertMcWhannell> law(kPaper, 0.2);
+  SingleBodyOptions opt;
+  opt.record_series = true;
+  const SingleBodyResult sim = simulate_single_body(law, 5.0, opt);
+  const auto& s = sim.series;
+  REQUIRE(s.t.size() > 10);
+  REQUIRE(s.force.size() == s.t.size());
+  REQUIRE(s.delta.size() == s.t.size());
+  CHECK(s.t.front() == 0.0);
+  CHECK(s.t.back() == Approx(sim.contact_duration).epsilon(1e-12));
+  CHECK(std::is_sorted(s.t.begin(), s.t.end()));
+  // No sample above the located peak (beyond the integration tolerance 1e-8), none negative.
+  CHECK(*std::max_element(s.force.begin(), s.force.end()) <= sim.f_max * (1 + 1e-8));
+  CHECK(*std::min_element(s.force.begin(), s.force.end()) >= 0.0);
+  // Every sample lies on the law (Eq. 15), identity 1e-14.
+  for (std::size_t i = 0; i < s.t.size(); ++i)
+    CHECK(s.force[i] == Approx(law.force(s.delta[i], s.delta_dot[i])).epsilon(1e-14).margin(1e-300));
+  // Same peak as without series (1e-9).
+  CHECK(sim.f_max == Approx(simulate_single_body(law, 5.0).f_max).epsilon(1e-9));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Input validation
+// ---------------------------------------------------------------------------------------------
+
+TEST_CASE("bad contact inputs are InputErrors that name the parameter", "[contact]") {
+  const double nan = std::nan("");
+  const double inf = std::numeric_limits<double>::infinity();
+  auto make = [](ContactParams p, double v0) { return make_contact_law("hunt-crossley", p, v0); };
+  CHECK_THROWS_WITH(make({-1e9, 1.5, 0.9}, 0.2), Contains("stiffness K") && Contains("-1000000000"));
+  CHECK_THROWS_WITH(make({0.0, 1.5, 0.9}, 0.2), Contains("stiffness K"));
+  CHECK_THROWS_WITH(make({inf, 1.5, 0.9}, 0.2), Contains("stiffness K"));
+  CHECK_THROWS_WITH(make({nan, 1.5, 0.9}, 0.2), Contains("stiffness K"));
+  CHECK_THROWS_WITH(make({1e9, 0.0, 0.9}, 0.2), Contains("exponent alpha"));
+  CHECK_THROWS_WITH(make({1e9, -1.5, 0.9}, 0.2), Contains("exponent alpha"));
+  CHECK_THROWS_WITH(make({1e9, nan, 0.9}, 0.2), Contains("exponent alpha"));
+  CHECK_THROWS_WITH(make({1e9, 1.5, 0.0}, 0.2), Contains("restitution c_r") && Contains("got 0"));
+  CHECK_THROWS_WITH(make({1e9, 1.5, 1.1}, 0.2), Contains("restitution c_r") && Contains("1.1"));
+  CHECK_THROWS_WITH(make({1e9, 1.5, -0.5}, 0.2), Contains("restitution c_r"));
+  CHECK_THROWS_WITH(make({1e9, 1.5, nan}, 0.2), Contains("restitution c_r"));
+  CHECK_THROWS_WITH(make({1e9, 1.5, 0.9}, -0.1), Contains("approach velocity") && Contains("receding"));
+  CHECK_THROWS_WITH(make({1e9, 1.5, 0.9}, 0.0), Contains("approach velocity"));
+  CHECK_THROWS_WITH(make({1e9, 1.5, 0.9}, nan), Contains("approach velocity"));
+  CHECK_THROWS_AS(make({-1e9, 1.5, 0.9}, 0.2), InputError);
+  CHECK_THROWS_AS(make({1e9, 1.5, 0.9}, -0.1), InputError);
+  CHECK_THROWS_AS((HertzDamped<Flores>({1e9, 1.5, 0.0}, 0.2)), InputError);  // f would be inf
+
+  const auto law = make({1e9, 1.5, 0.9}, 0.2);
+  for (double M : {0.0, -1.0, nan, inf}) {
+    CHECK_THROWS_WITH(max_force_closed_form(law, M), Contains("M_ie"));
+    CHECK_THROWS_WITH(max_force_exact(law, M), Contains("M_ie"));
+    CHECK_THROWS_WITH(max_deformation(law, M), Contains("M_ie"));
+    CHECK_THROWS_AS(max_force_estimate(law, M), InputError);
+    CHECK_THROWS_AS(simulate_single_body(law, M), InputError);
+  }
+  // A rate the contact never reaches (faster than the approach).
+  CHECK_THROWS_AS(std::get<0>(law).deformation(1.0, 0.3), InputError);
+
+  // Unknown name: the message lists every valid one.
+  try {
+    make_contact_law("hertz", kPaper, 0.2);
+    FAIL("no exception for an unknown law");
+  } catch (const InputError& e) {
+    const std::string msg = e.what();
+    CHECK_THAT(msg, Contains("'hertz'"));
+    for (std::string_view n : contact_law_names()) CHECK_THAT(msg, Contains(std::string(n)));
+  }
+  // Eq. 32.
+  CHECK(model_accuracy(0.834e3, 0.844e3) == Approx(100 * (1 - 0.01 / 0.844)).epsilon(1e-12));
+  CHECK_THROWS_AS(model_accuracy(1.0, 0.0), InputError);
+  CHECK_THROWS_AS(model_accuracy(nan, 1.0), InputError);
+}
+
+// ---------------------------------------------------------------------------------------------
+// The CVODE wrapper
+// ---------------------------------------------------------------------------------------------
+
+namespace {
+struct MyError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+// y'' = -y as a first-order system: y = (sin t, cos t) from (0, 1).
+void oscillator(double, const Eigen::Ref<const Eigen::VectorXd>& y, Eigen::Ref<Eigen::VectorXd> yd) {
+  yd[0] = y[1];
+  yd[1] = -y[0];
+}
+}  // namespace
+
+TEST_CASE("cvode: harmonic oscillator with a root", "[cvode]") {
+  cvode::Roots g = [](double, const Eigen::Ref<const Eigen::VectorXd>& y, Eigen::Ref<Eigen::VectorXd> out) {
+    out[0] = y[0];  // sin t: zero at 0 (ignored), π (decreasing), 2π (increasing)
+  };
+  cvode::Integrator integ(oscillator, Eigen::Vector2d(0, 1), 0.0, {}, 1, g, {-1});
+  REQUIRE(integ.advance(10.0) == cvode::Integrator::Status::Root);
+  // Root at t = π (exact solution), tolerance 1e-8.
+  CHECK(integ.t() == Approx(kPi).epsilon(1e-8));
+  CHECK(integ.roots_found() == std::vector<int>{-1});
+  CHECK(integ.y()[1] == Approx(-1.0).epsilon(1e-8));
+  // Dense output inside the last step matches sin/cos to 1e-8 (absolute).
+  CHECK(integ.current_time() >= integ.t());
+  const double tm = integ.current_time() - 0.5 * integ.last_step();
+  const Eigen::VectorXd ym = integ.interpolate(tm);
+  CHECK(std::abs(ym[0] - std::sin(tm)) < 1e-8);
+  CHECK(std::abs(ym[1] - std::cos(tm)) < 1e-8);
+  CHECK_THROWS_AS(integ.interpolate(integ.t() - 5.0), IntegrationError);  // outside the last step
+  // The increasing crossing at 2π is skipped (direction -1); the next decreasing one is 3π.
+  CHECK(integ.advance(10.0) == cvode::Integrator::Status::Root);
+  CHECK(integ.t() == Approx(3 * kPi).epsilon(1e-8));
+  CHECK(integ.advance(10.0) == cvode::Integrator::Status::Reached);
+  CHECK(integ.t() == 10.0);
+  CHECK(integ.y()[0] == Approx(std::sin(10.0)).margin(1e-8));
+  CHECK(integ.num_steps() > 0);
+  CHECK(integ.num_rhs_evals() >= integ.num_steps());
+
+  // Step mode never passes the stop time and ends exactly on it.
+  cvode::Integrator stepper(oscillator, Eigen::Vector2d(0, 1), 0.0);
+  int n = 0;
+  cvode::Integrator::Status st{};
+  while ((st = stepper.step(1.0)) == cvode::Integrator::Status::Step && n < 100000) {
+    CHECK(stepper.t() < 1.0);
+    ++n;
+  }
+  CHECK(st == cvode::Integrator::Status::Reached);
+  CHECK(stepper.t() == 1.0);
+  CHECK(stepper.y()[0] == Approx(std::sin(1.0)).margin(1e-9));
+
+  // Move-only, and a moved integrator carries on.
+  cvode::Integrator moved = std::move(stepper);
+  CHECK(moved.advance(2.0) == cvode::Integrator::Status::Reached);
+  CHECK(moved.y()[0] == Approx(std::sin(2.0)).margin(1e-9));
+  // reinit restarts from a new state.
+  moved.reinit(0.0, Eigen::Vector2d(1, 0));
+  moved.advance(1.0);
+  CHECK(moved.y()[0] == Approx(std::cos(1.0)).margin(1e-9));
+  // Per-component absolute tolerances.
+  cvode::Options o;
+  o.atol_vector = Eigen::Vector2d(1e-12, 1e-12);
+  cvode::Integrator sv(oscillator, Eigen::Vector2d(0, 1), 0.0, o);
+  sv.advance(3.0);
+  CHECK(sv.y()[0] == Approx(std::sin(3.0)).margin(1e-8));
+}
+
+TEST_CASE("cvode: an exception in the right-hand side propagates unchanged", "[cvode]") {
+  cvode::Rhs throwing_later = [](double t, const Eigen::Ref<const Eigen::VectorXd>& y,
+                                 Eigen::Ref<Eigen::VectorXd> yd) {
+    if (t > 0.5) throw MyError("boom at t > 0.5");
+    oscillator(t, y, yd);
+  };
+  cvode::Integrator a(throwing_later, Eigen::Vector2d(0, 1), 0.0);
+  CHECK_THROWS_AS(a.advance(1.0), MyError);
+  CHECK_THROWS_WITH(cvode::Integrator(throwing_later, Eigen::Vector2d(0, 1), 0.0).advance(1.0),
+                    "boom at t > 0.5");
+  // Throwing on the very first evaluation, and in step mode.
+  cvode::Rhs always = [](double, const Eigen::Ref<const Eigen::VectorXd>&, Eigen::Ref<Eigen::VectorXd>) {
+    throw MyError("always");
+  };
+  cvode::Integrator b(always, Eigen::Vector2d(0, 1), 0.0);
+  CHECK_THROWS_AS(b.step(1.0), MyError);
+  // A throwing root function too.
+  cvode::Roots bad_root = [](double t, const Eigen::Ref<const Eigen::VectorXd>&, Eigen::Ref<Eigen::VectorXd> g) {
+    if (t > 0.1) throw MyError("root");
+    g[0] = 1;
+  };
+  cvode::Integrator c(oscillator, Eigen::Vector2d(0, 1), 0.0, {}, 1, bad_root);
+  CHECK_THROWS_AS(c.advance(1.0), MyError);
+  // A non-finite derivative is an IntegrationError that says so.
+  cvode::Rhs nan_rhs = [](double t, const Eigen::Ref<const Eigen::VectorXd>& y, Eigen::Ref<Eigen::VectorXd> yd) {
+    oscillator(t, y, yd);
+    if (t > 0.2) yd[1] = std::nan("");
+  };
+  cvode::Integrator d(nan_rhs, Eigen::Vector2d(0, 1), 0.0);
+  CHECK_THROWS_WITH(d.advance(1.0), Contains("ydot[1]") && Contains("nan"));
+}
+
+TEST_CASE("cvode: failures are IntegrationErrors naming the flag", "[cvode]") {
+  cvode::Options few;
+  few.max_num_steps = 5;
+  cvode::Integrator a(oscillator, Eigen::Vector2d(0, 1), 0.0, few);
+  CHECK_THROWS_AS(a.advance(100.0), IntegrationError);
+  CHECK_THROWS_WITH(cvode::Integrator(oscillator, Eigen::Vector2d(0, 1), 0.0, few).advance(100.0),
+                    Contains("CV_TOO_MUCH_WORK") && Contains("at t = "));
+  cvode::Options tight;
+  tight.rtol = 1e-30;
+  tight.atol = 1e-300;
+  CHECK_THROWS_WITH(cvode::Integrator(oscillator, Eigen::Vector2d(0, 1), 0.0, tight).advance(1.0),
+                    Contains("CV_TOO_MUCH_ACC"));
+  // Bad options and arguments are InputErrors.
+  cvode::Options o;
+  o.max_num_steps = 0;
+  CHECK_THROWS_AS(cvode::Integrator(oscillator, Eigen::Vector2d(0, 1), 0.0, o), InputError);
+  o = {};
+  o.rtol = -1;
+  CHECK_THROWS_AS(cvode::Integrator(oscillator, Eigen::Vector2d(0, 1), 0.0, o), InputError);
+  o = {};
+  o.max_order = 6;
+  CHECK_THROWS_AS(cvode::Integrator(oscillator, Eigen::Vector2d(0, 1), 0.0, o), InputError);
+  o = {};
+  o.atol_vector = Eigen::Vector3d::Constant(1e-10);
+  CHECK_THROWS_AS(cvode::Integrator(oscillator, Eigen::Vector2d(0, 1), 0.0, o), InputError);
+  CHECK_THROWS_AS(cvode::Integrator(oscillator, Eigen::Vector2d(0, std::nan("")), 0.0), InputError);
+  CHECK_THROWS_AS(cvode::Integrator({}, Eigen::Vector2d(0, 1), 0.0), InputError);
+  CHECK_THROWS_AS(cvode::Integrator(oscillator, Eigen::Vector2d(0, 1), 0.0, {}, 2, {}), InputError);
+  cvode::Roots g = [](double, const Eigen::Ref<const Eigen::VectorXd>& y, Eigen::Ref<Eigen::VectorXd> out) {
+    out[0] = y[0];
+  };
+  CHECK_THROWS_AS(cvode::Integrator(oscillator, Eigen::Vector2d(0, 1), 0.0, {}, 1, g, {-1, 1}), InputError);
+  CHECK_THROWS_AS(cvode::Integrator(oscillator, Eigen::Vector2d(0, 1), 0.0, {}, 1, g, {2}), InputError);
+  cvode::Integrator b(oscillator, Eigen::Vector2d(0, 1), 1.0);
+  CHECK_THROWS_AS(b.advance(0.5), InputError);  // forward only
+  CHECK_THROWS_AS(b.step(std::nan("")), InputError);
+  CHECK_THROWS_AS(b.reinit(0.0, Eigen::Vector3d::Zero()), InputError);
+}
