@@ -1,0 +1,301 @@
+// ffsr/simulate/multibody.hpp -- the full robot-plus-target contact simulation (Figure 2), the
+// "classical numerical integration method" that the paper uses as its reference (Tables 3 and 6).
+//
+// The free-floating robot (joints passive: zero torque; gravity model.gravity, zero by default) and
+// the target (a free rigid body) touch at one point. The target's surface near the contact is the
+// plane through its material contact point (r_tp) with normal u_n, both fixed in the target; the
+// end-effector is a point. The deformation is the end-effector's penetration of that plane,
+// delta = u . (p_e - p_tp) with u = R_t u_n, and the law of contact/contact_law.hpp gives the force
+// F(delta, delta_dot) >= 0. It acts along u: +F u on the target and -F u on the robot, both at the
+// end-effector point, so the pair is collinear and the total linear and angular momentum of robot
+// plus target are conserved exactly (a test checks it).
+//
+// Start: first touch (delta = 0). The robot moves with zero total momentum and the end-effector
+// velocity equal to `approach_speed` along u (joint rates from the pseudo-inverse of the linear rows
+// of J_f; the base follows from momentum conservation); the target moves with its own velocity and
+// spin. delta_dot^- = u . (v_e - v_tp) of that state (Eq. 10-12) sets the damping (Eq. 22).
+// Integration: SUNDIALS CVODE (BDF, Newton, dense), tight tolerances, on displacements from the
+// initial state so that the ~0.1 mm deformation is resolved; separation (delta back to zero) and the
+// force peak (dF/dt = 0) are located by CVODE's root finding.
+#pragma once
+
+#include "ffsr/algorithm/effective_mass.hpp"
+#include "ffsr/algorithm/forward_dynamics.hpp"
+#include "ffsr/algorithm/jacobian.hpp"
+#include "ffsr/algorithm/momentum.hpp"
+#include "ffsr/contact/contact_law.hpp"
+#include "ffsr/simulate/cvode.hpp"
+
+#include <string>
+#include <vector>
+
+namespace ffsr {
+
+struct MultibodyContactOptions {
+  double rtol = 1e-10;              ///< CVODE relative tolerance
+  double atol_position = 1e-15;     ///< m and rad (the states are displacements from the start)
+  double atol_velocity = 1e-13;     ///< m/s and rad/s
+  long max_num_steps = 200000;      ///< CVODE step budget
+  double max_duration = 0;          ///< give up after this contact time (s); 0: 100 x the Hertz estimate
+  bool record_series = false;       ///< keep (t, F, delta) at every internal step
+};
+
+struct ContactSample {
+  double t = 0, force = 0, delta = 0;
+};
+
+struct MultibodyContactResult {
+  std::string model;                   ///< contact law name
+  double approach_velocity = 0;        ///< delta_dot^- (m/s)
+  double integrated_effective_mass = 0;  ///< M_ie at the first touch (kg), Eq. 14
+  double f_max = 0;                    ///< peak contact force (N)
+  double t_at_f_max = 0;               ///< time of the peak from first touch (s)
+  double delta_at_f_max = 0;           ///< deformation at the peak (m)
+  double delta_max = 0;                ///< largest deformation (m)
+  double contact_duration = 0;         ///< time to separation (s)
+  double separation_velocity = 0;      ///< delta_dot at separation (m/s, negative)
+  double restitution = 0;              ///< realized coefficient: -separation_velocity / approach_velocity
+  Vector6 momentum_start = Vector6::Zero();  ///< [P; L about o] of robot + target at first touch
+  Vector6 momentum_end = Vector6::Zero();    ///< the same at separation
+  long steps = 0;                      ///< CVODE internal steps
+  std::vector<ContactSample> series;   ///< when requested
+};
+
+namespace detail {
+
+/// Rate of a rotation vector phi (R = exp([phi]) R_0) for the angular velocity w in o:
+/// phi_dot = J_l(phi)^-1 w.
+inline Vector3 rotation_vector_rate(const Vector3& phi, const Vector3& w) {
+  const double th2 = phi.squaredNorm();
+  double c;  // (1 - (th/2) cot(th/2)) / th^2
+  if (th2 < 1e-6) {
+    c = 1.0 / 12.0 + th2 / 720.0;
+  } else {
+    const double th = std::sqrt(th2);
+    c = (1.0 - 0.5 * th / std::tan(0.5 * th)) / th2;
+  }
+  return w - 0.5 * phi.cross(w) + c * phi.cross(phi.cross(w));
+}
+
+/// The state of the contact simulation: displacements from the first touch and velocities.
+///  [dp0 (3), phi0 (3), dtheta (n), v0 (3), w0 (3), theta_dot (n), dp_t (3), phi_t (3), v_t (3), w_t (3)]
+struct ContactSystem {
+  const Model& model;
+  Data data;
+  BasePose base0;
+  Eigen::VectorXd theta0;
+  int frame;
+  Target target;          ///< at the first touch
+  Matrix3 Rt0;
+  Vector3 ct0, r0;        ///< target centre of mass and contact offset (in o) at the first touch
+  int n;
+  // scratch
+  Eigen::VectorXd theta, v, tau, a, ydot_scratch, y_scratch;
+
+  ContactSystem(const Model& m, const BasePose& b, const Eigen::VectorXd& th, int f, const Target& t)
+      : model(m), data(m), base0(b), theta0(th), frame(f), target(t), n(m.n()),
+        theta(m.n()), v(m.nv()), tau(m.nv()), a(m.nv()) {
+    base0.orientation.normalize();
+    Rt0 = target.rotation();
+    ct0 = target.position;
+    r0 = Rt0 * target.contact_offset;
+  }
+  Eigen::Index size() const { return 26 + 2 * n; }
+  // offsets
+  Eigen::Index iv() const { return 6 + n; }
+  Eigen::Index it() const { return 12 + 2 * n; }
+
+  struct Kin {
+    BasePose base;
+    Matrix3 Rt;
+    Vector3 ct, u, pe, ve, ptp, vtp, wt, vt;
+    double delta, delta_dot;
+  };
+  /// Kinematics of the contact at state y (writes data kinematics and data.J).
+  Kin kinematics(const Eigen::Ref<const Eigen::VectorXd>& y) {
+    Kin k;
+    k.base.position = base0.position + y.segment<3>(0);
+    k.base.orientation = Quaternion(rotation_from_vector(y.segment<3>(3)) * base0.orientation.toRotationMatrix());
+    theta = theta0 + y.segment(6, n);
+    v = y.segment(iv(), 6 + n);
+    forward_kinematics(model, data, k.base, theta);
+    frame_jacobian(model, data, frame);
+    k.pe = frame_pose(model, data, frame).p;
+    k.ve = data.J.topRows<3>() * v;
+    const Eigen::Index t0 = it();
+    k.Rt = rotation_from_vector(y.segment<3>(t0 + 3)) * Rt0;
+    k.ct = ct0 + y.segment<3>(t0);
+    k.vt = y.segment<3>(t0 + 6);
+    k.wt = y.segment<3>(t0 + 9);
+    k.u = k.Rt * target.normal.normalized();
+    k.ptp = k.ct + k.Rt * target.contact_offset;
+    k.vtp = k.vt + k.wt.cross(k.ptp - k.ct);
+    const Vector3 d = k.pe - k.ptp;
+    k.delta = k.u.dot(d);
+    k.delta_dot = k.wt.cross(k.u).dot(d) + k.u.dot(k.ve - k.vtp);
+    return k;
+  }
+
+  template <class Law>
+  double force(const Law& law, const Kin& k) const {
+    return law.force(k.delta, k.delta_dot);
+  }
+
+  template <class Law>
+  void rhs(const Law& law, const Eigen::Ref<const Eigen::VectorXd>& y, Eigen::Ref<Eigen::VectorXd> ydot) {
+    const Kin k = kinematics(y);
+    const double F = law.force(k.delta, k.delta_dot);
+    // robot: H a = J^T (-F u) - C
+    tau.noalias() = data.J.topRows<3>().transpose() * (-F * k.u);
+    forward_dynamics(model, data, k.base, theta, v, tau, a);
+    ydot.segment<3>(0) = v.head<3>();
+    ydot.segment<3>(3) = rotation_vector_rate(y.segment<3>(3), v.segment<3>(3));
+    ydot.segment(6, n) = v.tail(n);
+    ydot.segment(iv(), 6 + n) = a;
+    // target: m v_dot = F u; I w_dot = (p_e - c) x F u - w x I w
+    const Eigen::Index t0 = it();
+    const Matrix3 I = k.Rt * target.inertia * k.Rt.transpose();
+    const Vector3 f = F * k.u;
+    ydot.segment<3>(t0) = k.vt;
+    ydot.segment<3>(t0 + 3) = rotation_vector_rate(y.segment<3>(t0 + 3), k.wt);
+    ydot.segment<3>(t0 + 6) = f / target.mass + model.gravity;
+    ydot.segment<3>(t0 + 9) = I.ldlt().solve((k.pe - k.ct).cross(f) - k.wt.cross(I * k.wt));
+  }
+
+  /// Total momentum of robot + target, [P; L about o].
+  Vector6 total_momentum(const Eigen::Ref<const Eigen::VectorXd>& y) {
+    const Kin k = kinematics(y);
+    Vector6 h = momentum(model, data, v);  // about the base origin
+    Vector6 out;
+    out.head<3>() = h.head<3>();
+    out.tail<3>() = h.tail<3>() + k.base.position.cross(h.head<3>());
+    const Matrix3 I = k.Rt * target.inertia * k.Rt.transpose();
+    out.head<3>() += target.mass * k.vt;
+    out.tail<3>() += k.ct.cross(target.mass * k.vt) + I * k.wt;
+    return out;
+  }
+};
+
+}  // namespace detail
+
+/// Initial joint rates of the approach: the end-effector moves at `approach_speed` along u with
+/// zero total momentum, theta_dot = pinv(J_f,v) (approach_speed u) (complete orthogonal
+/// decomposition, so a rank-deficient J_f such as the planar robot's works). Runs crba.
+inline Eigen::VectorXd approach_joint_rates(const Model& model, Data& data, const BasePose& base,
+                                            const Eigen::Ref<const Eigen::VectorXd>& theta, int frame,
+                                            const Vector3& u, double approach_speed) {
+  generalized_jacobian(model, data, base, theta, frame);
+  const Eigen::MatrixXd Jv = data.Jf.topRows<3>();
+  Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod(Jv);
+  cod.setThreshold(1e-10);
+  return cod.solve(Vector3(approach_speed * u));
+}
+
+/// The full multibody contact simulation (see the top of this file). `theta` is the capture
+/// configuration; the target is placed so that its contact point touches the end-effector
+/// (its `position` is ignored). Throws InputError for bad arguments or receding bodies,
+/// IntegrationError for a CVODE failure, NumericalError if the bodies do not separate.
+inline MultibodyContactResult simulate_contact(const Model& model, const BasePose& base,
+                                               const Eigen::Ref<const Eigen::VectorXd>& theta, int frame,
+                                               Target target, double approach_speed, const ContactParams& params,
+                                               std::string_view law_name,
+                                               const MultibodyContactOptions& options = {}) {
+  using detail::str;
+  target.validate("simulate_contact: target");
+  validate(params, "simulate_contact");
+  detail::require_finite(approach_speed, "simulate_contact", "approach speed");
+  Data data(model);
+  // place the target at the first touch
+  crba(model, data, base, theta);
+  const Vector3 pe = frame_pose(model, data, frame).p;
+  const Vector3 u = target.normal_world();
+  target.position = pe - target.offset_world();
+  const double M_ie = 1.0 / (inverse_effective_mass(model, data, frame, u) + target.inverse_mass_along_normal());
+  const Eigen::VectorXd qd = approach_joint_rates(model, data, base, theta, frame, u, approach_speed);
+  const Vector6 xb = base_velocity_from_momentum(model, data, qd);
+
+  detail::ContactSystem sys(model, base, Eigen::VectorXd(theta), frame, target);
+  const Eigen::Index N = sys.size();
+  Eigen::VectorXd y0 = Eigen::VectorXd::Zero(N);
+  y0.segment<6>(sys.iv()) = xb;
+  y0.segment(sys.iv() + 6, model.n()) = qd;
+  y0.segment<3>(sys.it() + 6) = target.velocity;
+  y0.segment<3>(sys.it() + 9) = target.angular_velocity_world();
+  const auto k0 = sys.kinematics(y0);
+  const double vin = k0.delta_dot;
+  if (!(vin > 0))
+    throw InputError(str("simulate_contact: the bodies do not approach (delta_dot^- = ", vin,
+                         " m/s); increase the approach speed"));
+  const AnyContactLaw any_law = make_contact_law(law_name, params, vin);
+
+  return std::visit(
+      [&](const auto& law) {
+        MultibodyContactResult res;
+        res.model = std::string(law_name);
+        res.approach_velocity = vin;
+        res.integrated_effective_mass = M_ie;
+        // Hertz time scale of the contact, (M/K)^(1/(alpha+1)) v^((1-alpha)/(alpha+1)): a few of it
+        const double a1 = params.alpha + 1;
+        const double t_hertz = std::pow(M_ie / params.K, 1.0 / a1) * std::pow(vin, (1.0 - params.alpha) / a1);
+        const double t_max = options.max_duration > 0 ? options.max_duration : 100.0 * t_hertz;
+
+        cvode::Options co;
+        co.rtol = options.rtol;
+        co.max_num_steps = options.max_num_steps;
+        co.atol_vector = Eigen::VectorXd::Constant(N, options.atol_velocity);
+        co.atol_vector.segment(0, 6 + model.n()).setConstant(options.atol_position);
+        co.atol_vector.segment<6>(sys.it()).setConstant(options.atol_position);
+        co.initial_step = 1e-3 * t_hertz;
+        co.max_step = 0.05 * t_hertz;
+
+        auto rhs = [&](double, const Eigen::Ref<const Eigen::VectorXd>& y, Eigen::Ref<Eigen::VectorXd> yd) {
+          sys.rhs(law, y, yd);
+        };
+        // root 0: delta (separation, decreasing); root 1: dF/dt (peak, decreasing), by a central
+        // difference of F along the exact state derivative.
+        Eigen::VectorXd yd(N), yp(N);
+        auto roots = [&](double, const Eigen::Ref<const Eigen::VectorXd>& y, Eigen::Ref<Eigen::VectorXd> g) {
+          const auto k = sys.kinematics(y);
+          g(0) = k.delta;
+          sys.rhs(law, y, yd);
+          const double h = 1e-6 * t_hertz;
+          yp = y + h * yd;
+          const double Fp = sys.force(law, sys.kinematics(yp));
+          yp = y - h * yd;
+          const double Fm = sys.force(law, sys.kinematics(yp));
+          g(1) = (Fp - Fm) / (2 * h);
+        };
+        cvode::Integrator integ(rhs, y0, 0.0, co, 2, roots, {-1, -1});
+        res.momentum_start = sys.total_momentum(y0);
+        auto record = [&](double t, const Eigen::VectorXd& y) {
+          const auto k = sys.kinematics(y);
+          const double F = sys.force(law, k);
+          res.delta_max = std::max(res.delta_max, k.delta);
+          if (F > res.f_max) {
+            res.f_max = F;
+            res.t_at_f_max = t;
+            res.delta_at_f_max = k.delta;
+          }
+          if (options.record_series) res.series.push_back({t, F, k.delta});
+          return k;
+        };
+        record(0.0, y0);
+        for (long guard = 0; guard <= options.max_num_steps; ++guard) {
+          const auto status = integ.step(t_max);
+          const auto k = record(integ.t(), integ.y());
+          if (status == cvode::Integrator::Status::Root && integ.roots_found()[0] != 0 && integ.t() > 0) {
+            res.contact_duration = integ.t();
+            res.separation_velocity = k.delta_dot;
+            res.restitution = -k.delta_dot / vin;
+            res.momentum_end = sys.total_momentum(integ.y());
+            res.steps = integ.num_steps();
+            return res;
+          }
+          if (status == cvode::Integrator::Status::Reached) break;
+        }
+        throw NumericalError(str("simulate_contact: the bodies did not separate within ", t_max, " s"));
+      },
+      any_law);
+}
+
+}  // namespace ffsr
