@@ -13,7 +13,7 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", FFSR_VERSION);
   Action action;
   register_inspect(app, action);
-  // register_contact(app, action);
+  register_contact(app, action);
   app.require_subcommand(0, 1);
   try {
     app.parse(argc, argv);
