@@ -70,3 +70,55 @@ inline double integrated_effective_mass(const Model& model, Data& data, const Ba
 }
 
 }  // namespace ffsr
+
+namespace ffsr {
+
+/// Analytic gradient of the integrated effective mass with respect to the joint angles, at a fixed
+/// base pose and for a fixed inertial contact direction u and target inverse mass along the normal
+/// (Target::inverse_mass_along_normal). With y = H^-1 w, w = J_v^T u, and 1/m_e = w^T y:
+///   d(1/m_e)/dtheta_k = 2 u . d(J_v y)/dtheta_k - y^T (dH/dtheta_k) y,
+/// where y^T (dH/dtheta_k) y = 2 (V_k x S_k) . h_k (V_k the spatial velocity of body k and h_k the
+/// spatial momentum of the subtree of k, both for the velocity y), and d(J_v y)/dtheta_k follows
+/// from moving the subtree of k by the twist S_k. Then dM_ie = -M_ie^2 d(1/m_e). O(n) after the
+/// Cholesky factorization. Runs crba. Writes data.H, data.L, data.w, data.y, data.V, data.F and
+/// `grad` (size n). Returns M_ie.
+inline double integrated_effective_mass_gradient(const Model& model, Data& data, const BasePose& base,
+                                                 const Eigen::Ref<const Eigen::VectorXd>& theta, int frame,
+                                                 const Vector3& u, double target_inverse_mass,
+                                                 Eigen::Ref<Eigen::VectorXd> grad) {
+  detail::require_size(grad.size(), model.n(), "integrated_effective_mass_gradient", "grad");
+  crba(model, data, base, theta);
+  const double inv_me = inverse_effective_mass(model, data, frame, u);
+  const double M = 1.0 / (inv_me + target_inverse_mass);
+  const int nb = model.n() + 1;
+  const Vector3& p0 = data.p[0];
+  // velocities and momenta of the bodies for the generalized velocity y
+  data.V[0] = data.y.head<6>();
+  for (int i = 1; i < nb; ++i)
+    data.V[static_cast<size_t>(i)] = data.V[static_cast<size_t>(model.body(i).parent)] + data.S.col(i - 1) * data.y(5 + i);
+  for (int i = 0; i < nb; ++i) {
+    const auto ui = static_cast<size_t>(i);
+    const Inertia& in = model.body(i).inertia;
+    const Matrix3& Ri = data.R[ui];
+    data.F[ui] = SpatialInertia::from_com(in.mass, data.p[ui] + Ri * in.com - p0, Ri * in.I * Ri.transpose()) * data.V[ui];
+  }
+  for (int i = nb - 1; i > 0; --i) data.F[static_cast<size_t>(model.body(i).parent)] += data.F[static_cast<size_t>(i)];
+  const int ee_body = model.frame(frame).body;
+  const Vector3 pe = frame_pose(model, data, frame).p;
+  const Vector6& Vee = data.V[static_cast<size_t>(ee_body)];
+  for (int i = 1; i < nb; ++i) {
+    const auto ui = static_cast<size_t>(i);
+    const Vector6 S = data.S.col(i - 1);
+    const double yHy = 2.0 * cross_motion(data.V[ui], S).dot(data.F[ui]);
+    double udv = 0.0;
+    if (supports(model, i, ee_body)) {
+      const Vector6 X = cross_motion(S, Vee - data.V[ui]);
+      const Vector3 dp = S.head<3>() + S.tail<3>().cross(pe - p0);
+      udv = u.dot(X.head<3>() + X.tail<3>().cross(pe - p0) + Vee.tail<3>().cross(dp));
+    }
+    grad(i - 1) = -M * M * (2.0 * udv - yHy);
+  }
+  return M;
+}
+
+}  // namespace ffsr
