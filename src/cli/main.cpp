@@ -14,6 +14,7 @@ int main(int argc, char** argv) {
   Action action;
   register_inspect(app, action);
   register_contact(app, action);
+  register_run(app, action, argc, argv);
   app.require_subcommand(0, 1);
   try {
     app.parse(argc, argv);
@@ -29,10 +30,6 @@ int main(int argc, char** argv) {
   } catch (const ffsr::Error& e) {
     std::cerr << "ffsr-optimize: error: " << e.what() << "\n";
     return kExitInput;
-  }
-  if (!action) {
-    std::cout << app.help();
-    return 0;
   }
   try {
     return action();

@@ -1,0 +1,392 @@
+// ffsr-optimize [--config SCENARIO.toml] [flags]: the main job. Plans the approach of the robot to
+// the tumbling target twice -- plain (rho = 0) and optimized (rho of the scenario) -- and reports
+// how much the capture configuration lowers M_ie and the maximum contact force (Tables 4 and 7).
+#include "common.hpp"
+#include "embedded.hpp"
+#include "subcommands.hpp"
+
+#include "ffsr/io/urdf.hpp"
+#include "ffsr/optimize/capture.hpp"
+
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <iomanip>
+#include <iostream>
+#include <memory>
+#include <set>
+#include <sstream>
+
+namespace ffsr::cli {
+namespace {
+
+using detail::str;
+
+struct RunOptions {
+  std::string config;
+  std::string urdf, end_effector;
+  std::vector<double> joints_deg, base_position{0, 0, 0}, base_rpy_deg{0, 0, 0};
+  double target_mass = 0;
+  std::vector<double> target_inertia, target_position, target_rpy_deg{0, 0, 0}, target_angular_velocity_deg,
+      target_velocity{0, 0, 0}, contact_offset, normal;
+  std::string model;
+  double stiffness = 0, exponent = 0, restitution = 0, approach_speed = 0;
+  std::string task, task_axes = "xyz", baseline_task;
+  std::vector<double> final_rpy_deg;
+  double duration = 0, step = 0, gain = 0, feedback = 1.0, tolerance = 0, orientation_tolerance_deg = 0.5;
+  std::string objective = "mass";
+  std::string json, csv;
+  bool quiet = false;
+};
+
+/// Keys a scenario file must name (the others have defaults).
+const char* const kRequired[] = {"urdf", "joints-deg", "target-mass", "target-inertia", "target-position",
+                                 "target-angular-velocity-deg", "contact-offset", "normal", "model", "stiffness",
+                                 "exponent", "restitution", "approach-speed", "task", "duration", "step", "gain",
+                                 "tolerance"};
+
+Vector3 vec3(const std::vector<double>& v, const char* key) {
+  if (v.size() != 3) throw InputError(str("--", key, ": expected 3 numbers, got ", v.size()));
+  for (double x : v)
+    if (!std::isfinite(x)) throw InputError(str("--", key, ": values must be finite, got ", x));
+  return {v[0], v[1], v[2]};
+}
+
+double finite(double x, const char* key) {
+  if (!std::isfinite(x)) throw InputError(str("--", key, ": must be finite, got ", x));
+  return x;
+}
+
+CaptureTask parse_task(const std::string& kind, const std::string& axes, const std::vector<double>& final_rpy,
+                       const char* key) {
+  CaptureTask t;
+  if (kind == "position") {
+    t.kind = CaptureTask::Kind::Position;
+    if (axes.empty() || axes.find_first_not_of("xyz") != std::string::npos)
+      throw InputError(str("--task-axes: expected letters from 'xyz' (for example 'xy'), got '", axes, "'"));
+    t.axes = {axes.find('x') != std::string::npos, axes.find('y') != std::string::npos,
+              axes.find('z') != std::string::npos};
+  } else if (kind == "pose") {
+    t.kind = CaptureTask::Kind::Pose;
+    if (!final_rpy.empty()) t.final_orientation = rotation_from_rpy(vec3(final_rpy, "final-rpy-deg") * (M_PI / 180.0));
+  } else {
+    throw InputError(str("--", key, ": unknown task '", kind, "'; expected 'position' or 'pose'"));
+  }
+  return t;
+}
+
+std::string deg_list(const Eigen::VectorXd& theta, int precision = 2) {
+  std::ostringstream os;
+  os << std::fixed << std::setprecision(precision) << "[";
+  for (Eigen::Index i = 0; i < theta.size(); ++i) os << (i ? ", " : "") << theta(i) * 180.0 / M_PI;
+  os << "]";
+  return os.str();
+}
+
+nlohmann::json result_json(const CaptureResult& r, const CaptureTask& task, double gain) {
+  const Eigen::Vector4d q = r.base.orientation.coeffs();
+  return {{"task", task.kind == CaptureTask::Kind::Pose ? "pose" : "position"},
+          {"gain", gain},
+          {"capture_configuration_deg", to_json(Eigen::VectorXd(r.theta * (180.0 / M_PI)))},
+          {"integrated_effective_mass", r.M_ie},
+          {"approach_velocity", r.approach_velocity},
+          {"f_max_closed_form", r.f_max_closed_form},
+          {"f_max_exact", r.f_max_exact},
+          {"tracking_error", r.tracking_error},
+          {"orientation_error_deg", r.orientation_error * 180.0 / M_PI},
+          {"end_effector_position", to_json(Eigen::VectorXd(r.end_effector))},
+          {"capture_point", to_json(Eigen::VectorXd(r.capture_point))},
+          {"base_position", to_json(Eigen::VectorXd(r.base.position))},
+          {"base_quaternion_wxyz", {q(3), q(0), q(1), q(2)}},
+          {"base_position_drift", r.base_position_drift},
+          {"base_attitude_drift_deg", r.base_attitude_drift * 180.0 / M_PI},
+          {"max_total_momentum", r.max_momentum},
+          {"min_singular_value", r.min_singular_value},
+          {"damped_evaluations", r.damped_steps},
+          {"steps", r.steps}};
+}
+
+/// Progress on a terminal for runs longer than a second.
+struct Progress {
+  std::string label;
+  std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
+  bool shown = false;
+  bool enabled = isatty(fileno(stderr)) != 0;
+  void operator()(double fraction) {
+    if (!enabled) return;
+    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (s < 1.0 && !shown) return;
+    shown = true;
+    std::fprintf(stderr, "\rffsr-optimize: %s run %3.0f%%", label.c_str(), fraction * 100.0);
+    if (fraction >= 1.0) std::fprintf(stderr, "\n");
+  }
+};
+
+int run_scenario(RunOptions o, const CLI::App& app, bool urdf_on_command_line) {
+  // --- the scenario: a file, or the built-in default (the paper's 3-DOF robot) -----------------
+  const bool builtin = o.config.empty();
+  const std::string where = builtin ? std::string("built-in scenario") : "scenario " + o.config;
+  if (!builtin) {
+    for (const char* key : kRequired)
+      if (app.get_option(std::string("--") + key)->count() == 0)
+        throw InputError(str(where, ": missing key '", key, "'"));
+  }
+  Model model = [&] {
+    if (builtin && !urdf_on_command_line && o.urdf == "paper_3dof.urdf")
+      return model_from_urdf_string(kPaper3dofUrdf, "built-in paper_3dof.urdf", o.end_effector);
+    std::string path = o.urdf;
+    if (!builtin && !urdf_on_command_line && !path.empty() && path.front() != '/') {
+      const size_t slash = o.config.find_last_of('/');
+      if (slash != std::string::npos) path = o.config.substr(0, slash + 1) + path;
+    }
+    o.urdf = path;
+    return model_from_urdf_file(path, o.end_effector);
+  }();
+
+  CaptureProblem pb;
+  pb.model = &model;
+  pb.frame = model.end_effector();
+  if (static_cast<int>(o.joints_deg.size()) != model.n())
+    throw InputError(str("--joints-deg: got ", o.joints_deg.size(), " angles, the robot has ", model.n(), " joints"));
+  pb.theta = Eigen::Map<const Eigen::VectorXd>(o.joints_deg.data(), model.n()) * (M_PI / 180.0);
+  for (double x : o.joints_deg) finite(x, "joints-deg");
+  pb.base.position = vec3(o.base_position, "base-position");
+  pb.base.orientation = Quaternion(rotation_from_rpy(vec3(o.base_rpy_deg, "base-rpy-deg") * (M_PI / 180.0)));
+  Target& t = pb.target;
+  t.mass = finite(o.target_mass, "target-mass");
+  if (o.target_inertia.size() != 3 && o.target_inertia.size() != 6)
+    throw InputError(str("--target-inertia: expected 3 or 6 numbers, got ", o.target_inertia.size()));
+  {
+    std::ostringstream s;
+    for (size_t i = 0; i < o.target_inertia.size(); ++i) s << (i ? "," : "") << std::setprecision(17) << o.target_inertia[i];
+    t.inertia = parse_inertia(s.str(), "--target-inertia");
+  }
+  t.position = vec3(o.target_position, "target-position");
+  t.attitude = Quaternion(rotation_from_rpy(vec3(o.target_rpy_deg, "target-rpy-deg") * (M_PI / 180.0)));
+  t.angular_velocity = vec3(o.target_angular_velocity_deg, "target-angular-velocity-deg") * (M_PI / 180.0);
+  t.velocity = vec3(o.target_velocity, "target-velocity");
+  t.contact_offset = vec3(o.contact_offset, "contact-offset");
+  const Vector3 nrm = vec3(o.normal, "normal");
+  if (nrm.norm() < 1e-12) throw InputError("--normal: the contact normal must be a non-zero vector");
+  t.normal = nrm.normalized();
+  try {
+    t.validate("target");
+  } catch (const InputError& e) {
+    throw InputError(str("--target-mass/--target-inertia: ", e.what()));
+  }
+  pb.contact = {finite(o.stiffness, "stiffness"), finite(o.exponent, "exponent"), finite(o.restitution, "restitution")};
+  try {
+    validate(pb.contact, "contact");
+  } catch (const InputError& e) {
+    throw InputError(str("--stiffness/--exponent/--restitution: ", e.what()));
+  }
+  make_contact_law(o.model, pb.contact, 1.0);  // an unknown --model lists the laws
+  pb.law = o.model;
+  pb.approach_speed = finite(o.approach_speed, "approach-speed");
+  if (pb.approach_speed <= 0) throw InputError(str("--approach-speed: must be positive, got ", pb.approach_speed));
+
+  const CaptureTask task = parse_task(o.task, o.task_axes, o.final_rpy_deg, "task");
+  const CaptureTask baseline_task =
+      o.baseline_task.empty() ? task : parse_task(o.baseline_task, o.task_axes, o.final_rpy_deg, "baseline-task");
+  CaptureOptions opt;
+  opt.duration = finite(o.duration, "duration");
+  opt.step = finite(o.step, "step");
+  opt.gain = finite(o.gain, "gain");
+  opt.feedback = finite(o.feedback, "feedback");
+  opt.tolerance = finite(o.tolerance, "tolerance");
+  opt.orientation_tolerance = finite(o.orientation_tolerance_deg, "orientation-tolerance-deg") * M_PI / 180.0;
+  if (o.duration <= 0) throw InputError(str("--duration: must be positive, got ", o.duration));
+  if (o.step <= 0 || o.step > o.duration) throw InputError(str("--step: must be in (0, duration], got ", o.step));
+  if (o.tolerance <= 0) throw InputError(str("--tolerance: must be positive, got ", o.tolerance));
+  if (o.objective == "mass") opt.objective = CaptureObjective::IntegratedEffectiveMass;
+  else if (o.objective == "exact-force") opt.objective = CaptureObjective::ExactMaxForce;
+  else throw InputError(str("--objective: unknown objective '", o.objective, "'; expected 'mass' or 'exact-force'"));
+  if (opt.gain != 0.0 && task.rows() >= model.n())
+    throw InputError(str("--gain: the ", o.task, " task has ", task.rows(), " rows and the robot ", model.n(),
+                         " joints: no null space to optimize in (set gain = 0 or constrain fewer axes)"));
+  const bool want_series = !o.csv.empty();
+  opt.record_series = want_series;
+
+  // --- the two runs ------------------------------------------------------------------------------
+  CaptureOptions plain = opt;
+  plain.gain = 0.0;
+  Progress p1{"plain"}, p2{"optimized"};
+  if (!o.quiet) {
+    plain.progress = std::ref(p1);
+    opt.progress = std::ref(p2);
+  }
+  auto labelled = [](const char* label, auto&& f) {
+    try {
+      return f();
+    } catch (const NumericalError& e) {
+      throw NumericalError(str(label, " run: ", e.what()));
+    }
+  };
+  const CaptureResult base_run = labelled("plain", [&] { return plan_capture(pb, baseline_task, plain); });
+  const CaptureResult opt_run = labelled("optimized", [&] { return plan_capture(pb, task, opt); });
+  const double mass_red = 100.0 * (base_run.M_ie - opt_run.M_ie) / base_run.M_ie;
+  const double force_red = 100.0 * (base_run.f_max_closed_form - opt_run.f_max_closed_form) / base_run.f_max_closed_form;
+  const double exact_red = 100.0 * (base_run.f_max_exact - opt_run.f_max_exact) / base_run.f_max_exact;
+
+  // --- outputs: all built first, then written atomically ------------------------------------------
+  nlohmann::json j;
+  j["version"] = FFSR_VERSION;
+  j["scenario"] = {{"source", builtin ? "built-in paper_3dof" : o.config},
+                   {"urdf", o.urdf},
+                   {"end_effector", model.frame(pb.frame).name},
+                   {"joint_names", model.joint_names()},
+                   {"joints-deg", o.joints_deg},
+                   {"base-position", o.base_position},
+                   {"base-rpy-deg", o.base_rpy_deg},
+                   {"target-mass", o.target_mass},
+                   {"target-inertia", o.target_inertia},
+                   {"target-position", o.target_position},
+                   {"target-rpy-deg", o.target_rpy_deg},
+                   {"target-angular-velocity-deg", o.target_angular_velocity_deg},
+                   {"target-velocity", o.target_velocity},
+                   {"contact-offset", o.contact_offset},
+                   {"normal", o.normal},
+                   {"model", o.model},
+                   {"stiffness", o.stiffness},
+                   {"exponent", o.exponent},
+                   {"restitution", o.restitution},
+                   {"approach-speed", o.approach_speed},
+                   {"task", o.task},
+                   {"task-axes", o.task_axes},
+                   {"baseline-task", o.baseline_task.empty() ? o.task : o.baseline_task},
+                   {"duration", o.duration},
+                   {"step", o.step},
+                   {"gain", o.gain},
+                   {"feedback", o.feedback},
+                   {"tolerance", o.tolerance},
+                   {"objective", o.objective}};
+  j["capture_point"] = to_json(Eigen::VectorXd(base_run.capture_point));
+  j["baseline"] = result_json(base_run, baseline_task, 0.0);
+  j["optimized"] = result_json(opt_run, task, opt.gain);
+  j["mass_reduction_percent"] = mass_red;
+  j["force_reduction_percent"] = force_red;
+  j["exact_force_reduction_percent"] = exact_red;
+
+  std::string csv;
+  if (want_series) {
+    std::ostringstream c;
+    c << std::setprecision(12) << "run,t";
+    for (const auto& name : model.joint_names()) c << "," << name << "_deg";
+    c << ",base_x,base_y,base_z,base_qw,base_qx,base_qy,base_qz,ee_x,ee_y,ee_z,M_ie,F_max_estimate\n";
+    for (const auto* run : {&base_run, &opt_run}) {
+      for (const CaptureSample& s : run->series) {
+        c << (run == &base_run ? "baseline" : "optimized") << "," << s.t;
+        for (Eigen::Index i = 0; i < s.theta.size(); ++i) c << "," << s.theta(i) * 180.0 / M_PI;
+        const auto& q = s.base.orientation;
+        c << "," << s.base.position.x() << "," << s.base.position.y() << "," << s.base.position.z() << "," << q.w()
+          << "," << q.x() << "," << q.y() << "," << q.z() << "," << s.end_effector.x() << "," << s.end_effector.y()
+          << "," << s.end_effector.z() << "," << s.M_ie << "," << s.f_max_estimate << "\n";
+      }
+    }
+    csv = c.str();
+  }
+  if (!o.json.empty()) write_file_atomic(o.json, j.dump(2) + "\n");
+  if (!o.csv.empty()) write_file_atomic(o.csv, csv);
+
+  std::ostream& out = std::cout;
+  out << "ffsr-optimize " << FFSR_VERSION << ": " << where << " (" << model.n() << " joints, " << o.model
+      << ", T = " << o.duration << " s, step " << o.step << " s, rho = " << opt.gain << ")\n\n";
+  const int w = 8 * model.n() + 4;
+  out << std::left << std::setw(24) << "" << std::setw(w) << "Capture configuration (deg)" << std::right
+      << std::setw(11) << "M_ie (kg)" << std::setw(14) << "F_max (kN)" << std::setw(14) << "exact (kN)"
+      << std::setw(15) << "tracking (m)" << "\n";
+  auto row = [&](const char* label, const CaptureResult& r) {
+    out << std::left << std::setw(24) << label << std::setw(w) << deg_list(r.theta) << std::right << std::fixed
+        << std::setprecision(3) << std::setw(11) << r.M_ie << std::setw(14) << r.f_max_closed_form / 1e3
+        << std::setw(14) << r.f_max_exact / 1e3 << std::setw(15) << std::scientific << std::setprecision(2)
+        << r.tracking_error << std::fixed << "\n";
+  };
+  row("Without optimization", base_run);
+  row("With optimization", opt_run);
+  out << std::left << std::setw(24 + w) << "Reduction" << std::right << std::fixed << std::setprecision(2)
+      << std::setw(10) << mass_red << "%" << std::setw(13) << force_red << "%" << std::setw(13) << exact_red << "%\n\n";
+  out << std::setprecision(4) << "capture point [" << base_run.capture_point.transpose().format(Eigen::IOFormat(4, 0, ", "))
+      << "] m, approach velocity delta_dot^- = " << base_run.approach_velocity << " m/s\n"
+      << "base drift: plain " << base_run.base_position_drift * 1e3 << " mm / "
+      << base_run.base_attitude_drift * 180.0 / M_PI << " deg, optimized " << opt_run.base_position_drift * 1e3
+      << " mm / " << opt_run.base_attitude_drift * 180.0 / M_PI << " deg\n"
+      << "tasks: plain " << (baseline_task.kind == CaptureTask::Kind::Pose ? "pose" : "position") << ", optimized "
+      << (task.kind == CaptureTask::Kind::Pose ? "pose" : "position")
+      << "; F_max: Eq. 24 closed form; exact: peak of the single-body model (Eq. 16)\n";
+  if (base_run.damped_steps + opt_run.damped_steps > 0)
+    out << "note: near a singularity the pseudo-inverse was damped in " << base_run.damped_steps + opt_run.damped_steps
+        << " evaluations (smallest singular value " << std::min(base_run.min_singular_value, opt_run.min_singular_value)
+        << ")\n";
+  return 0;
+}
+
+}  // namespace
+
+void register_run(CLI::App& app, Action& action, int argc, char** argv) {
+  auto o = std::make_shared<RunOptions>();
+  bool urdf_cli = false;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--urdf" || a.rfind("--urdf=", 0) == 0) urdf_cli = true;
+    if (a == "inspect" || a == "contact") break;
+  }
+  app.set_config("--config", "", "Scenario file (TOML); every key is also a flag. Default: the built-in paper 3-DOF scenario");
+  app.get_config_ptr()->check(CLI::ExistingFile);
+  auto vec = [&](const char* name, std::vector<double>& v, const char* help) {
+    return app.add_option(name, v, help)->delimiter(',')->allow_extra_args(false);
+  };
+  app.add_option("--urdf", o->urdf, "Robot URDF (relative to the scenario file)");
+  app.add_option("--end-effector", o->end_effector, "End-effector frame (default: the single leaf link)");
+  vec("--joints-deg", o->joints_deg, "Initial joint angles, deg");
+  vec("--base-position", o->base_position, "Initial base position, m");
+  vec("--base-rpy-deg", o->base_rpy_deg, "Initial base attitude (roll, pitch, yaw), deg");
+  app.add_option("--target-mass", o->target_mass, "Target mass, kg");
+  vec("--target-inertia", o->target_inertia, "Target inertia: Ixx,Iyy,Izz[,Ixy,Ixz,Iyz], kg m^2 (target frame)");
+  vec("--target-position", o->target_position, "Target centre of mass at t = 0, m");
+  vec("--target-rpy-deg", o->target_rpy_deg, "Target attitude at t = 0, deg");
+  vec("--target-angular-velocity-deg", o->target_angular_velocity_deg, "Target spin (target frame), deg/s");
+  vec("--target-velocity", o->target_velocity, "Target linear velocity, m/s");
+  vec("--contact-offset", o->contact_offset, "r_tp: contact point from the target centre of mass (target frame), m");
+  vec("--normal", o->normal, "u_n: contact normal (target frame)");
+  app.add_option("--model", o->model, "Hysteresis damping law (Table 1)");
+  app.add_option("--stiffness", o->stiffness, "K, N/m^alpha");
+  app.add_option("--exponent", o->exponent, "alpha");
+  app.add_option("--restitution", o->restitution, "c_r, 0 < c_r <= 1");
+  app.add_option("--approach-speed", o->approach_speed, "End-effector speed along the normal at the capture, m/s");
+  app.add_option("--task", o->task, "Optimized run's task: position or pose");
+  app.add_option("--task-axes", o->task_axes, "Position task: constrained inertial axes, e.g. xy")->capture_default_str();
+  app.add_option("--baseline-task", o->baseline_task, "Plain run's task (default: the optimized run's)");
+  vec("--final-rpy-deg", o->final_rpy_deg, "Pose task: final end-effector orientation (default: hold the initial)");
+  app.add_option("--duration", o->duration, "Task time T, s");
+  app.add_option("--step", o->step, "RK4 step, s");
+  app.add_option("--gain", o->gain, "rho of Eq. 30 (< 0 lowers the objective)");
+  app.add_option("--feedback", o->feedback, "Tracking feedback gain, 1/s")->capture_default_str();
+  app.add_option("--tolerance", o->tolerance, "Required capture-point accuracy, m");
+  app.add_option("--orientation-tolerance-deg", o->orientation_tolerance_deg, "Pose task: required orientation accuracy, deg")
+      ->capture_default_str();
+  app.add_option("--objective", o->objective, "mass (M_ie, the paper's) or exact-force")->capture_default_str();
+  app.add_option("--json", o->json, "Write the result (with the resolved scenario and the version) to this JSON file");
+  app.add_option("--csv", o->csv, "Write the time series of both runs to this CSV file");
+  app.add_flag("--quiet", o->quiet, "No progress line");
+  app.callback([o, &app, &action, urdf_cli] {
+    if (!app.get_subcommands().empty()) return;
+    action = [o, &app, urdf_cli] {
+      if (o->config.empty()) {
+        // the built-in default scenario fills every key not given on the command line
+        std::istringstream in(kPaper3dofScenario);
+        for (const CLI::ConfigItem& item : CLI::ConfigTOML().from_config(in)) {
+          CLI::Option* opt = app.get_option_no_throw("--" + item.name);
+          if (opt && opt->count() == 0) {
+            opt->add_result(item.inputs);
+            opt->run_callback();
+          }
+        }
+      }
+      return run_scenario(*o, app, urdf_cli);
+    };
+  });
+  app.get_config_ptr()->each([o](const std::string& s) { o->config = s; });
+}
+
+}  // namespace ffsr::cli
