@@ -57,6 +57,8 @@ struct MultibodyContactResult {
   double restitution = 0;              ///< realized coefficient: -separation_velocity / approach_velocity
   Vector6 momentum_start = Vector6::Zero();  ///< [P; L about o] of robot + target at first touch
   Vector6 momentum_end = Vector6::Zero();    ///< the same at separation
+  double energy_start = 0;             ///< kinetic energy of robot + target at first touch (J)
+  double energy_end = 0;               ///< the same at separation (equal for c_r = 1)
   long steps = 0;                      ///< CVODE internal steps
   std::vector<ContactSample> series;   ///< when requested
 };
@@ -100,7 +102,7 @@ struct ContactSystem {
     ct0 = target.position;
     r0 = Rt0 * target.contact_offset;
   }
-  Eigen::Index size() const { return 26 + 2 * n; }
+  Eigen::Index size() const { return 24 + 2 * n; }
   // offsets
   Eigen::Index iv() const { return 6 + n; }
   Eigen::Index it() const { return 12 + 2 * n; }
@@ -160,6 +162,13 @@ struct ContactSystem {
     ydot.segment<3>(t0 + 3) = rotation_vector_rate(y.segment<3>(t0 + 3), k.wt);
     ydot.segment<3>(t0 + 6) = f / target.mass + model.gravity;
     ydot.segment<3>(t0 + 9) = I.ldlt().solve((k.pe - k.ct).cross(f) - k.wt.cross(I * k.wt));
+  }
+
+  /// Kinetic energy of robot + target (bodies summed).
+  double total_energy(const Eigen::Ref<const Eigen::VectorXd>& y) {
+    const Kin k = kinematics(y);
+    const Matrix3 I = k.Rt * target.inertia * k.Rt.transpose();
+    return kinetic_energy(model, data, v) + 0.5 * target.mass * k.vt.squaredNorm() + 0.5 * k.wt.dot(I * k.wt);
   }
 
   /// Total momentum of robot + target, [P; L about o].
@@ -267,6 +276,7 @@ inline MultibodyContactResult simulate_contact(const Model& model, const BasePos
         };
         cvode::Integrator integ(rhs, y0, 0.0, co, 2, roots, {-1, -1});
         res.momentum_start = sys.total_momentum(y0);
+        res.energy_start = sys.total_energy(y0);
         auto record = [&](double t, const Eigen::VectorXd& y) {
           const auto k = sys.kinematics(y);
           const double F = sys.force(law, k);
@@ -288,6 +298,7 @@ inline MultibodyContactResult simulate_contact(const Model& model, const BasePos
             res.separation_velocity = k.delta_dot;
             res.restitution = -k.delta_dot / vin;
             res.momentum_end = sys.total_momentum(integ.y());
+            res.energy_end = sys.total_energy(integ.y());
             res.steps = integ.num_steps();
             return res;
           }
