@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <random>
 #include <sstream>
@@ -115,21 +116,44 @@ Robot load_robot(const RobotOptions& o) {
 }
 
 void write_file_atomic(const std::string& path, const std::string& content) {
+  write_files_atomic({{path, content}});
+}
+
+void write_files_atomic(const std::vector<std::pair<std::string, std::string>>& files) {
   std::random_device rd;
-  const std::string tmp = path + ".tmp-" + std::to_string(rd());
-  {
+  std::vector<std::string> tmps;
+  auto remove_tmps = [&tmps](size_t from) {
+    for (size_t k = from; k < tmps.size(); ++k) std::remove(tmps[k].c_str());
+  };
+  for (const auto& [path, content] : files) {
+    const std::string tmp = path + ".tmp-" + std::to_string(rd());
     std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) throw InputError(str(path, ": cannot write the output file"));
+    if (!out) {
+      remove_tmps(0);
+      throw InputError(str(path, ": cannot write the output file"));
+    }
+    tmps.push_back(tmp);
     out << content;
     out.flush();
     if (!out) {
-      std::remove(tmp.c_str());
+      out.close();
+      remove_tmps(0);
       throw InputError(str(path, ": cannot write the output file"));
     }
   }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    std::remove(tmp.c_str());
-    throw InputError(str(path, ": cannot write the output file (rename failed)"));
+  // a directory cannot be replaced by a file: check them all before renaming any
+  for (const auto& f : files) {
+    std::error_code ec;
+    if (std::filesystem::is_directory(f.first, ec)) {
+      remove_tmps(0);
+      throw InputError(str(f.first, ": cannot write the output file (it is a directory)"));
+    }
+  }
+  for (size_t i = 0; i < files.size(); ++i) {
+    if (std::rename(tmps[i].c_str(), files[i].first.c_str()) != 0) {
+      remove_tmps(i);
+      throw InputError(str(files[i].first, ": cannot write the output file (rename failed)"));
+    }
   }
 }
 

@@ -60,6 +60,10 @@ Matrix3 parse_inertia(const std::string& text, const std::string& flag);
 /// Writes a file atomically: a temporary file in the same directory, then rename. Throws InputError
 /// naming the path when it cannot be written; never leaves a partial file behind.
 void write_file_atomic(const std::string& path, const std::string& content);
+/// Writes several files all or nothing: every content goes to a temporary file next to its path
+/// first, and only when all of them are written are they renamed into place. A failure removes the
+/// temporary files and throws InputError naming the path, so no output of the run is left behind.
+void write_files_atomic(const std::vector<std::pair<std::string, std::string>>& files);
 
 /// Matrix -> JSON array of rows.
 nlohmann::json to_json(const Eigen::MatrixXd& m);

@@ -77,7 +77,11 @@ int run_contact(const ContactOptions& o) {
   if (o.model == "all") {
     for (auto n : contact_law_names()) names.emplace_back(n);
   } else {
-    make_contact_law(o.model, {o.stiffness, o.exponent, o.restitution}, 1.0);  // unknown name: InputError listing the laws
+    try {
+      make_contact_law(o.model, {o.stiffness, o.exponent, o.restitution}, 1.0);  // unknown name: lists the laws
+    } catch (const InputError& e) {
+      throw InputError(std::string("--model: ") + e.what());
+    }
     names.push_back(o.model);
   }
   std::vector<Row> rows;

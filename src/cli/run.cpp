@@ -181,7 +181,11 @@ int run_scenario(RunOptions o, const CLI::App& app, bool urdf_on_command_line) {
   } catch (const InputError& e) {
     throw InputError(str("--stiffness/--exponent/--restitution: ", e.what()));
   }
-  make_contact_law(o.model, pb.contact, 1.0);  // an unknown --model lists the laws
+  try {
+    make_contact_law(o.model, pb.contact, 1.0);  // an unknown --model lists the laws
+  } catch (const InputError& e) {
+    throw InputError(str("--model: ", e.what()));
+  }
   pb.law = o.model;
   pb.approach_speed = finite(o.approach_speed, "approach-speed");
   if (pb.approach_speed <= 0) throw InputError(str("--approach-speed: must be positive, got ", pb.approach_speed));
@@ -286,8 +290,10 @@ int run_scenario(RunOptions o, const CLI::App& app, bool urdf_on_command_line) {
     }
     csv = c.str();
   }
-  if (!o.json.empty()) write_file_atomic(o.json, j.dump(2) + "\n");
-  if (!o.csv.empty()) write_file_atomic(o.csv, csv);
+  std::vector<std::pair<std::string, std::string>> files;  // all or nothing: no partial output
+  if (!o.json.empty()) files.emplace_back(o.json, j.dump(2) + "\n");
+  if (!o.csv.empty()) files.emplace_back(o.csv, csv);
+  if (!files.empty()) write_files_atomic(files);
 
   std::ostream& out = std::cout;
   out << "ffsr-optimize " << FFSR_VERSION << ": " << where << " (" << model.n() << " joints, " << o.model
@@ -333,6 +339,7 @@ void register_run(CLI::App& app, Action& action, int argc, char** argv) {
   }
   app.set_config("--config", "", "Scenario file (TOML); every key is also a flag. Default: the built-in paper 3-DOF scenario");
   app.get_config_ptr()->check(CLI::ExistingFile);
+  app.allow_config_extras(CLI::config_extras_mode::error);  // an unknown key in a scenario is an error
   auto vec = [&](const char* name, std::vector<double>& v, const char* help) {
     return app.add_option(name, v, help)->delimiter(',')->allow_extra_args(false);
   };

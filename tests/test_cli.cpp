@@ -1,0 +1,677 @@
+// End-to-end tests of the ffsr-optimize command: inspect, contact and the main job (a capture
+// scenario), their JSON/CSV outputs against the paper (Tables 3 and 4), and a catalogue of bad
+// inputs, each of which must give exit code 2 (3 for a capture point out of reach) and one error
+// line on stderr naming the offending input, print no result and leave no output file behind.
+//
+// The command is run without a shell (tests/support/run_command.hpp), from a fresh temporary
+// directory, with absolute paths to the repository's files, so nothing depends on the working
+// directory of the test runner.
+#include "support/run_command.hpp"
+
+#include <catch2/catch.hpp>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <regex>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace {
+
+namespace fs = std::filesystem;
+using ffsr::test::CommandResult;
+using ffsr::test::run_command;
+using ffsr::test::TempDir;
+using Args = std::vector<std::string>;
+using nlohmann::json;
+
+const std::string kCli = FFSR_CLI;
+const std::string kSource = FFSR_SOURCE_DIR;
+const std::string kUrdf3 = kSource + "/robots/paper_3dof.urdf";
+const std::string kUrdf7 = kSource + "/robots/paper_7dof.urdf";
+const std::string kScenario3 = kSource + "/robots/paper_3dof.toml";
+const std::string kBadScenarios = kSource + "/tests/data/bad_scenarios";
+const std::string kBadUrdfs = kSource + "/tests/data/bad_urdf";
+const std::string kErrorPrefix = "ffsr-optimize: error:";
+
+/// Runs ffsr-optimize with `args` in `cwd` (empty: a throw-away temporary directory).
+CommandResult cli(const Args& args, const std::string& cwd = {}) {
+  Args full{kCli};
+  full.insert(full.end(), args.begin(), args.end());
+  if (!cwd.empty()) return run_command(full, cwd);
+  TempDir tmp;
+  return run_command(full, tmp.str());
+}
+
+std::string describe(const Args& args) {
+  std::string s = "ffsr-optimize";
+  for (const auto& a : args) s += " " + a;
+  return s;
+}
+
+/// Parses stdout as JSON; fails the test with the output when it is not.
+json parse_json(const CommandResult& r) {
+  INFO("stdout: " << r.out << "\nstderr: " << r.err);
+  REQUIRE(r.exit_code == 0);
+  json j;
+  REQUIRE_NOTHROW(j = json::parse(r.out));
+  REQUIRE(j.is_object());
+  return j;
+}
+
+json read_json_file(const std::string& path) {
+  std::ifstream in(path);
+  REQUIRE(in.good());
+  json j;
+  REQUIRE_NOTHROW(j = json::parse(in));
+  return j;
+}
+
+std::vector<std::string> split(const std::string& s, char sep) {
+  std::vector<std::string> out;
+  std::string item;
+  std::stringstream ss(s);
+  while (std::getline(ss, item, sep)) out.push_back(item);
+  return out;
+}
+
+/// CSV file -> header and rows of cells.
+struct Csv {
+  std::vector<std::string> header;
+  std::vector<std::vector<std::string>> rows;
+  int column(const std::string& name) const {
+    for (size_t i = 0; i < header.size(); ++i)
+      if (header[i] == name) return static_cast<int>(i);
+    return -1;
+  }
+};
+
+Csv read_csv(const std::string& path) {
+  std::ifstream in(path);
+  REQUIRE(in.good());
+  Csv c;
+  std::string line;
+  REQUIRE(std::getline(in, line));
+  c.header = split(line, ',');
+  while (std::getline(in, line))
+    if (!line.empty()) c.rows.push_back(split(line, ','));
+  return c;
+}
+
+/// The version in the top-level CMakeLists.txt: project(ffsr VERSION x.y.z ...).
+std::string project_version() {
+  std::ifstream in(kSource + "/CMakeLists.txt");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  std::smatch m;
+  const std::string text = ss.str();
+  if (std::regex_search(text, m, std::regex(R"(project\s*\(\s*ffsr\s+VERSION\s+([0-9.]+))"))) return m[1];
+  return {};
+}
+
+std::vector<double> numbers(const json& a) {
+  std::vector<double> v;
+  for (const auto& x : a) v.push_back(x.get<double>());
+  return v;
+}
+
+}  // namespace
+
+// ------------------------------------------------------------------------------------------------
+// 1. inspect
+// ------------------------------------------------------------------------------------------------
+
+TEST_CASE("inspect --json on the 3-DOF robot at [0, 90, -90] deg (Table 3, row 5)", "[cli][paper]") {
+  const auto j = parse_json(cli({"inspect", "--urdf", kUrdf3, "--joints-deg", "0,90,-90", "--json"}));
+  for (const char* key : {"H", "J_f", "end_effector_position", "effective_mass", "integrated_effective_mass",
+                          "joint_names"})
+    CHECK(j.contains(key));
+
+  // H: (6 + 3) x (6 + 3), symmetric
+  const auto& H = j.at("H");
+  REQUIRE(H.size() == 9);
+  for (size_t r = 0; r < 9; ++r) {
+    REQUIRE(H[r].size() == 9);
+    for (size_t c = 0; c < 9; ++c) {
+      INFO("H(" << r << ", " << c << ")");
+      CHECK(H[r][c].get<double>() == Approx(H[c][r].get<double>()).margin(1e-9));
+    }
+  }
+  // J_f: 6 rows of n = 3
+  const auto& Jf = j.at("J_f");
+  REQUIRE(Jf.size() == 6);
+  for (const auto& row : Jf) CHECK(row.size() == 3);
+
+  // End-effector by hand: the base at the origin, joint 1 at a = 0.6 along x; link 1 (b = 1.4) at
+  // 0 deg along x, link 2 (c = 1.6) at 0 + 90 = 90 deg along y, link 3 (d = 0.5) at 90 - 90 = 0 deg
+  // along x: p_e = (a + b + d, c, 0) = (2.5, 1.6, 0).
+  const double a = 0.6, b = 1.4, c = 1.6, d = 0.5;
+  const auto p = numbers(j.at("end_effector_position"));
+  REQUIRE(p.size() == 3);
+  CHECK(p[0] == Approx(a + b + d).margin(1e-9));
+  CHECK(p[1] == Approx(c).margin(1e-9));
+  CHECK(p[2] == Approx(0.0).margin(1e-9));
+
+  // Table 3: M_ie = 5.817 kg at [0, 90, -90] deg, within 0.1 %
+  const double M_ie = j.at("integrated_effective_mass").get<double>();
+  CHECK(M_ie == Approx(5.817).epsilon(1e-3));
+  // m_e is the robot side alone, so it exceeds M_ie = 1 / (1/m_e + 1/m_t,eff) and is finite
+  const double m_e = j.at("effective_mass").get<double>();
+  CHECK(std::isfinite(m_e));
+  CHECK(m_e > M_ie);
+  CHECK(j.at("joint_names") == json({"joint1", "joint2", "joint3"}));
+}
+
+TEST_CASE("inspect: negative angles work as --joints-deg=... and as --joints-deg ...", "[cli]") {
+  const auto eq = parse_json(cli({"inspect", "--urdf", kUrdf3, "--joints-deg=-2.29,91.75,-79.77", "--json"}));
+  const auto sp = parse_json(cli({"inspect", "--urdf", kUrdf3, "--joints-deg", "-2.29,91.75,-79.77", "--json"}));
+  const auto deg_eq = numbers(eq.at("joints_deg"));
+  const auto deg_sp = numbers(sp.at("joints_deg"));
+  REQUIRE(deg_eq.size() == 3);
+  CHECK(deg_eq[0] == Approx(-2.29));
+  CHECK(deg_eq[1] == Approx(91.75));
+  CHECK(deg_eq[2] == Approx(-79.77));
+  CHECK(deg_eq == deg_sp);
+  CHECK(eq.at("integrated_effective_mass").get<double>() == sp.at("integrated_effective_mass").get<double>());
+  CHECK(eq.at("end_effector_position") == sp.at("end_effector_position"));
+  // Table 4, plain run: the paper's capture configuration has M_ie = 5.43 kg
+  CHECK(eq.at("integrated_effective_mass").get<double>() == Approx(5.43).epsilon(0.01));
+}
+
+TEST_CASE("inspect: the 7-DOF robot's end-effector at [0, 90, 90, -90, 90, 90, 0] deg", "[cli][paper]") {
+  const auto j = parse_json(cli({"inspect", "--urdf", kUrdf7, "--joints-deg", "0,90,90,-90,90,90,0", "--json"}));
+  const auto p = numbers(j.at("end_effector_position"));
+  REQUIRE(p.size() == 3);
+  CHECK(p[0] == Approx(1.8).margin(0.05));
+  CHECK(p[1] == Approx(-0.6).margin(0.05));
+  CHECK(p[2] == Approx(1.8).margin(0.05));
+  CHECK(j.at("H").size() == 13);
+  CHECK(j.at("J_f").size() == 6);
+  CHECK(j.at("J_f")[0].size() == 7);
+  CHECK(j.at("joint_names").size() == 7);
+}
+
+TEST_CASE("inspect without --json prints a readable summary", "[cli]") {
+  const auto r = cli({"inspect", "--urdf", kUrdf3, "--joints-deg", "0,90,-90"});
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  CHECK(r.err.empty());
+  CHECK(r.out.find("M_ie") != std::string::npos);
+  CHECK(r.out.find("5.81") != std::string::npos);
+}
+
+// ------------------------------------------------------------------------------------------------
+// 2. contact
+// ------------------------------------------------------------------------------------------------
+
+TEST_CASE("contact --json at [0, 90, -90] deg reproduces Table 3, row 5", "[cli][paper]") {
+  const auto j = parse_json(cli({"contact", "--urdf", kUrdf3, "--joints-deg", "0,90,-90", "--json"}));
+  for (const char* key : {"integrated_effective_mass", "approach_velocity", "f_max_closed_form", "f_max_exact",
+                          "f_max_multibody", "model_accuracy"})
+    CHECK(j.contains(key));
+  CHECK(j.at("integrated_effective_mass").get<double>() == Approx(5.817).epsilon(1e-3));
+  // 0.2 m/s along the normal plus the target's 2 deg/s spin at r_tp = (-0.25, 0.15, 0)
+  CHECK(j.at("approach_velocity").get<double>() == Approx(0.2 + 0.15 * 2.0 * M_PI / 180.0).epsilon(1e-6));
+  CHECK(j.at("approach_velocity").get<double>() == Approx(0.2052).epsilon(1e-3));
+  CHECK(j.at("f_max_closed_form").get<double>() == Approx(1840.0).epsilon(3e-3));  // Proposed Method
+  CHECK(j.at("f_max_multibody").get<double>() == Approx(1861.0).epsilon(0.025));   // Numerical Integration
+  const double exact = j.at("f_max_exact").get<double>();
+  CHECK(exact == Approx(j.at("f_max_multibody").get<double>()).epsilon(5e-3));
+  CHECK(exact > j.at("f_max_closed_form").get<double>());
+  const double acc = j.at("model_accuracy").get<double>();
+  CHECK(acc > 98.5);
+  CHECK(acc < 99.5);
+}
+
+TEST_CASE("contact --model all --json lists the eight laws", "[cli]") {
+  const auto j =
+      parse_json(cli({"contact", "--urdf", kUrdf3, "--joints-deg", "0,90,-90", "--model", "all", "--json"}));
+  REQUIRE(j.contains("laws"));
+  const auto& laws = j.at("laws");
+  REQUIRE(laws.is_array());
+  REQUIRE(laws.size() == 8);
+  std::vector<std::string> names;
+  for (const auto& law : laws) {
+    REQUIRE(law.contains("model"));
+    names.push_back(law.at("model").get<std::string>());
+    CHECK(law.at("f_max_closed_form").get<double>() > 0);
+    CHECK(law.at("f_max_multibody").get<double>() > 0);
+  }
+  CHECK(names == std::vector<std::string>{"hunt-crossley", "herbert-mcwhannell", "lankarani-nikravesh", "lee-wang",
+                                          "flores", "gonthier", "zhiying-qishao", "hu-guo"});
+}
+
+TEST_CASE("contact --series writes F(t) and delta(t)", "[cli]") {
+  TempDir tmp;
+  const auto r = cli({"contact", "--urdf", kUrdf3, "--joints-deg", "0,90,-90", "--series", "series.csv"}, tmp.str());
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  CHECK(tmp.entries() == std::vector<std::string>{"series.csv"});  // no temporary file left
+  const Csv c = read_csv(tmp / "series.csv");
+  const int t_col = c.column("t_s"), f_col = c.column("force_N"), d_col = c.column("delta_m");
+  REQUIRE(t_col >= 0);
+  REQUIRE(f_col >= 0);
+  REQUIRE(d_col >= 0);
+  REQUIRE(c.rows.size() > 10);
+  CHECK(std::stod(c.rows.front()[static_cast<size_t>(t_col)]) == 0.0);
+  double f_max = 0, t_prev = -1;
+  for (const auto& row : c.rows) {
+    REQUIRE(row.size() == c.header.size());
+    const double t = std::stod(row[static_cast<size_t>(t_col)]), f = std::stod(row[static_cast<size_t>(f_col)]);
+    CHECK(f >= 0.0);
+    CHECK(t >= t_prev);
+    t_prev = t;
+    f_max = std::max(f_max, f);
+  }
+  CHECK(f_max == Approx(1861.0).epsilon(0.025));
+}
+
+// ------------------------------------------------------------------------------------------------
+// 3. the main job
+// ------------------------------------------------------------------------------------------------
+
+namespace {
+
+void check_result_keys(const json& j) {
+  for (const char* run : {"baseline", "optimized"}) {
+    INFO(run);
+    REQUIRE(j.contains(run));
+    for (const char* key : {"capture_configuration_deg", "integrated_effective_mass", "f_max_closed_form",
+                            "tracking_error"})
+      CHECK(j.at(run).contains(key));
+  }
+  CHECK(j.contains("mass_reduction_percent"));
+  CHECK(j.contains("force_reduction_percent"));
+}
+
+/// Issue 4, "What it must show" 1 (Table 4).
+void check_table4(const json& j) {
+  check_result_keys(j);
+  const auto& base = j.at("baseline");
+  const auto& opt = j.at("optimized");
+  CHECK(base.at("tracking_error").get<double>() < 1e-3);
+  CHECK(opt.at("tracking_error").get<double>() < 1e-3);
+  const auto theta = numbers(base.at("capture_configuration_deg"));
+  const std::vector<double> paper{-2.29, 91.75, -79.77};
+  REQUIRE(theta.size() == 3);
+  for (size_t i = 0; i < 3; ++i) {
+    INFO("joint " << i + 1 << ": " << theta[i] << " deg, paper " << paper[i]);
+    CHECK(std::abs(theta[i] - paper[i]) <= 10.0);
+  }
+  const double M_base = base.at("integrated_effective_mass").get<double>();
+  const double M_opt = opt.at("integrated_effective_mass").get<double>();
+  CHECK(M_base >= 5.0);
+  CHECK(M_base <= 6.0);
+  CHECK(M_opt <= 1.4);
+  CHECK(j.at("force_reduction_percent").get<double>() >= 50.0);
+  CHECK(j.at("mass_reduction_percent").get<double>() == Approx(100.0 * (M_base - M_opt) / M_base).epsilon(1e-9));
+  const double F_base = base.at("f_max_closed_form").get<double>(), F_opt = opt.at("f_max_closed_form").get<double>();
+  CHECK(j.at("force_reduction_percent").get<double>() == Approx(100.0 * (F_base - F_opt) / F_base).epsilon(1e-9));
+}
+
+void check_series_csv(const std::string& path, size_t n_joints) {
+  const Csv c = read_csv(path);
+  REQUIRE(c.column("run") == 0);
+  for (const char* col : {"t", "M_ie", "F_max_estimate", "ee_x", "ee_y", "ee_z", "base_x", "base_qw"}) {
+    INFO(col);
+    CHECK(c.column(col) >= 0);
+  }
+  CHECK(c.header.size() == 2 + n_joints + 7 + 3 + 2);
+  size_t baseline = 0, optimized = 0;
+  for (const auto& row : c.rows) {
+    REQUIRE(row.size() == c.header.size());
+    if (row[0] == "baseline") ++baseline;
+    if (row[0] == "optimized") ++optimized;
+  }
+  CHECK(baseline > 10);
+  CHECK(optimized > 10);
+  CHECK(baseline + optimized == c.rows.size());
+}
+
+}  // namespace
+
+TEST_CASE("the built-in default scenario (no arguments) reproduces Table 4", "[cli][paper]") {
+  TempDir tmp;  // an empty working directory: the default must not read robots/ from it
+  const auto r = cli({"--json", "out.json", "--csv", "out.csv", "--quiet"}, tmp.str());
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  CHECK(r.err.empty());
+  CHECK(r.out.find("Without optimization") != std::string::npos);
+  CHECK(r.out.find("With optimization") != std::string::npos);
+  CHECK(tmp.entries() == std::vector<std::string>{"out.csv", "out.json"});
+  const json j = read_json_file(tmp / "out.json");
+  check_table4(j);
+  CHECK(j.at("version").get<std::string>() == project_version());
+  check_series_csv(tmp / "out.csv", 3);
+}
+
+TEST_CASE("run: --config robots/paper_3dof.toml from another directory finds its URDF", "[cli][paper]") {
+  TempDir tmp;
+  const auto r = cli({"--config", kScenario3, "--json", "out.json", "--csv", "out.csv", "--quiet"}, tmp.str());
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  const json j = read_json_file(tmp / "out.json");
+  check_table4(j);
+  // the URDF was resolved next to the scenario file, not in the working directory
+  CHECK(fs::equivalent(j.at("scenario").at("urdf").get<std::string>(), kUrdf3));
+  check_series_csv(tmp / "out.csv", 3);
+
+  SECTION("the scenario and the built-in default give the same result") {
+    const auto d = cli({"--json", "default.json", "--quiet"}, tmp.str());
+    REQUIRE(d.exit_code == 0);
+    const json jd = read_json_file(tmp / "default.json");
+    CHECK(jd.at("baseline").at("integrated_effective_mass").get<double>() ==
+          Approx(j.at("baseline").at("integrated_effective_mass").get<double>()).epsilon(1e-12));
+    CHECK(jd.at("optimized").at("integrated_effective_mass").get<double>() ==
+          Approx(j.at("optimized").at("integrated_effective_mass").get<double>()).epsilon(1e-12));
+  }
+  SECTION("a relative --config path is resolved against the working directory, the URDF against the file") {
+    const auto rel = cli({"--config", "robots/paper_3dof.toml", "--quiet"}, kSource);
+    INFO(rel.err);
+    CHECK(rel.exit_code == 0);
+  }
+}
+
+TEST_CASE("a flag on the command line overrides the scenario file", "[cli]") {
+  TempDir tmp;
+  const auto r = cli({"--config", kScenario3, "--gain", "0", "--json", "out.json", "--quiet"}, tmp.str());
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  const json j = read_json_file(tmp / "out.json");
+  check_result_keys(j);
+  CHECK(j.at("optimized").at("gain").get<double>() == 0.0);
+  CHECK(j.at("scenario").at("gain").get<double>() == 0.0);
+  CHECK(j.at("optimized").at("integrated_effective_mass").get<double>() ==
+        Approx(j.at("baseline").at("integrated_effective_mass").get<double>()).epsilon(1e-12));
+  CHECK(j.at("mass_reduction_percent").get<double>() == Approx(0.0).margin(1e-9));
+
+  SECTION("also over the built-in default, with negative numbers after a space") {
+    const auto d = cli({"--joints-deg", "-10,150,-100", "--json", "d.json", "--quiet"}, tmp.str());
+    INFO(d.err);
+    REQUIRE(d.exit_code == 0);
+    const json jd = read_json_file(tmp / "d.json");
+    CHECK(numbers(jd.at("scenario").at("joints-deg")) == std::vector<double>{-10, 150, -100});
+    const auto e = cli({"--joints-deg=-10,150,-100", "--json", "e.json", "--quiet"}, tmp.str());
+    REQUIRE(e.exit_code == 0);
+    CHECK(read_json_file(tmp / "e.json").at("baseline") == jd.at("baseline"));
+  }
+}
+
+// ------------------------------------------------------------------------------------------------
+// 4. bad inputs
+// ------------------------------------------------------------------------------------------------
+
+namespace {
+
+struct BadCase {
+  const char* name;
+  Args args;                           ///< "{TMP}" is replaced by the case's working directory
+  std::vector<std::string> must_name;  ///< substrings the error line must contain
+  int exit_code = 2;
+  std::vector<std::string> dirs = {};  ///< directories to create in the working directory first
+};
+
+const std::string kLaws = "hunt-crossley, herbert-mcwhannell, lankarani-nikravesh, lee-wang, flores, gonthier, "
+                          "zhiying-qishao, hu-guo";
+
+Args inspect3(Args extra) {
+  Args a{"inspect", "--urdf", kUrdf3};
+  a.insert(a.end(), extra.begin(), extra.end());
+  return a;
+}
+Args inspect3q(Args extra) {  // with valid angles
+  Args a{"inspect", "--urdf", kUrdf3, "--joints-deg", "0,90,-90"};
+  a.insert(a.end(), extra.begin(), extra.end());
+  return a;
+}
+Args contact3(Args extra) {
+  Args a{"contact", "--urdf", kUrdf3, "--joints-deg", "0,90,-90"};
+  a.insert(a.end(), extra.begin(), extra.end());
+  return a;
+}
+Args run_default(Args extra) {  // the built-in scenario, asking for both output files
+  Args a{"--quiet", "--json", "out.json", "--csv", "out.csv"};
+  a.insert(a.end(), extra.begin(), extra.end());
+  return a;
+}
+Args scenario(const std::string& file) {
+  return {"--config", kBadScenarios + "/" + file, "--quiet", "--json", "out.json", "--csv", "out.csv"};
+}
+
+std::vector<BadCase> bad_cases() {
+  return {
+      // --- inspect: robot -----------------------------------------------------------------------
+      {"missing URDF file", {"inspect", "--urdf", "{TMP}/no_such_robot.urdf", "--joints-deg", "0,90,-90"},
+       {"no_such_robot.urdf", "cannot open"}},
+      {"missing --urdf", {"inspect", "--joints-deg", "0,90,-90"}, {"--urdf"}},
+      {"wrong joint count", inspect3({"--joints-deg", "0,90"}), {"--joints-deg", "3 joints"}},
+      {"wrong joint count, 7-DOF", {"inspect", "--urdf", kUrdf7, "--joints-deg", "0,90,-90"},
+       {"--joints-deg", "7 joints"}},
+      {"non-numeric angle", inspect3({"--joints-deg", "0,abc,-90"}), {"--joints-deg", "'abc'"}},
+      {"NaN angle", inspect3({"--joints-deg", "0,nan,-90"}), {"--joints-deg", "'nan'", "finite"}},
+      {"inf angle", inspect3({"--joints-deg", "0,inf,-90"}), {"--joints-deg", "'inf'", "finite"}},
+      {"overflowing angle", inspect3({"--joints-deg", "0,1e999,-90"}), {"--joints-deg", "1e999"}},
+      {"trailing comma", inspect3({"--joints-deg", "0,90,"}), {"--joints-deg", "trailing comma"}},
+      {"empty angle list", inspect3({"--joints-deg", ""}), {"--joints-deg", "empty"}},
+      {"unknown flag", inspect3q({"--bogus"}), {"--bogus"}},
+      {"base position of 2 values", inspect3q({"--base-position", "1,2"}), {"--base-position", "got 2"}},
+      {"base rpy of 2 values", inspect3q({"--base-rpy-deg", "1,2"}), {"--base-rpy-deg"}},
+      {"unknown end-effector", inspect3q({"--end-effector", "nope"}),
+       {"'nope'", "base, link1, link2, link3, ee"}},
+      // --- inspect: target ----------------------------------------------------------------------
+      {"target inertia of 4 values", inspect3q({"--target-inertia", "100,100,100,0"}),
+       {"--target-inertia", "3 or 6", "got 4"}},
+      {"contact offset of 2 values", inspect3q({"--contact-offset", "-0.25,0.15"}), {"--contact-offset", "got 2"}},
+      {"normal of 4 values", inspect3q({"--normal", "1,0,0,0"}), {"--normal", "got 4"}},
+      {"zero normal", inspect3q({"--normal", "0,0,0"}), {"--normal", "non-zero"}},
+      {"negative target mass", inspect3q({"--target-mass", "-200"}), {"--target-mass", "-200"}},
+      {"zero target mass", inspect3q({"--target-mass", "0"}), {"--target-mass", "positive"}},
+      {"NaN target mass", inspect3q({"--target-mass", "nan"}), {"--target-mass"}},
+      {"non-PD target inertia", inspect3q({"--target-inertia", "100,100,100,200,0,0"}),
+       {"--target-inertia", "positive definite"}},
+      {"negative target moment", inspect3q({"--target-inertia", "-100,100,100"}),
+       {"--target-inertia", "positive definite"}},
+      {"triangle inequality", inspect3q({"--target-inertia", "1,1,10"}),
+       {"--target-inertia", "triangle inequality"}},
+      {"NaN target attitude", inspect3q({"--target-rpy-deg", "nan,0,0"}), {"--target-rpy-deg", "'nan'"}},
+      // --- contact --------------------------------------------------------------------------------
+      {"negative stiffness", contact3({"--stiffness", "-1e9"}), {"--stiffness", "stiffness K must be positive"}},
+      {"non-numeric stiffness", contact3({"--stiffness", "abc"}), {"--stiffness", "abc"}},
+      {"zero exponent", contact3({"--exponent", "0"}), {"--exponent", "alpha must be positive"}},
+      {"c_r = 0", contact3({"--restitution", "0"}), {"--restitution", "0 < c_r <= 1", "got 0"}},
+      {"c_r > 1", contact3({"--restitution", "1.5"}), {"--restitution", "0 < c_r <= 1", "got 1.5"}},
+      {"c_r NaN", contact3({"--restitution", "nan"}), {"--restitution", "0 < c_r <= 1", "got nan"}},
+      {"unknown contact law", contact3({"--model", "newton", "--json"}), {"--model", "'newton'", kLaws}},
+      {"receding bodies", contact3({"--approach-speed", "-0.2"}), {"do not approach"}},
+      {"zero approach speed, no spin",
+       contact3({"--approach-speed", "0", "--target-angular-velocity-deg", "0,0,0"}), {"do not approach"}},
+      {"infinite approach speed", contact3({"--approach-speed", "inf"}), {"--approach-speed", "finite"}},
+      {"target spin of 2 values", contact3({"--target-angular-velocity-deg", "0,2"}),
+       {"--target-angular-velocity-deg"}},
+      {"--series into a missing directory", contact3({"--series", "missing_dir/series.csv"}),
+       {"missing_dir/series.csv", "cannot write"}},
+      {"--series onto a directory", contact3({"--series", "a_dir", "--json"}), {"a_dir", "cannot write"}, 2,
+       {"a_dir"}},
+      // --- main job, flags over the built-in scenario ---------------------------------------------
+      {"run: wrong joint count", run_default({"--joints-deg", "1,2"}), {"--joints-deg", "got 2"}},
+      {"run: non-numeric angle", run_default({"--joints-deg", "1,abc,3"}), {"--joints-deg", "abc"}},
+      {"run: unknown contact law", run_default({"--model", "newton"}), {"--model", "'newton'", kLaws}},
+      {"run: c_r = 0", run_default({"--restitution", "0"}), {"--restitution", "c_r"}},
+      {"run: target inertia of 4 values", run_default({"--target-inertia", "100,100,100,0"}),
+       {"--target-inertia", "got 4"}},
+      {"run: negative target mass", run_default({"--target-mass", "-5"}), {"--target-mass", "-5"}},
+      {"run: zero normal", run_default({"--normal", "0,0,0"}), {"--normal", "non-zero"}},
+      {"run: base position of 2 values", run_default({"--base-position", "1,2"}), {"--base-position", "got 2"}},
+      {"run: zero approach speed", run_default({"--approach-speed", "0"}), {"--approach-speed", "positive"}},
+      {"run: zero tolerance", run_default({"--tolerance", "0"}), {"--tolerance", "positive"}},
+      {"run: NaN gain", run_default({"--gain", "nan"}), {"--gain", "finite"}},
+      {"run: pose task on 3 joints with gain", run_default({"--task", "pose"}), {"--gain", "no null space"}},
+      {"run: unknown task", run_default({"--task", "orbit"}), {"--task", "'orbit'"}},
+      {"run: unknown baseline task", run_default({"--baseline-task", "orbit"}), {"--baseline-task", "'orbit'"}},
+      {"run: bad task axes", run_default({"--task-axes", "xw"}), {"--task-axes", "'xw'"}},
+      {"run: negative duration", run_default({"--duration", "-1"}), {"--duration", "positive"}},
+      {"run: zero step", run_default({"--step", "0"}), {"--step", "got 0"}},
+      {"run: step > duration", run_default({"--step", "500"}), {"--step", "got 500"}},
+      {"run: unknown objective", run_default({"--objective", "speed"}), {"--objective", "'speed'"}},
+      {"run: unknown end-effector", run_default({"--end-effector", "nope"}), {"'nope'", "link3, ee"}},
+      {"run: missing URDF", run_default({"--urdf", "{TMP}/no_such_robot.urdf"}), {"no_such_robot.urdf"}},
+      {"run: stray positional argument", run_default({"orbit"}), {"orbit"}},
+      {"run: non-existent --config", run_default({"--config", "{TMP}/no_such_scenario.toml"}),
+       {"--config", "no_such_scenario.toml"}},
+      {"run: --json into a missing directory", {"--quiet", "--json", "missing_dir/out.json"},
+       {"missing_dir/out.json", "cannot write"}},
+      {"run: --csv into a missing directory, --json fine",
+       {"--quiet", "--json", "out.json", "--csv", "missing_dir/out.csv"}, {"missing_dir/out.csv", "cannot write"}},
+      {"run: --csv onto a directory, --json fine", {"--quiet", "--json", "out.json", "--csv", "a_dir"},
+       {"a_dir", "cannot write"}, 2, {"a_dir"}},
+      {"run: capture point out of reach", run_default({"--target-position", "20,1.45,0"}),
+       {"missed the capture point"}, 3},
+      // --- scenario files -------------------------------------------------------------------------
+      {"scenario: missing key", scenario("missing_duration.toml"), {"missing key 'duration'", "missing_duration.toml"}},
+      {"scenario: unknown key", scenario("unknown_key.toml"), {"colour"}},
+      {"scenario: unreadable URDF", scenario("unreadable_urdf.toml"),
+       {"bad_scenarios/no_such_robot.urdf", "cannot open"}},
+      {"scenario: capture point out of reach", scenario("out_of_reach.toml"), {"missed the capture point"}, 3},
+      {"scenario: non-redundant task with gain", scenario("pose_with_gain.toml"), {"--gain", "no null space"}},
+      {"scenario: unknown task", scenario("unknown_task.toml"), {"--task", "'orbit'"}},
+      {"scenario: bad task axes", scenario("bad_task_axes.toml"), {"--task-axes", "'xw'"}},
+      {"scenario: negative duration", scenario("negative_duration.toml"), {"--duration", "-180"}},
+      {"scenario: NaN duration", scenario("nan_duration.toml"), {"--duration", "finite"}},
+      {"scenario: zero step", scenario("zero_step.toml"), {"--step", "got 0"}},
+      {"scenario: step > duration", scenario("step_too_large.toml"), {"--step", "got 200"}},
+      {"scenario: zero tolerance", scenario("zero_tolerance.toml"), {"--tolerance"}},
+      {"scenario: unknown objective", scenario("unknown_objective.toml"), {"--objective", "'speed'"}},
+      {"scenario: unknown contact law", scenario("unknown_model.toml"), {"--model", "'newton'", kLaws}},
+      {"scenario: c_r = 0", scenario("zero_restitution.toml"), {"--restitution", "c_r"}},
+      {"scenario: joint angles not numbers", scenario("joints_not_numbers.toml"), {"--joints-deg", "zero"}},
+      {"scenario: wrong joint count", scenario("wrong_joint_count.toml"), {"--joints-deg", "got 2"}},
+      {"scenario: receding approach", scenario("receding.toml"), {"--approach-speed", "positive"}},
+      {"scenario: target inertia of 4 values", scenario("bad_target_inertia.toml"), {"--target-inertia", "got 4"}},
+      {"scenario: zero normal", scenario("zero_normal.toml"), {"--normal", "non-zero"}},
+  };
+}
+
+std::string replace_all(std::string s, const std::string& from, const std::string& to) {
+  for (size_t pos = s.find(from); pos != std::string::npos; pos = s.find(from, pos + to.size()))
+    s.replace(pos, from.size(), to);
+  return s;
+}
+
+/// The checks every bad input must pass. `expected_entries`: what the working directory holds
+/// afterwards (what was there before: no output and no temporary file may appear).
+void check_bad(const CommandResult& r, int exit_code, const std::vector<std::string>& must_name,
+               const std::vector<std::string>& expected_entries, const TempDir& dir) {
+  INFO("exit code " << r.exit_code << "\nstdout: [" << r.out << "]\nstderr: [" << r.err << "]");
+  CHECK_FALSE(r.signaled);
+  CHECK(r.exit_code == exit_code);
+  // exactly one line, with the prefix
+  CHECK(r.err.rfind(kErrorPrefix, 0) == 0);
+  CHECK(!r.err.empty());
+  CHECK(std::count(r.err.begin(), r.err.end(), '\n') == 1);
+  CHECK((!r.err.empty() && r.err.back() == '\n'));
+  for (const auto& s : must_name) {
+    INFO("the error must name: " << s);
+    CHECK(r.err.find(s) != std::string::npos);
+  }
+  CHECK(r.out.empty());  // no result, no table, no JSON
+  CHECK(dir.entries() == expected_entries);
+}
+
+}  // namespace
+
+TEST_CASE("bad inputs: one error line naming the input, exit 2 (3 when out of reach), no output", "[cli]") {
+  const auto cases = bad_cases();
+  REQUIRE(cases.size() >= 40);
+  for (const auto& c : cases) {
+    TempDir tmp;
+    std::vector<std::string> before;
+    for (const auto& d : c.dirs) {
+      fs::create_directory(tmp.path() / d);
+      before.push_back(d);
+    }
+    std::sort(before.begin(), before.end());
+    Args args;
+    for (const auto& a : c.args) args.push_back(replace_all(a, "{TMP}", tmp.str()));
+    INFO("case: " << c.name << "\n  " << describe(args));
+    const auto r = cli(args, tmp.str());
+    check_bad(r, c.exit_code, c.must_name, before, tmp);
+  }
+}
+
+// Not run by default: prints the catalogue with what each case printed (ffsr-optimize's messages).
+TEST_CASE("print the bad-input catalogue", "[.][cli-table]") {
+  for (const auto& c : bad_cases()) {
+    TempDir tmp;
+    for (const auto& d : c.dirs) fs::create_directory(tmp.path() / d);
+    Args args;
+    for (const auto& a : c.args) args.push_back(replace_all(a, "{TMP}", tmp.str()));
+    const auto r = cli(args, tmp.str());
+    std::string err = replace_all(replace_all(r.err, tmp.str(), "$TMP"), kSource, "$SRC");
+    if (!err.empty() && err.back() == '\n') err.pop_back();
+    std::cout << "| " << c.name << " | " << r.exit_code << " | " << err << " |\n";
+  }
+}
+
+TEST_CASE("bad inputs: every malformed URDF in tests/data/bad_urdf gives exit 2 naming the file", "[cli]") {
+  if (!fs::is_directory(kBadUrdfs)) {
+    WARN("tests/data/bad_urdf is missing: nothing to check");
+    return;
+  }
+  std::vector<fs::path> files;
+  for (const auto& e : fs::directory_iterator(kBadUrdfs))
+    if (e.path().extension() == ".urdf") files.push_back(e.path());
+  std::sort(files.begin(), files.end());
+  CHECK(files.size() >= 15);
+  for (const auto& f : files) {
+    TempDir tmp;
+    // the angles are never looked at: the model must be rejected first
+    const Args args{"inspect", "--urdf", f.string(), "--joints-deg", "0", "--json"};
+    INFO("case: " << f.filename().string() << "\n  " << describe(args));
+    const auto r = cli(args, tmp.str());
+    check_bad(r, 2, {f.string()}, {}, tmp);
+  }
+}
+
+TEST_CASE("an output file from an earlier run is not replaced by a failing run", "[cli]") {
+  TempDir tmp;
+  {
+    std::ofstream(tmp / "out.json") << "{\"earlier\": true}\n";
+  }
+  const auto r = cli({"--quiet", "--json", "out.json", "--target-position", "20,1.45,0"}, tmp.str());
+  CHECK(r.exit_code == 3);
+  CHECK(tmp.entries() == std::vector<std::string>{"out.json"});
+  CHECK(read_json_file(tmp / "out.json") == json({{"earlier", true}}));
+}
+
+// ------------------------------------------------------------------------------------------------
+// 5. help and version
+// ------------------------------------------------------------------------------------------------
+
+TEST_CASE("help and version: --help lists the subcommands, --version prints the version", "[cli]") {
+  const auto h = cli({"--help"});
+  REQUIRE(h.exit_code == 0);
+  CHECK(h.out.find("inspect") != std::string::npos);
+  CHECK(h.out.find("contact") != std::string::npos);
+  CHECK(h.out.find("--config") != std::string::npos);
+  CHECK(h.err.empty());
+
+  for (const char* sub : {"inspect", "contact"}) {
+    const auto s = cli({sub, "--help"});
+    INFO(sub);
+    CHECK(s.exit_code == 0);
+    CHECK(s.out.find("--urdf") != std::string::npos);
+    CHECK(s.out.find("--joints-deg") != std::string::npos);
+  }
+
+  const auto v = cli({"--version"});
+  REQUIRE(v.exit_code == 0);
+  const std::string version = project_version();
+  REQUIRE(!version.empty());
+  CHECK(v.out.find(version) != std::string::npos);
+  CHECK(v.err.empty());
+}
