@@ -102,6 +102,8 @@ nlohmann::json result_json(const CaptureResult& r, const CaptureTask& task, doub
           {"base_position_drift", r.base_position_drift},
           {"base_attitude_drift_deg", r.base_attitude_drift * 180.0 / M_PI},
           {"max_total_momentum", r.max_momentum},
+          {"max_center_of_mass_drift", r.max_com_drift},
+          {"max_tracking_error", r.max_tracking_error},
           {"min_singular_value", r.min_singular_value},
           {"damped_evaluations", r.damped_steps},
           {"steps", r.steps}};

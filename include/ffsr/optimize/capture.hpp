@@ -16,7 +16,9 @@
 //
 // Joint limits from the URDF: the null-space term is pushed away from a limit by a repulsive
 // gradient inside a margin of 10 % of the range, and a run whose joint leaves its range fails with
-// a NumericalError naming the joint (the task has priority and is never clamped).
+// a NumericalError naming the joint (the task has priority and is never clamped). A run whose
+// end-effector falls more than max(10 tolerance, 1 cm) behind the line stops with a NumericalError:
+// the capture point is out of reach (or the line crosses a singularity), not a result.
 #pragma once
 
 #include "ffsr/algorithm/effective_mass.hpp"
@@ -102,6 +104,8 @@ struct CaptureResult {
   double max_momentum = 0;          ///< largest |total momentum| along the run (checked each step)
   double max_body_momentum = 0;     ///< largest |body momentum| along the run, for scale
   double max_quaternion_error = 0;  ///< largest | |q| - 1 | before renormalization
+  double max_com_drift = 0;         ///< largest motion of the system centre of mass (zero momentum: ~0)
+  double max_tracking_error = 0;    ///< largest end-effector position error along the line, m
   double min_singular_value = 0;    ///< smallest task singular value seen
   long damped_steps = 0;            ///< evaluations where the pseudo-inverse was damped
   long steps = 0;
@@ -323,19 +327,36 @@ inline CaptureResult plan_capture(const CaptureProblem& pb, const CaptureTask& t
   };
   if (opt.record_series) sample(0.0);
   BasePose b2;
-  Eigen::VectorXd th2(n);
+  Eigen::VectorXd th2(n), vgen(model.nv());
+  Vector3 com0 = Vector3::Zero();
+  const double divergence = std::max(10.0 * opt.tolerance, 1e-2);  // m: the line is lost
   for (long k = 0; k < nsteps; ++k) {
     const double t = static_cast<double>(k) * h;
     rates(t, base, theta, k_th[0], k_b[0]);
-    // momentum check on the first stage of every step: the total momentum of the commanded motion
+    // Checks on the first stage of every step (data holds the kinematics of the current state):
+    // the total momentum of the commanded motion, the system centre of mass (it must not move when
+    // the momentum is zero: an independent check of the integration), and the tracking error.
     {
-      Eigen::VectorXd v(model.nv());
-      v << k_b[0], k_th[0];
-      res.max_momentum = std::max(res.max_momentum, momentum(model, data, v).norm());
-      for_each_body_velocity(model, data, v, [&](int i, const Vector3& w, const Vector3& vc, const Vector3&) {
+      vgen << k_b[0], k_th[0];
+      res.max_momentum = std::max(res.max_momentum, momentum(model, data, vgen).norm());
+      for_each_body_velocity(model, data, vgen, [&](int i, const Vector3& w, const Vector3& vc, const Vector3&) {
         const Inertia& in = model.body(i).inertia;
         res.max_body_momentum = std::max(res.max_body_momentum, in.mass * vc.norm() + (in.I * w).norm());
       });
+      const Vector3 com = data.p[0] + data.Ic[0].h / data.Ic[0].m;
+      if (k == 0) com0 = com;
+      res.max_com_drift = std::max(res.max_com_drift, (com - com0).norm());
+      double s, sdot;
+      detail::quintic(t * inv_T, s, sdot);
+      const Vector3 e = x0 + s * (x_cap - x0) - frame_pose(model, data, pb.frame).p;
+      double err2 = 0;
+      for (int r : rows)
+        if (r < 3) err2 += e(r) * e(r);
+      const double err = std::sqrt(err2);
+      res.max_tracking_error = std::max(res.max_tracking_error, err);
+      if (err > divergence)
+        throw NumericalError(str("plan_capture: the end-effector cannot follow the line to the capture point (tracking "
+                                 "error ", err, " m at t = ", t, " s); the point may be out of reach"));
     }
     k_q[0] = quat_rate(base.orientation, k_b[0].tail<3>());
     stage(base, theta, k_b[0], k_q[0], k_th[0], 0.5 * h, b2, th2);
