@@ -1,0 +1,13 @@
+# Included from tests/CMakeLists.txt. ctest case: install ffsr into a scratch prefix and build the
+# consumer project tests/package against it (find_package(ffsr) with ffsr::ffsr, ffsr::urdf and
+# ffsr::cvode). It needs the whole project built first (cmake --build, then ctest).
+add_test(NAME package_consumer
+  COMMAND ${CMAKE_COMMAND}
+    -DFFSR_BINARY_DIR=${PROJECT_BINARY_DIR}
+    -DCONSUMER_SOURCE_DIR=${CMAKE_CURRENT_LIST_DIR}
+    -DWORK_DIR=${CMAKE_CURRENT_BINARY_DIR}/package_consumer
+    -DCONFIG=$<CONFIG>
+    -DGENERATOR=${CMAKE_GENERATOR}
+    -DCXX_COMPILER=${CMAKE_CXX_COMPILER}
+    -P ${CMAKE_CURRENT_LIST_DIR}/run_consumer.cmake)
+set_tests_properties(package_consumer PROPERTIES LABELS package TIMEOUT 600)

@@ -1,0 +1,86 @@
+# ctest case package_consumer: install the built ffsr into a fresh prefix, then configure, build and
+# run the consumer project tests/package against that prefix only, as a user would; finally
+# configure it once more with urdfdom and SUNDIALS hidden, where find_package(ffsr) must give
+# ffsr::ffsr alone (a user of the dynamics needs only Eigen).
+#
+#   cmake -DFFSR_BINARY_DIR=<ffsr build dir> -DCONSUMER_SOURCE_DIR=<tests/package>
+#         -DWORK_DIR=<scratch dir> [-DCONFIG=Release] [-DGENERATOR=Ninja]
+#         [-DCXX_COMPILER=/usr/bin/c++] -P run_consumer.cmake
+#
+# The scratch dir is wiped first. Fails (message(FATAL_ERROR), non-zero exit) on any step.
+cmake_minimum_required(VERSION 3.16)
+
+foreach(var FFSR_BINARY_DIR CONSUMER_SOURCE_DIR WORK_DIR)
+  if(NOT ${var})
+    message(FATAL_ERROR "run_consumer.cmake: -D${var}=... is required")
+  endif()
+endforeach()
+
+set(prefix "${WORK_DIR}/prefix")
+set(build "${WORK_DIR}/build")
+file(REMOVE_RECURSE "${WORK_DIR}")
+file(MAKE_DIRECTORY "${WORK_DIR}")
+
+function(run_step what)
+  execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "package consumer: ${what} failed (${rc}):\n${out}\n${err}")
+  endif()
+  set(step_output "${out}" PARENT_SCOPE)
+endfunction()
+
+# 1. install
+set(config_args)
+if(CONFIG)
+  set(config_args --config "${CONFIG}")
+endif()
+run_step("cmake --install" "${CMAKE_COMMAND}" --install "${FFSR_BINARY_DIR}" --prefix "${prefix}" ${config_args})
+file(GLOB_RECURSE config_file "${prefix}/*/ffsrConfig.cmake")
+if(NOT config_file)
+  message(FATAL_ERROR "package consumer: no ffsrConfig.cmake under ${prefix}")
+endif()
+
+# 2. configure: only the fresh prefix, no package registry, the same generator and compiler
+set(configure_args -S "${CONSUMER_SOURCE_DIR}" "-DCMAKE_PREFIX_PATH=${prefix}"
+    -DCMAKE_FIND_USE_PACKAGE_REGISTRY=OFF -DCMAKE_FIND_PACKAGE_NO_PACKAGE_REGISTRY=ON)
+if(GENERATOR)
+  list(APPEND configure_args -G "${GENERATOR}")
+endif()
+if(CXX_COMPILER)
+  list(APPEND configure_args "-DCMAKE_CXX_COMPILER=${CXX_COMPILER}")
+endif()
+if(CONFIG)
+  list(APPEND configure_args "-DCMAKE_BUILD_TYPE=${CONFIG}")
+endif()
+run_step("configuring the consumer" "${CMAKE_COMMAND}" ${configure_args} -B "${build}")
+file(STRINGS "${build}/CMakeCache.txt" ffsr_dir REGEX "^ffsr_DIR:")
+string(REGEX REPLACE "^ffsr_DIR:[A-Z]*=" "" ffsr_dir "${ffsr_dir}")
+file(REAL_PATH "${prefix}" real_prefix)
+file(REAL_PATH "${ffsr_dir}" real_ffsr_dir)
+string(FIND "${real_ffsr_dir}/" "${real_prefix}/" at)
+if(NOT at EQUAL 0)
+  message(FATAL_ERROR "package consumer: found ffsr in '${ffsr_dir}', not in the install prefix ${prefix}")
+endif()
+
+# 3. build
+run_step("building the consumer" "${CMAKE_COMMAND}" --build "${build}" ${config_args})
+
+# 4. run the three executables (ffsr::ffsr, ffsr::urdf, ffsr::cvode)
+foreach(exe consumer_dynamics consumer_urdf consumer_cvode)
+  file(GLOB_RECURSE path "${build}/${exe}" "${build}/${exe}.exe" "${build}/*/${exe}" "${build}/*/${exe}.exe")
+  if(NOT path)
+    message(FATAL_ERROR "package consumer: ${exe} was not built")
+  endif()
+  list(GET path 0 path)
+  run_step("running ${exe}" "${path}")
+  if(NOT step_output MATCHES "M_ie at \\[0, 90, -90\\] deg = [0-9.]+ kg")
+    message(FATAL_ERROR "package consumer: unexpected output of ${exe}:\n${step_output}")
+  endif()
+  message(STATUS "${exe}:\n${step_output}")
+endforeach()
+
+# 5. without urdfdom and SUNDIALS: configure only
+run_step("configuring the consumer without urdfdom and SUNDIALS" "${CMAKE_COMMAND}"
+         ${configure_args} -B "${WORK_DIR}/build_dynamics_only" -DCONSUMER_DYNAMICS_ONLY=ON
+         -DCMAKE_DISABLE_FIND_PACKAGE_urdfdom=ON -DCMAKE_DISABLE_FIND_PACKAGE_SUNDIALS=ON)
+message(STATUS "find_package(ffsr) without urdfdom and SUNDIALS: ffsr::ffsr only, as expected")
