@@ -95,11 +95,33 @@ inline Model model_from_urdf_string(const std::string& xml, const std::string& s
     }
     if (!urdf)
       throw ModelError(str(source, ": malformed URDF", capture.messages.empty() ? "" : ": " + capture.messages));
+    // urdfdom ignores the result of parsing a <link>: a link whose <inertial> fails to parse (a mass
+    // or moment that is not a number, "inf") is kept with zeros after logging an error. Any error it
+    // logged is a malformed file.
+    if (!capture.messages.empty()) throw ModelError(str(source, ": malformed URDF: ", capture.messages));
   }
+  // urdfdom's links own their children through shared_ptr: a loop in a malformed file is a cycle that
+  // would leak. Break it on every way out of this function.
+  struct BreakCycles {
+    urdf::ModelInterface& m;
+    ~BreakCycles() {
+      for (const auto& lp : m.links_) lp.second->child_links.clear();
+    }
+  } break_cycles{*urdf};
   const urdf::LinkConstSharedPtr root = urdf->getRoot();
   if (!root) throw ModelError(str(source, ": URDF has no root link"));
 
-  // Every joint must be reachable from the root exactly once (no loops, one tree).
+  // Every joint must be reachable from the root exactly once (no loops, one tree). urdfdom keeps only
+  // the last parent joint of a link with several, so a closed loop is found here, by child name.
+  {
+    std::map<std::string, std::string> parent_joint_of;
+    for (const auto& jp : urdf->joints_) {
+      const auto [it, inserted] = parent_joint_of.emplace(jp.second->child_link_name, jp.first);
+      if (!inserted)
+        throw ModelError(str(source, ": link '", jp.second->child_link_name, "' has two parent joints ('", it->second,
+                             "' and '", jp.first, "'): closed loops are not supported"));
+    }
+  }
   const std::map<std::string, int> file_order = detail::joint_order_in_file(xml);
   auto in_file_order = [&](const urdf::LinkSharedPtr& a, const urdf::LinkSharedPtr& b) {
     const auto ia = file_order.find(a->parent_joint->name), ib = file_order.find(b->parent_joint->name);
