@@ -94,6 +94,7 @@ nlohmann::json result_json(const CaptureResult& r, const CaptureTask& task, doub
           {"f_max_closed_form", r.f_max_closed_form},
           {"f_max_exact", r.f_max_exact},
           {"tracking_error", r.tracking_error},
+          {"capture_distance", r.capture_distance},
           {"orientation_error_deg", r.orientation_error * 180.0 / M_PI},
           {"end_effector_position", to_json(Eigen::VectorXd(r.end_effector))},
           {"capture_point", to_json(Eigen::VectorXd(r.capture_point))},

@@ -93,7 +93,8 @@ struct CaptureResult {
   BasePose base;              ///< base pose at T
   Vector3 end_effector = Vector3::Zero();
   Vector3 capture_point = Vector3::Zero();
-  double tracking_error = 0;  ///< |p_e(T) - capture point|, m
+  double tracking_error = 0;  ///< |p_e(T) - capture point| on the task's constrained axes, m
+  double capture_distance = 0;  ///< |p_e(T) - capture point| in 3-D (differs for a task on fewer axes), m
   double orientation_error = 0;  ///< pose task: angle between the reached and desired orientation, rad
   double base_position_drift = 0;   ///< |p_0(T) - p_0(0)|, m
   double base_attitude_drift = 0;   ///< rotation angle between the base attitudes at 0 and T, rad
@@ -391,7 +392,12 @@ inline CaptureResult plan_capture(const CaptureProblem& pb, const CaptureTask& t
   res.theta = theta;
   res.base = base;
   res.end_effector = ee.p;
-  res.tracking_error = (ee.p - x_cap).norm();
+  // the tracking error on the constrained position axes (all three for a pose task)
+  double e2 = 0;
+  for (int r : rows)
+    if (r < 3) e2 += (ee.p(r) - x_cap(r)) * (ee.p(r) - x_cap(r));
+  res.tracking_error = std::sqrt(e2);
+  res.capture_distance = (ee.p - x_cap).norm();
   res.orientation_error = task.kind == CaptureTask::Kind::Pose ? rotation_angle(R_end * ee.R.transpose()) : 0.0;
   res.base_position_drift = (base.position - pb.base.position).norm();
   res.base_attitude_drift = rotation_angle(base.orientation.toRotationMatrix() *

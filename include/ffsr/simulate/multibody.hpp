@@ -261,11 +261,18 @@ inline MultibodyContactResult simulate_contact(const Model& model, const BasePos
           sys.rhs(law, y, yd);
         };
         // root 0: delta (separation, decreasing); root 1: dF/dt (peak, decreasing), by a central
-        // difference of F along the exact state derivative.
+        // difference of F along the exact state derivative. The peak root is armed only in
+        // compression with a positive force, where the peak lies (at delta_dot = 0, dF/dt =
+        // lambda delta^alpha delta_ddot < 0): in restitution a strongly damped contact hovers at the
+        // clamp, where dF/dt vanishes on an interval, which CVODE's root finder must not see.
         Eigen::VectorXd yd(N), yp(N);
         auto roots = [&](double, const Eigen::Ref<const Eigen::VectorXd>& y, Eigen::Ref<Eigen::VectorXd> g) {
           const auto k = sys.kinematics(y);
           g(0) = k.delta;
+          if (!(sys.force(law, k) > 0.0) || !(k.delta_dot > 0.0)) {
+            g(1) = -1.0;
+            return;
+          }
           sys.rhs(law, y, yd);
           const double h = 1e-6 * t_hertz;
           yp = y + h * yd;

@@ -109,7 +109,10 @@ SingleBodyResult simulate_single_body(const HertzDamped<Damping>& law, double M_
                            Eigen::Ref<Eigen::VectorXd> g) {
     const double x = y[0], v = y[1];
     const double a = -scaled_force(x, v) * accel_scale;
-    g[0] = alpha * v * (1.0 + f * v) + f * x * a;
+    // Armed only in compression (v > 0), where the peak lies (at v = 0, dF/dt = λ δ^α δ̈ < 0): in
+    // restitution a strongly damped contact hovers at the clamp 1 + f v = 0, where this expression
+    // vanishes on an interval and CVODE's root finder would stop (CV_ILL_INPUT).
+    g[0] = v > 0.0 ? alpha * v * (1.0 + f * v) + f * x * a : -1.0;
     g[1] = v;
     g[2] = x;
   };
