@@ -61,19 +61,30 @@ inline void cholesky(const Eigen::MatrixXd& A, Eigen::MatrixXd& L, const char* w
   }
 }
 
-/// Solves L L^T x = b in place (x holds b on entry).
-inline void cholesky_solve(const Eigen::MatrixXd& L, Eigen::VectorXd& x) {
+/// Forward substitution: solves L z = b in place (x holds b on entry, z on exit).
+inline void cholesky_forward(const Eigen::MatrixXd& L, Eigen::VectorXd& x) {
   const Eigen::Index n = L.rows();
   for (Eigen::Index i = 0; i < n; ++i) {
     double s = x(i);
     for (Eigen::Index k = 0; k < i; ++k) s -= L(i, k) * x(k);
     x(i) = s / L(i, i);
   }
+}
+
+/// Back substitution: solves L^T y = z in place.
+inline void cholesky_backward(const Eigen::MatrixXd& L, Eigen::VectorXd& x) {
+  const Eigen::Index n = L.rows();
   for (Eigen::Index i = n - 1; i >= 0; --i) {
     double s = x(i);
     for (Eigen::Index k = i + 1; k < n; ++k) s -= L(k, i) * x(k);
     x(i) = s / L(i, i);
   }
+}
+
+/// Solves L L^T x = b in place (x holds b on entry).
+inline void cholesky_solve(const Eigen::MatrixXd& L, Eigen::VectorXd& x) {
+  cholesky_forward(L, x);
+  cholesky_backward(L, x);
 }
 
 }  // namespace detail

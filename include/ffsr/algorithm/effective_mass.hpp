@@ -30,7 +30,8 @@ inline void check_unit_direction(const Vector3& u, const char* where) {
 }  // namespace detail
 
 /// Inverse effective mass u^T J_v H^-1 J_v^T u (the denominator of Eq. 4) at the configuration of
-/// the last crba. Reads data.H and the kinematics. Writes data.L, data.w, data.y (y = H^-1 w).
+/// the last crba, computed as |L^-1 w|^2 with H = L L^T and w = J_v^T u (one forward substitution).
+/// Reads data.H and the kinematics. Writes data.L, data.w and data.y (= L^-1 w).
 inline double inverse_effective_mass(const Model& model, Data& data, int frame, const Vector3& u) {
   detail::check_unit_direction(u, "effective_mass");
   if (frame < 0 || frame >= static_cast<int>(model.frames().size()))
@@ -38,8 +39,8 @@ inline double inverse_effective_mass(const Model& model, Data& data, int frame, 
   detail::linear_jacobian_transpose_times(model, data, frame, u);
   detail::cholesky(data.H, data.L, "effective_mass");
   data.y = data.w;
-  detail::cholesky_solve(data.L, data.y);
-  return data.w.dot(data.y);
+  detail::cholesky_forward(data.L, data.y);
+  return data.y.squaredNorm();
 }
 
 /// Effective mass m_e = 1 / (u^T (J_v H^-1 J_v^T) u) of the free-floating robot at the origin of
@@ -89,6 +90,7 @@ inline double integrated_effective_mass_gradient(const Model& model, Data& data,
   detail::require_size(grad.size(), model.n(), "integrated_effective_mass_gradient", "grad");
   crba(model, data, base, theta);
   const double inv_me = inverse_effective_mass(model, data, frame, u);
+  detail::cholesky_backward(data.L, data.y);  // y = H^-1 w
   const double M = 1.0 / (inv_me + target_inverse_mass);
   const int nb = model.n() + 1;
   const Vector3& p0 = data.p[0];

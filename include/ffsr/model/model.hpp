@@ -3,8 +3,9 @@
 // Coordinates (the one place they are fixed; see also README "Conventions"):
 //  - Configuration: the base pose (position of the base link frame origin and its attitude,
 //    both in the inertial frame o) and the joint positions theta (radians or metres), one per
-//    moving joint, in model order (depth-first from the base; siblings in the order in which
-//    their joints were added -- for URDF, the order of the <joint> elements in the file).
+//    moving joint, in model order: for a URDF, depth-first from the base with siblings in the order
+//    of their <joint> elements in the file; for a ModelBuilder, the order the joints were added
+//    (every parent before its children).
 //  - Generalized velocity (6+n): [v0, w0, theta_dot] with v0 the linear velocity of the base
 //    link frame origin and w0 the angular velocity of the base, both in the inertial frame.
 //  - Generalized acceleration: the time derivative of that vector.
@@ -211,7 +212,7 @@ class ModelBuilder {
   Model build() const {
     using detail::str;
     Model m = model_;
-    if (m.n() < 1) throw ModelError(str(m.source, ": the robot has no moving joint"));
+    if (m.n() < 1) throw ModelError("the robot has no moving joint");
     validate_inertia(m.bodies_[0].inertia, "base link '" + m.bodies_[0].name + "'", true);
     for (int i = 1; i <= m.n(); ++i)
       validate_inertia(m.body(i).inertia, "link '" + m.body(i).name + "' (moving)", true);

@@ -274,7 +274,7 @@ inline CaptureResult plan_capture(const CaptureProblem& pb, const CaptureTask& t
     if (opt.gain != 0.0) {
       integrated_effective_mass_gradient(model, data, base, theta, pb.frame, u_cap, target_inv_mass, grad);
       if (opt.objective == CaptureObjective::ExactMaxForce) {
-        const double M = 1.0 / (data.w.dot(data.y) + target_inv_mass);
+        const double M = 1.0 / (data.w.dot(data.y) + target_inv_mass);  // y = H^-1 w after the gradient
         grad *= f_scale * std::pow(M, -1.0 / (pb.contact.alpha + 1));  // dF/dM dM/dtheta
       }
       // joint limits: repulsive gradient inside 10 % of the range
