@@ -237,83 +237,87 @@ inline MultibodyContactResult simulate_contact(const Model& model, const BasePos
                          " m/s); increase the approach speed"));
   const AnyContactLaw any_law = make_contact_law(law_name, params, vin);
 
-  return std::visit(
-      [&](const auto& law) {
-        MultibodyContactResult res;
-        res.model = std::string(law_name);
-        res.approach_velocity = vin;
-        res.integrated_effective_mass = M_ie;
-        // Hertz time scale of the contact, (M/K)^(1/(alpha+1)) v^((1-alpha)/(alpha+1)): a few of it
-        const double a1 = params.alpha + 1;
-        const double t_hertz = std::pow(M_ie / params.K, 1.0 / a1) * std::pow(vin, (1.0 - params.alpha) / a1);
-        const double t_max = options.max_duration > 0 ? options.max_duration : 100.0 * t_hertz;
+  // One instantiation for all laws: the simulation needs only F(delta, delta_dot), and a visit per
+  // force evaluation costs nothing beside the dynamics (templating the whole run on the law would
+  // compile it eight times).
+  struct LawForce {
+    const AnyContactLaw& any;
+    double force(double d, double dd) const { return ffsr::force(any, d, dd); }
+  };
+  const LawForce law{any_law};
+  MultibodyContactResult res;
+  res.model = std::string(law_name);
+  res.approach_velocity = vin;
+  res.integrated_effective_mass = M_ie;
+  // Hertz time scale of the contact, (M/K)^(1/(alpha+1)) v^((1-alpha)/(alpha+1)): a few of it
+  const double a1 = params.alpha + 1;
+  const double t_hertz = std::pow(M_ie / params.K, 1.0 / a1) * std::pow(vin, (1.0 - params.alpha) / a1);
+  const double t_max = options.max_duration > 0 ? options.max_duration : 100.0 * t_hertz;
 
-        cvode::Options co;
-        co.rtol = options.rtol;
-        co.max_num_steps = options.max_num_steps;
-        co.atol_vector = Eigen::VectorXd::Constant(N, options.atol_velocity);
-        co.atol_vector.segment(0, 6 + model.n()).setConstant(options.atol_position);
-        co.atol_vector.segment<6>(sys.it()).setConstant(options.atol_position);
-        co.initial_step = 1e-3 * t_hertz;
-        co.max_step = 0.05 * t_hertz;
+  cvode::Options co;
+  co.rtol = options.rtol;
+  co.max_num_steps = options.max_num_steps;
+  co.atol_vector = Eigen::VectorXd::Constant(N, options.atol_velocity);
+  co.atol_vector.segment(0, 6 + model.n()).setConstant(options.atol_position);
+  co.atol_vector.segment<6>(sys.it()).setConstant(options.atol_position);
+  co.initial_step = 1e-3 * t_hertz;
+  co.max_step = 0.05 * t_hertz;
 
-        auto rhs = [&](double, const Eigen::Ref<const Eigen::VectorXd>& y, Eigen::Ref<Eigen::VectorXd> yd) {
-          sys.rhs(law, y, yd);
-        };
-        // root 0: delta (separation, decreasing); root 1: dF/dt (peak, decreasing), by a central
-        // difference of F along the exact state derivative. The peak root is armed only in
-        // compression with a positive force, where the peak lies (at delta_dot = 0, dF/dt =
-        // lambda delta^alpha delta_ddot < 0): in restitution a strongly damped contact hovers at the
-        // clamp, where dF/dt vanishes on an interval, which CVODE's root finder must not see.
-        Eigen::VectorXd yd(N), yp(N);
-        auto roots = [&](double, const Eigen::Ref<const Eigen::VectorXd>& y, Eigen::Ref<Eigen::VectorXd> g) {
-          const auto k = sys.kinematics(y);
-          g(0) = k.delta;
-          if (!(sys.force(law, k) > 0.0) || !(k.delta_dot > 0.0)) {
-            g(1) = -1.0;
-            return;
-          }
-          sys.rhs(law, y, yd);
-          const double h = 1e-6 * t_hertz;
-          yp = y + h * yd;
-          const double Fp = sys.force(law, sys.kinematics(yp));
-          yp = y - h * yd;
-          const double Fm = sys.force(law, sys.kinematics(yp));
-          g(1) = (Fp - Fm) / (2 * h);
-        };
-        cvode::Integrator integ(rhs, y0, 0.0, co, 2, roots, {-1, -1});
-        res.momentum_start = sys.total_momentum(y0);
-        res.energy_start = sys.total_energy(y0);
-        auto record = [&](double t, const Eigen::VectorXd& y) {
-          const auto k = sys.kinematics(y);
-          const double F = sys.force(law, k);
-          res.delta_max = std::max(res.delta_max, k.delta);
-          if (F > res.f_max) {
-            res.f_max = F;
-            res.t_at_f_max = t;
-            res.delta_at_f_max = k.delta;
-          }
-          if (options.record_series) res.series.push_back({t, F, k.delta});
-          return k;
-        };
-        record(0.0, y0);
-        for (long guard = 0; guard <= options.max_num_steps; ++guard) {
-          const auto status = integ.step(t_max);
-          const auto k = record(integ.t(), integ.y());
-          if (status == cvode::Integrator::Status::Root && integ.roots_found()[0] != 0 && integ.t() > 0) {
-            res.contact_duration = integ.t();
-            res.separation_velocity = k.delta_dot;
-            res.restitution = -k.delta_dot / vin;
-            res.momentum_end = sys.total_momentum(integ.y());
-            res.energy_end = sys.total_energy(integ.y());
-            res.steps = integ.num_steps();
-            return res;
-          }
-          if (status == cvode::Integrator::Status::Reached) break;
-        }
-        throw NumericalError(str("simulate_contact: the bodies did not separate within ", t_max, " s"));
-      },
-      any_law);
+  auto rhs = [&](double, const Eigen::Ref<const Eigen::VectorXd>& y, Eigen::Ref<Eigen::VectorXd> yd) {
+    sys.rhs(law, y, yd);
+  };
+  // root 0: delta (separation, decreasing); root 1: dF/dt (peak, decreasing), by a central
+  // difference of F along the exact state derivative. The peak root is armed only in
+  // compression with a positive force, where the peak lies (at delta_dot = 0, dF/dt =
+  // lambda delta^alpha delta_ddot < 0): in restitution a strongly damped contact hovers at the
+  // clamp, where dF/dt vanishes on an interval, which CVODE's root finder must not see.
+  Eigen::VectorXd yd(N), yp(N);
+  auto roots = [&](double, const Eigen::Ref<const Eigen::VectorXd>& y, Eigen::Ref<Eigen::VectorXd> g) {
+    const auto k = sys.kinematics(y);
+    g(0) = k.delta;
+    if (!(sys.force(law, k) > 0.0) || !(k.delta_dot > 0.0)) {
+      g(1) = -1.0;
+      return;
+    }
+    sys.rhs(law, y, yd);
+    const double h = 1e-6 * t_hertz;
+    yp = y + h * yd;
+    const double Fp = sys.force(law, sys.kinematics(yp));
+    yp = y - h * yd;
+    const double Fm = sys.force(law, sys.kinematics(yp));
+    g(1) = (Fp - Fm) / (2 * h);
+  };
+  cvode::Integrator integ(rhs, y0, 0.0, co, 2, roots, {-1, -1});
+  res.momentum_start = sys.total_momentum(y0);
+  res.energy_start = sys.total_energy(y0);
+  auto record = [&](double t, const Eigen::VectorXd& y) {
+    const auto k = sys.kinematics(y);
+    const double F = sys.force(law, k);
+    res.delta_max = std::max(res.delta_max, k.delta);
+    if (F > res.f_max) {
+      res.f_max = F;
+      res.t_at_f_max = t;
+      res.delta_at_f_max = k.delta;
+    }
+    if (options.record_series) res.series.push_back({t, F, k.delta});
+    return k;
+  };
+  record(0.0, y0);
+  for (long guard = 0; guard <= options.max_num_steps; ++guard) {
+    const auto status = integ.step(t_max);
+    const auto k = record(integ.t(), integ.y());
+    if (status == cvode::Integrator::Status::Root && integ.roots_found()[0] != 0 && integ.t() > 0) {
+      res.contact_duration = integ.t();
+      res.separation_velocity = k.delta_dot;
+      res.restitution = -k.delta_dot / vin;
+      res.momentum_end = sys.total_momentum(integ.y());
+      res.energy_end = sys.total_energy(integ.y());
+      res.steps = integ.num_steps();
+      return res;
+    }
+    if (status == cvode::Integrator::Status::Reached) break;
+  }
+  throw NumericalError(str("simulate_contact: the bodies did not separate within ", t_max, " s"));
 }
 
 }  // namespace ffsr
