@@ -152,7 +152,7 @@ inline double approach_velocity(const Eigen::Vector3d& u, const Eigen::Vector3d&
                          const Eigen::Vector3d& r);
 
 /// Model accuracy of Eq. 32, in percent: (1 - |F_model - F_exact| / F_exact) × 100.
-/// InputError unless both are finite and F_exact > 0.
+/// InputError unless both are finite and F_exact > 0; NumericalError if the result overflows.
 inline double model_accuracy(double F_model, double F_exact);
 
 // ============================================================================================
@@ -203,6 +203,14 @@ inline double contact_peak_rate(double f, double alpha) {
     s = next;
   }
   throw NumericalError(str("contact_peak_rate: no convergence for f = ", f, ", alpha = ", alpha));
+}
+
+/// Returns x; throws NumericalError when a result computed from finite, valid arguments is not finite
+/// (it overflows double precision, e.g. M_ie = 1e300 kg).
+inline double require_finite_result(double x, std::string_view where, const char* what, double M_ie) {
+  if (!std::isfinite(x))
+    throw NumericalError(str(where, ": ", what, " is not representable (", x, ") for M_ie = ", M_ie, " kg"));
+  return x;
 }
 
 inline void require_positive_mass(double M_ie, std::string_view where) {
@@ -266,13 +274,21 @@ HertzDamped<Damping>::HertzDamped(const ContactParams& p, double approach_veloci
   // Eq. 25 written with G(0) = h(f)/f²: ζ = K^(1/(α+1)) ((α+1) δ̇⁻² G(0))^(α/(α+1)).
   const double a = p.alpha;
   zeta_ = std::pow(p.K, 1.0 / (a + 1.0)) * std::pow((a + 1.0) * v0_ * v0_ * G0_, a / (a + 1.0));
+  // Finite inputs can still overflow the law's constants (an approach velocity of 1e200 m/s, or
+  // K = 1e300 with a tiny approach velocity): an error, not a law that answers inf or NaN.
+  if (!std::isfinite(lambda_) || !std::isfinite(zeta_))
+    throw InputError(str(where, ": the parameters overflow double precision (lambda = f K / approach velocity = ",
+                         lambda_, ", zeta = ", zeta_, " for K = ", p.K, ", alpha = ", p.alpha, ", approach velocity ",
+                         approach_velocity, ")"));
 }
 
 template <class Damping>
 double HertzDamped<Damping>::force(double delta, double delta_dot) const {
   if (delta <= 0.0) return 0.0;
-  const double F = std::pow(delta, p_.alpha) * (p_.K + lambda_ * delta_dot);
-  return F < 0.0 ? 0.0 : F;
+  const double g = p_.K + lambda_ * delta_dot;  // the force is pushing while K + λ δ̇ > 0
+  if (!(g > 0.0)) return g <= 0.0 ? 0.0 : g;    // never pulls; NaN propagates
+  const double P = std::pow(delta, p_.alpha);
+  return P == 0.0 ? 0.0 : P * g;                // δ^α underflowing to 0 times a huge g is 0, not NaN
 }
 
 template <class Damping>
@@ -289,24 +305,24 @@ double HertzDamped<Damping>::deformation(double M_ie, double delta_dot) const {
   if (!(G >= 0.0))
     throw InputError(detail::str(name, ": deformation: delta_dot = ", delta_dot,
                                  " is not reached during a contact with approach velocity ", v0_));
-  return delta_from_G(M_ie, G);
+  return detail::require_finite_result(delta_from_G(M_ie, G), name, "deformation", M_ie);
 }
 
 template <class Damping>
 double HertzDamped<Damping>::max_deformation(double M_ie) const {
   detail::require_positive_mass(M_ie, name);
-  return delta_from_G(M_ie, G0_);
+  return detail::require_finite_result(delta_from_G(M_ie, G0_), name, "delta_max", M_ie);
 }
 
 template <class Damping>
 double HertzDamped<Damping>::max_force_estimate(double M_ie) const {
-  return p_.K * std::pow(max_deformation(M_ie), p_.alpha);
+  return detail::require_finite_result(p_.K * std::pow(max_deformation(M_ie), p_.alpha), name, "F'_max", M_ie);
 }
 
 template <class Damping>
 double HertzDamped<Damping>::max_force_closed_form(double M_ie) const {
   detail::require_positive_mass(M_ie, name);
-  return zeta_ * std::pow(M_ie, p_.alpha / (p_.alpha + 1.0));
+  return detail::require_finite_result(zeta_ * std::pow(M_ie, p_.alpha / (p_.alpha + 1.0)), name, "F_max", M_ie);
 }
 
 template <class Damping>
@@ -317,6 +333,8 @@ ForcePeak HertzDamped<Damping>::exact_peak(double M_ie) const {
   pk.deformation = delta_from_G(M_ie, detail::contact_G(f_, s));
   pk.deformation_rate = s * v0_;
   pk.force = p_.K * std::pow(pk.deformation, p_.alpha) * (1.0 + f_ * s);
+  detail::require_finite_result(pk.deformation, name, "deformation at the force peak", M_ie);
+  detail::require_finite_result(pk.force, name, "exact F_max", M_ie);
   return pk;
 }
 
@@ -395,7 +413,11 @@ inline double model_accuracy(double F_model, double F_exact) {
   detail::require_finite(F_model, "model_accuracy", "F_model");
   if (!(F_exact > 0.0) || !std::isfinite(F_exact))
     throw InputError(detail::str("model_accuracy: F_exact must be positive and finite, got ", F_exact));
-  return (1.0 - std::abs(F_model - F_exact) / F_exact) * 100.0;  // Eq. 32
+  const double accuracy = (1.0 - std::abs(F_model - F_exact) / F_exact) * 100.0;  // Eq. 32
+  if (!std::isfinite(accuracy))  // |F_model - F_exact| / F_exact overflows, e.g. F_exact = 1e-310 N
+    throw NumericalError(detail::str("model_accuracy: the accuracy is not representable for F_model = ", F_model,
+                                     ", F_exact = ", F_exact));
+  return accuracy;
 }
 
 }  // namespace ffsr

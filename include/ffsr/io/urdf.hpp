@@ -78,6 +78,65 @@ inline std::map<std::string, int> joint_order_in_file(const std::string& xml) {
   return order;
 }
 
+/// Throws ModelError when the <joint> elements of a URDF document form a directed loop of links
+/// (a link that is its own ancestor). urdfdom links a parent to its children through shared_ptr, so
+/// such a loop is a reference cycle, and when urdfdom then rejects the file for another reason it
+/// returns nothing and the cycle leaks (found by fuzz_urdf). The loop is rejected before urdfdom sees
+/// the file. Each joint is followed once: O(joints).
+inline void reject_joint_loops(const std::string& xml, const std::string& source) {
+  TiXmlDocument doc;
+  doc.Parse(xml.c_str());
+  const TiXmlElement* robot = doc.FirstChildElement("robot");
+  struct Edge {
+    std::string joint, child;
+  };
+  std::map<std::string, std::vector<Edge>> children;  // parent link -> joints to its children
+  for (const TiXmlElement* j = robot ? robot->FirstChildElement("joint") : nullptr; j; j = j->NextSiblingElement("joint")) {
+    const TiXmlElement* p = j->FirstChildElement("parent");
+    const TiXmlElement* c = j->FirstChildElement("child");
+    const char* parent = p ? p->Attribute("link") : nullptr;
+    const char* child = c ? c->Attribute("link") : nullptr;
+    const char* name = j->Attribute("name");
+    if (parent && child) children[parent].push_back({name ? name : "", child});
+  }
+  // Depth-first search with an explicit stack; state 1 = on the current path, 2 = done.
+  std::map<std::string, int> state;
+  for (const auto& start : children) {
+    if (state[start.first] != 0) continue;
+    struct Frame {
+      std::string link;
+      size_t next = 0;
+      std::string via;  // the joint that led here
+    };
+    std::vector<Frame> path{{start.first, 0, ""}};
+    state[start.first] = 1;
+    while (!path.empty()) {
+      Frame& top = path.back();
+      const auto it = children.find(top.link);
+      if (it == children.end() || top.next >= it->second.size()) {
+        state[top.link] = 2;
+        path.pop_back();
+        continue;
+      }
+      const Edge e = it->second[top.next++];
+      int& st = state[e.child];
+      if (st == 1) {  // back edge: the loop is the path from e.child to here, closed by e.joint
+        std::string loop;
+        size_t k = 0;
+        while (path[k].link != e.child) ++k;
+        for (size_t i = k + 1; i < path.size(); ++i)
+          loop += str("'", path[i].via, "' ('", path[i - 1].link, "' -> '", path[i].link, "'), ");
+        loop += str("'", e.joint, "' ('", top.link, "' -> '", e.child, "')");
+        throw ModelError(str(source, ": the joints ", loop, " form a closed loop (closed loops are not supported)"));
+      }
+      if (st == 0) {
+        st = 1;
+        path.push_back({e.child, 0, e.joint});
+      }
+    }
+  }
+}
+
 }  // namespace detail
 
 /// Builds a Model from URDF text. `source` names the file in error messages. `end_effector` names
@@ -86,6 +145,8 @@ inline Model model_from_urdf_string(const std::string& xml, const std::string& s
                                     const std::string& end_effector = "") {
   using detail::str;
   urdf::ModelInterfaceSharedPtr urdf;
+  std::string urdf_errors;
+  detail::reject_joint_loops(xml, source);
   {
     detail::UrdfLogCapture capture;
     try {
@@ -95,19 +156,20 @@ inline Model model_from_urdf_string(const std::string& xml, const std::string& s
     }
     if (!urdf)
       throw ModelError(str(source, ": malformed URDF", capture.messages.empty() ? "" : ": " + capture.messages));
-    // urdfdom ignores the result of parsing a <link>: a link whose <inertial> fails to parse (a mass
-    // or moment that is not a number, "inf") is kept with zeros after logging an error. Any error it
-    // logged is a malformed file.
-    if (!capture.messages.empty()) throw ModelError(str(source, ": malformed URDF: ", capture.messages));
+    urdf_errors = capture.messages;
   }
   // urdfdom's links own their children through shared_ptr: a loop in a malformed file is a cycle that
-  // would leak. Break it on every way out of this function.
+  // would leak. Break it on every way out of this function (set up before the first throw below).
   struct BreakCycles {
     urdf::ModelInterface& m;
     ~BreakCycles() {
       for (const auto& lp : m.links_) lp.second->child_links.clear();
     }
   } break_cycles{*urdf};
+  // urdfdom ignores the result of parsing a <link>: a link whose <inertial> fails to parse (a mass
+  // or moment that is not a number, "inf") is kept with zeros after logging an error. Any error it
+  // logged is a malformed file.
+  if (!urdf_errors.empty()) throw ModelError(str(source, ": malformed URDF: ", urdf_errors));
   const urdf::LinkConstSharedPtr root = urdf->getRoot();
   if (!root) throw ModelError(str(source, ": URDF has no root link"));
 

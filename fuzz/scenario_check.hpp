@@ -1,0 +1,93 @@
+// fuzz/scenario_check.hpp -- the fuzz_scenario check, shared by the libFuzzer harness (which runs the
+// command's code in-process, fuzz_scenario.cpp) and tests/test_fuzz_regressions.cpp (which runs the
+// built ffsr-optimize on each reproducer).
+//
+// A scenario text is run as `ffsr-optimize --config DIR/scenario.toml` plus scenario_arguments(): a
+// short bounded run (command-line flags override the file) whose outputs go to DIR. The URDFs the
+// seed scenarios name (paper_3dof.urdf, paper_7dof.urdf) are copied into DIR. Asserted afterwards:
+//  - the exit code is 0, 2 (bad input) or 3 (numerical failure): 1 means an exception that is not an
+//    ffsr::Error or a CLI11 parse error reached main;
+//  - a failed run leaves no output file and no temporary file behind;
+//  - a successful run's JSON parses and has no null (nlohmann writes NaN and inf as null) and no
+//    non-finite number, its CSV and its terminal table contain no nan or inf.
+#pragma once
+
+#include "fuzz_checks.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace ffsr_fuzz {
+
+/// Copies the paper's URDFs into `dir` (the seed scenarios name them relative to the file).
+inline void prepare_scenario_dir(const std::string& dir) {
+  namespace fs = std::filesystem;
+  for (const char* name : {"paper_3dof.urdf", "paper_7dof.urdf"})
+    fs::copy_file(fs::path(FFSR_SOURCE_DIR) / "robots" / name, fs::path(dir) / name,
+                  fs::copy_options::overwrite_existing);
+}
+
+/// The arguments after the program name: the scenario in `dir`, a bounded run, outputs in `dir`.
+inline std::vector<std::string> scenario_arguments(const std::string& dir) {
+  return {"--config", dir + "/scenario.toml", "--quiet", "--duration", "2", "--step", "0.1",
+          "--json", dir + "/out.json", "--csv", dir + "/out.csv"};
+}
+
+inline std::string read_text(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+/// True when `text` has a token nan or inf (any case, with a sign or not) that is not part of a word.
+inline bool has_non_finite_token(const std::string& text) {
+  static const std::regex re("(^|[^A-Za-z0-9_])[-+]?(nan|inf)(inity)?([^A-Za-z0-9_]|$)", std::regex::icase);
+  return std::regex_search(text, re);
+}
+
+inline void check_json_finite(const nlohmann::json& j, const std::string& path) {
+  if (j.is_null()) fail("JSON output: null (a NaN or inf) at " + path);
+  if (j.is_number_float() && !std::isfinite(j.get<double>())) fail("JSON output: non-finite number at " + path);
+  if (j.is_object())
+    for (auto it = j.begin(); it != j.end(); ++it) check_json_finite(it.value(), path + "/" + it.key());
+  if (j.is_array())
+    for (size_t i = 0; i < j.size(); ++i) check_json_finite(j[i], path + "/" + std::to_string(i));
+}
+
+/// The checks after one run of the scenario in `dir` (see the top of this file). `terminal` is what
+/// the command printed on stdout.
+inline void check_scenario_outputs(const std::string& dir, int exit_code, const std::string& terminal) {
+  namespace fs = std::filesystem;
+  if (exit_code != 0 && exit_code != 2 && exit_code != 3)
+    fail("exit code " + std::to_string(exit_code) + " (an unexpected exception type reached main)");
+  for (const auto& e : fs::directory_iterator(dir))
+    if (e.path().filename().string().find(".tmp-") != std::string::npos)
+      fail("temporary output file left behind: " + e.path().string());
+  const bool json = fs::exists(dir + "/out.json"), csv = fs::exists(dir + "/out.csv");
+  if (exit_code != 0) {
+    if (json || csv) fail("a failed run left an output file behind");
+    return;
+  }
+  if (json != csv) fail("a successful run wrote only one of its two output files");
+  std::string table = terminal;
+  for (size_t p; (p = table.find(dir)) != std::string::npos;) table.erase(p, dir.size());
+  if (has_non_finite_token(table)) fail("the terminal output has nan or inf:\n" + terminal);
+  if (!json) return;  // --help, --version
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(read_text(dir + "/out.json"));
+  } catch (const std::exception& e) {
+    fail(std::string("the JSON output does not parse: ") + e.what());
+  }
+  check_json_finite(j, "");
+  if (has_non_finite_token(read_text(dir + "/out.csv"))) fail("the CSV output has nan or inf");
+}
+
+}  // namespace ffsr_fuzz
