@@ -14,8 +14,8 @@ namespace ffsr_fuzz {
 /// The checks on one evaluated configuration of an accepted model.
 inline void check_configuration(const ffsr::Model& model, ffsr::Data& data, const ffsr::BasePose& base,
                                 const Eigen::VectorXd& theta, int frame, const ffsr::Target& target) {
-  const bool ok = returns_or_ffsr_error("crba", [&] { ffsr::crba(model, data, base, theta); });
-  if (!ok) fail("crba threw on a finite configuration of an accepted model");
+  // crba may refuse (NumericalError) when the model's finite values overflow H; it must not return NaN.
+  if (!returns_or_ffsr_error("crba", [&] { ffsr::crba(model, data, base, theta); })) return;
   require_finite(data.H, "H");
   returns_or_ffsr_error("integrated_effective_mass", [&] {
     const double M_ie = ffsr::integrated_effective_mass(model, data, base, theta, frame, target);

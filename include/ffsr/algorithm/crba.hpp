@@ -9,7 +9,8 @@ namespace ffsr {
 /// algorithm (RBDA 6.2), with all spatial quantities in inertial axes about the base frame origin,
 /// so that the base motion subspace is the identity and composite inertias add without transforms.
 /// Reads base, theta. Writes the kinematics (forward_kinematics), data.Ic and data.H, the full
-/// symmetric (6+n)x(6+n) matrix in the coordinates of model.hpp. Returns data.H.
+/// symmetric (6+n)x(6+n) matrix in the coordinates of model.hpp. Returns data.H. Throws NumericalError
+/// when H overflows (not finite).
 inline const Eigen::MatrixXd& crba(const Model& model, Data& data, const BasePose& base,
                                    const Eigen::Ref<const Eigen::VectorXd>& theta) {
   forward_kinematics(model, data, base, theta);
@@ -38,6 +39,12 @@ inline const Eigen::MatrixXd& crba(const Model& model, Data& data, const BasePos
     H.block<1, 6>(ci, 0) = F.transpose();
   }
   // Entries between joints on different branches are never written: they keep the zero Data set.
+  // Finite but huge lengths, masses or prismatic positions (a joint origin of 1e186 m in a URDF,
+  // found by fuzz_urdf) overflow to inf/NaN here: an error, never a NaN answer downstream.
+  for (Eigen::Index k = 0; k < H.size(); ++k)
+    if (!std::isfinite(H.data()[k]))
+      throw NumericalError(detail::str("crba: the inertia matrix H is not finite: the model's lengths, masses or the "
+                                       "joint positions overflow double precision (", model.source, ")"));
   return H;
 }
 

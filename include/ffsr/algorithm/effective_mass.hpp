@@ -11,6 +11,8 @@ namespace detail {
 /// point produces. Reads the kinematics. Writes data.w.
 inline void linear_jacobian_transpose_times(const Model& model, Data& data, int frame, const Vector3& u) {
   const Vector3 pe = frame_pose(model, data, frame).p;
+  if (!pe.allFinite()) throw NumericalError(str("effective_mass: the position of frame '", model.frame(frame).name,
+                                                "' overflows double precision"));
   data.w.setZero();
   data.w.head<3>() = u;
   data.w.segment<3>(3) = (pe - data.p[0]).cross(u);

@@ -13,6 +13,8 @@ inline const Eigen::MatrixXd& frame_jacobian(const Model& model, Data& data, int
     throw InputError(detail::str("frame_jacobian: frame index ", frame, " out of range"));
   Eigen::MatrixXd& J = data.J;
   const Vector3 pe = frame_pose(model, data, frame).p;
+  if (!pe.allFinite()) throw NumericalError(detail::str("frame_jacobian: the position of frame '", model.frame(frame).name,
+                                                        "' overflows double precision"));
   const Vector3 d0 = pe - data.p[0];
   J.setZero();
   J.topLeftCorner<3, 3>().setIdentity();
