@@ -14,6 +14,7 @@
 #include <urdf_parser/urdf_parser.h>
 
 #include <algorithm>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <set>
@@ -253,6 +254,14 @@ inline Model model_from_urdf_string(const std::string& xml, const std::string& s
 
 /// Builds a Model from a URDF file (see model_from_urdf_string).
 inline Model model_from_urdf_file(const std::string& path, const std::string& end_effector = "") {
+  // Only regular files of a sane size: /dev/zero or a FIFO would be read forever.
+  std::error_code ec;
+  const auto status = std::filesystem::status(path, ec);
+  if (ec || !std::filesystem::exists(status)) throw ModelError(detail::str(path, ": cannot open the URDF file"));
+  if (!std::filesystem::is_regular_file(status)) throw ModelError(detail::str(path, ": not a regular file"));
+  const auto size = std::filesystem::file_size(path, ec);
+  constexpr std::uintmax_t kMaxBytes = 64u << 20;
+  if (ec || size > kMaxBytes) throw ModelError(detail::str(path, ": the URDF file is larger than 64 MiB"));
   std::ifstream in(path, std::ios::binary);
   if (!in) throw ModelError(detail::str(path, ": cannot open the URDF file"));
   std::ostringstream ss;
