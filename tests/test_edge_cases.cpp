@@ -2,6 +2,8 @@
 // none hangs and none answers NaN. The README's "Edge cases" table points here.
 #include <catch2/catch.hpp>
 
+#include "support/paper.hpp"
+
 #include "ffsr/ffsr.hpp"
 #include "ffsr/io/urdf.hpp"
 #include "ffsr/optimize/capture.hpp"
@@ -11,17 +13,11 @@
 #include <string>
 
 using namespace ffsr;
+using ffsr::test::deg;
+using ffsr::test::kRobots;
 
 namespace {
 
-const std::string kRobots = std::string(FFSR_SOURCE_DIR) + "/robots/";
-
-Eigen::VectorXd deg(std::initializer_list<double> d) {
-  Eigen::VectorXd v(static_cast<Eigen::Index>(d.size()));
-  Eigen::Index i = 0;
-  for (double x : d) v(i++) = x * M_PI / 180.0;
-  return v;
-}
 
 Inertia rod(double m, double L) {  // uniform rod along x, centre of mass at mid-length
   return {m, Vector3(L / 2, 0, 0), Vector3(0.0, m * L * L / 12, m * L * L / 12).asDiagonal()};

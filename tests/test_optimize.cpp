@@ -2,6 +2,8 @@
 // shipped scenario files, conservation along the runs, and the failure modes.
 #include <catch2/catch.hpp>
 
+#include "support/paper.hpp"
+
 #include "ffsr/ffsr.hpp"
 #include "ffsr/io/urdf.hpp"
 #include "ffsr/optimize/capture.hpp"
@@ -15,18 +17,11 @@
 #include <string>
 
 using namespace ffsr;
+using ffsr::test::deg;
+using ffsr::test::kRobots;
 
 namespace {
 
-const std::string kSource = FFSR_SOURCE_DIR;
-const std::string kRobots = kSource + "/robots/";
-
-Eigen::VectorXd deg(std::initializer_list<double> d) {
-  Eigen::VectorXd v(static_cast<Eigen::Index>(d.size()));
-  Eigen::Index i = 0;
-  for (double x : d) v(i++) = x * M_PI / 180.0;
-  return v;
-}
 
 /// Runs ffsr-optimize on a scenario and returns its JSON result (REQUIREs exit 0).
 nlohmann::json run_scenario(const std::string& scenario, const std::string& extra = "") {

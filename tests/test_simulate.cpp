@@ -2,6 +2,8 @@
 // the single-body exact maximum, and conservation laws.
 #include <catch2/catch.hpp>
 
+#include "support/paper.hpp"
+
 #include "ffsr/ffsr.hpp"
 #include "ffsr/io/urdf.hpp"
 #include "ffsr/simulate/multibody.hpp"
@@ -10,17 +12,11 @@
 #include <string>
 
 using namespace ffsr;
+using ffsr::test::deg;
+using ffsr::test::kRobots;
 
 namespace {
 
-const std::string kRobots = std::string(FFSR_SOURCE_DIR) + "/robots/";
-
-Eigen::VectorXd deg(std::initializer_list<double> d) {
-  Eigen::VectorXd v(static_cast<Eigen::Index>(d.size()));
-  Eigen::Index i = 0;
-  for (double x : d) v(i++) = x * M_PI / 180.0;
-  return v;
-}
 
 // The paper's target (Sections 5.1 and 5.2): 200 kg, diag(100,100,100), identity attitude.
 Target paper_target(bool seven_dof) {
