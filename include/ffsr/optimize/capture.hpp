@@ -292,8 +292,7 @@ inline CaptureResult plan_capture(const CaptureProblem& pb, const CaptureTask& t
         if (sv(i) > 1e-12) Nproj.noalias() -= svd.matrixV().col(i) * svd.matrixV().col(i).transpose();
       theta_dot.noalias() += opt.gain * (Nproj * grad);
     }
-    crba(model, data, base, theta);  // the gradient pass overwrote nothing of H, but keep it explicit
-    xb = base_velocity_from_momentum(model, data, theta_dot);
+    xb = base_velocity_from_momentum(model, data, theta_dot);  // data.H is H(base, theta): the gradient re-ran crba there
   };
 
   // RK4 on (p0, q0, theta)
