@@ -23,6 +23,23 @@
 namespace ffsr {
 namespace detail {
 
+/// Throws ModelError unless `xml` is well-formed UTF-8 without NUL bytes. TinyXML (under urdfdom)
+/// trusts UTF-8 lead bytes and reads past the end of a buffer that ends inside a multi-byte
+/// sequence (found by fuzz_urdf under AddressSanitizer), so nothing malformed may reach it.
+inline void require_utf8(const std::string& xml, const std::string& source) {
+  const auto* b = reinterpret_cast<const unsigned char*>(xml.data());
+  const size_t n = xml.size();
+  for (size_t i = 0; i < n;) {
+    const unsigned c = b[i];
+    size_t len = c < 0x80 ? 1 : (c >> 5) == 0x6 ? 2 : (c >> 4) == 0xE ? 3 : (c >> 3) == 0x1E ? 4 : 0;
+    if (c == 0 || len == 0 || i + len > n)
+      throw ModelError(str(source, ": not a text file in UTF-8 (byte ", i, ")"));
+    for (size_t k = 1; k < len; ++k)
+      if ((b[i + k] >> 6) != 0x2) throw ModelError(str(source, ": not a text file in UTF-8 (byte ", i + k, ")"));
+    i += len;
+  }
+}
+
 /// Collects urdfdom's console_bridge messages instead of printing them (the library never prints).
 class UrdfLogCapture : public console_bridge::OutputHandler {
  public:
@@ -145,6 +162,7 @@ inline void reject_joint_loops(const std::string& xml, const std::string& source
 inline Model model_from_urdf_string(const std::string& xml, const std::string& source = "<string>",
                                     const std::string& end_effector = "") {
   using detail::str;
+  detail::require_utf8(xml, source);
   urdf::ModelInterfaceSharedPtr urdf;
   std::string urdf_errors;
   detail::reject_joint_loops(xml, source);
