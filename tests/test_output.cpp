@@ -196,7 +196,7 @@ class FifoReader {
 // 1. '-' is standard output
 // ------------------------------------------------------------------------------------------------
 
-TEST_CASE("--json - prints the result on standard output, the table on standard error", "[output]") {
+TEST_CASE("output: --json - prints the result on standard output, the table on standard error", "[output]") {
   TempDir tmp;
   const auto r = cli({"--quiet", "--json", "-"}, tmp.str());
   INFO(r.err);
@@ -277,7 +277,7 @@ TEST_CASE("a FIFO read by another thread receives the JSON and stays a FIFO", "[
   CHECK(tmp.entries() == std::vector<std::string>{"result.fifo", "series.csv"});  // no temporary file left
 }
 
-TEST_CASE("/dev/null is written, not replaced; /dev/full is a write error naming it", "[output]") {
+TEST_CASE("devices: /dev/null is written, not replaced, and /dev/full is a write error naming it", "[output]") {
   TempDir tmp;
   REQUIRE(is_char_device("/dev/null"));
   const auto r = cli({"--quiet", "--json", "/dev/null", "--csv", "/dev/null"}, tmp.str());
@@ -390,7 +390,7 @@ std::vector<std::string> moved_lines(const std::string& err) {
 
 }  // namespace
 
-TEST_CASE("--expect: a result compared with itself passes; a moved value gives exit 4 naming it", "[output][expect]") {
+TEST_CASE("expect: a result compared with itself passes, a moved value gives exit 4 naming it", "[output][expect]") {
   TempDir tmp;
   REQUIRE(cli({"--quiet", "--json", "base.json"}, tmp.str()).exit_code == 0);
   const json base = json::parse(read_file(tmp / "base.json"));
@@ -465,7 +465,7 @@ TEST_CASE("--expect: a result compared with itself passes; a moved value gives e
   }
 }
 
-TEST_CASE("--expect: a bad baseline or tolerance is exit 2 naming it", "[output][expect]") {
+TEST_CASE("expect: a bad baseline or tolerance is exit 2 naming it", "[output][expect]") {
   TempDir tmp;
   write_text(tmp / "not_json.json", "{\"baseline\": ");
   write_text(tmp / "array.json", "[1, 2]");
@@ -490,7 +490,7 @@ TEST_CASE("--expect: a bad baseline or tolerance is exit 2 naming it", "[output]
   }
 }
 
-TEST_CASE("--expect and rtol as scenario keys; expect is relative to the scenario file", "[output][expect]") {
+TEST_CASE("expect: expect and rtol as scenario keys, expect relative to the scenario file", "[output][expect]") {
   TempDir tmp;
   fs::create_directory(tmp.path() / "s");
   // the paper's scenario with an absolute URDF path and the two keys
