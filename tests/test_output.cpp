@@ -480,6 +480,7 @@ TEST_CASE("expect: a bad baseline or tolerance is exit 2 naming it", "[output][e
       {{"--quiet", "--expect", "."}, {"--expect", "."}},
       {{"--quiet", "--expect", "array.json", "--rtol", "-1"}, {"--rtol", "-1"}},
       {{"--quiet", "--expect", "array.json", "--atol", "nan"}, {"--atol"}},
+      {{"--quiet", "--rtol", "-1e-3"}, {"--rtol", "-0.001"}},  // checked without --expect too
   };
   for (const auto& c : cases) {
     const auto r = cli(c.args, tmp.str());

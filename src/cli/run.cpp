@@ -160,9 +160,9 @@ int run_scenario(RunOptions o, const CLI::App& app, FromCommandLine cli) {
   outputs.add("--csv", o.csv);
   nlohmann::json expected;
   Tolerance tol{o.rtol, o.atol};
+  if (!std::isfinite(o.rtol) || o.rtol < 0) throw InputError(str("--rtol: must be finite and >= 0, got ", o.rtol));
+  if (!std::isfinite(o.atol) || o.atol < 0) throw InputError(str("--atol: must be finite and >= 0, got ", o.atol));
   if (!o.expect.empty()) {
-    if (!std::isfinite(o.rtol) || o.rtol < 0) throw InputError(str("--rtol: must be finite and >= 0, got ", o.rtol));
-    if (!std::isfinite(o.atol) || o.atol < 0) throw InputError(str("--atol: must be finite and >= 0, got ", o.atol));
     o.expect = next_to_config(o.expect, cli.expect);
     expected = load_baseline(o.expect, "--expect");
   }
