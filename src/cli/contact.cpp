@@ -63,6 +63,9 @@ nlohmann::json row_json(const Row& r) {
 }
 
 int run_contact(const ContactOptions& o) {
+  Outputs outputs;  // --series '-' and --json both print on standard output: one of them only
+  if (o.json) outputs.claim_stdout("--json");
+  outputs.add("--series", o.series);
   const Robot r = load_robot(o.robot);
   Target target = o.target.build();
   target.angular_velocity = parse_vec3(o.target_angular_velocity_deg, "--target-angular-velocity-deg") * (M_PI / 180.0);
@@ -92,7 +95,8 @@ int run_contact(const ContactOptions& o) {
     csv << std::setprecision(12) << "model,t_s,force_N,delta_m\n";
     for (const auto& row : rows)
       for (const auto& s : row.series) csv << row.model << "," << s.t << "," << s.force << "," << s.delta << "\n";
-    write_file_atomic(o.series, csv.str());
+    outputs.set("--series", csv.str());
+    outputs.write();
   }
   if (o.json) {
     nlohmann::json j = o.model == "all" ? nlohmann::json::object() : row_json(rows.front());
@@ -108,18 +112,19 @@ int run_contact(const ContactOptions& o) {
     std::cout << j.dump(2) << "\n";
     return 0;
   }
-  std::cout << std::setprecision(6) << "integrated effective mass M_ie = " << rows.front().M_ie << " kg (Eq. 14)\n"
-            << "approach velocity delta_dot^-  = " << rows.front().v_in << " m/s (Eq. 10-12)\n\n";
-  std::cout << std::left << std::setw(20) << "model" << std::right << std::setw(13) << "closed (N)" << std::setw(13)
-            << "exact (N)" << std::setw(15) << "multibody (N)" << std::setw(13) << "accuracy %" << std::setw(10)
-            << "xi %" << std::setw(13) << "duration ms" << std::setw(11) << "c_r real" << "\n";
+  std::ostream& out = outputs.table();  // standard error when --series is '-'
+  out << std::setprecision(6) << "integrated effective mass M_ie = " << rows.front().M_ie << " kg (Eq. 14)\n"
+      << "approach velocity delta_dot^-  = " << rows.front().v_in << " m/s (Eq. 10-12)\n\n";
+  out << std::left << std::setw(20) << "model" << std::right << std::setw(13) << "closed (N)" << std::setw(13)
+      << "exact (N)" << std::setw(15) << "multibody (N)" << std::setw(13) << "accuracy %" << std::setw(10)
+      << "xi %" << std::setw(13) << "duration ms" << std::setw(11) << "c_r real" << "\n";
   for (const auto& row : rows)
-    std::cout << std::left << std::setw(20) << row.model << std::right << std::fixed << std::setprecision(2)
-              << std::setw(13) << row.f_closed << std::setw(13) << row.f_exact << std::setw(15) << row.f_multibody
-              << std::setw(13) << row.accuracy << std::setw(10) << row.xi << std::setw(13) << row.duration * 1e3
-              << std::setw(11) << std::setprecision(4) << row.restitution << "\n";
-  std::cout << "\nclosed: Eq. 24 (F at the maximum deformation); exact: peak of the single-body model Eq. 16;\n"
-               "multibody: CVODE integration of robot + target (Figure 2); accuracy: Eq. 32, closed vs multibody.\n";
+    out << std::left << std::setw(20) << row.model << std::right << std::fixed << std::setprecision(2)
+        << std::setw(13) << row.f_closed << std::setw(13) << row.f_exact << std::setw(15) << row.f_multibody
+        << std::setw(13) << row.accuracy << std::setw(10) << row.xi << std::setw(13) << row.duration * 1e3
+        << std::setw(11) << std::setprecision(4) << row.restitution << "\n";
+  out << "\nclosed: Eq. 24 (F at the maximum deformation); exact: peak of the single-body model Eq. 16;\n"
+         "multibody: CVODE integration of robot + target (Figure 2); accuracy: Eq. 32, closed vs multibody.\n";
   return 0;
 }
 
@@ -140,7 +145,7 @@ void register_contact(CLI::App& app, Action& action) {
                   "Target spin (target frame), deg/s")->capture_default_str();
   sub->add_option("--target-velocity", o->target_velocity, "Target linear velocity (inertial frame), m/s")
       ->capture_default_str();
-  sub->add_option("--series", o->series, "Write F(t), delta(t) of the multibody run(s) to this CSV file");
+  sub->add_option("--series", o->series, "Write F(t), delta(t) of the multibody run(s) to this CSV file ('-': standard output)");
   sub->add_flag("--json", o->json, "Print one JSON object on stdout");
   sub->callback([o, &action] { action = [o] { return run_contact(*o); }; });
 }

@@ -1,6 +1,7 @@
 // ffsr-optimize [--config SCENARIO.toml] [flags]: the main job. Plans the approach of the robot to
 // the tumbling target twice -- plain (rho = 0) and optimized (rho of the scenario) -- and reports
 // how much the capture configuration lowers M_ie and the maximum contact force (Tables 4 and 7).
+#include "baseline.hpp"
 #include "common.hpp"
 #include "embedded.hpp"
 #include "subcommands.hpp"
@@ -37,6 +38,8 @@ struct RunOptions {
   double duration = 0, step = 0, gain = 0, feedback = 1.0, tolerance = 0, orientation_tolerance_deg = 0.5;
   std::string objective = "mass";
   std::string json, csv;
+  std::string expect;  ///< a stored result to compare with (regression run)
+  double rtol = 1e-6, atol = 1e-9;
   bool quiet = false;
 };
 
@@ -126,7 +129,17 @@ struct Progress {
   }
 };
 
-int run_scenario(RunOptions o, const CLI::App& app, bool urdf_on_command_line) {
+/// Which keys came from the command line: they are not resolved against the scenario's folder.
+struct FromCommandLine {
+  bool urdf = false, expect = false;
+};
+
+/// Top-level keys of the result that --expect does not compare: inputs, not results (the resolved
+/// scenario holds paths that differ between machines; the version changes with every release).
+const std::vector<std::string> kNotCompared = {"version", "scenario"};
+
+int run_scenario(RunOptions o, const CLI::App& app, FromCommandLine cli) {
+  const bool urdf_on_command_line = cli.urdf;
   // --- the scenario: a file, or the built-in default (the paper's 3-DOF robot) -----------------
   const bool builtin = o.config.empty();
   const std::string where = builtin ? std::string("built-in scenario") : "scenario " + o.config;
@@ -135,16 +148,29 @@ int run_scenario(RunOptions o, const CLI::App& app, bool urdf_on_command_line) {
       if (app.get_option(std::string("--") + key)->count() == 0)
         throw InputError(str(where, ": missing key '", key, "'"));
   }
+  // a path in a scenario file is relative to the file
+  auto next_to_config = [&](const std::string& path, bool on_command_line) {
+    if (builtin || on_command_line || path.empty() || path.front() == '/') return path;
+    const size_t slash = o.config.find_last_of('/');
+    return slash == std::string::npos ? path : o.config.substr(0, slash + 1) + path;
+  };
+  // outputs and baseline first: a conflict or an unreadable baseline is found before the work
+  Outputs outputs;
+  outputs.add("--json", o.json);
+  outputs.add("--csv", o.csv);
+  nlohmann::json expected;
+  Tolerance tol{o.rtol, o.atol};
+  if (!std::isfinite(o.rtol) || o.rtol < 0) throw InputError(str("--rtol: must be finite and >= 0, got ", o.rtol));
+  if (!std::isfinite(o.atol) || o.atol < 0) throw InputError(str("--atol: must be finite and >= 0, got ", o.atol));
+  if (!o.expect.empty()) {
+    o.expect = next_to_config(o.expect, cli.expect);
+    expected = load_baseline(o.expect, "--expect");
+  }
   Model model = [&] {
     if (builtin && !urdf_on_command_line && o.urdf == "paper_3dof.urdf")
       return model_from_urdf_string(kPaper3dofUrdf, "built-in paper_3dof.urdf", o.end_effector);
-    std::string path = o.urdf;
-    if (!builtin && !urdf_on_command_line && !path.empty() && path.front() != '/') {
-      const size_t slash = o.config.find_last_of('/');
-      if (slash != std::string::npos) path = o.config.substr(0, slash + 1) + path;
-    }
-    o.urdf = path;
-    return model_from_urdf_file(path, o.end_effector);
+    o.urdf = next_to_config(o.urdf, urdf_on_command_line);
+    return model_from_urdf_file(o.urdf, o.end_effector);
   }();
 
   CaptureProblem pb;
@@ -293,12 +319,11 @@ int run_scenario(RunOptions o, const CLI::App& app, bool urdf_on_command_line) {
     }
     csv = c.str();
   }
-  std::vector<std::pair<std::string, std::string>> files;  // all or nothing: no partial output
-  if (!o.json.empty()) files.emplace_back(o.json, j.dump(2) + "\n");
-  if (!o.csv.empty()) files.emplace_back(o.csv, csv);
-  if (!files.empty()) write_files_atomic(files);
+  outputs.set("--json", j.dump(2) + "\n");
+  outputs.set("--csv", csv);
+  outputs.write();  // all or nothing: no partial output
 
-  std::ostream& out = std::cout;
+  std::ostream& out = outputs.table();  // standard error when --json or --csv is '-'
   out << "ffsr-optimize " << FFSR_VERSION << ": " << where << " (" << model.n() << " joints, " << o.model
       << ", T = " << o.duration << " s, step " << o.step << " s, rho = " << opt.gain << ")\n\n";
   const int w = 8 * model.n() + 4;
@@ -327,6 +352,18 @@ int run_scenario(RunOptions o, const CLI::App& app, bool urdf_on_command_line) {
     out << "note: near a singularity the pseudo-inverse was damped in " << base_run.damped_steps + opt_run.damped_steps
         << " evaluations (smallest singular value " << std::min(base_run.min_singular_value, opt_run.min_singular_value)
         << ")\n";
+
+  // --- regression run: every number of the result against the stored one -------------------------
+  if (!o.expect.empty()) {
+    const auto moved = compare_results(expected, j, tol, kNotCompared);
+    if (!moved.empty()) {
+      for (const auto& line : moved) std::cerr << line << "\n";
+      std::cerr << "ffsr-optimize: error: --expect " << o.expect << ": " << moved.size()
+                << (moved.size() == 1 ? " value differs" : " values differ") << " from the baseline (rtol "
+                << tol.rtol << ", atol " << tol.atol << "; regenerate it with --json FILE)\n";
+      return kExitRegression;
+    }
+  }
   return 0;
 }
 
@@ -334,10 +371,11 @@ int run_scenario(RunOptions o, const CLI::App& app, bool urdf_on_command_line) {
 
 void register_run(CLI::App& app, Action& action, int argc, char** argv) {
   auto o = std::make_shared<RunOptions>();
-  bool urdf_cli = false;
+  FromCommandLine from_cli;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
-    if (a == "--urdf" || a.rfind("--urdf=", 0) == 0) urdf_cli = true;
+    if (a == "--urdf" || a.rfind("--urdf=", 0) == 0) from_cli.urdf = true;
+    if (a == "--expect" || a.rfind("--expect=", 0) == 0) from_cli.expect = true;
     if (a == "inspect" || a == "contact") break;
   }
   app.set_config("--config", "", "Scenario file (TOML); every key is also a flag. Default: the built-in paper 3-DOF scenario");
@@ -376,12 +414,18 @@ void register_run(CLI::App& app, Action& action, int argc, char** argv) {
   app.add_option("--orientation-tolerance-deg", o->orientation_tolerance_deg, "Pose task: required orientation accuracy, deg")
       ->capture_default_str();
   app.add_option("--objective", o->objective, "mass (M_ie, the paper's) or exact-force")->capture_default_str();
-  app.add_option("--json", o->json, "Write the result (with the resolved scenario and the version) to this JSON file");
-  app.add_option("--csv", o->csv, "Write the time series of both runs to this CSV file");
+  app.add_option("--json", o->json,
+                 "Write the result (with the resolved scenario and the version) to this JSON file ('-': standard output)");
+  app.add_option("--csv", o->csv, "Write the time series of both runs to this CSV file ('-': standard output)");
+  app.add_option("--expect", o->expect,
+                 "Regression run: compare every number of the result with this stored --json result; exit 4 "
+                 "when one moved (relative to the scenario file)");
+  app.add_option("--rtol", o->rtol, "--expect: relative tolerance")->capture_default_str();
+  app.add_option("--atol", o->atol, "--expect: absolute floor for values near zero")->capture_default_str();
   app.add_flag("--quiet", o->quiet, "No progress line");
-  app.callback([o, &app, &action, urdf_cli] {
+  app.callback([o, &app, &action, from_cli] {
     if (!app.get_subcommands().empty()) return;
-    action = [o, &app, urdf_cli] {
+    action = [o, &app, from_cli] {
       if (o->config.empty()) {
         // the built-in default scenario fills every key not given on the command line
         std::istringstream in(kPaper3dofScenario);
@@ -393,7 +437,7 @@ void register_run(CLI::App& app, Action& action, int argc, char** argv) {
           }
         }
       }
-      return run_scenario(*o, app, urdf_cli);
+      return run_scenario(*o, app, from_cli);
     };
   });
   app.get_config_ptr()->each([o](const std::string& s) { o->config = s; });
