@@ -1,5 +1,6 @@
 // ffsr-optimize contact: closed-form, exact and multibody (CVODE) maximum contact force.
 #include "common.hpp"
+#include "figures.hpp"
 #include "subcommands.hpp"
 
 #include "ffsr/simulate/multibody.hpp"
@@ -22,7 +23,7 @@ struct ContactOptions {
   double approach_speed = 0.2;
   std::string target_angular_velocity_deg = "0,0,2";
   std::string target_velocity = "0,0,0";
-  std::string series;
+  std::string series, plot, plot_format = "png";
   bool json = false;
 };
 
@@ -30,12 +31,13 @@ struct Row {
   std::string model;
   double M_ie, v_in, f_closed, f_exact, f_multibody, accuracy, xi, delta_max, t_peak, duration, restitution;
   std::vector<ContactSample> series;
+  double mb_delta_max = 0, mb_delta_at_f_max = 0;  ///< of the multibody run, for the F-delta figure
 };
 
 Row evaluate(const Robot& r, const Target& target, const ContactOptions& o, const std::string& law_name) {
   const ContactParams p{o.stiffness, o.exponent, o.restitution};
   MultibodyContactOptions mo;
-  mo.record_series = !o.series.empty();
+  mo.record_series = !o.series.empty() || !o.plot.empty();
   MultibodyContactResult mb =
       simulate_contact(r.model, r.base, r.theta, r.end_effector, target, o.approach_speed, p, law_name, mo);
   const AnyContactLaw law = make_contact_law(law_name, p, mb.approach_velocity);
@@ -44,6 +46,8 @@ Row evaluate(const Robot& r, const Target& target, const ContactOptions& o, cons
           mb.f_max, 0, relative_error(law), max_deformation(law, mb.integrated_effective_mass), mb.t_at_f_max,
           mb.contact_duration, mb.restitution, std::move(mb.series)};
   row.accuracy = model_accuracy(row.f_closed, row.f_multibody);
+  row.mb_delta_max = mb.delta_max;
+  row.mb_delta_at_f_max = mb.delta_at_f_max;
   return row;
 }
 
@@ -76,6 +80,11 @@ int run_contact(const ContactOptions& o) {
   } catch (const InputError& e) {
     throw InputError(std::string("--stiffness/--exponent/--restitution: ") + e.what());
   }
+  const plot::Format plot_format = plot::parse_format(o.plot_format, "--plot-format");
+  if (!o.plot.empty()) {
+    plot::require_available("--plot");
+    plot::check_folder(o.plot, "--plot");
+  }
   std::vector<std::string> names;
   if (o.model == "all") {
     for (auto n : contact_law_names()) names.emplace_back(n);
@@ -90,6 +99,25 @@ int run_contact(const ContactOptions& o) {
   std::vector<Row> rows;
   for (const auto& n : names) rows.push_back(evaluate(r, target, o, n));
 
+  if (!o.plot.empty()) {  // Figure 3 from the same rows; the marked points from the multibody run
+    std::vector<figures::ContactCurve> curves;
+    for (const auto& row : rows) {
+      figures::ContactCurve c;
+      c.law = row.model;
+      for (const auto& s : row.series) {
+        c.t.push_back(s.t);
+        c.delta.push_back(s.delta);
+        c.force.push_back(s.force);
+      }
+      const AnyContactLaw law = make_contact_law(row.model, {o.stiffness, o.exponent, o.restitution}, row.v_in);
+      c.delta_max = row.mb_delta_max;
+      c.force_at_delta_max = force(law, row.mb_delta_max, 0.0);  // delta_dot = 0 at the largest deformation
+      c.delta_at_f_max = row.mb_delta_at_f_max;
+      c.f_max = row.f_multibody;
+      curves.push_back(std::move(c));
+    }
+    plot::render({figures::contact(curves, rows.front().M_ie, rows.front().v_in)}, o.plot, plot_format);
+  }
   if (!o.series.empty()) {
     std::ostringstream csv;
     csv << std::setprecision(12) << "model,t_s,force_N,delta_m\n";
@@ -147,6 +175,8 @@ void register_contact(CLI::App& app, Action& action) {
       ->capture_default_str();
   sub->add_option("--series", o->series, "Write F(t), delta(t) of the multibody run(s) to this CSV file ('-': standard output)");
   sub->add_flag("--json", o->json, "Print one JSON object on stdout");
+  sub->add_option("--plot", o->plot, "Draw the F-delta loop(s) and F(t) (Figure 3) into this (existing) folder");
+  sub->add_option("--plot-format", o->plot_format, "Figure format: png, svg or pdf")->capture_default_str();
   sub->callback([o, &action] { action = [o] { return run_contact(*o); }; });
 }
 

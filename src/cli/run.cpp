@@ -4,6 +4,7 @@
 #include "baseline.hpp"
 #include "common.hpp"
 #include "embedded.hpp"
+#include "figures.hpp"
 #include "subcommands.hpp"
 
 #include "ffsr/io/urdf.hpp"
@@ -37,7 +38,7 @@ struct RunOptions {
   std::vector<double> final_rpy_deg;
   double duration = 0, step = 0, gain = 0, feedback = 1.0, tolerance = 0, orientation_tolerance_deg = 0.5;
   std::string objective = "mass";
-  std::string json, csv;
+  std::string json, csv, plot, plot_format = "png";
   std::string expect;  ///< a stored result to compare with (regression run)
   double rtol = 1e-6, atol = 1e-9;
   bool quiet = false;
@@ -239,7 +240,12 @@ int run_scenario(RunOptions o, const CLI::App& app, FromCommandLine cli) {
     throw InputError(str("--gain: the ", o.task, " task has ", task.rows(), " rows and the robot ", model.n(),
                          " joints: no null space to optimize in (set gain = 0 or constrain fewer axes)"));
   const bool want_series = !o.csv.empty();
-  opt.record_series = want_series;
+  const plot::Format plot_format = plot::parse_format(o.plot_format, "--plot-format");
+  if (!o.plot.empty()) {
+    plot::require_available("--plot");
+    plot::check_folder(o.plot, "--plot");
+  }
+  opt.record_series = want_series || !o.plot.empty();
 
   // --- the two runs ------------------------------------------------------------------------------
   CaptureOptions plain = opt;
@@ -319,6 +325,10 @@ int run_scenario(RunOptions o, const CLI::App& app, FromCommandLine cli) {
     }
     csv = c.str();
   }
+  if (!o.plot.empty())  // the pictures of the same result structs; the runs are one vector entry each
+    plot::render(figures::capture(model, pb.frame, pb.target, opt.duration,
+                                  {{"plain", &base_run, baseline_task}, {"optimized", &opt_run, task}}),
+                 o.plot, plot_format);
   outputs.set("--json", j.dump(2) + "\n");
   outputs.set("--csv", csv);
   outputs.write();  // all or nothing: no partial output
@@ -376,7 +386,7 @@ void register_run(CLI::App& app, Action& action, int argc, char** argv) {
     const std::string a = argv[i];
     if (a == "--urdf" || a.rfind("--urdf=", 0) == 0) from_cli.urdf = true;
     if (a == "--expect" || a.rfind("--expect=", 0) == 0) from_cli.expect = true;
-    if (a == "inspect" || a == "contact") break;
+    if (a == "inspect" || a == "contact" || a == "xi") break;
   }
   app.set_config("--config", "", "Scenario file (TOML); every key is also a flag. Default: the built-in paper 3-DOF scenario");
   app.get_config_ptr()->check(CLI::ExistingFile);
@@ -422,6 +432,8 @@ void register_run(CLI::App& app, Action& action, int argc, char** argv) {
                  "when one moved (relative to the scenario file)");
   app.add_option("--rtol", o->rtol, "--expect: relative tolerance")->capture_default_str();
   app.add_option("--atol", o->atol, "--expect: absolute floor for values near zero")->capture_default_str();
+  app.add_option("--plot", o->plot, "Draw the capture process and time histories into this (existing) folder");
+  app.add_option("--plot-format", o->plot_format, "Figure format: png, svg or pdf")->capture_default_str();
   app.add_flag("--quiet", o->quiet, "No progress line");
   app.callback([o, &app, &action, from_cli] {
     if (!app.get_subcommands().empty()) return;

@@ -12,6 +12,8 @@ using Action = std::function<int()>;
 
 void register_inspect(CLI::App& app, Action& action);
 void register_contact(CLI::App& app, Action& action);
+/// xi: the relative error of the closed-form maximum force against K, delta_dot^- and c_r.
+void register_xi(CLI::App& app, Action& action);
 /// The main job (no subcommand): run a capture scenario. `argv` lets it tell which keys came from
 /// the command line (they override the scenario file and are not resolved against its folder).
 void register_run(CLI::App& app, Action& action, int argc, char** argv);

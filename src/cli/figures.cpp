@@ -1,0 +1,549 @@
+// src/cli/figures.cpp -- builds the figures of figures.hpp (no PLplot here: plain data).
+#include "figures.hpp"
+
+#include "ffsr/algorithm/kinematics.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <iomanip>
+#include <sstream>
+
+namespace ffsr::cli::figures {
+namespace {
+
+using ffsr::detail::str;
+using plot::Curve;
+using plot::Curve3;
+using plot::Panel;
+using plot::Panel3;
+
+constexpr int kInstants = 8;
+constexpr int kBlack = 6;
+
+std::string fixed(double x, int digits) {
+  std::ostringstream s;
+  s << std::fixed << std::setprecision(digits) << x;
+  return s.str();
+}
+
+/// Points of one drawing in the inertial frame: polylines (each a list of 3-D points) and dots.
+struct Drawing {
+  std::vector<std::vector<Vector3>> lines;
+  std::vector<Vector3> dots;
+};
+
+/// The robot at one recorded state: the base as a box around its frame origin (half side: the
+/// farthest joint mounted on it, so the mounts sit on the box), the links as segments between
+/// joint origins and to the end-effector, the joints as dots.
+Drawing robot_drawing(const Model& model, Data& data, int frame, const CaptureSample& s, bool planar) {
+  forward_kinematics(model, data, s.base, s.theta);
+  Drawing d;
+  double half = 0.05;
+  for (int i = 1; i <= model.n(); ++i)
+    if (model.body(i).parent == 0) half = std::max(half, model.body(i).tree.p.cwiseAbs().maxCoeff());
+  const Matrix3& R0 = data.R[0];
+  const Vector3& p0 = data.p[0];
+  auto corner = [&](double a, double b, double c) { return Vector3(p0 + R0 * Vector3(a * half, b * half, c * half)); };
+  if (planar) {
+    d.lines.push_back({corner(-1, -1, 0), corner(1, -1, 0), corner(1, 1, 0), corner(-1, 1, 0), corner(-1, -1, 0)});
+  } else {
+    for (int c : {-1, 1})
+      d.lines.push_back({corner(-1, -1, c), corner(1, -1, c), corner(1, 1, c), corner(-1, 1, c), corner(-1, -1, c)});
+    for (int a : {-1, 1})
+      for (int b : {-1, 1}) d.lines.push_back({corner(a, b, -1), corner(a, b, 1)});
+  }
+  for (int i = 1; i <= model.n(); ++i) {
+    const int parent = model.body(i).parent;
+    if (parent > 0) d.lines.push_back({data.p[static_cast<size_t>(parent)], data.p[static_cast<size_t>(i)]});
+    d.dots.push_back(data.p[static_cast<size_t>(i)]);
+  }
+  const Frame& f = model.frame(frame);
+  d.lines.push_back({data.p[static_cast<size_t>(f.body)], frame_pose(model, data, frame).p});
+  return d;
+}
+
+/// The target at T: its outline (a square, or a cube, of half side max |r_tp|, so that the contact
+/// point lies on its surface -- a schematic, the target's shape is not part of the model), the
+/// contact point and an arrow along the contact normal.
+Drawing target_drawing(const Target& t, bool planar, double arrow) {
+  Drawing d;
+  const double h = std::max(0.1, t.contact_offset.cwiseAbs().maxCoeff());
+  const Matrix3 R = t.rotation();
+  auto corner = [&](double a, double b, double c) { return Vector3(t.position + R * Vector3(a * h, b * h, c * h)); };
+  if (planar) {
+    d.lines.push_back({corner(-1, -1, 0), corner(1, -1, 0), corner(1, 1, 0), corner(-1, 1, 0), corner(-1, -1, 0)});
+  } else {
+    for (int c : {-1, 1})
+      d.lines.push_back({corner(-1, -1, c), corner(1, -1, c), corner(1, 1, c), corner(-1, 1, c), corner(-1, -1, c)});
+    for (int a : {-1, 1})
+      for (int b : {-1, 1}) d.lines.push_back({corner(a, b, -1), corner(a, b, 1)});
+  }
+  const Vector3 cp = t.contact_point(), u = t.normal_world();
+  // the normal points from the end-effector into the target: draw it arriving at the contact point
+  const Vector3 tail = cp - arrow * u;
+  Vector3 side = u.cross(Vector3::UnitZ());
+  if (side.norm() < 1e-6) side = u.cross(Vector3::UnitX());
+  side.normalize();
+  d.lines.push_back({tail, cp});
+  d.lines.push_back({cp - 0.25 * arrow * u + 0.12 * arrow * side, cp, cp - 0.25 * arrow * u - 0.12 * arrow * side});
+  d.dots.push_back(cp);
+  return d;
+}
+
+/// Indices of about kInstants samples evenly spread over the series, first and last included.
+std::vector<size_t> instants(size_t n) {
+  std::vector<size_t> k;
+  if (n == 0) return k;
+  const int m = static_cast<int>(std::min<size_t>(kInstants, n));
+  for (int i = 0; i < m; ++i)
+    k.push_back(m == 1 ? 0 : static_cast<size_t>(std::llround(double(i) * double(n - 1) / double(m - 1))));
+  return k;
+}
+
+/// Adds a drawing to a 2-D panel (axes a, b of the inertial frame) or a 3-D panel.
+void add(Panel& p, const Drawing& d, int a, int b, int color, double alpha, double width, const std::string& label,
+         const std::string& dot, double dot_scale) {
+  bool first = true;
+  for (const auto& l : d.lines) {
+    Curve c;
+    c.color = color;
+    c.alpha = alpha;
+    c.width = width;
+    if (first && dot.empty()) c.label = label;
+    first = false;
+    for (const auto& v : l) {
+      c.x.push_back(v(a));
+      c.y.push_back(v(b));
+    }
+    p.curves.push_back(std::move(c));
+  }
+  if (!d.dots.empty() && !dot.empty()) {
+    Curve c;
+    c.color = color;
+    c.alpha = alpha;
+    c.line_style = 0;
+    c.symbol = dot;
+    c.symbol_scale = dot_scale;
+    c.label = label;
+    for (const auto& v : d.dots) {
+      c.x.push_back(v(a));
+      c.y.push_back(v(b));
+    }
+    p.curves.push_back(std::move(c));
+  }
+}
+
+void add(Panel3& p, const Drawing& d, int color, double alpha, double width, const std::string& dot, double dot_scale) {
+  for (const auto& l : d.lines) {
+    Curve3 c;
+    c.color = color;
+    c.alpha = alpha;
+    c.width = width;
+    for (const auto& v : l) {
+      c.x.push_back(v.x());
+      c.y.push_back(v.y());
+      c.z.push_back(v.z());
+    }
+    p.curves.push_back(std::move(c));
+  }
+  if (!d.dots.empty() && !dot.empty()) {
+    Curve3 c;
+    c.color = color;
+    c.alpha = alpha;
+    c.line_style = 0;
+    c.symbol = dot;
+    c.symbol_scale = dot_scale;
+    for (const auto& v : d.dots) {
+      c.x.push_back(v.x());
+      c.y.push_back(v.y());
+      c.z.push_back(v.z());
+    }
+    p.curves.push_back(std::move(c));
+  }
+}
+
+/// Smallest singular value of the task rows of J_f at a recorded state (as the planner computes it).
+double task_singular_value(const Model& model, Data& data, int frame, const CaptureSample& s, const CaptureTask& task) {
+  const Eigen::MatrixXd& Jf = generalized_jacobian(model, data, s.base, s.theta, frame);
+  Eigen::MatrixXd Jt(task.rows(), model.n());
+  int r = 0;
+  if (task.kind == CaptureTask::Kind::Pose) {
+    Jt = Jf;
+  } else {
+    for (int k = 0; k < 3; ++k)
+      if (task.axes[static_cast<size_t>(k)]) Jt.row(r++) = Jf.row(k);
+  }
+  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(Jt);
+  return svd.singularValues().minCoeff();
+}
+
+/// Rotation angle between two unit quaternions, deg.
+double angle_deg(const Quaternion& a, const Quaternion& b) {
+  return Eigen::AngleAxisd(a.normalized().conjugate() * b.normalized()).angle() * 180.0 / M_PI;
+}
+
+}  // namespace
+
+std::vector<plot::Figure> capture(const Model& model, int frame, const Target& target_at_start, double duration,
+                                  const std::vector<CaptureRun>& runs) {
+  Data data(model);
+  const Target target = propagate_target(target_at_start, duration);
+  // planar: every joint, the end-effector and the contact point stay in one plane z = const
+  bool planar = true;
+  const double z0 = target.contact_point().z();
+  for (const auto& run : runs)
+    for (const auto& s : run.result->series) {
+      forward_kinematics(model, data, s.base, s.theta);
+      for (int i = 0; i <= model.n() && planar; ++i) planar = std::abs(data.p[static_cast<size_t>(i)].z() - z0) < 1e-6;
+    }
+  double reach = 0;
+  for (int i = 1; i <= model.n(); ++i) reach += model.body(i).tree.p.norm();
+  const double arrow = std::max(0.2, 0.12 * reach);
+
+  std::vector<plot::Figure> out;
+  for (size_t r = 0; r < runs.size(); ++r) {
+    const CaptureResult& res = *runs[r].result;
+    const int color = static_cast<int>(r);
+    const std::string title = str("Capture process, ", runs[r].label, " run: M_ie = ", fixed(res.M_ie, 3),
+                                  " kg, F_max = ", fixed(res.f_max_closed_form / 1e3, 2), " kN at T = ",
+                                  fixed(duration, 0), " s");
+    const auto idx = instants(res.series.size());
+    std::vector<Drawing> arms;
+    for (size_t k : idx) arms.push_back(robot_drawing(model, data, frame, res.series[k], planar));
+    const Drawing tgt = target_drawing(target, planar, arrow);
+    Drawing path;
+    path.lines.emplace_back();
+    for (const auto& s : res.series) path.lines.back().push_back(s.end_effector);
+    auto alpha = [&](size_t i) { return arms.size() < 2 ? 1.0 : 0.2 + 0.8 * double(i) / double(arms.size() - 1); };
+
+    plot::Figure fig;
+    fig.name = "capture_" + runs[r].label;
+    fig.title = title;
+    auto top_view = [&](Panel& p) {
+      p.equal_aspect = true;
+      p.legend_outside = true;
+      p.xlabel = "x (m)";
+      p.ylabel = "y (m)";
+      for (size_t i = 0; i < arms.size(); ++i) {
+        const bool last = i + 1 == arms.size();
+        add(p, arms[i], 0, 1, color, alpha(i), 2.0,
+            i == 0 ? "arm at t = 0" : last ? str("arm at T = ", fixed(duration, 0), " s") : "", "●", 0.7);
+      }
+      add(p, path, 0, 1, kBlack, 1.0, 1.0, "end-effector path", "", 1.0);
+      p.curves.back().line_style = 2;
+      add(p, tgt, 0, 1, 1, 1.0, 1.5, "target at T: contact point, normal", "●", 0.9);
+    };
+    if (planar) {
+      Panel p;
+      p.title = str("the arm at ", arms.size(), " instants (faint: early, dark: late)");
+      top_view(p);
+      fig.panels.emplace_back(std::move(p));
+    } else {
+      fig.cols = 2;
+      Panel3 q;
+      q.title = str("oblique view, the arm at ", arms.size(), " instants (faint: early)");
+      q.xlabel = "x (m)";
+      q.ylabel = "y (m)";
+      q.zlabel = "z (m)";
+      for (size_t i = 0; i < arms.size(); ++i) add(q, arms[i], color, alpha(i), 2.0, "●", 0.6);
+      add(q, path, kBlack, 1.0, 1.0, "", 1.0);
+      q.curves.back().line_style = 2;
+      add(q, tgt, 1, 1.0, 1.5, "●", 0.8);
+      fig.panels.emplace_back(std::move(q));
+      Panel p;
+      p.title = "top view (x-y)";
+      top_view(p);
+      p.legend_outside = false;
+      fig.panels.emplace_back(std::move(p));
+    }
+    out.push_back(std::move(fig));
+  }
+
+  // --- time histories, all runs on shared axes -------------------------------------------------
+  plot::Figure h;
+  h.name = "histories";
+  h.title = "Capture process: time histories (target at T)";
+  h.rows = 2;
+  h.cols = 2;
+  Panel mie, fmax, drift, sigma;
+  mie.title = "integrated effective mass (Eq. 14)";
+  mie.ylabel = "M#die#u (kg)";
+  fmax.title = "closed-form maximum contact force (Eq. 24)";
+  fmax.ylabel = "F#dmax#u (kN)";
+  drift.title = "base attitude drift";
+  drift.ylabel = "rotation from t = 0 (deg)";
+  sigma.title = "smallest singular value of the task Jacobian";
+  sigma.ylabel = "σ#dmin#u (m/rad)";
+  for (Panel* p : {&mie, &fmax, &drift, &sigma}) p->xlabel = "time t (s)";
+  plot::Figure joints;
+  joints.name = "joints";
+  joints.title = "Capture process: joint angles";
+  joints.cols = static_cast<int>(std::max<size_t>(1, runs.size()));
+  std::vector<Panel> joint_panels;
+  double jmin = 1e300, jmax = -1e300;
+  for (size_t r = 0; r < runs.size(); ++r) {
+    const CaptureResult& res = *runs[r].result;
+    Curve cm, cf, cd, cs;
+    for (Curve* c : {&cm, &cf, &cd, &cs}) {
+      c->label = runs[r].label;
+      c->color = static_cast<int>(r);
+      c->line_style = static_cast<int>(r % 3) + 1;
+    }
+    for (const auto& s : res.series) {
+      for (Curve* c : {&cm, &cf, &cd, &cs}) c->x.push_back(s.t);
+      cm.y.push_back(s.M_ie);
+      cf.y.push_back(s.f_max_estimate / 1e3);
+      cd.y.push_back(angle_deg(res.series.front().base.orientation, s.base.orientation));
+      cs.y.push_back(task_singular_value(model, data, frame, s, runs[r].task));
+    }
+    mie.curves.push_back(cm);
+    fmax.curves.push_back(cf);
+    drift.curves.push_back(cd);
+    sigma.curves.push_back(cs);
+    Panel jp;
+    jp.title = runs[r].label + " run";
+    jp.xlabel = "time t (s)";
+    jp.ylabel = "joint angle (deg)";
+    jp.legend_outside = r + 1 == runs.size();
+    const auto names = model.joint_names();
+    for (int j = 0; j < model.n(); ++j) {
+      Curve c;
+      c.label = r + 1 == runs.size() ? names[static_cast<size_t>(j)] : "";
+      c.color = j;
+      c.line_style = j / plot::kPaletteSize + 1;
+      for (const auto& s : res.series) {
+        c.x.push_back(s.t);
+        c.y.push_back(s.theta(j) * 180.0 / M_PI);
+        jmin = std::min(jmin, c.y.back());
+        jmax = std::max(jmax, c.y.back());
+      }
+      jp.curves.push_back(std::move(c));
+    }
+    joint_panels.push_back(std::move(jp));
+  }
+  const double pad = 0.06 * std::max(1.0, jmax - jmin);
+  for (auto& jp : joint_panels) {
+    double tmax = 0;
+    for (const auto& c : jp.curves)
+      if (!c.x.empty()) tmax = std::max(tmax, c.x.back());
+    jp.limits = {0.0, std::max(tmax, 1e-9), jmin - pad, jmax + pad};
+    joints.panels.emplace_back(std::move(jp));
+  }
+  for (Panel* p : {&mie, &fmax, &drift, &sigma}) h.panels.emplace_back(std::move(*p));
+  out.push_back(std::move(h));
+  out.push_back(std::move(joints));
+  return out;
+}
+
+plot::Figure contact(const std::vector<ContactCurve>& curves, double M_ie, double approach_velocity) {
+  plot::Figure fig;
+  fig.name = "contact";
+  fig.title = str("Contact force (multibody run): M_ie = ", fixed(M_ie, 3), " kg, δ̇⁻ = ", fixed(approach_velocity, 3),
+                  " m/s");
+  fig.cols = 2;
+  Panel loop, time;
+  loop.title = "F-δ hysteresis loop (Figure 3)";
+  loop.xlabel = "deformation δ (mm)";
+  loop.ylabel = "contact force F (kN)";
+  time.title = "force history";
+  time.xlabel = "time from first touch (ms)";
+  time.ylabel = "contact force F (kN)";
+  const bool one = curves.size() == 1;
+  for (size_t k = 0; k < curves.size(); ++k) {
+    const auto& c = curves[k];
+    Curve l, t;
+    l.label = t.label = c.law;
+    l.color = t.color = static_cast<int>(k);
+    l.line_style = t.line_style = static_cast<int>(k / 4) + 1;
+    l.width = t.width = 1.8;
+    for (size_t i = 0; i < c.t.size(); ++i) {
+      l.x.push_back(c.delta[i] * 1e3);
+      l.y.push_back(c.force[i] / 1e3);
+      t.x.push_back(c.t[i] * 1e3);
+      t.y.push_back(c.force[i] / 1e3);
+    }
+    if (one) t.label.clear();
+    loop.curves.push_back(std::move(l));
+    time.curves.push_back(std::move(t));
+    Curve peak, dmax;
+    peak.line_style = dmax.line_style = 0;
+    peak.color = dmax.color = one ? 1 : static_cast<int>(k);
+    peak.symbol = "*";
+    peak.symbol_scale = 1.6;
+    dmax.symbol = "○";
+    dmax.symbol_scale = 1.1;
+    peak.x = {c.delta_at_f_max * 1e3};
+    peak.y = {c.f_max / 1e3};
+    dmax.x = {c.delta_max * 1e3};
+    dmax.y = {c.force_at_delta_max / 1e3};
+    if (one || k == 0) {
+      peak.label = "* (δ'max, Fmax)";
+      dmax.label = "○ (δmax, F'max)";
+    }
+    loop.curves.push_back(std::move(peak));
+    loop.curves.push_back(std::move(dmax));
+  }
+  loop.legend_outside = false;
+  fig.panels.emplace_back(std::move(loop));
+  fig.panels.emplace_back(std::move(time));
+  return fig;
+}
+
+plot::Figure xi(const XiStudy& s) {
+  plot::Figure fig;
+  fig.name = s.name;
+  Panel p;
+  p.title = s.title;
+  p.xlabel = s.xlabel;
+  p.ylabel = "relative error ξ of the closed form (%)";
+  p.log_x = s.log_x;
+  p.legend_outside = true;
+  for (size_t l = 0; l < s.laws.size(); ++l) {
+    Curve c;
+    c.label = s.laws[l];
+    c.color = static_cast<int>(l);
+    c.line_style = static_cast<int>(l / 4) + 1;
+    c.symbol = s.x.size() <= 25 ? "●" : "";
+    c.symbol_scale = 0.6;
+    c.x = s.x;
+    c.y = s.xi[l];
+    p.curves.push_back(std::move(c));
+  }
+  fig.panels.emplace_back(std::move(p));
+  return fig;
+}
+
+void Grid::validate(size_t dims) const {
+  if (axes.size() != dims || axis_labels.size() != dims)
+    throw InputError(str("map plot: expected ", dims, " varied joints, got ", axes.size()));
+  size_t n = 1;
+  for (const auto& a : axes) {
+    if (a.size() < 2) throw InputError("map plot: every varied joint needs at least 2 grid values");
+    if (!std::is_sorted(a.begin(), a.end())) throw InputError("map plot: grid values must be ascending");
+    n *= a.size();
+  }
+  if (values.size() != n) throw InputError(str("map plot: ", values.size(), " values for a grid of ", n, " points"));
+}
+
+namespace {
+std::string point_text(const Grid& g, size_t flat) {
+  std::vector<size_t> idx(g.axes.size());
+  for (size_t d = g.axes.size(); d-- > 0;) {
+    idx[d] = flat % g.axes[d].size();
+    flat /= g.axes[d].size();
+  }
+  std::string s = "[";
+  for (size_t d = 0; d < idx.size(); ++d) s += (d ? ", " : "") + fixed(g.axes[d][idx[d]], 1);
+  return s + "] deg";
+}
+
+size_t nearest(const std::vector<double>& axis, double v) {
+  return static_cast<size_t>(std::min_element(axis.begin(), axis.end(),
+                                              [&](double a, double b) { return std::abs(a - v) < std::abs(b - v); }) -
+                             axis.begin());
+}
+}  // namespace
+
+plot::Figure map_heat(const Grid& g, const std::string& name, const std::string& title) {
+  g.validate(2);
+  plot::Figure fig;
+  fig.name = name;
+  plot::HeatPanel h;
+  const size_t imax = static_cast<size_t>(std::max_element(g.values.begin(), g.values.end()) - g.values.begin());
+  h.title = title.empty() ? str("maximum ", fixed(g.values[imax], 3), " at ", point_text(g, imax)) : title;
+  h.xlabel = g.axis_labels[0];
+  h.ylabel = g.axis_labels[1];
+  h.zlabel = g.value_label;
+  h.x = g.axes[0];
+  h.y = g.axes[1];
+  h.z = g.values;
+  Curve m;
+  m.label = "maximum";
+  m.symbol = "▲";
+  m.color = 1;
+  m.line_style = 0;
+  m.x = {g.axes[0][imax / g.axes[1].size()]};
+  m.y = {g.axes[1][imax % g.axes[1].size()]};
+  h.overlay.push_back(m);
+  fig.panels.emplace_back(std::move(h));
+  return fig;
+}
+
+plot::Figure map_slices(const Grid& g, const std::vector<double>& point, const std::string& name,
+                        const std::string& title) {
+  g.validate(3);
+  if (point.size() != 3) throw InputError("map plot: the slice point needs one value per varied joint");
+  plot::Figure fig;
+  fig.name = name;
+  const size_t imax = static_cast<size_t>(std::max_element(g.values.begin(), g.values.end()) - g.values.begin());
+  fig.title = title.empty() ? str("grid maximum ", fixed(g.values[imax], 3), " at ", point_text(g, imax)) : title;
+  fig.cols = 3;
+  const size_t n1 = g.axes[1].size(), n2 = g.axes[2].size();
+  const size_t c[3] = {nearest(g.axes[0], point[0]), nearest(g.axes[1], point[1]), nearest(g.axes[2], point[2])};
+  double lo = *std::min_element(g.values.begin(), g.values.end()), hi = g.values[imax];
+  for (int fixed_axis = 0; fixed_axis < 3; ++fixed_axis) {
+    const int a = fixed_axis == 0 ? 1 : 0, b = fixed_axis == 2 ? 1 : 2;
+    plot::HeatPanel h;
+    h.title = g.axis_labels[static_cast<size_t>(fixed_axis)] + " = " +
+              fixed(g.axes[static_cast<size_t>(fixed_axis)][c[fixed_axis]], 1);
+    h.xlabel = g.axis_labels[static_cast<size_t>(a)];
+    h.ylabel = g.axis_labels[static_cast<size_t>(b)];
+    h.zlabel = g.value_label;
+    h.x = g.axes[static_cast<size_t>(a)];
+    h.y = g.axes[static_cast<size_t>(b)];
+    h.zmin = lo;
+    h.zmax = hi;
+    h.levels = 16;
+    h.contours = 8;
+    size_t smax = 0;
+    for (size_t i = 0; i < h.x.size(); ++i)
+      for (size_t j = 0; j < h.y.size(); ++j) {
+        size_t idx[3];
+        idx[fixed_axis] = c[fixed_axis];
+        idx[a] = i;
+        idx[b] = j;
+        h.z.push_back(g.values[idx[0] * n1 * n2 + idx[1] * n2 + idx[2]]);
+        if (h.z.back() > h.z[smax]) smax = h.z.size() - 1;
+      }
+    Curve m;
+    m.label = fixed_axis == 2 ? "slice maximum" : "";
+    m.symbol = "▲";
+    m.color = 1;
+    m.line_style = 0;
+    m.x = {h.x[smax / h.y.size()]};
+    m.y = {h.y[smax % h.y.size()]};
+    h.overlay.push_back(m);
+    fig.panels.emplace_back(std::move(h));
+  }
+  fig.height = 420;
+  fig.width = 1400;
+  return fig;
+}
+
+plot::Figure map_cloud(const Grid& g, const std::string& name, const std::string& title, size_t max_points) {
+  g.validate(3);
+  plot::Figure fig;
+  fig.name = name;
+  plot::CloudPanel p;
+  p.title = title.empty() ? "M_ie over the joint grid" : title;
+  p.xlabel = g.axis_labels[0];
+  p.ylabel = g.axis_labels[1];
+  p.zlabel = g.axis_labels[2];
+  p.clabel = g.value_label;
+  // an even stride per axis so that at most max_points remain
+  const size_t n0 = g.axes[0].size(), n1 = g.axes[1].size(), n2 = g.axes[2].size();
+  size_t stride = 1;
+  while ((n0 + stride - 1) / stride * ((n1 + stride - 1) / stride) * ((n2 + stride - 1) / stride) > max_points) ++stride;
+  for (size_t i = 0; i < n0; i += stride)
+    for (size_t j = 0; j < n1; j += stride)
+      for (size_t k = 0; k < n2; k += stride) {
+        p.x.push_back(g.axes[0][i]);
+        p.y.push_back(g.axes[1][j]);
+        p.z.push_back(g.axes[2][k]);
+        p.c.push_back(g.values[i * n1 * n2 + j * n2 + k]);
+      }
+  fig.panels.emplace_back(std::move(p));
+  return fig;
+}
+
+}  // namespace ffsr::cli::figures

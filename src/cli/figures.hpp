@@ -1,0 +1,71 @@
+// src/cli/figures.hpp -- the paper's figures as plot::Figure descriptions, built from the result
+// structs the JSON and CSV are written from (CaptureResult, the contact rows, a map grid).
+#pragma once
+
+#include "plot.hpp"
+
+#include "ffsr/optimize/capture.hpp"
+
+#include <string>
+#include <vector>
+
+namespace ffsr::cli::figures {
+
+/// One capture run to draw (plain, the paper's method, a global run, ...): its label in legends
+/// and file names, its result with the recorded series, and its task (for the singular value).
+struct CaptureRun {
+  std::string label;  ///< e.g. "plain"; the file is capture_<label>
+  const CaptureResult* result = nullptr;
+  CaptureTask task;
+};
+
+/// Figures 10, 11, 13-15: for each run the arm at eight instants (links as segments, joints as
+/// dots, the base as a box, fading from early to late), the end-effector path and the target at T
+/// with its contact point and normal -- in the plane for a planar robot, else an oblique view and a
+/// top view. Then "histories" (M_ie, closed-form F_max, base attitude drift and the task's smallest
+/// singular value against time, all runs on shared axes) and "joints" (the joint angles).
+/// Forward kinematics and the task Jacobian are recomputed from each recorded state.
+/// Reads the runs' series (record_series must have been on).
+std::vector<plot::Figure> capture(const Model& model, int frame, const Target& target_at_start, double duration,
+                                  const std::vector<CaptureRun>& runs);
+
+/// One contact run of `contact`: F(t), delta(t) and the two marked points of Figure 3.
+struct ContactCurve {
+  std::string law;
+  std::vector<double> t, delta, force;  ///< s, m, N
+  double delta_max = 0, force_at_delta_max = 0;  ///< (delta_max, F'_max)
+  double delta_at_f_max = 0, f_max = 0;          ///< (delta'_max, F_max)
+};
+/// Figure 3: the F-delta hysteresis loop(s) with the two points marked, and F(t).
+plot::Figure contact(const std::vector<ContactCurve>& curves, double M_ie, double approach_velocity);
+
+/// One xi study (Figures 4-6): xi of each law (percent) against one parameter.
+struct XiStudy {
+  std::string name, title, xlabel;
+  bool log_x = false;
+  std::vector<double> x;
+  std::vector<std::string> laws;
+  std::vector<std::vector<double>> xi;  ///< xi[law][k], percent
+};
+plot::Figure xi(const XiStudy& study);
+
+/// Values over a grid of joint angles: values[i0 * n1 * n2 + i1 * n2 + i2] (last axis fastest).
+struct Grid {
+  std::vector<std::string> axis_labels;      ///< e.g. "θ1 (deg)"
+  std::vector<std::vector<double>> axes;     ///< ascending, 2 or 3 axes
+  std::vector<double> values;
+  std::string value_label = "M_ie (kg)";
+  /// Checks axes and the number of values; InputError otherwise.
+  void validate(size_t dims) const;
+};
+/// Figure 9 for two varied joints: heat map, contour lines, colour bar, the maximum marked.
+plot::Figure map_heat(const Grid& grid, const std::string& name, const std::string& title);
+/// Figure 9 for three varied joints: the three orthogonal slices through the grid point nearest to
+/// `point` (one value per axis), each a heat map; the maximum of the whole grid is named in the title.
+plot::Figure map_slices(const Grid& grid, const std::vector<double>& point, const std::string& name,
+                        const std::string& title);
+/// Figure 8: the grid as coloured points in 3-D (at most `max_points`, evenly strided).
+plot::Figure map_cloud(const Grid& grid, const std::string& name, const std::string& title,
+                       size_t max_points = 12000);
+
+}  // namespace ffsr::cli::figures

@@ -1,0 +1,106 @@
+// ffsr-optimize xi: the relative error xi of the closed-form maximum force (Eq. 24 against the
+// exact peak of Eq. 16) for the eight damping laws, against K, delta_dot^- and c_r -- the studies of
+// Figures 4-6. CSV always (a file, or stdout), pictures on request.
+#include "common.hpp"
+#include "figures.hpp"
+#include "subcommands.hpp"
+
+#include <iomanip>
+#include <iostream>
+#include <memory>
+#include <sstream>
+
+namespace ffsr::cli {
+namespace {
+
+struct XiOptions {
+  double stiffness = 1e9, exponent = 1.5, restitution = 0.9, approach_speed = 0.2;
+  int points = 41;
+  std::string csv, plot, plot_format = "png";
+};
+
+/// n values from a to b, evenly spaced (on a log scale when `log`).
+std::vector<double> spaced(double a, double b, int n, bool log) {
+  std::vector<double> v;
+  for (int k = 0; k < n; ++k) {
+    const double f = n == 1 ? 0.0 : double(k) / double(n - 1);
+    v.push_back(log ? a * std::pow(b / a, f) : a + (b - a) * f);
+  }
+  v.back() = b;
+  return v;
+}
+
+int run_xi(const XiOptions& o) {
+  using detail::str;
+  if (o.points < 2 || o.points > 100000) throw InputError(str("--points: expected 2 to 100000, got ", o.points));
+  const ContactParams base{o.stiffness, o.exponent, o.restitution};
+  try {
+    validate(base, "contact");
+  } catch (const InputError& e) {
+    throw InputError(str("--stiffness/--exponent/--restitution: ", e.what()));
+  }
+  if (!std::isfinite(o.approach_speed) || o.approach_speed <= 0)
+    throw InputError(str("--approach-speed: must be positive and finite, got ", o.approach_speed));
+  const plot::Format plot_format = plot::parse_format(o.plot_format, "--plot-format");
+  if (!o.plot.empty()) {
+    plot::require_available("--plot");
+    plot::check_folder(o.plot, "--plot");
+  }
+  std::vector<std::string> laws;
+  for (auto n : contact_law_names()) laws.emplace_back(n);
+  const std::string fixed_k = str("K = ", o.stiffness, " N/m^", o.exponent), fixed_v = str("δ̇⁻ = ", o.approach_speed, " m/s"),
+                    fixed_c = str("c_r = ", o.restitution);
+  std::vector<figures::XiStudy> studies(3);
+  studies[0] = {"xi_stiffness", "ξ against the stiffness (Figure 4; " + fixed_v + ", " + fixed_c + ")",
+                "contact stiffness K (N/m^α)", true, spaced(1e7, 1e11, o.points, true), laws, {}};
+  studies[1] = {"xi_approach_speed", "ξ against the approach velocity (Figure 5; " + fixed_k + ", " + fixed_c + ")",
+                "initial relative contact velocity δ̇⁻ (m/s)", true, spaced(0.01, 1.0, o.points, true), laws, {}};
+  studies[2] = {"xi_restitution", "ξ against the restitution (Figure 6; " + fixed_k + ", " + fixed_v + ")",
+                "coefficient of restitution c#dr#u", false, spaced(0.1, 1.0, o.points, false), laws, {}};
+  std::ostringstream csv;
+  csv << std::setprecision(12) << "study,parameter,law,xi_percent\n";
+  const char* column[] = {"stiffness", "approach_speed", "restitution"};
+  for (size_t s = 0; s < studies.size(); ++s) {
+    auto& st = studies[s];
+    st.xi.assign(laws.size(), {});
+    for (size_t l = 0; l < laws.size(); ++l)
+      for (double x : st.x) {
+        ContactParams p = base;
+        double v = o.approach_speed;
+        if (s == 0) p.K = x;
+        if (s == 1) v = x;
+        if (s == 2) p.c_r = x;
+        const double xi = relative_error(make_contact_law(laws[l], p, v));
+        st.xi[l].push_back(xi);
+        csv << column[s] << "," << x << "," << laws[l] << "," << xi << "\n";
+      }
+  }
+  if (!o.plot.empty()) {
+    std::vector<plot::Figure> figs;
+    for (const auto& st : studies) figs.push_back(figures::xi(st));
+    plot::render(figs, o.plot, plot_format);
+  }
+  if (o.csv.empty()) std::cout << csv.str();
+  else write_file_atomic(o.csv, csv.str());
+  return 0;
+}
+
+}  // namespace
+
+void register_xi(CLI::App& app, Action& action) {
+  auto o = std::make_shared<XiOptions>();
+  CLI::App* sub = app.add_subcommand(
+      "xi", "Relative error xi of the closed-form maximum force against K, delta_dot^- and c_r (Figures 4-6)");
+  sub->add_option("--stiffness", o->stiffness, "K held fixed in the other studies, N/m^alpha")->capture_default_str();
+  sub->add_option("--exponent", o->exponent, "Contact exponent alpha")->capture_default_str();
+  sub->add_option("--restitution", o->restitution, "c_r held fixed in the other studies")->capture_default_str();
+  sub->add_option("--approach-speed", o->approach_speed, "delta_dot^- held fixed in the other studies, m/s")
+      ->capture_default_str();
+  sub->add_option("--points", o->points, "Values per study")->capture_default_str();
+  sub->add_option("--csv", o->csv, "Write study,parameter,law,xi_percent to this file (default: stdout)");
+  sub->add_option("--plot", o->plot, "Draw the three studies into this (existing) folder");
+  sub->add_option("--plot-format", o->plot_format, "Figure format: png, svg or pdf")->capture_default_str();
+  sub->callback([o, &action] { action = [o] { return run_xi(*o); }; });
+}
+
+}  // namespace ffsr::cli
