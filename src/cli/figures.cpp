@@ -231,7 +231,7 @@ std::vector<plot::Figure> capture(const Model& model, int frame, const Target& t
       }
       add(p, path, 0, 1, kBlack, 1.0, 1.0, "end-effector path", "", 1.0);
       p.curves.back().line_style = 2;
-      add(p, tgt, 0, 1, 1, 1.0, 1.5, "target at T: contact point, normal", "●", 0.9);
+      add(p, tgt, 0, 1, 1, 1.0, 1.5, "target at T, contact point, normal", "●", 0.9);
     };
     if (planar) {
       Panel p;
@@ -273,7 +273,8 @@ std::vector<plot::Figure> capture(const Model& model, int frame, const Target& t
   drift.title = "base attitude drift";
   drift.ylabel = "rotation from t = 0 (deg)";
   sigma.title = "smallest singular value of the task Jacobian";
-  sigma.ylabel = "σ#dmin#u (m/rad)";
+  const bool any_pose = std::any_of(runs.begin(), runs.end(), [](const CaptureRun& r) { return r.task.kind == CaptureTask::Kind::Pose; });
+  sigma.ylabel = any_pose ? "σ#dmin#u of J#dt#u (m/rad; rad/rad for rotation rows)" : "σ#dmin#u of J#dt#u (m/rad)";
   for (Panel* p : {&mie, &fmax, &drift, &sigma}) p->xlabel = "time t (s)";
   plot::Figure joints;
   joints.name = "joints";
@@ -345,10 +346,11 @@ plot::Figure contact(const std::vector<ContactCurve>& curves, double M_ie, doubl
   loop.title = "F-δ hysteresis loop (Figure 3)";
   loop.xlabel = "deformation δ (mm)";
   loop.ylabel = "contact force F (kN)";
-  time.title = "force history";
+  time.title = "force history (colours as on the left)";
   time.xlabel = "time from first touch (ms)";
   time.ylabel = "contact force F (kN)";
   const bool one = curves.size() == 1;
+  std::vector<Curve> markers;
   for (size_t k = 0; k < curves.size(); ++k) {
     const auto& c = curves[k];
     Curve l, t;
@@ -362,7 +364,7 @@ plot::Figure contact(const std::vector<ContactCurve>& curves, double M_ie, doubl
       t.x.push_back(c.t[i] * 1e3);
       t.y.push_back(c.force[i] / 1e3);
     }
-    if (one) t.label.clear();
+    t.label.clear();
     loop.curves.push_back(std::move(l));
     time.curves.push_back(std::move(t));
     Curve peak, dmax;
@@ -380,9 +382,10 @@ plot::Figure contact(const std::vector<ContactCurve>& curves, double M_ie, doubl
       peak.label = "* (δ'max, Fmax)";
       dmax.label = "○ (δmax, F'max)";
     }
-    loop.curves.push_back(std::move(peak));
-    loop.curves.push_back(std::move(dmax));
+    markers.push_back(std::move(peak));
+    markers.push_back(std::move(dmax));
   }
+  for (auto& m : markers) loop.curves.push_back(std::move(m));  // after the laws: last in the legend
   loop.legend_outside = false;
   fig.panels.emplace_back(std::move(loop));
   fig.panels.emplace_back(std::move(time));

@@ -68,7 +68,7 @@ std::array<int, 3> palette(int i) {
                                                                           {230, 159, 0},
                                                                           {86, 180, 233},
                                                                           {0, 0, 0},
-                                                                          {240, 228, 66}}};
+                                                                          {136, 34, 85}}};
   return okabe_ito[static_cast<size_t>(((i % kPaletteSize) + kPaletteSize) % kPaletteSize)];
 }
 
@@ -77,6 +77,8 @@ namespace {
 
 // cmap0 layout: 0 background (white), 1 text and axes (black), 2..9 the palette, 10 scratch (alpha).
 constexpr int kText = 1, kFirst = 2, kScratch = 10, kGrey = 11;
+// text size relative to PLplot's default: readable at 100 % on a 1000 x 700 page
+constexpr double kScale = 0.75;
 
 const char* device(Format f) {
   switch (f) {
@@ -122,14 +124,14 @@ class Renderer {
 
   void draw() {
     pls_.adv(0);
-    const double top = fig_.title.empty() ? 1.0 : 0.94;
+    const double top = fig_.title.empty() ? 1.0 : 0.95;
     if (!fig_.title.empty()) {
       pls_.vpor(0, 1, 0, 1);
       pls_.wind(0, 1, 0, 1);
       pls_.col0(kText);
-      pls_.schr(0, 1.15);
-      pls_.ptex(0.5, 0.965, 1, 0, 0.5, fig_.title.c_str());
-      pls_.schr(0, 1.0);
+      pls_.schr(0, kScale * (1.15));
+      pls_.ptex(0.5, 0.972, 1, 0, 0.5, fig_.title.c_str());
+      pls_.schr(0, kScale);
     }
     const int rows = std::max(1, fig_.rows), cols = std::max(1, fig_.cols);
     for (size_t k = 0; k < fig_.panels.size(); ++k) {
@@ -153,16 +155,16 @@ class Renderer {
   /// The viewport of a 2-D panel inside its cell: room for tick labels, axis labels and the title.
   void viewport(const Cell& c, double right_extra, double& vx0, double& vx1, double& vy0, double& vy1) {
     const double px = 1.0 / fig_.width, py = 1.0 / fig_.height;
-    vx0 = c.x0 + 78 * px;
+    vx0 = c.x0 + 70 * px;
     vx1 = c.x1 - (18 + right_extra) * px;
-    vy0 = c.y0 + 58 * py;
-    vy1 = c.y1 - 34 * py;
+    vy0 = c.y0 + 50 * py;
+    vy1 = c.y1 - 30 * py;
   }
 
   void draw(const Panel& p, const Cell& cell) {
     const bool has_legend = std::any_of(p.curves.begin(), p.curves.end(), [](const Curve& c) { return !c.label.empty(); });
     double vx0, vx1, vy0, vy1;
-    viewport(cell, p.legend_outside && has_legend ? 190 : 0, vx0, vx1, vy0, vy1);
+    viewport(cell, p.legend_outside && has_legend ? 250 : 0, vx0, vx1, vy0, vy1);
     double xmin, xmax, ymin, ymax;
     if (p.limits.size() == 4) {
       xmin = p.limits[0], xmax = p.limits[1], ymin = p.limits[2], ymax = p.limits[3];
@@ -206,21 +208,41 @@ class Renderer {
         pls_.lsty(1);
       }
       if (!c.symbol.empty()) {
-        pls_.schr(0, c.symbol_scale);
+        pls_.schr(0, kScale * (c.symbol_scale));
         pls_.string(n, x.data(), c.y.data(), c.symbol.c_str());
-        pls_.schr(0, 1.0);
+        pls_.schr(0, kScale);
       }
     }
     pls_.col0(kText);
     pls_.width(1.0);
     pls_.box(p.log_x ? "bcnstl" : "bcnst", 0, 0, "bcnstv", 0, 0);
-    pls_.mtex("b", 2.8, 0.5, 0.5, p.xlabel.c_str());
-    pls_.mtex("l", 4.2, 0.5, 0.5, p.ylabel.c_str());
+    pls_.mtex("b", 3.0, 0.5, 0.5, p.xlabel.c_str());
+    pls_.mtex("l", 4.5, 0.5, 0.5, p.ylabel.c_str());
     pls_.mtex("t", 1.0, 0.5, 0.5, p.title.c_str());
-    if (has_legend) legend(p.curves, p.legend_outside);
+    if (has_legend) legend(p.curves, p.legend_outside, emptiest_corner(p.curves, tx, xmin, xmax, ymin, ymax));
   }
 
-  void legend(const std::vector<Curve>& curves, bool outside) {
+  /// The corner of the axes (0 top right, 1 top left, 2 bottom right, 3 bottom left) whose
+  /// quarter holds the fewest curve points (densely sampled curves; segments count by their ends),
+  /// so that an inside legend hides as little as possible.
+  template <class Tx>
+  static int emptiest_corner(const std::vector<Curve>& curves, Tx tx, double xmin, double xmax, double ymin,
+                             double ymax) {
+    long count[4] = {0, 0, 0, 0};
+    for (const auto& c : curves)
+      for (size_t i = 0; i < std::min(c.x.size(), c.y.size()); ++i) {
+        const double u = (tx(c.x[i]) - xmin) / (xmax - xmin), v = (c.y[i] - ymin) / (ymax - ymin);
+        // sample along segments too, so sparse polylines count where they pass
+        const bool right = u > 0.55, left = u < 0.45, top = v > 0.55, bottom = v < 0.45;
+        if (top && right) ++count[0];
+        if (top && left) ++count[1];
+        if (bottom && right) ++count[2];
+        if (bottom && left) ++count[3];
+      }
+    return static_cast<int>(std::min_element(count, count + 4) - count);
+  }
+
+  void legend(const std::vector<Curve>& curves, bool outside, int corner = 0) {
     std::vector<PLINT> opt, text_colors, line_colors, line_styles, symbol_colors, symbol_numbers, box_i;
     std::vector<PLFLT> line_widths, symbol_scales, box_f;
     std::vector<const char*> text, symbols;
@@ -245,15 +267,17 @@ class Renderer {
       box_f.push_back(0);
     }
     PLFLT w = 0, h = 0;
-    const PLINT pos = outside ? (PL_POSITION_RIGHT | PL_POSITION_TOP | PL_POSITION_OUTSIDE)
-                              : (PL_POSITION_RIGHT | PL_POSITION_TOP | PL_POSITION_INSIDE);
-    pls_.schr(0, 0.85);
-    pls_.legend(&w, &h, PL_LEGEND_BACKGROUND | PL_LEGEND_BOUNDING_BOX, pos, outside ? 0.02 : 0.01, 0.01, 0.06, 0, kText,
-                1, 0, 0, static_cast<PLINT>(text.size()), opt.data(), 0.8, 0.85, 1.9, 0.0, text_colors.data(),
+    const PLINT horizontal = corner == 1 || corner == 3 ? PL_POSITION_LEFT : PL_POSITION_RIGHT;
+    const PLINT vertical = corner >= 2 ? PL_POSITION_BOTTOM : PL_POSITION_TOP;
+    const PLINT pos = outside ? (PL_POSITION_RIGHT | PL_POSITION_OUTSIDE)
+                              : (horizontal | vertical | PL_POSITION_INSIDE);
+    pls_.schr(0, kScale);
+    pls_.legend(&w, &h, PL_LEGEND_BACKGROUND | PL_LEGEND_BOUNDING_BOX, pos, outside ? 0.02 : 0.01, outside ? 0.0 : 0.01,
+                0.06, 0, kText, 1, 0, 0, static_cast<PLINT>(text.size()), opt.data(), 0.8, 0.8, 1.7, 0.0, text_colors.data(),
                 text.data(), box_i.data(), box_i.data(), box_f.data(), box_f.data(), line_colors.data(),
                 line_styles.data(), line_widths.data(), symbol_colors.data(), symbol_scales.data(),
                 symbol_numbers.data(), symbols.data());
-    pls_.schr(0, 1.0);
+    pls_.schr(0, kScale);
   }
 
   void box3(const std::string& xl, const std::string& yl, const std::string& zl) {
@@ -275,9 +299,10 @@ class Renderer {
     range(zs, 0.05, z0, z1);
     // equal scale on the three axes: the box sides are proportional to the data ranges
     const double d = std::max({x1 - x0, y1 - y0, z1 - z0});
+    auto side = [&](double r) { return 1.2 * std::max(0.5, r / d); };  // a flat axis keeps room for its ticks
     pls_.vpor(cell.x0 + 0.01, cell.x1 - 0.01, cell.y0 + 0.02, cell.y1 - 0.05);
     pls_.wind(-1.0, 1.0, -0.9, 1.5);
-    pls_.w3d(1.2 * (x1 - x0) / d, 1.2 * (y1 - y0) / d, 1.2 * (z1 - z0) / d, x0, x1, y0, y1, z0, z1, p.altitude,
+    pls_.w3d(side(x1 - x0), side(y1 - y0), side(z1 - z0), x0, x1, y0, y1, z0, z1, p.altitude,
              p.azimuth);
     box3(p.xlabel, p.ylabel, p.zlabel);
     for (const auto& c : p.curves) {
@@ -291,9 +316,9 @@ class Renderer {
         pls_.lsty(1);
       }
       if (!c.symbol.empty()) {
-        pls_.schr(0, c.symbol_scale);
+        pls_.schr(0, kScale * (c.symbol_scale));
         pls_.string3(n, c.x.data(), c.y.data(), c.z.data(), c.symbol.c_str());
-        pls_.schr(0, 1.0);
+        pls_.schr(0, kScale);
       }
     }
     pls_.col0(kText);
@@ -319,10 +344,10 @@ class Renderer {
     PLINT sub_ticks[] = {0};
     PLINT n_values[] = {static_cast<PLINT>(levels.size())};
     const PLFLT* values[] = {levels.data()};
-    pls_.schr(0, 0.9);
+    pls_.schr(0, kScale * (0.9));
     pls_.colorbar(&w, &h, kind, PL_POSITION_RIGHT | PL_POSITION_OUTSIDE, 0.02, 0.0, 0.035, 1.0, 0, kText, 1, 0, 0,
                   0, 0, 1, &label_opt, labels, 1, axis, ticks, sub_ticks, n_values, values);
-    pls_.schr(0, 1.0);
+    pls_.schr(0, kScale);
   }
 
   void draw(const HeatPanel& p, const Cell& cell) {
@@ -359,20 +384,20 @@ class Renderer {
       color(c.color, c.alpha);
       const auto n = static_cast<PLINT>(std::min(c.x.size(), c.y.size()));
       if (!c.symbol.empty() && n > 0) {
-        pls_.schr(0, c.symbol_scale);
+        pls_.schr(0, kScale * (c.symbol_scale));
         pls_.string(n, c.x.data(), c.y.data(), c.symbol.c_str());
-        pls_.schr(0, 1.0);
+        pls_.schr(0, kScale);
       }
     }
     pls_.col0(kText);
     pls_.width(1.0);
     pls_.box("bcnst", 0, 0, "bcnstv", 0, 0);
-    pls_.mtex("b", 2.8, 0.5, 0.5, p.xlabel.c_str());
-    pls_.mtex("l", 4.2, 0.5, 0.5, p.ylabel.c_str());
+    pls_.mtex("b", 3.0, 0.5, 0.5, p.xlabel.c_str());
+    pls_.mtex("l", 4.5, 0.5, 0.5, p.ylabel.c_str());
     pls_.mtex("t", 1.0, 0.5, 0.5, p.title.c_str());
     if (std::any_of(p.overlay.begin(), p.overlay.end(), [](const Curve& c) { return !c.label.empty(); }))
       legend(p.overlay, false);
-    colorbar(shade, p.zlabel, PL_COLORBAR_SHADE | PL_COLORBAR_SHADE_LABEL);
+    colorbar(shade, p.zlabel, PL_COLORBAR_SHADE);
   }
 
   void draw(const CloudPanel& p, const Cell& cell) {
@@ -404,10 +429,10 @@ class Renderer {
         z.push_back(p.z[k]);
       }
       pls_.col1((b + 0.5) / bins);
-      pls_.schr(0, 0.55);
+      pls_.schr(0, kScale * (0.55));
       pls_.string3(static_cast<PLINT>(x.size()), x.data(), y.data(), z.data(), "●");
     }
-    pls_.schr(0, 1.0);
+    pls_.schr(0, kScale);
     pls_.col0(kText);
     pls_.vpor(cell.x0, cell.x1 - 0.13, cell.y0, cell.y1 - 0.05);
     pls_.mtex("t", 1.0, 0.5, 0.5, p.title.c_str());
@@ -435,7 +460,7 @@ void render_one(const Figure& fig, const std::string& path, Format format) {
   pls.scol0(kGrey, 225, 225, 225);
   pls.setopt("bg", "FFFFFF");
   pls.init();
-  pls.schr(0, 1.0);
+  pls.schr(0, kScale);
   Renderer(pls, fig).draw();
 }
 

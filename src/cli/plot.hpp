@@ -32,7 +32,8 @@ const char* extension(Format f);
 void check_folder(const std::string& dir, const std::string& flag);
 
 /// The colour-blind-safe palette of Okabe and Ito (2008), in the order used for runs and laws:
-/// blue, vermillion, bluish green, reddish purple, orange, sky blue, black, yellow.
+/// blue, vermillion, bluish green, reddish purple, orange, sky blue, black -- and wine (Tol's muted
+/// scheme) in place of Okabe-Ito's yellow, which is unreadable as a thin line on white.
 constexpr int kPaletteSize = 8;
 std::array<int, 3> palette(int i);
 

@@ -48,14 +48,19 @@ int run_xi(const XiOptions& o) {
   }
   std::vector<std::string> laws;
   for (auto n : contact_law_names()) laws.emplace_back(n);
-  const std::string fixed_k = str("K = ", o.stiffness, " N/m^", o.exponent), fixed_v = str("δ̇⁻ = ", o.approach_speed, " m/s"),
-                    fixed_c = str("c_r = ", o.restitution);
+  auto g = [](double x) {
+    std::ostringstream os;
+    os << std::setprecision(4) << x;
+    return os.str();
+  };
+  const std::string fixed_k = "K = " + g(o.stiffness) + " N/m^" + g(o.exponent),
+                    fixed_v = "δ̇⁻ = " + g(o.approach_speed) + " m/s", fixed_c = "c#dr#u = " + g(o.restitution);
   std::vector<figures::XiStudy> studies(3);
-  studies[0] = {"xi_stiffness", "ξ against the stiffness (Figure 4; " + fixed_v + ", " + fixed_c + ")",
-                "contact stiffness K (N/m^α)", true, spaced(1e7, 1e11, o.points, true), laws, {}};
-  studies[1] = {"xi_approach_speed", "ξ against the approach velocity (Figure 5; " + fixed_k + ", " + fixed_c + ")",
+  studies[0] = {"xi_stiffness", "ξ against K (Figure 4): " + fixed_v + ", " + fixed_c, "contact stiffness K (N/m^α)",
+                true, spaced(1e7, 1e11, o.points, true), laws, {}};
+  studies[1] = {"xi_approach_speed", "ξ against δ̇⁻ (Figure 5): " + fixed_k + ", " + fixed_c,
                 "initial relative contact velocity δ̇⁻ (m/s)", true, spaced(0.01, 1.0, o.points, true), laws, {}};
-  studies[2] = {"xi_restitution", "ξ against the restitution (Figure 6; " + fixed_k + ", " + fixed_v + ")",
+  studies[2] = {"xi_restitution", "ξ against c#dr#u (Figure 6): " + fixed_k + ", " + fixed_v,
                 "coefficient of restitution c#dr#u", false, spaced(0.1, 1.0, o.points, false), laws, {}};
   std::ostringstream csv;
   csv << std::setprecision(12) << "study,parameter,law,xi_percent\n";

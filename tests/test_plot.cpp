@@ -1,0 +1,280 @@
+// Figures (issue 10): the plotting module and the pictures of the command. Every picture made here
+// is decoded (PNG: size from IHDR, more than one colour, the long dark lines of the axes box) or
+// parsed (SVG as XML). The drawings are checked against independent computations: the arm drawn at
+// T ends where the planner's end-effector is, the attitude-drift curve ends at the planner's drift,
+// the map's maximum sits at the stretched arm (Section 5.1), xi from the closed form against the
+// exact peak. Bad inputs: a missing plot folder and an unknown format, one error line each.
+#include "cli/figures.hpp"
+#include "cli/plot.hpp"
+#include "support/image_check.hpp"
+#include "support/paper.hpp"
+#include "support/run_command.hpp"
+
+#include "ffsr/io/urdf.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <filesystem>
+#include <fstream>
+#include <map>
+
+namespace {
+
+namespace fs = std::filesystem;
+using namespace ffsr;
+using namespace ffsr::cli;
+using ffsr::test::run_command;
+using ffsr::test::TempDir;
+
+const std::string kCli = FFSR_CLI;
+
+/// A valid PNG of the expected size with content: many colours and the axes' straight lines.
+void check_png(const std::string& path, uint32_t w, uint32_t h, size_t min_colors = 2) {
+  INFO(path);
+  const auto img = ffsr::test::decode_png(path);
+  CHECK(img.width == w);
+  CHECK(img.height == h);
+  CHECK(ffsr::test::distinct_colors(img) >= min_colors);
+  CHECK(ffsr::test::longest_dark_line(img, true) >= w / 5);   // an axis box side
+  CHECK(ffsr::test::longest_dark_line(img, false) >= h / 5);
+}
+
+void check_svg(const std::string& path) {
+  INFO(path);
+  std::string root;
+  const int paths = ffsr::test::svg_count(path, "path", root);
+  CHECK(root == "svg");
+  CHECK(paths > 20);  // axes, ticks, curves and glyphs are paths in cairo's SVG
+}
+
+/// The paper's 3-DOF robot and target (robots/paper_3dof.toml).
+struct Paper3 {
+  Model model = model_from_urdf_file(ffsr::test::kRobots + "paper_3dof.urdf", "ee");
+  Target target;
+  Paper3() {
+    target.position = Vector3(2.75, 1.45, 0);
+    target.angular_velocity = Vector3(0, 0, 2 * M_PI / 180);
+  }
+};
+
+/// M_ie over a grid of joint angles (deg), last axis fastest, evaluated directly with Eq. 14.
+figures::Grid mie_grid(const Paper3& p, const std::vector<std::vector<double>>& axes) {
+  figures::Grid g;
+  g.axes = axes;
+  for (size_t d = 0; d < axes.size(); ++d) g.axis_labels.push_back("θ" + std::to_string(d + 1) + " (deg)");
+  Data data(p.model);
+  const BasePose base;
+  Eigen::VectorXd th = Eigen::VectorXd::Zero(3);
+  const size_t n0 = axes[0].size(), n1 = axes[1].size(), n2 = axes.size() > 2 ? axes[2].size() : 1;
+  for (size_t i = 0; i < n0; ++i)
+    for (size_t j = 0; j < n1; ++j)
+      for (size_t k = 0; k < n2; ++k) {
+        th << axes[0][i], axes[1][j], axes.size() > 2 ? axes[2][k] : 0.0;
+        g.values.push_back(integrated_effective_mass(p.model, data, base, th * (M_PI / 180), p.model.end_effector(), p.target));
+      }
+  return g;
+}
+
+std::vector<double> range_deg(double a, double b, double step) {
+  std::vector<double> v;
+  for (double x = a; x <= b + 1e-9; x += step) v.push_back(x);
+  return v;
+}
+
+}  // namespace
+
+TEST_CASE("plot: format names and the folder check", "[plot]") {
+  CHECK(plot::parse_format("svg", "--plot-format") == plot::Format::Svg);
+  CHECK_THROWS_WITH(plot::parse_format("jpeg", "--plot-format"),
+                    Catch::StartsWith("--plot-format: unknown format 'jpeg'; expected png, svg or pdf"));
+  CHECK_THROWS_WITH(plot::check_folder("/nonexistent/ffsr", "--plot"),
+                    Catch::Contains("--plot: folder '/nonexistent/ffsr' does not exist"));
+  CHECK(plot::available());
+}
+
+TEST_CASE("map plots: 3-DOF M_ie slices, heat map and 3-D view; the maximum at the stretched arm", "[plot][paper]") {
+  const Paper3 p;
+  // the ranges of Figure 8 (theta1 in [-90, 90], theta2 and theta3 in [-120, 120] deg) at 10 deg;
+  // Eq. 14 evaluated here
+  const auto a1 = range_deg(-90, 90, 10), a2 = range_deg(-120, 120, 10);
+  const figures::Grid g3 = mie_grid(p, {a1, a2, a2});
+  const size_t imax = size_t(std::max_element(g3.values.begin(), g3.values.end()) - g3.values.begin());
+  const size_t n = a2.size();
+  // Section 5.1: the largest M_ie over the whole grid at theta = [0, 0, 0] deg
+  CHECK(a1[imax / (n * n)] == 0.0);
+  CHECK(a2[imax / n % n] == 0.0);
+  CHECK(a2[imax % n] == 0.0);
+  const plot::Figure slices = figures::map_slices(g3, {0, 0, 0}, "slices", "");
+  CHECK_THAT(slices.title, Catch::Contains("at [0.0, 0.0, 0.0] deg"));
+  REQUIRE(slices.panels.size() == 3);
+  // each slice goes through [0, 0, 0]: its marked maximum is the grid maximum, at (0, 0)
+  for (const auto& panel : slices.panels) {
+    const auto& h = std::get<plot::HeatPanel>(panel);
+    CHECK(h.overlay.at(0).x.at(0) == 0.0);
+    CHECK(h.overlay.at(0).y.at(0) == 0.0);
+    CHECK(*std::max_element(h.z.begin(), h.z.end()) == g3.values[imax]);
+  }
+  // two varied joints (theta1 = 0): a heat map with its maximum marked
+  const figures::Grid g2 = mie_grid(p, {range_deg(-120, 120, 5), range_deg(-120, 120, 5)});
+  const plot::Figure heat = figures::map_heat(g2, "heat", "");
+  const auto& hp = std::get<plot::HeatPanel>(heat.panels.at(0));
+  CHECK(hp.overlay.at(0).x.at(0) == 0.0);
+  CHECK(hp.overlay.at(0).y.at(0) == 0.0);
+
+  TempDir dir;
+  const auto png = plot::render({heat, slices, figures::map_cloud(g3, "cloud", "")}, dir.str(), plot::Format::Png);
+  REQUIRE(png.size() == 3);
+  check_png(dir / "heat.png", 1000, 700, 16);  // the colour levels
+  check_png(dir / "slices.png", 1400, 420, 16);
+  check_png(dir / "cloud.png", 1000, 700, 16);
+  const auto svg = plot::render({slices}, dir.str(), plot::Format::Svg);
+  check_svg(dir / "slices.svg");
+  CHECK(dir.entries() == std::vector<std::string>{"cloud.png", "heat.png", "slices.png", "slices.svg"});
+
+  figures::Grid bad = g2;
+  bad.values.pop_back();
+  CHECK_THROWS_AS(figures::map_heat(bad, "x", ""), InputError);
+}
+
+TEST_CASE("capture figures: the drawn arm at T meets the planner's end-effector; drift and histories", "[plot]") {
+  const Paper3 p;
+  CaptureProblem pb;
+  pb.model = &p.model;
+  pb.frame = p.model.end_effector();
+  pb.theta = ffsr::test::deg({0, 150, -100});
+  pb.target = p.target;
+  CaptureTask task;
+  task.axes = {true, true, false};
+  CaptureOptions opt;
+  opt.duration = 180;
+  opt.step = 0.2;
+  opt.record_series = true;
+  const CaptureResult plain = plan_capture(pb, task, opt);
+  opt.gain = -0.01;
+  const CaptureResult optimized = plan_capture(pb, task, opt);
+  const auto figs = figures::capture(p.model, pb.frame, pb.target, opt.duration,
+                                     {{"plain", &plain, task}, {"optimized", &optimized, task}});
+  REQUIRE(figs.size() == 4);  // one drawing per run, histories, joints
+  for (size_t r = 0; r < 2; ++r) {
+    const CaptureResult& res = r == 0 ? plain : optimized;
+    REQUIRE(figs[r].panels.size() == 1);  // planar robot: one view, in its plane
+    const auto& panel = std::get<plot::Panel>(figs[r].panels[0]);
+    CHECK(panel.equal_aspect);
+    // the last (opaque) line of the arm's colour before its joint dots is the link to the end-effector
+    const plot::Curve* ee_link = nullptr;
+    for (const auto& c : panel.curves)
+      if (c.color == int(r) && c.alpha == 1.0 && c.line_style > 0 && c.symbol.empty()) ee_link = &c;
+    REQUIRE(ee_link);
+    CHECK(ee_link->x.back() == Approx(res.end_effector.x()).margin(1e-9));
+    CHECK(ee_link->y.back() == Approx(res.end_effector.y()).margin(1e-9));
+    // the target's contact point is the planner's capture point
+    bool found = false;
+    for (const auto& c : panel.curves)
+      if (c.label.rfind("target at T", 0) == 0) {
+        found = true;
+        CHECK(c.x.at(0) == Approx(res.capture_point.x()).margin(1e-12));
+        CHECK(c.y.at(0) == Approx(res.capture_point.y()).margin(1e-12));
+      }
+    CHECK(found);
+  }
+  // histories: M_ie, F_max, attitude drift, sigma_min; the drift at T is the planner's
+  const auto& drift = std::get<plot::Panel>(figs[2].panels.at(2));
+  CHECK(drift.curves.at(0).y.back() == Approx(plain.base_attitude_drift * 180 / M_PI).epsilon(1e-9));
+  CHECK(drift.curves.at(1).y.back() == Approx(optimized.base_attitude_drift * 180 / M_PI).epsilon(1e-9));
+  const auto& sigma = std::get<plot::Panel>(figs[2].panels.at(3));
+  for (size_t r = 0; r < 2; ++r) {
+    const double smin = *std::min_element(sigma.curves[r].y.begin(), sigma.curves[r].y.end());
+    // the planner also sees the RK4 stages, so its minimum is at most the recorded samples' one
+    CHECK(smin >= (r == 0 ? plain : optimized).min_singular_value - 1e-12);
+    CHECK(smin == Approx((r == 0 ? plain : optimized).min_singular_value).epsilon(0.01));
+  }
+  TempDir dir;
+  plot::render(figs, dir.str(), plot::Format::Png);
+  for (const char* f : {"capture_plain.png", "capture_optimized.png", "histories.png", "joints.png"})
+    check_png(dir / f, 1000, 700);
+}
+
+TEST_CASE("ffsr-optimize --plot: the 3-DOF scenario's figures as PNG and SVG", "[plot][cli]") {
+  TempDir dir;
+  fs::create_directory(dir / "png");
+  fs::create_directory(dir / "svg");
+  auto r = run_command({kCli, "--plot", dir / "png", "--quiet"});
+  REQUIRE(r.exit_code == 0);
+  CHECK(r.err.empty());
+  CHECK(r.out.find("With optimization") != std::string::npos);
+  for (const char* f : {"capture_plain.png", "capture_optimized.png", "histories.png", "joints.png"})
+    check_png(dir / (std::string("png/") + f), 1000, 700);
+  r = run_command({kCli, "--plot", dir / "svg", "--plot-format", "svg", "--quiet"});
+  REQUIRE(r.exit_code == 0);
+  for (const char* f : {"capture_plain.svg", "capture_optimized.svg", "histories.svg", "joints.svg"})
+    check_svg(dir / (std::string("svg/") + f));
+}
+
+TEST_CASE("contact --plot (Figure 3) and xi (Figures 4-6)", "[plot][cli]") {
+  TempDir dir;
+  const std::string urdf = ffsr::test::kRobots + "paper_3dof.urdf";
+  auto r = run_command({kCli, "contact", "--urdf", urdf, "--joints-deg=0,90,-90", "--model", "all", "--plot", dir.str()});
+  REQUIRE(r.exit_code == 0);
+  check_png(dir / "contact.png", 1000, 700, 8);
+  r = run_command({kCli, "xi", "--points", "5", "--csv", dir / "xi.csv", "--plot", dir.str()});
+  REQUIRE(r.exit_code == 0);
+  for (const char* f : {"xi_stiffness.png", "xi_approach_speed.png", "xi_restitution.png"}) check_png(dir / f, 1000, 700, 8);
+  // the CSV: xi does not depend on K nor on delta_dot^- (Figures 4 and 5), and equals
+  // 1 - F'_max / F_max from the closed form against the exact peak of Eq. 16 (M_ie = 1 kg)
+  std::ifstream in(dir / "xi.csv");
+  std::string line;
+  std::getline(in, line);
+  CHECK(line == "study,parameter,law,xi_percent");
+  std::map<std::string, std::vector<double>> by_study_law;
+  int rows = 0;
+  while (std::getline(in, line)) {
+    std::stringstream s(line);
+    std::string study, x, law, xi;
+    std::getline(s, study, ',');
+    std::getline(s, x, ',');
+    std::getline(s, law, ',');
+    std::getline(s, xi, ',');
+    by_study_law[study + "/" + law].push_back(std::stod(xi));
+    ContactParams cp;
+    double v = 0.2;
+    if (study == "stiffness") cp.K = std::stod(x);
+    if (study == "approach_speed") v = std::stod(x);
+    if (study == "restitution") cp.c_r = std::stod(x);
+    const AnyContactLaw l = make_contact_law(law, cp, v);
+    const double expected = 100.0 * (1.0 - max_force_closed_form(l, 1.0) / max_force_exact(l, 1.0));
+    CHECK(std::stod(xi) == Approx(expected).margin(1e-9));
+    ++rows;
+  }
+  CHECK(rows == 3 * 5 * 8);
+  for (const auto& [key, xs] : by_study_law)
+    if (key.rfind("restitution", 0) != 0)
+      for (double x : xs) CHECK(x == Approx(xs.front()).margin(1e-9));
+}
+
+TEST_CASE("--plot bad inputs: a missing folder, an unknown format; one error line, no output", "[plot][cli]") {
+  TempDir dir;
+  const std::string missing = dir / "no_such_folder";
+  const std::string urdf = ffsr::test::kRobots + "paper_3dof.urdf";
+  struct Case {
+    std::vector<std::string> args;
+    std::string message;
+  };
+  const std::vector<Case> cases = {
+      {{kCli, "--plot", missing, "--quiet"}, "--plot: folder '" + missing + "' does not exist"},
+      {{kCli, "--plot", dir.str(), "--plot-format", "gif", "--quiet"}, "--plot-format: unknown format 'gif'"},
+      {{kCli, "contact", "--urdf", urdf, "--joints-deg=0,90,-90", "--plot", missing}, "--plot: folder '" + missing},
+      {{kCli, "contact", "--urdf", urdf, "--joints-deg=0,90,-90", "--plot", dir.str(), "--plot-format", "bmp"},
+       "--plot-format: unknown format 'bmp'"},
+      {{kCli, "xi", "--plot", missing}, "--plot: folder '" + missing},
+      {{kCli, "xi", "--points", "1"}, "--points: expected 2 to 100000, got 1"},
+  };
+  for (const auto& c : cases) {
+    INFO(c.args.back());
+    const auto r = run_command(c.args);
+    CHECK(r.exit_code == 2);
+    CHECK(r.out.empty());
+    CHECK(r.err.rfind("ffsr-optimize: error: " + c.message, 0) == 0);
+    CHECK(std::count(r.err.begin(), r.err.end(), '\n') == 1);
+  }
+  CHECK(dir.entries().empty());  // nothing written, no temporary folder left
+}
