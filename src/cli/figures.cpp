@@ -19,6 +19,7 @@ using plot::Panel3;
 
 constexpr int kInstants = 8;
 constexpr int kBlack = 6;
+constexpr int kTargetColor = 3;  // reddish purple: runs use 0, 1, 2
 
 std::string fixed(double x, int digits) {
   std::ostringstream s;
@@ -205,7 +206,7 @@ std::vector<plot::Figure> capture(const Model& model, int frame, const Target& t
     const CaptureResult& res = *runs[r].result;
     const int color = static_cast<int>(r);
     const std::string title = str("Capture process, ", runs[r].label, " run: M_ie = ", fixed(res.M_ie, 3),
-                                  " kg, F_max = ", fixed(res.f_max_closed_form / 1e3, 2), " kN at T = ",
+                                  " kg, F#dmax#u = ", fixed(res.f_max_closed_form / 1e3, 2), " kN at T = ",
                                   fixed(duration, 0), " s");
     const auto idx = instants(res.series.size());
     std::vector<Drawing> arms;
@@ -231,7 +232,7 @@ std::vector<plot::Figure> capture(const Model& model, int frame, const Target& t
       }
       add(p, path, 0, 1, kBlack, 1.0, 1.0, "end-effector path", "", 1.0);
       p.curves.back().line_style = 2;
-      add(p, tgt, 0, 1, 1, 1.0, 1.5, "target at T, contact point, normal", "●", 0.9);
+      add(p, tgt, 0, 1, kTargetColor, 1.0, 1.5, "target at T, normal", "●", 0.9);
     };
     if (planar) {
       Panel p;
@@ -248,7 +249,7 @@ std::vector<plot::Figure> capture(const Model& model, int frame, const Target& t
       for (size_t i = 0; i < arms.size(); ++i) add(q, arms[i], color, alpha(i), 2.0, "●", 0.6);
       add(q, path, kBlack, 1.0, 1.0, "", 1.0);
       q.curves.back().line_style = 2;
-      add(q, tgt, 1, 1.0, 1.5, "●", 0.8);
+      add(q, tgt, kTargetColor, 1.0, 1.5, "●", 0.8);
       fig.panels.emplace_back(std::move(q));
       Panel p;
       p.title = "top view (x-y)";
@@ -339,7 +340,7 @@ std::vector<plot::Figure> capture(const Model& model, int frame, const Target& t
 plot::Figure contact(const std::vector<ContactCurve>& curves, double M_ie, double approach_velocity) {
   plot::Figure fig;
   fig.name = "contact";
-  fig.title = str("Contact force (multibody run): M_ie = ", fixed(M_ie, 3), " kg, δ̇⁻ = ", fixed(approach_velocity, 3),
+  fig.title = str("Contact force (multibody run): M#die#u = ", fixed(M_ie, 3), " kg, δ̇⁻ = ", fixed(approach_velocity, 3),
                   " m/s");
   fig.cols = 2;
   Panel loop, time;
