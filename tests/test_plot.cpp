@@ -92,7 +92,7 @@ TEST_CASE("plot: format names and the folder check", "[plot]") {
   CHECK(plot::available());
 }
 
-TEST_CASE("map plots: 3-DOF M_ie slices, heat map and 3-D view; the maximum at the stretched arm", "[plot][paper]") {
+TEST_CASE("map plots: 3-DOF M_ie slices and heat map and 3-D view with the maximum at the stretched arm", "[plot][paper]") {
   const Paper3 p;
   // the ranges of Figure 8 (theta1 in [-90, 90], theta2 and theta3 in [-120, 120] deg) at 10 deg;
   // Eq. 14 evaluated here
@@ -136,7 +136,7 @@ TEST_CASE("map plots: 3-DOF M_ie slices, heat map and 3-D view; the maximum at t
   CHECK_THROWS_AS(figures::map_heat(bad, "x", ""), InputError);
 }
 
-TEST_CASE("capture figures: the drawn arm at T meets the planner's end-effector; drift and histories", "[plot]") {
+TEST_CASE("capture figures: the drawn arm at T meets the planner's end-effector and the drift curve its drift", "[plot]") {
   const Paper3 p;
   CaptureProblem pb;
   pb.model = &p.model;
@@ -194,7 +194,7 @@ TEST_CASE("capture figures: the drawn arm at T meets the planner's end-effector;
     check_png(dir / f, 1000, 700);
 }
 
-TEST_CASE("ffsr-optimize --plot: the 3-DOF scenario's figures as PNG and SVG", "[plot][cli]") {
+TEST_CASE("main job with --plot: the 3-DOF scenario's figures as PNG and SVG", "[plot][cli]") {
   TempDir dir;
   fs::create_directory(dir / "png");
   fs::create_directory(dir / "svg");
@@ -251,7 +251,7 @@ TEST_CASE("contact --plot (Figure 3) and xi (Figures 4-6)", "[plot][cli]") {
       for (double x : xs) CHECK(x == Approx(xs.front()).margin(1e-9));
 }
 
-TEST_CASE("--plot bad inputs: a missing folder, an unknown format; one error line, no output", "[plot][cli]") {
+TEST_CASE("plot bad inputs: a missing folder or an unknown format give one error line and no output", "[plot][cli]") {
   TempDir dir;
   const std::string missing = dir / "no_such_folder";
   const std::string urdf = ffsr::test::kRobots + "paper_3dof.urdf";
