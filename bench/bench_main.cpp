@@ -23,6 +23,9 @@
 #include <ffsr/io/urdf.hpp>
 #include <ffsr/optimize/capture.hpp>
 #include <ffsr/simulate/multibody.hpp>
+#ifdef FFSR_HAVE_GLOBAL
+#include <ffsr/optimize/global.hpp>
+#endif
 
 #include "bench_contact.hpp"
 
@@ -457,6 +460,56 @@ void bench_scenarios(const Settings& s, const Robot& r3, const Robot& r7) {
   print_row(r7.name, "scenario position: plain + optimized (xyz)", {plain7 + pos7, plain7 + pos7, -1, 1}, "< 2 s", 2.0);
 }
 
+#ifdef FFSR_HAVE_GLOBAL
+/// Global capture optimization (issue 9): the whole plan_capture_global (task-only run, search,
+/// reaching run, search at the reached base pose, ...) with the scenario files' 3 deg/s limit; and
+/// the multibody-force search (CVODE ranking of the local optima) at c_r = 0.3.
+void bench_global(const Settings& s, const Robot& r3, const Robot& r7) {
+  using namespace ffsr;
+  auto run = [&](const Robot& r, double T, const CaptureTask& task, const char* target, double limit) {
+    CaptureProblem pb;
+    pb.model = &r.model;
+    pb.frame = r.ee;
+    pb.theta = r.theta_start;
+    pb.target = r.target;
+    pb.contact = kContact;
+    pb.law = kLaw;
+    pb.approach_speed = kApproachSpeed;
+    CaptureOptions opt;
+    opt.duration = T;
+    opt.step = 0.1;
+    opt.max_joint_rate = 3.0 * M_PI / 180.0;
+    GlobalCaptureResult last;
+    const Timing t = measure_runs(s.capture_runs, [&] {
+      last = plan_capture_global(pb, task, opt, GlobalCaptureOptions{});
+      return last.run.M_ie;
+    });
+    print_row(r.name, "plan_capture_global (search + reaching plan)", t, target, limit);
+    std::printf("%-11s   M_ie = %.4f kg, gap %.3f %%, %d shooting iteration(s), %ld SLSQP evaluations, search %.3f s\n",
+                "", last.run.M_ie, last.optimality_gap_percent, last.shooting_iterations, last.evaluations,
+                last.search_seconds);
+    return pb;
+  };
+  run(r3, 180.0, position_task(true, true, false), "< 1 s", 1.0);
+  CaptureProblem pb = run(r7, 157.0, position_task(true, true, true), "< 3 s", 3.0);
+  pb.contact.c_r = 0.3;
+  CaptureOptions opt;
+  opt.duration = 157.0;
+  const CaptureTask task = position_task(true, true, true);
+  const CaptureSetup setup = prepare_capture(pb, task, opt);
+  ManifoldSearchOptions so;
+  so.objective = GlobalObjective::MultibodyForce;
+  ManifoldSearchResult last;
+  const Timing t = measure_runs(s.capture_runs, [&] {
+    last = search_capture_manifold(pb, task, setup, pb.base, so);
+    return last.best.objective;
+  });
+  print_row(r7.name, "multibody-force search (c_r = 0.3, xyz)", t, "", 0);
+  std::printf("%-11s   CVODE F_max = %.1f N at M_ie = %.4f kg; %ld SLSQP evaluations, %ld CVODE runs\n", "",
+              last.best.objective, last.best.M_ie, last.evaluations, last.objective_evaluations);
+}
+#endif
+
 std::string robots_dir(const std::string& arg) {
   auto exists = [](const std::string& p) { return std::ifstream(p).good(); };
   const std::string base = arg.empty() ? std::string(FFSR_SOURCE_DIR) + "/robots" : arg;
@@ -524,6 +577,10 @@ int main(int argc, char** argv) {
 
     print_header("capture scenarios: whole plan_capture runs (RK4, step 0.1 s; 3-DOF T = 180 s, 7-DOF T = 157 s)");
     bench_scenarios(s, r3, r7);
+#ifdef FFSR_HAVE_GLOBAL
+    print_header("global capture optimization (optimize/global.hpp; 3 deg/s joint-rate limit)");
+    bench_global(s, r3, r7);
+#endif
 
     if (!check.failures.empty()) {
       std::printf("\nFAIL: hot paths allocate per call:\n");

@@ -7,6 +7,7 @@
 
 #include "ffsr/io/urdf.hpp"
 #include "ffsr/optimize/capture.hpp"
+#include "ffsr/optimize/global.hpp"
 
 #include <unistd.h>
 
@@ -15,6 +16,7 @@
 #include <iomanip>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <set>
 #include <sstream>
 
@@ -36,6 +38,10 @@ struct RunOptions {
   std::vector<double> final_rpy_deg;
   double duration = 0, step = 0, gain = 0, feedback = 1.0, tolerance = 0, orientation_tolerance_deg = 0.5;
   std::string objective = "mass";
+  bool global = true;                 // the third row: global capture optimization (issue 9)
+  std::string seed = "1";             // parsed here, so that a bad value gets a one-line error naming the key
+  double max_joint_rate_deg = 0;      // 0: not set (the global run is then not rate limited)
+  int global_starts = 32;
   std::string json, csv;
   bool quiet = false;
 };
@@ -87,6 +93,7 @@ std::string deg_list(const Eigen::VectorXd& theta, int precision = 2) {
 nlohmann::json result_json(const CaptureResult& r, const CaptureTask& task, double gain) {
   const Eigen::Vector4d q = r.base.orientation.coeffs();
   return {{"task", task.kind == CaptureTask::Kind::Pose ? "pose" : "position"},
+          {"max_joint_rate_deg", r.max_joint_rate * 180.0 / M_PI},
           {"gain", gain},
           {"capture_configuration_deg", to_json(Eigen::VectorXd(r.theta * (180.0 / M_PI)))},
           {"integrated_effective_mass", r.M_ie},
@@ -125,6 +132,90 @@ struct Progress {
     if (fraction >= 1.0) std::fprintf(stderr, "\n");
   }
 };
+
+/// The global run (issue 9) and what the outputs need beside it.
+struct GlobalRun {
+  GlobalCaptureResult result;
+  double paper_objective = 0;  ///< the objective at the paper's-method run's capture configuration
+};
+
+/// Plans the global run: the optimized run's task, no gain, the joint-rate limit, the paper's-method
+/// capture configuration as an extra start (so the global row is never worse than it).
+GlobalRun run_global(const CaptureProblem& pb, const CaptureTask& task, CaptureOptions opt, GlobalObjective objective,
+                     std::uint64_t seed, const RunOptions& o, const CaptureResult& paper_run) {
+  opt.gain = 0.0;
+  opt.max_joint_rate = o.max_joint_rate_deg * M_PI / 180.0;
+  opt.progress = nullptr;
+  GlobalCaptureOptions g;
+  g.search.seed = seed;
+  g.search.starts = o.global_starts;
+  g.search.objective = objective;
+  g.extra_starts = {paper_run.theta};
+  GlobalRun r;
+  try {
+    r.result = plan_capture_global(pb, task, opt, g);
+  } catch (const InputError& e) {
+    if (std::string(e.what()).find("max joint rate") != std::string::npos)
+      throw InputError(str("--max-joint-rate-deg: ", e.what()));
+    throw InputError(str("global run: ", e.what()));
+  } catch (const NumericalError& e) {
+    throw NumericalError(str("global run: ", e.what()));
+  }
+  const CaptureSetup setup = prepare_capture(pb, task, opt);
+  r.paper_objective = evaluate_capture(pb, setup, paper_run.base, paper_run.theta, objective).objective;
+  return r;
+}
+
+void add_global_json(nlohmann::json& j, const GlobalRun& g, const CaptureResult& base_run, const CaptureTask& task,
+                     const RunOptions& o) {
+  const GlobalCaptureResult& r = g.result;
+  nlohmann::json x = result_json(r.run, task, 0.0);
+  x.erase("gain");
+  x["objective"] = o.objective;
+  x["objective_value"] = r.objective;
+  x["manifold_optimum"] = r.manifold_optimum;
+  x["optimality_gap_percent"] = r.optimality_gap_percent;
+  x["shooting_iterations"] = r.shooting_iterations;
+  x["search"] = {{"method", r.search.method},
+                 {"starts", r.search.starts},
+                 {"evaluations", r.evaluations},
+                 {"multibody_evaluations", r.objective_evaluations},
+                 {"seconds", r.search_seconds}};
+  if (o.objective == "multibody-force") {
+    // the ranked local optima of M_ie at the reached base pose: how far the mass and force optima are apart
+    nlohmann::json ranked = nlohmann::json::array();
+    for (const ManifoldPoint& p : r.search.local_optima)
+      if (p.objective > 0) ranked.push_back({{"integrated_effective_mass", p.M_ie}, {"f_max_multibody", p.objective}});
+    x["search"]["ranked_local_optima"] = ranked;
+    x["f_max_multibody"] = r.objective;
+    j["optimized"]["f_max_multibody"] = g.paper_objective;
+  }
+  j["global"] = x;
+  j["global_mass_reduction_percent"] = 100.0 * (base_run.M_ie - r.run.M_ie) / base_run.M_ie;
+  j["global_force_reduction_percent"] =
+      100.0 * (base_run.f_max_closed_form - r.run.f_max_closed_form) / base_run.f_max_closed_form;
+  j["global_exact_force_reduction_percent"] = 100.0 * (base_run.f_max_exact - r.run.f_max_exact) / base_run.f_max_exact;
+}
+
+void print_global_notes(std::ostream& out, const GlobalRun& g, const CaptureResult& opt_run, const RunOptions& o) {
+  const GlobalCaptureResult& r = g.result;
+  const bool mb = o.objective == "multibody-force";
+  const double unit = mb || o.objective == "exact-force" ? 1e3 : 1.0;
+  const char* u = unit == 1.0 ? " kg" : " kN";
+  out << std::fixed << std::setprecision(3) << "global (" << o.objective << ", seed " << o.seed
+      << "): reached " << r.objective / unit << u << ", manifold optimum at the reached base pose "
+      << r.manifold_optimum / unit << u << " (gap " << r.optimality_gap_percent << " %), " << r.shooting_iterations
+      << " shooting iteration(s); search: " << r.search.method << ", " << r.search.starts << " starts, "
+      << r.evaluations << " evaluations" << (mb ? ", " + std::to_string(r.objective_evaluations) + " CVODE runs" : "")
+      << ", " << r.search_seconds << " s\n";
+  if (mb)
+    out << "CVODE multibody F_max: optimization " << g.paper_objective / 1e3 << " kN, global " << r.objective / 1e3
+        << " kN\n";
+  out << "largest joint rate: optimization " << opt_run.max_joint_rate * 180.0 / M_PI << " deg/s (not limited), global "
+      << r.run.max_joint_rate * 180.0 / M_PI << " deg/s ("
+      << (o.max_joint_rate_deg > 0 ? "limit " + std::to_string(o.max_joint_rate_deg) + " deg/s" : std::string("not limited"))
+      << ")\n";
+}
 
 int run_scenario(RunOptions o, const CLI::App& app, bool urdf_on_command_line) {
   // --- the scenario: a file, or the built-in default (the paper's 3-DOF robot) -----------------
@@ -206,9 +297,22 @@ int run_scenario(RunOptions o, const CLI::App& app, bool urdf_on_command_line) {
   if (o.duration <= 0) throw InputError(str("--duration: must be positive, got ", o.duration));
   if (o.step <= 0 || o.step > o.duration) throw InputError(str("--step: must be in (0, duration], got ", o.step));
   if (o.tolerance <= 0) throw InputError(str("--tolerance: must be positive, got ", o.tolerance));
+  // multibody-force has no gradient: the paper's method descends M_ie, the global search ranks by the CVODE peak
+  GlobalObjective gobj = GlobalObjective::Mass;
   if (o.objective == "mass") opt.objective = CaptureObjective::IntegratedEffectiveMass;
-  else if (o.objective == "exact-force") opt.objective = CaptureObjective::ExactMaxForce;
-  else throw InputError(str("--objective: unknown objective '", o.objective, "'; expected 'mass' or 'exact-force'"));
+  else if (o.objective == "exact-force") opt.objective = CaptureObjective::ExactMaxForce, gobj = GlobalObjective::ExactForce;
+  else if (o.objective == "multibody-force") gobj = GlobalObjective::MultibodyForce;
+  else throw InputError(str("--objective: unknown objective '", o.objective, "'; expected 'mass', 'exact-force' or 'multibody-force'"));
+  std::uint64_t seed = 0;
+  {
+    const std::string& sd = o.seed;
+    if (sd.empty() || sd.size() > 19 || sd.find_first_not_of("0123456789") != std::string::npos)
+      throw InputError(str("--seed: expected a non-negative integer (at most 19 digits), got '", sd, "'"));
+    seed = std::stoull(sd);
+  }
+  if (o.global_starts < 1) throw InputError(str("--global-starts: must be >= 1, got ", o.global_starts));
+  if (app.get_option("--max-joint-rate-deg")->count() > 0 && !(finite(o.max_joint_rate_deg, "max-joint-rate-deg") > 0))
+    throw InputError(str("--max-joint-rate-deg: must be positive, got ", o.max_joint_rate_deg));
   if (opt.gain != 0.0 && task.rows() >= model.n())
     throw InputError(str("--gain: the ", o.task, " task has ", task.rows(), " rows and the robot ", model.n(),
                          " joints: no null space to optimize in (set gain = 0 or constrain fewer axes)"));
@@ -235,6 +339,8 @@ int run_scenario(RunOptions o, const CLI::App& app, bool urdf_on_command_line) {
   const double mass_red = 100.0 * (base_run.M_ie - opt_run.M_ie) / base_run.M_ie;
   const double force_red = 100.0 * (base_run.f_max_closed_form - opt_run.f_max_closed_form) / base_run.f_max_closed_form;
   const double exact_red = 100.0 * (base_run.f_max_exact - opt_run.f_max_exact) / base_run.f_max_exact;
+  std::optional<GlobalRun> global;
+  if (o.global) global = run_global(pb, task, opt, gobj, seed, o, opt_run);
 
   // --- outputs: all built first, then written atomically ------------------------------------------
   nlohmann::json j;
@@ -274,6 +380,11 @@ int run_scenario(RunOptions o, const CLI::App& app, bool urdf_on_command_line) {
   j["mass_reduction_percent"] = mass_red;
   j["force_reduction_percent"] = force_red;
   j["exact_force_reduction_percent"] = exact_red;
+  j["scenario"]["global"] = o.global;
+  j["scenario"]["seed"] = o.seed;
+  j["scenario"]["max-joint-rate-deg"] = o.max_joint_rate_deg;
+  j["scenario"]["global-starts"] = o.global_starts;
+  if (global) add_global_json(j, *global, base_run, task, o);
 
   std::string csv;
   if (want_series) {
@@ -281,9 +392,11 @@ int run_scenario(RunOptions o, const CLI::App& app, bool urdf_on_command_line) {
     c << std::setprecision(12) << "run,t";
     for (const auto& name : model.joint_names()) c << "," << name << "_deg";
     c << ",base_x,base_y,base_z,base_qw,base_qx,base_qy,base_qz,ee_x,ee_y,ee_z,M_ie,F_max_estimate\n";
-    for (const auto* run : {&base_run, &opt_run}) {
+    std::vector<const CaptureResult*> runs{&base_run, &opt_run};
+    if (global) runs.push_back(&global->result.run);
+    for (const auto* run : runs) {
       for (const CaptureSample& s : run->series) {
-        c << (run == &base_run ? "baseline" : "optimized") << "," << s.t;
+        c << (run == &base_run ? "baseline" : run == &opt_run ? "optimized" : "global") << "," << s.t;
         for (Eigen::Index i = 0; i < s.theta.size(); ++i) c << "," << s.theta(i) * 180.0 / M_PI;
         const auto& q = s.base.orientation;
         c << "," << s.base.position.x() << "," << s.base.position.y() << "," << s.base.position.z() << "," << q.w()
@@ -313,8 +426,18 @@ int run_scenario(RunOptions o, const CLI::App& app, bool urdf_on_command_line) {
   };
   row("Without optimization", base_run);
   row("With optimization", opt_run);
-  out << std::left << std::setw(24 + w) << "Reduction" << std::right << std::fixed << std::setprecision(2)
-      << std::setw(10) << mass_red << "%" << std::setw(13) << force_red << "%" << std::setw(13) << exact_red << "%\n\n";
+  if (global) row("Global", global->result.run);
+  out << std::left << std::setw(24 + w) << "Reduction (optimization)" << std::right << std::fixed << std::setprecision(2)
+      << std::setw(10) << mass_red << "%" << std::setw(13) << force_red << "%" << std::setw(13) << exact_red << "%\n";
+  if (global) {
+    const CaptureResult& g = global->result.run;
+    out << std::left << std::setw(24 + w) << "Reduction (global)" << std::right << std::setw(10)
+        << 100.0 * (base_run.M_ie - g.M_ie) / base_run.M_ie << "%" << std::setw(13)
+        << 100.0 * (base_run.f_max_closed_form - g.f_max_closed_form) / base_run.f_max_closed_form << "%" << std::setw(13)
+        << 100.0 * (base_run.f_max_exact - g.f_max_exact) / base_run.f_max_exact << "%\n";
+    print_global_notes(out, *global, opt_run, o);
+  }
+  out << "\n";
   out << std::setprecision(4) << "capture point [" << base_run.capture_point.transpose().format(Eigen::IOFormat(4, 0, ", "))
       << "] m, approach velocity delta_dot^- = " << base_run.approach_velocity << " m/s\n"
       << "base drift: plain " << base_run.base_position_drift * 1e3 << " mm / "
@@ -375,7 +498,15 @@ void register_run(CLI::App& app, Action& action, int argc, char** argv) {
   app.add_option("--tolerance", o->tolerance, "Required capture-point accuracy, m");
   app.add_option("--orientation-tolerance-deg", o->orientation_tolerance_deg, "Pose task: required orientation accuracy, deg")
       ->capture_default_str();
-  app.add_option("--objective", o->objective, "mass (M_ie, the paper's) or exact-force")->capture_default_str();
+  app.add_option("--objective", o->objective,
+                 "mass (M_ie, the paper's), exact-force, or multibody-force (CVODE peak; global search only, the "
+                 "paper's method then descends M_ie)")
+      ->capture_default_str();
+  app.add_option("--global", o->global, "Also run the global capture optimization (true/false)")->capture_default_str();
+  app.add_option("--seed", o->seed, "Seed of the global search's random starts (non-negative integer)")->capture_default_str();
+  app.add_option("--max-joint-rate-deg", o->max_joint_rate_deg,
+                 "Global run: largest joint rate, deg/s (> 0; default: not limited; the paper's method is not limited)");
+  app.add_option("--global-starts", o->global_starts, "Global search: random starts (>= 1)")->capture_default_str();
   app.add_option("--json", o->json, "Write the result (with the resolved scenario and the version) to this JSON file");
   app.add_option("--csv", o->csv, "Write the time series of both runs to this CSV file");
   app.add_flag("--quiet", o->quiet, "No progress line");

@@ -71,7 +71,7 @@ struct ManifoldPoint {
 
 struct ManifoldSearchResult {
   ManifoldPoint best;
-  std::vector<ManifoldPoint> local_optima;  ///< distinct, sorted by M_ie
+  std::vector<ManifoldPoint> local_optima;  ///< distinct, sorted by M_ie (multibody-force: objective 0 = not ranked)
   std::string method;
   int starts = 0;             ///< starts drawn (plus extra starts given)
   int projected_starts = 0;   ///< starts that the projection put on the manifold
@@ -322,6 +322,7 @@ inline ManifoldSearchResult search_capture_manifold(const CaptureProblem& pb, co
         res.best = p;
       }
     }
+    for (size_t i = k; i < res.local_optima.size(); ++i) res.local_optima[i].objective = 0;  // not evaluated
   } else {
     res.best = evaluate_capture(pb, s, base, found.front().theta, so.objective);
     for (ManifoldPoint& p : res.local_optima)
