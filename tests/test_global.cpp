@@ -110,10 +110,11 @@ void check_run(const Shared& s, double bound_M_ie) {
                       << " gap " << g.optimality_gap_percent << " % iterations " << g.shooting_iterations);
   CHECK(g.run.M_ie <= bound_M_ie);
   CHECK(g.run.M_ie <= s.paper.M_ie);              // never worse than the paper's method
+  CHECK(g.reached_manifold_optimum);
   CHECK(g.optimality_gap_percent <= 1.0);
   CHECK(g.optimality_gap_percent >= -1e-6);       // the optimum is the best the search knows, the reached point among the starts
   CHECK(g.shooting_iterations >= 1);
-  CHECK(g.shooting_iterations <= 8);
+  CHECK(g.shooting_iterations <= 8 * g.goals_tried);
   CHECK(g.run.tracking_error <= s.opt.tolerance);
   CHECK(g.run.max_joint_rate <= kRate * (1 + 1e-9));  // the limit of the scenario
   // zero total momentum along the run (relative to the bodies' own momenta) and a still centre of mass
@@ -304,7 +305,10 @@ TEST_CASE("ffsr-optimize: the global row and its JSON keys (7-DOF pose scenario)
   CHECK(g["tracking_error"].get<double>() <= 1e-3);
   CHECK(g["orientation_error_deg"].get<double>() <= 0.5);
   CHECK(g["max_joint_rate_deg"].get<double>() <= 3.0 + 1e-9);
-  CHECK(g["optimality_gap_percent"].get<double>() <= 1.0);
+  // on the 1-D self-motion manifold of the pose task the optimum may lie on a component the arm cannot
+  // reach; the result says so, and the gap is then the honest distance to it
+  if (g["reached_manifold_optimum"].get<bool>()) CHECK(g["optimality_gap_percent"].get<double>() <= 1.0);
+  CHECK(g["optimality_gap_percent"].get<double>() >= -1e-6);
 }
 
 TEST_CASE("ffsr-optimize: bad global inputs give one error line naming the key", "[global][cli]") {

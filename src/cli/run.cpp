@@ -170,12 +170,13 @@ void add_global_json(nlohmann::json& j, const GlobalRun& g, const CaptureResult&
                      const RunOptions& o) {
   const GlobalCaptureResult& r = g.result;
   nlohmann::json x = result_json(r.run, task, 0.0);
-  x.erase("gain");
   x["objective"] = o.objective;
   x["objective_value"] = r.objective;
   x["manifold_optimum"] = r.manifold_optimum;
   x["optimality_gap_percent"] = r.optimality_gap_percent;
   x["shooting_iterations"] = r.shooting_iterations;
+  x["goals_tried"] = r.goals_tried;
+  x["reached_manifold_optimum"] = r.reached_manifold_optimum;
   x["search"] = {{"method", r.search.method},
                  {"starts", r.search.starts},
                  {"evaluations", r.evaluations},
@@ -205,9 +206,12 @@ void print_global_notes(std::ostream& out, const GlobalRun& g, const CaptureResu
   out << std::fixed << std::setprecision(3) << "global (" << o.objective << ", seed " << o.seed
       << "): reached " << r.objective / unit << u << ", manifold optimum at the reached base pose "
       << r.manifold_optimum / unit << u << " (gap " << r.optimality_gap_percent << " %), " << r.shooting_iterations
-      << " shooting iteration(s); search: " << r.search.method << ", " << r.search.starts << " starts, "
+      << " reaching run(s), " << r.goals_tried << " goal(s) tried; search: " << r.search.method << ", " << r.search.starts << " starts, "
       << r.evaluations << " evaluations" << (mb ? ", " + std::to_string(r.objective_evaluations) + " CVODE runs" : "")
       << ", " << r.search_seconds << " s\n";
+  if (!r.reached_manifold_optimum)
+    out << "note: the better optima at the reached base pose lie on other components of the self-motion manifold; "
+           "the servo reached none of them\n";
   if (mb)
     out << "CVODE multibody F_max: optimization " << g.paper_objective / 1e3 << " kN, global " << r.objective / 1e3
         << " kN\n";

@@ -224,20 +224,37 @@ inline ManifoldPoint evaluate_capture(const CaptureProblem& pb, const CaptureSet
 /// this file). `extra_starts` are tried first (projected like the random ones). Throws InputError
 /// for bad options or when no start can be put on the manifold (the capture point is out of reach
 /// from this base pose). Deterministic for a given seed.
+namespace detail {
+/// search_capture_manifold with `random_starts` random starts (0: the extra starts only, the local
+/// optima near them). Does not check the options.
+inline ManifoldSearchResult search_manifold(const CaptureProblem& pb, const CaptureTask& task, const CaptureSetup& s,
+                                            const BasePose& base, const ManifoldSearchOptions& so,
+                                            const std::vector<Eigen::VectorXd>& extra_starts, int random_starts);
+}  // namespace detail
+
 inline ManifoldSearchResult search_capture_manifold(const CaptureProblem& pb, const CaptureTask& task,
                                                     const CaptureSetup& s, const BasePose& base,
                                                     const ManifoldSearchOptions& so,
                                                     const std::vector<Eigen::VectorXd>& extra_starts = {}) {
   using detail::str;
-  const auto t0 = std::chrono::steady_clock::now();
   if (!pb.model) throw InputError("search_capture_manifold: no model");
-  const Model& model = *pb.model;
-  const int n = model.n();
-  detail::check_configuration(model, base, pb.theta, "search_capture_manifold");
+  detail::check_configuration(*pb.model, base, pb.theta, "search_capture_manifold");
   if (so.starts < 1) throw InputError(str("search_capture_manifold: starts must be >= 1, got ", so.starts));
   if (!(so.constraint_tolerance > 0)) throw InputError("search_capture_manifold: constraint tolerance must be positive");
   if (so.max_local_evaluations < 1) throw InputError("search_capture_manifold: max_local_evaluations must be >= 1");
   if (so.max_ranked < 1) throw InputError("search_capture_manifold: max_ranked must be >= 1");
+  return detail::search_manifold(pb, task, s, base, so, extra_starts, so.starts);
+}
+
+inline ManifoldSearchResult detail::search_manifold(const CaptureProblem& pb, const CaptureTask& task,
+                                                    const CaptureSetup& s, const BasePose& base,
+                                                    const ManifoldSearchOptions& so,
+                                                    const std::vector<Eigen::VectorXd>& extra_starts,
+                                                    int random_starts) {
+  using detail::str;
+  const auto t0 = std::chrono::steady_clock::now();
+  const Model& model = *pb.model;
+  const int n = model.n();
   Data data(model);
   ManifoldSearchResult res;
   res.method = so.objective == GlobalObjective::MultibodyForce
@@ -245,7 +262,7 @@ inline ManifoldSearchResult search_capture_manifold(const CaptureProblem& pb, co
                    : "multistart NLopt SLSQP";
   std::mt19937_64 rng(so.seed);
   std::vector<Eigen::VectorXd> starts = extra_starts;
-  for (int i = 0; i < so.starts; ++i) {
+  for (int i = 0; i < random_starts; ++i) {
     Eigen::VectorXd q(n);
     for (int k = 0; k < n; ++k) {
       const Joint& j = model.body(k + 1).joint;
@@ -334,7 +351,8 @@ inline ManifoldSearchResult search_capture_manifold(const CaptureProblem& pb, co
 
 struct GlobalCaptureOptions {
   ManifoldSearchOptions search;
-  int max_iterations = 8;      ///< shooting iterations (plan + search) before a NumericalError
+  int max_iterations = 8;      ///< shooting iterations per goal before the goal is given up
+  int max_goals = 6;           ///< local optima tried as goals, best first
   double gap_percent = 1.0;    ///< required (reached - optimum) / optimum at the reached base pose, %
   std::vector<Eigen::VectorXd> extra_starts;  ///< e.g. the paper's method's capture configuration
 };
@@ -345,29 +363,40 @@ struct GlobalCaptureResult {
   double objective = 0;              ///< objective at the reached capture configuration
   double manifold_optimum = 0;       ///< objective at the optimum of C(reached base pose)
   double optimality_gap_percent = 0; ///< 100 (objective - manifold_optimum) / manifold_optimum
-  int shooting_iterations = 0;
+  /// false: no better optimum than the one reached could be reached (it lies on another component
+  /// of the self-motion manifold: the servo ended elsewhere); the gap then exceeds gap_percent
+  bool reached_manifold_optimum = true;
+  int shooting_iterations = 0;       ///< reaching runs over every goal tried
+  int goals_tried = 0;
   long evaluations = 0;              ///< over every search
   long objective_evaluations = 0;    ///< multibody simulations over every search
   double search_seconds = 0;         ///< over every search
 };
 
-/// Global capture planning (see the top of this file): search, plan the reaching run, search again
-/// at the reached base pose, until the reached objective is within gap_percent of the optimum there.
-/// opt.gain is not used; opt.max_joint_rate limits the joint rates (0: not limited). Throws
-/// InputError for bad arguments (as plan_capture, plus a rate limit below what the task alone
-/// needs), NumericalError when the reaching run fails or the gap does not close.
+/// Global capture planning (see the top of this file). Goals are the local optima of the search at
+/// the base pose of the task-only run, best first. For each goal: plan the reaching run, re-optimize
+/// the goal locally at the reached base pose, repeat until the reached objective is within
+/// gap_percent of that local optimum (the goal is then reached) or the run ends away from it (the
+/// goal lies on another component of the self-motion manifold: next goal). A reached goal is checked
+/// against a full search at the reached base pose: within gap_percent of its optimum, done.
+/// Otherwise the best reached goal is returned with reached_manifold_optimum = false and the gap
+/// as measured. opt.gain is not used; opt.max_joint_rate limits the joint rates (0: not limited).
+/// Throws InputError for bad arguments (as plan_capture, plus a rate limit below what the task alone
+/// needs), NumericalError when a run fails the checks of integrate_capture or no goal is reached.
 inline GlobalCaptureResult plan_capture_global(const CaptureProblem& pb, const CaptureTask& task,
                                                const CaptureOptions& opt, const GlobalCaptureOptions& g) {
   using detail::str;
   const char* where = "plan_capture_global";
   CaptureOptions o = opt;
   o.gain = 0.0;
+  o.progress = nullptr;
   const CaptureSetup setup = prepare_capture(pb, task, o, where);
   if (g.max_iterations < 1) throw InputError(str(where, ": max_iterations must be >= 1"));
+  if (g.max_goals < 1) throw InputError(str(where, ": max_goals must be >= 1"));
   if (!(g.gap_percent > 0)) throw InputError(str(where, ": gap_percent must be positive"));
+  const Model& model = *pb.model;
   CaptureOptions quiet = o;
   quiet.record_series = false;
-  quiet.progress = nullptr;
 
   // the task alone (no null-space motion): a first base pose at T, and the rate it needs
   ServoPolicy none;
@@ -377,44 +406,84 @@ inline GlobalCaptureResult plan_capture_global(const CaptureProblem& pb, const C
                          " deg/s is below what the task alone needs (", plain.max_joint_rate * 180 / M_PI, " deg/s)"));
 
   GlobalCaptureResult res;
+  auto account = [&](const ManifoldSearchResult& sr) {
+    res.evaluations += sr.evaluations;
+    res.objective_evaluations += sr.objective_evaluations;
+    res.search_seconds += sr.seconds;
+  };
   std::vector<Eigen::VectorXd> extra = g.extra_starts;
   extra.push_back(plain.theta);
-  ManifoldSearchResult search = search_capture_manifold(pb, task, setup, plain.base, g.search, extra);
-  res.evaluations += search.evaluations;
-  res.objective_evaluations += search.objective_evaluations;
-  res.search_seconds += search.seconds;
-  Eigen::VectorXd goal = search.best.theta;
-  double last_gap = 0;
-  for (int it = 1; it <= g.max_iterations; ++it) {
-    ServoPolicy servo;
-    servo.theta_goal = goal;
-    CaptureOptions run_opt = quiet;
-    run_opt.record_series = opt.record_series;
-    CaptureResult run = integrate_capture(pb, task, run_opt, setup, servo, where);
-    std::vector<Eigen::VectorXd> ex = g.extra_starts;
-    ex.push_back(goal);
-    ex.push_back(run.theta);
-    search = search_capture_manifold(pb, task, setup, run.base, g.search, ex);
-    res.evaluations += search.evaluations;
-    res.objective_evaluations += search.objective_evaluations;
-    res.search_seconds += search.seconds;
-    const ManifoldPoint reached = evaluate_capture(pb, setup, run.base, run.theta, g.search.objective, g.search.multibody);
-    if (g.search.objective == GlobalObjective::MultibodyForce) ++res.objective_evaluations;
-    last_gap = 100.0 * (reached.objective - search.best.objective) / search.best.objective;
-    if (!std::isfinite(last_gap)) throw NumericalError(str(where, ": the optimality gap is not finite"));
-    if (last_gap <= g.gap_percent) {
-      res.run = std::move(run);
-      res.search = std::move(search);
-      res.objective = reached.objective;
-      res.manifold_optimum = res.search.best.objective;
-      res.optimality_gap_percent = last_gap;
-      res.shooting_iterations = it;
-      return res;
+  const ManifoldSearchResult first = search_capture_manifold(pb, task, setup, plain.base, g.search, extra);
+  account(first);
+  std::vector<ManifoldPoint> goals;
+  for (const ManifoldPoint& p : first.local_optima)
+    if (p.objective > 0) goals.push_back(p);  // multibody-force: the ranked ones
+  std::stable_sort(goals.begin(), goals.end(),
+                   [](const ManifoldPoint& a, const ManifoldPoint& b) { return a.objective < b.objective; });
+  if (goals.size() > static_cast<size_t>(g.max_goals)) goals.resize(static_cast<size_t>(g.max_goals));
+
+  std::optional<GlobalCaptureResult> fallback;
+  double last_gap = std::numeric_limits<double>::infinity();
+  for (const ManifoldPoint& target_goal : goals) {
+    ++res.goals_tried;
+    Eigen::VectorXd goal = target_goal.theta;
+    for (int it = 1; it <= g.max_iterations; ++it) {
+      ServoPolicy servo;
+      servo.theta_goal = goal;
+      CaptureOptions run_opt = quiet;
+      run_opt.record_series = opt.record_series;
+      CaptureResult run = integrate_capture(pb, task, run_opt, setup, servo, where);
+      ++res.shooting_iterations;
+      const ManifoldPoint reached = evaluate_capture(pb, setup, run.base, run.theta, g.search.objective, g.search.multibody);
+      if (g.search.objective == GlobalObjective::MultibodyForce) ++res.objective_evaluations;
+      // the goal re-optimized locally at the reached base pose
+      ManifoldSearchResult local;
+      try {
+        local = detail::search_manifold(pb, task, setup, run.base, g.search, {goal}, 0);
+      } catch (const InputError&) {
+        break;  // the goal cannot be put on the manifold at this base pose
+      }
+      account(local);
+      // ended elsewhere: more than 0.5 rad from it on some joint (the servo leaves ~e^-10 of the error; the
+      // rest is the move of the manifold with the base pose, small against the distance between components)
+      if (detail::configuration_distance(model, run.theta, local.best.theta) > 0.5) break;
+      const double local_gap = 100.0 * (reached.objective - local.best.objective) / local.best.objective;
+      if (!std::isfinite(local_gap)) throw NumericalError(str(where, ": the optimality gap is not finite"));
+      if (local_gap > g.gap_percent) {
+        goal = local.best.theta;
+        continue;
+      }
+      // the goal is reached: compare with the whole manifold at the reached base pose
+      std::vector<Eigen::VectorXd> ex = g.extra_starts;
+      ex.push_back(goal);
+      ex.push_back(run.theta);
+      ManifoldSearchResult full = search_capture_manifold(pb, task, setup, run.base, g.search, ex);
+      account(full);
+      const double gap = 100.0 * (reached.objective - full.best.objective) / full.best.objective;
+      last_gap = std::min(last_gap, gap);
+      GlobalCaptureResult r = res;
+      r.run = std::move(run);
+      r.search = std::move(full);
+      r.objective = reached.objective;
+      r.manifold_optimum = r.search.best.objective;
+      r.optimality_gap_percent = gap;
+      r.reached_manifold_optimum = gap <= g.gap_percent;
+      if (r.reached_manifold_optimum) return r;
+      if (!fallback || r.objective < fallback->objective) fallback = std::move(r);
+      break;
     }
-    goal = search.best.theta;
   }
-  throw NumericalError(str(where, ": the reached capture configuration is still ", last_gap,
-                           " % above the manifold optimum after ", g.max_iterations, " shooting iterations"));
+  if (fallback) {
+    // the counters of every goal tried, the run of the best reached one
+    fallback->shooting_iterations = res.shooting_iterations;
+    fallback->goals_tried = res.goals_tried;
+    fallback->evaluations = res.evaluations;
+    fallback->objective_evaluations = res.objective_evaluations;
+    fallback->search_seconds = res.search_seconds;
+    return *fallback;
+  }
+  throw NumericalError(str(where, ": no capture configuration chosen by the search was reached (", res.goals_tried,
+                           " goals, ", res.shooting_iterations, " reaching runs)"));
 }
 
 }  // namespace ffsr
