@@ -418,9 +418,20 @@ inline GlobalCaptureResult plan_capture_global(const CaptureProblem& pb, const C
   std::vector<ManifoldPoint> goals;
   for (const ManifoldPoint& p : first.local_optima)
     if (p.objective > 0) goals.push_back(p);  // multibody-force: the ranked ones
-  std::stable_sort(goals.begin(), goals.end(),
-                   [](const ManifoldPoint& a, const ManifoldPoint& b) { return a.objective < b.objective; });
+  auto by_objective = [](const ManifoldPoint& a, const ManifoldPoint& b) { return a.objective < b.objective; };
+  std::stable_sort(goals.begin(), goals.end(), by_objective);
   if (goals.size() > static_cast<size_t>(g.max_goals)) goals.resize(static_cast<size_t>(g.max_goals));
+  // and the local optima next to the extra starts and to the task-only run's configuration: on the
+  // component of the self-motion manifold the arm is on, so reachable when the better ones are not
+  for (const Eigen::VectorXd& x : extra) {
+    try {
+      const ManifoldSearchResult near = detail::search_manifold(pb, task, setup, plain.base, g.search, {x}, 0);
+      account(near);
+      goals.push_back(near.best);
+    } catch (const InputError&) {
+    }
+  }
+  std::stable_sort(goals.begin(), goals.end(), by_objective);
 
   std::optional<GlobalCaptureResult> fallback;
   double last_gap = std::numeric_limits<double>::infinity();
