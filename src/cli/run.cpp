@@ -113,22 +113,6 @@ nlohmann::json result_json(const CaptureResult& r, const CaptureTask& task, doub
           {"steps", r.steps}};
 }
 
-/// Progress on a terminal for runs longer than a second.
-struct Progress {
-  std::string label;
-  std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
-  bool shown = false;
-  bool enabled = isatty(fileno(stderr)) != 0;
-  void operator()(double fraction) {
-    if (!enabled) return;
-    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    if (s < 1.0 && !shown) return;
-    shown = true;
-    std::fprintf(stderr, "\rffsr-optimize: %s run %3.0f%%", label.c_str(), fraction * 100.0);
-    if (fraction >= 1.0) std::fprintf(stderr, "\n");
-  }
-};
-
 /// Which keys came from the command line: they are not resolved against the scenario's folder.
 struct FromCommandLine {
   bool urdf = false, expect = false;
