@@ -4,6 +4,7 @@
 #include "baseline.hpp"
 #include "common.hpp"
 #include "embedded.hpp"
+#include "scenario.hpp"
 #include "subcommands.hpp"
 
 #include "ffsr/io/urdf.hpp"
@@ -24,24 +25,6 @@ namespace {
 
 using detail::str;
 
-struct RunOptions {
-  std::string config;
-  std::string urdf, end_effector;
-  std::vector<double> joints_deg, base_position{0, 0, 0}, base_rpy_deg{0, 0, 0};
-  double target_mass = 0;
-  std::vector<double> target_inertia, target_position, target_rpy_deg{0, 0, 0}, target_angular_velocity_deg,
-      target_velocity{0, 0, 0}, contact_offset, normal;
-  std::string model;
-  double stiffness = 0, exponent = 0, restitution = 0, approach_speed = 0;
-  std::string task, task_axes = "xyz", baseline_task;
-  std::vector<double> final_rpy_deg;
-  double duration = 0, step = 0, gain = 0, feedback = 1.0, tolerance = 0, orientation_tolerance_deg = 0.5;
-  std::string objective = "mass";
-  std::string json, csv;
-  std::string expect;  ///< a stored result to compare with (regression run)
-  double rtol = 1e-6, atol = 1e-9;
-  bool quiet = false;
-};
 
 /// Keys a scenario file must name (the others have defaults).
 const char* const kRequired[] = {"urdf", "joints-deg", "target-mass", "target-inertia", "target-position",
@@ -113,6 +96,7 @@ nlohmann::json result_json(const CaptureResult& r, const CaptureTask& task, doub
           {"steps", r.steps}};
 }
 
+
 /// Which keys came from the command line: they are not resolved against the scenario's folder.
 struct FromCommandLine {
   bool urdf = false, expect = false;
@@ -122,8 +106,9 @@ struct FromCommandLine {
 /// scenario holds paths that differ between machines; the version changes with every release).
 const std::vector<std::string> kNotCompared = {"version", "scenario"};
 
-int run_scenario(RunOptions o, const CLI::App& app, FromCommandLine cli) {
-  const bool urdf_on_command_line = cli.urdf;
+}  // namespace
+
+Scenario prepare_scenario(RunOptions o, const CLI::App& app, bool urdf_on_command_line) {
   // --- the scenario: a file, or the built-in default (the paper's 3-DOF robot) -----------------
   const bool builtin = o.config.empty();
   const std::string where = builtin ? std::string("built-in scenario") : "scenario " + o.config;
@@ -138,24 +123,13 @@ int run_scenario(RunOptions o, const CLI::App& app, FromCommandLine cli) {
     const size_t slash = o.config.find_last_of('/');
     return slash == std::string::npos ? path : o.config.substr(0, slash + 1) + path;
   };
-  // outputs and baseline first: a conflict or an unreadable baseline is found before the work
-  Outputs outputs;
-  outputs.add("--json", o.json);
-  outputs.add("--csv", o.csv);
-  nlohmann::json expected;
-  Tolerance tol{o.rtol, o.atol};
-  if (!std::isfinite(o.rtol) || o.rtol < 0) throw InputError(str("--rtol: must be finite and >= 0, got ", o.rtol));
-  if (!std::isfinite(o.atol) || o.atol < 0) throw InputError(str("--atol: must be finite and >= 0, got ", o.atol));
-  if (!o.expect.empty()) {
-    o.expect = next_to_config(o.expect, cli.expect);
-    expected = load_baseline(o.expect, "--expect");
-  }
-  Model model = [&] {
+  auto model_ptr = std::make_unique<Model>([&] {
     if (builtin && !urdf_on_command_line && o.urdf == "paper_3dof.urdf")
       return model_from_urdf_string(kPaper3dofUrdf, "built-in paper_3dof.urdf", o.end_effector);
     o.urdf = next_to_config(o.urdf, urdf_on_command_line);
     return model_from_urdf_file(o.urdf, o.end_effector);
-  }();
+  }());
+  const Model& model = *model_ptr;
 
   CaptureProblem pb;
   pb.model = &model;
@@ -222,14 +196,17 @@ int run_scenario(RunOptions o, const CLI::App& app, FromCommandLine cli) {
   if (opt.gain != 0.0 && task.rows() >= model.n())
     throw InputError(str("--gain: the ", o.task, " task has ", task.rows(), " rows and the robot ", model.n(),
                          " joints: no null space to optimize in (set gain = 0 or constrain fewer axes)"));
-  const bool want_series = !o.csv.empty();
-  opt.record_series = want_series;
+  Scenario sc{std::move(o), where, builtin, std::move(model_ptr), pb, task, baseline_task, opt};
+  sc.problem.model = sc.model.get();
+  return sc;
+}
 
-  // --- the two runs ------------------------------------------------------------------------------
+std::pair<CaptureResult, CaptureResult> plan_plain_and_optimized(const Scenario& sc, bool quiet) {
+  CaptureOptions opt = sc.capture;
   CaptureOptions plain = opt;
   plain.gain = 0.0;
   Progress p1{"plain"}, p2{"optimized"};
-  if (!o.quiet) {
+  if (!quiet) {
     plain.progress = std::ref(p1);
     opt.progress = std::ref(p2);
   }
@@ -240,8 +217,48 @@ int run_scenario(RunOptions o, const CLI::App& app, FromCommandLine cli) {
       throw NumericalError(str(label, " run: ", e.what()));
     }
   };
-  const CaptureResult base_run = labelled("plain", [&] { return plan_capture(pb, baseline_task, plain); });
-  const CaptureResult opt_run = labelled("optimized", [&] { return plan_capture(pb, task, opt); });
+  CaptureResult base_run = labelled("plain", [&] { return plan_capture(sc.problem, sc.baseline_task, plain); });
+  CaptureResult opt_run = labelled("optimized", [&] { return plan_capture(sc.problem, sc.task, opt); });
+  return {std::move(base_run), std::move(opt_run)};
+}
+
+namespace {
+
+int run_scenario(RunOptions options, const CLI::App& app, FromCommandLine cli) {
+  const bool expect_builtin = options.config.empty();
+  const std::string config_path = options.config;
+  // a path in a scenario file is relative to the file
+  auto next_to_config = [&](const std::string& path, bool on_command_line) {
+    if (expect_builtin || on_command_line || path.empty() || path.front() == '/') return path;
+    const size_t slash = config_path.find_last_of('/');
+    return slash == std::string::npos ? path : config_path.substr(0, slash + 1) + path;
+  };
+  Scenario sc = prepare_scenario(std::move(options), app, cli.urdf);
+  RunOptions& o = sc.options;
+  // outputs and baseline first: a conflict or an unreadable baseline is found before the work
+  Outputs outputs;
+  outputs.add("--json", o.json);
+  outputs.add("--csv", o.csv);
+  nlohmann::json expected;
+  Tolerance tol{o.rtol, o.atol};
+  if (!std::isfinite(o.rtol) || o.rtol < 0) throw InputError(str("--rtol: must be finite and >= 0, got ", o.rtol));
+  if (!std::isfinite(o.atol) || o.atol < 0) throw InputError(str("--atol: must be finite and >= 0, got ", o.atol));
+  if (!o.expect.empty()) {
+    o.expect = next_to_config(o.expect, cli.expect);
+    expected = load_baseline(o.expect, "--expect");
+  }
+  const Model& model = *sc.model;
+  const CaptureProblem& pb = sc.problem;
+  const CaptureTask& task = sc.task;
+  const CaptureTask& baseline_task = sc.baseline_task;
+  const CaptureOptions& opt = sc.capture;
+  const bool builtin = sc.builtin;
+  const std::string& where = sc.where;
+  const bool want_series = !o.csv.empty();
+  sc.capture.record_series = want_series;
+
+  // --- the two runs ------------------------------------------------------------------------------
+  const auto [base_run, opt_run] = plan_plain_and_optimized(sc, o.quiet);
   const double mass_red = 100.0 * (base_run.M_ie - opt_run.M_ie) / base_run.M_ie;
   const double force_red = 100.0 * (base_run.f_max_closed_form - opt_run.f_max_closed_form) / base_run.f_max_closed_form;
   const double exact_red = 100.0 * (base_run.f_max_exact - opt_run.f_max_exact) / base_run.f_max_exact;
@@ -353,6 +370,42 @@ int run_scenario(RunOptions o, const CLI::App& app, FromCommandLine cli) {
 
 }  // namespace
 
+void add_scenario_options(CLI::App& app, RunOptions& o) {
+  auto vec = [&](const char* name, std::vector<double>& v, const char* help) {
+    return app.add_option(name, v, help)->delimiter(',')->allow_extra_args(false);
+  };
+  app.add_option("--urdf", o.urdf, "Robot URDF (relative to the scenario file)");
+  app.add_option("--end-effector", o.end_effector, "End-effector frame (default: the single leaf link)");
+  vec("--joints-deg", o.joints_deg, "Initial joint angles, deg");
+  vec("--base-position", o.base_position, "Initial base position, m");
+  vec("--base-rpy-deg", o.base_rpy_deg, "Initial base attitude (roll, pitch, yaw), deg");
+  app.add_option("--target-mass", o.target_mass, "Target mass, kg");
+  vec("--target-inertia", o.target_inertia, "Target inertia: Ixx,Iyy,Izz[,Ixy,Ixz,Iyz], kg m^2 (target frame)");
+  vec("--target-position", o.target_position, "Target centre of mass at t = 0, m");
+  vec("--target-rpy-deg", o.target_rpy_deg, "Target attitude at t = 0, deg");
+  vec("--target-angular-velocity-deg", o.target_angular_velocity_deg, "Target spin (target frame), deg/s");
+  vec("--target-velocity", o.target_velocity, "Target linear velocity, m/s");
+  vec("--contact-offset", o.contact_offset, "r_tp: contact point from the target centre of mass (target frame), m");
+  vec("--normal", o.normal, "u_n: contact normal (target frame)");
+  app.add_option("--model", o.model, "Hysteresis damping law (Table 1)");
+  app.add_option("--stiffness", o.stiffness, "K, N/m^alpha");
+  app.add_option("--exponent", o.exponent, "alpha");
+  app.add_option("--restitution", o.restitution, "c_r, 0 < c_r <= 1");
+  app.add_option("--approach-speed", o.approach_speed, "End-effector speed along the normal at the capture, m/s");
+  app.add_option("--task", o.task, "Optimized run's task: position or pose");
+  app.add_option("--task-axes", o.task_axes, "Position task: constrained inertial axes, e.g. xy")->capture_default_str();
+  app.add_option("--baseline-task", o.baseline_task, "Plain run's task (default: the optimized run's)");
+  vec("--final-rpy-deg", o.final_rpy_deg, "Pose task: final end-effector orientation (default: hold the initial)");
+  app.add_option("--duration", o.duration, "Task time T, s");
+  app.add_option("--step", o.step, "RK4 step, s");
+  app.add_option("--gain", o.gain, "rho of Eq. 30 (< 0 lowers the objective)");
+  app.add_option("--feedback", o.feedback, "Tracking feedback gain, 1/s")->capture_default_str();
+  app.add_option("--tolerance", o.tolerance, "Required capture-point accuracy, m");
+  app.add_option("--orientation-tolerance-deg", o.orientation_tolerance_deg, "Pose task: required orientation accuracy, deg")
+      ->capture_default_str();
+  app.add_option("--objective", o.objective, "mass (M_ie, the paper's) or exact-force")->capture_default_str();
+}
+
 void register_run(CLI::App& app, Action& action, int argc, char** argv) {
   auto o = std::make_shared<RunOptions>();
   FromCommandLine from_cli;
@@ -360,44 +413,13 @@ void register_run(CLI::App& app, Action& action, int argc, char** argv) {
     const std::string a = argv[i];
     if (a == "--urdf" || a.rfind("--urdf=", 0) == 0) from_cli.urdf = true;
     if (a == "--expect" || a.rfind("--expect=", 0) == 0) from_cli.expect = true;
-    if (a == "inspect" || a == "contact") break;
+    if (a == "inspect" || a == "contact" || a == "robust") break;
   }
   app.set_config("--config", "", "Scenario file (TOML); every key is also a flag. Default: the built-in paper 3-DOF scenario");
+  app.config_formatter(std::make_shared<ScenarioConfig>());  // [uncertainty] is the robust command's
   app.get_config_ptr()->check(CLI::ExistingFile);
   app.allow_config_extras(CLI::config_extras_mode::error);  // an unknown key in a scenario is an error
-  auto vec = [&](const char* name, std::vector<double>& v, const char* help) {
-    return app.add_option(name, v, help)->delimiter(',')->allow_extra_args(false);
-  };
-  app.add_option("--urdf", o->urdf, "Robot URDF (relative to the scenario file)");
-  app.add_option("--end-effector", o->end_effector, "End-effector frame (default: the single leaf link)");
-  vec("--joints-deg", o->joints_deg, "Initial joint angles, deg");
-  vec("--base-position", o->base_position, "Initial base position, m");
-  vec("--base-rpy-deg", o->base_rpy_deg, "Initial base attitude (roll, pitch, yaw), deg");
-  app.add_option("--target-mass", o->target_mass, "Target mass, kg");
-  vec("--target-inertia", o->target_inertia, "Target inertia: Ixx,Iyy,Izz[,Ixy,Ixz,Iyz], kg m^2 (target frame)");
-  vec("--target-position", o->target_position, "Target centre of mass at t = 0, m");
-  vec("--target-rpy-deg", o->target_rpy_deg, "Target attitude at t = 0, deg");
-  vec("--target-angular-velocity-deg", o->target_angular_velocity_deg, "Target spin (target frame), deg/s");
-  vec("--target-velocity", o->target_velocity, "Target linear velocity, m/s");
-  vec("--contact-offset", o->contact_offset, "r_tp: contact point from the target centre of mass (target frame), m");
-  vec("--normal", o->normal, "u_n: contact normal (target frame)");
-  app.add_option("--model", o->model, "Hysteresis damping law (Table 1)");
-  app.add_option("--stiffness", o->stiffness, "K, N/m^alpha");
-  app.add_option("--exponent", o->exponent, "alpha");
-  app.add_option("--restitution", o->restitution, "c_r, 0 < c_r <= 1");
-  app.add_option("--approach-speed", o->approach_speed, "End-effector speed along the normal at the capture, m/s");
-  app.add_option("--task", o->task, "Optimized run's task: position or pose");
-  app.add_option("--task-axes", o->task_axes, "Position task: constrained inertial axes, e.g. xy")->capture_default_str();
-  app.add_option("--baseline-task", o->baseline_task, "Plain run's task (default: the optimized run's)");
-  vec("--final-rpy-deg", o->final_rpy_deg, "Pose task: final end-effector orientation (default: hold the initial)");
-  app.add_option("--duration", o->duration, "Task time T, s");
-  app.add_option("--step", o->step, "RK4 step, s");
-  app.add_option("--gain", o->gain, "rho of Eq. 30 (< 0 lowers the objective)");
-  app.add_option("--feedback", o->feedback, "Tracking feedback gain, 1/s")->capture_default_str();
-  app.add_option("--tolerance", o->tolerance, "Required capture-point accuracy, m");
-  app.add_option("--orientation-tolerance-deg", o->orientation_tolerance_deg, "Pose task: required orientation accuracy, deg")
-      ->capture_default_str();
-  app.add_option("--objective", o->objective, "mass (M_ie, the paper's) or exact-force")->capture_default_str();
+  add_scenario_options(app, *o);
   app.add_option("--json", o->json,
                  "Write the result (with the resolved scenario and the version) to this JSON file ('-': standard output)");
   app.add_option("--csv", o->csv, "Write the time series of both runs to this CSV file ('-': standard output)");
