@@ -356,8 +356,8 @@ void flush_stdout() {
   }
 }
 
-Progress::Progress(std::string label_, bool quiet)
-    : label(std::move(label_)), start(std::chrono::steady_clock::now()), enabled(!quiet && isatty(fileno(stderr)) != 0) {}
+Progress::Progress(std::string label_, bool quiet, std::string unit_)
+    : label(std::move(label_)), unit(std::move(unit_)), start(std::chrono::steady_clock::now()), enabled(!quiet && isatty(fileno(stderr)) != 0) {}
 
 void Progress::operator()(double fraction) {
   if (!enabled) return;
@@ -375,8 +375,8 @@ void Progress::operator()(unsigned long long done, unsigned long long total) {
   shown = true;
   const double rate = s > 0 ? static_cast<double>(done) / s : 0.0;
   const double left = rate > 0 ? static_cast<double>(total - done) / rate : 0.0;
-  std::fprintf(stderr, "\rffsr-optimize: %s %llu/%llu points (%3.0f%%), %.3g points/s, %.0f s left   ", label.c_str(),
-               done, total, total ? 100.0 * static_cast<double>(done) / static_cast<double>(total) : 100.0, rate, left);
+  std::fprintf(stderr, "\rffsr-optimize: %s %llu/%llu %s (%3.0f%%), %.3g %s/s, %.0f s left   ", label.c_str(),
+               done, total, unit.c_str(), total ? 100.0 * static_cast<double>(done) / static_cast<double>(total) : 100.0, rate, unit.c_str(), left);
   if (done >= total) std::fprintf(stderr, "\n");
 }
 

@@ -137,14 +137,14 @@ void flush_stdout();
 /// A progress line on stderr when it is a terminal, shown once a run has lasted a second
 /// (`label` names the run). Call from one thread only.
 struct Progress {
-  explicit Progress(std::string label_, bool quiet = false);
+  explicit Progress(std::string label_, bool quiet = false, std::string unit_ = "points");
   /// "label run  42%".
   void operator()(double fraction);
-  /// "label 1234/5678 points, 1.2e+06/s, 3 s left".
+  /// "label 1234/5678 points, 1.2e+06/s, 3 s left" (`unit` instead of "points").
   void operator()(unsigned long long done, unsigned long long total);
 
  private:
-  std::string label;
+  std::string label, unit;
   std::chrono::steady_clock::time_point start;
   bool shown = false;
   bool enabled;

@@ -416,20 +416,10 @@ int run_robust(RobustOptions& o, CLI::App& app) {  // by reference: the file's k
   const std::uint64_t first = spec.samples * shard_k / shard_n, end = spec.samples * (shard_k + 1) / shard_n;
   const std::uint64_t count = end - first;
   std::vector<UncertainSample> samples(count);
-  Progress progress{"robust"};
-  progress.enabled = progress.enabled && !o.quiet;
+  Progress progress("robust", o.quiet, "evaluations");
   const std::uint64_t total_work = count * (1 + configs.size());
   std::atomic<std::uint64_t> work_done{0};
-  auto report = [&](std::uint64_t) {
-    if (!progress.enabled) return;
-    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - progress.start).count();
-    if (s < 1.0 && !progress.shown) return;
-    progress.shown = true;
-    const double done = static_cast<double>(work_done.load()), rate = done / std::max(s, 1e-9);
-    std::fprintf(stderr, "\rffsr-optimize: robust %3.0f%% (%.0f evaluations/s, %.0f s left)   ",
-                 100.0 * done / static_cast<double>(total_work), rate,
-                 rate > 0 ? (static_cast<double>(total_work) - done) / rate : 0.0);
-  };
+  auto report = [&](std::uint64_t) { progress(work_done.load(), total_work); };
   parallel_for(0, count, o.threads, [&](std::uint64_t i) {
     samples[i] = draw_sample(spec, nominal, first + i);
     work_done.fetch_add(1);
@@ -455,7 +445,7 @@ int run_robust(RobustOptions& o, CLI::App& app) {  // by reference: the file's k
       }, report);
     }
   }
-  if (progress.shown) std::fprintf(stderr, "\n");
+  progress(total_work, total_work);  // ends the line if one was shown
 
   // --- outputs: built first, then written all or nothing ---------------------------------------
   nlohmann::json j;

@@ -61,22 +61,6 @@ Scenario prepare_scenario(RunOptions o, const CLI::App& app, bool urdf_on_comman
 /// NumericalError names the run. Progress on a terminal unless `quiet`.
 std::pair<CaptureResult, CaptureResult> plan_plain_and_optimized(const Scenario& sc, bool quiet);
 
-/// Progress on a terminal for runs longer than a second.
-struct Progress {
-  std::string label;
-  std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
-  bool shown = false;
-  bool enabled = isatty(fileno(stderr)) != 0;
-  void operator()(double fraction) {
-    if (!enabled) return;
-    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    if (s < 1.0 && !shown) return;
-    shown = true;
-    std::fprintf(stderr, "\rffsr-optimize: %s run %3.0f%%", label.c_str(), fraction * 100.0);
-    if (fraction >= 1.0) std::fprintf(stderr, "\n");
-  }
-};
-
 /// CLI11's TOML reader for the main job: drops the [uncertainty] table (read by `robust` with a
 /// full TOML parser: CLI11 2.1 does not parse its inline tables), keeps every other key.
 class ScenarioConfig : public CLI::ConfigTOML {
