@@ -2,7 +2,8 @@
 # Installs the Debian 12 packages ffsr needs, only when some are missing (needs root, as on CI).
 set -euo pipefail
 packages=(cmake ninja-build g++ pkg-config libeigen3-dev liburdfdom-dev libtinyxml-dev libsundials-dev
-          catch2 libcli11-dev nlohmann-json3-dev)
+          catch2 libcli11-dev nlohmann-json3-dev
+          libtomlplusplus-dev)
 packages+=(libnlopt-cxx-dev)  # NLopt: the global capture search (optimize/global.hpp, issue 9)
 missing=()
 for p in "${packages[@]}"; do

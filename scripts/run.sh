@@ -4,6 +4,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
-cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DFFSR_BUILD_TESTS=OFF -DFFSR_BUILD_BENCH=OFF >/dev/null
-cmake --build build --target ffsr-optimize --parallel 2
-./build/src/cli/ffsr-optimize "$@"
+# Its own build folder with every option set, so it never changes what .ci/run builds and tests.
+cmake -S . -B build-run -G Ninja -DCMAKE_BUILD_TYPE=Release -DFFSR_SANITIZE=OFF \
+      -DFFSR_BUILD_TESTS=OFF -DFFSR_BUILD_CLI=ON -DFFSR_BUILD_BENCH=OFF >/dev/null
+cmake --build build-run --target ffsr-optimize --parallel 2
+./build-run/src/cli/ffsr-optimize "$@"

@@ -607,3 +607,49 @@ TEST_CASE("cvode: failures are IntegrationErrors naming the flag", "[cvode]") {
   CHECK_THROWS_AS(b.step(std::nan("")), InputError);
   CHECK_THROWS_AS(b.reinit(0.0, Eigen::Vector3d::Zero()), InputError);
 }
+
+// fuzz finding ../shared/findings/fuzz_numeric-xi-inf.bin (Hu-Guo, K = 2.3e-307, α = 5.7e-320,
+// c_r = 4.4e-18): with a tiny exponent the force peak sits next to first touch, t* = 1 - s* ~ α.
+// Solved in s it rounded to s* = 1, where G = 0: ξ came out as -inf and the exact peak as F = 0.
+// The peak is now solved in t where t* < 1/2. Independent limit: as α -> 0 the factor
+// (G(0)/G*)^(α/(α+1)) -> 1 and s* -> 1, so F'/F -> 1/(1+f) and ξ -> 100 f/(1+f).
+TEST_CASE("the force peak next to first touch (tiny exponent) is found, and ξ is finite", "[contact][fuzz]") {
+  // f·G written without the underflow of G equals f times G where G is a normal number
+  for (double f : {1e-6, 0.1, 1.5, 1e3, 3e17})
+    for (double t : {1e-12, 1e-3, 0.3, 0.9, 1.0})
+      CHECK(rel(detail::contact_fG_lost(f, t), f * detail::contact_G_lost(f, t)) < 1e-13);
+  for (double c_r : {0.5, 0.9, 4.394556650046182e-18}) {
+    for (double alpha : {1e-3, 1e-8, 1e-13, 1e-17, 1e-100, 5.7035e-320}) {
+      for (double K : {1e9, 2.2634620632562607e-307}) {
+        const ContactParams p{K, alpha, c_r};
+        const auto law = make_contact_law("hu-guo", p, 0.2052);
+        const double f = damping_factor(law);
+        INFO("c_r = " << c_r << ", alpha = " << alpha << ", K = " << K << ", f = " << f);
+        const double xi = relative_error(law);
+        REQUIRE(std::isfinite(xi));
+        CHECK(xi > 0.0);
+        CHECK(xi <= 100.0);  // 100 f/(1+f) rounds to 100 for f = 3.4e17
+        if (alpha <= 1e-13) CHECK(rel(xi, 100.0 * f / (1.0 + f)) < 1e-9);
+        const detail::PeakRate pk = detail::contact_peak(f, alpha);
+        CHECK(pk.t > 0.0);
+        CHECK(pk.s + pk.t == Approx(1.0).epsilon(1e-15));
+        // a maximum of ln F(t) = α/(α+1) ln G(t) + ln(1 + f(1-t)): not below its neighbours
+        auto lnF = [&](double t) {
+          return alpha / (alpha + 1.0) * detail::contact_log_G_lost(f, t) + std::log1p(f * (1.0 - t));
+        };
+        for (double d : {1e-3, 1e-6})
+          CHECK(lnF(pk.t) >= std::max(lnF(pk.t * (1 - d)), lnF(std::min(1.0, pk.t * (1 + d)))) -
+                               1e-14 * std::max(1.0, std::abs(lnF(pk.t))));  // rounding of ln F
+        if (K == 1e9 && alpha < 1e-300) {
+          // δ at the peak (~t* ~ 1e-320 m) is not representable: an error, never F = 0
+          CHECK_THROWS_AS(exact_peak(law, 5.8158), NumericalError);
+        } else if (K == 1e9) {
+          const ForcePeak peak = exact_peak(law, 5.8158);
+          CHECK(peak.force > 0.0);
+          CHECK(std::isfinite(peak.force));
+          CHECK(peak.force >= max_force_estimate(law, 5.8158) * (1 - 1e-14));
+        }
+      }
+    }
+  }
+}

@@ -267,6 +267,27 @@ TEST_CASE("Edge: a long task (T = 1e4 s)", "[edge]") {
   CHECK_THROWS_AS(plan_capture(pb, planar(), opt), InputError);
 }
 
+// fuzz finding ../shared/findings/fuzz_numeric-plan_capture-inf.bin: T = 8.4e-227 s with a 0.2 s step
+// gave ceil(T/step - 1e-9) = 0 RK4 steps, so the run returned the initial state and a smallest task
+// singular value of +inf (never evaluated). A run has at least one step now.
+TEST_CASE("Edge: a duration far below one step still takes one step", "[edge][fuzz]") {
+  const Model m = model_from_urdf_file(kRobots + "paper_3dof.urdf");
+  CaptureProblem pb = problem_3dof(m, deg({0, 150, -100}), Vector3(0.6, 1.2, 0));
+  CaptureOptions opt;
+  opt.step = 0.2;
+  opt.tolerance = 1e79;  // the finding's: no miss is an error, so the result itself is checked
+  for (double T : {8.442542515286355e-227, 1e-12, 1e-10}) {
+    opt.duration = T;
+    INFO("T = " << T);
+    const CaptureResult r = plan_capture(pb, planar(), opt);
+    CHECK(r.steps == 1);
+    CHECK(std::isfinite(r.min_singular_value));
+    CHECK(r.min_singular_value > 0.0);
+    CHECK(r.theta.allFinite());
+    CHECK(std::isfinite(r.M_ie));
+  }
+}
+
 TEST_CASE("Edge: CVODE asked for impossible tolerances", "[edge]") {
   const Model m = model_from_urdf_file(kRobots + "paper_3dof.urdf");
   MultibodyContactOptions o;

@@ -2,14 +2,22 @@
 
 #include "ffsr/io/urdf.hpp"
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <random>
 #include <sstream>
+
+#include <unistd.h>
 
 namespace ffsr::cli {
 
@@ -102,6 +110,34 @@ Target TargetOptions::build() const {
   return t;
 }
 
+void ContactLawOptions::add_to(CLI::App& app, const std::string& model_help) {
+  app.add_option("--stiffness", stiffness, "Contact stiffness K, N/m^alpha")->capture_default_str();
+  app.add_option("--exponent", exponent, "Contact exponent alpha")->capture_default_str();
+  app.add_option("--restitution", restitution, "Coefficient of restitution c_r, 0 < c_r <= 1")->capture_default_str();
+  app.add_option("--model", model, model_help)->capture_default_str();
+  app.add_option("--approach-speed", approach_speed, "End-effector speed along the normal at first touch, m/s")
+      ->capture_default_str();
+  app.add_option("--target-angular-velocity-deg", target_angular_velocity_deg, "Target spin (target frame), deg/s")
+      ->capture_default_str();
+  app.add_option("--target-velocity", target_velocity, "Target linear velocity (inertial frame), m/s")
+      ->capture_default_str();
+}
+
+ContactParams ContactLawOptions::params() const {
+  const ContactParams p{stiffness, exponent, restitution};
+  try {
+    validate(p, "contact");
+  } catch (const InputError& e) {
+    throw InputError(std::string("--stiffness/--exponent/--restitution: ") + e.what());
+  }
+  return p;
+}
+
+void ContactLawOptions::set_target_motion(Target& target) const {
+  target.angular_velocity = parse_vec3(target_angular_velocity_deg, "--target-angular-velocity-deg") * (M_PI / 180.0);
+  target.velocity = parse_vec3(target_velocity, "--target-velocity");
+}
+
 Robot load_robot(const RobotOptions& o) {
   Robot r{model_from_urdf_file(o.urdf, o.end_effector), 0, {}, {}};
   r.end_effector = r.model.end_effector();
@@ -115,46 +151,233 @@ Robot load_robot(const RobotOptions& o) {
   return r;
 }
 
-void write_file_atomic(const std::string& path, const std::string& content) {
-  write_files_atomic({{path, content}});
+// --- output files ---------------------------------------------------------------------------------
+
+namespace {
+
+struct OutputSpec {
+  std::string flag, path;
+  const std::string* content;
+};
+
+enum class OutputKind { Stdout, Direct, Regular };
+
+/// "path (--flag)", or the path alone when no flag is known; standard output is named as such.
+std::string output_name(const OutputSpec& o) {
+  if (is_stdout_name(o.path)) return o.flag.empty() ? "standard output" : str("standard output (", o.flag, " ", o.path, ")");
+  return o.flag.empty() ? o.path : str(o.path, " (", o.flag, ")");
 }
 
-void write_files_atomic(const std::vector<std::pair<std::string, std::string>>& files) {
-  std::random_device rd;
-  std::vector<std::string> tmps;
-  auto remove_tmps = [&tmps](size_t from) {
-    for (size_t k = from; k < tmps.size(); ++k) std::remove(tmps[k].c_str());
+[[noreturn]] void throw_write_error(const std::string& name, int err, const char* what = "cannot write the output file") {
+  std::string msg = str(name, ": ", what);
+  if (err != 0) msg += str(": ", std::strerror(err));
+  if (err == EPIPE) msg += " (the reader closed the pipe)";
+  throw InputError(msg);
+}
+
+bool starts_with(const std::string& s, const char* prefix) { return s.rfind(prefix, 0) == 0; }
+
+/// What `path` is, following symbolic links one hop at a time (so that a dangling link gives the
+/// file it names). Regular: `final_path` is the file to replace atomically (the link's target).
+OutputKind resolve_output(const std::string& path, const std::string& name, std::string& final_path) {
+  if (is_stdout_name(path)) return OutputKind::Stdout;
+  std::string p = path;
+  bool alias = false;  // a name of an open file descriptor: never replaced
+  for (int hop = 0;; ++hop) {
+    alias = alias || starts_with(p, "/proc/") || starts_with(p, "/dev/fd/") || p == "/dev/stdout" || p == "/dev/stderr";
+    struct stat st {};
+    if (::lstat(p.c_str(), &st) != 0) {
+      if (errno != ENOENT) throw_write_error(name, errno);
+      final_path = p;  // a new file (a missing directory is reported when the file is created)
+      return alias ? OutputKind::Direct : OutputKind::Regular;
+    }
+    if (S_ISLNK(st.st_mode)) {
+      if (hop >= 40) throw_write_error(name, ELOOP);
+      std::error_code ec;
+      const std::filesystem::path target = std::filesystem::read_symlink(p, ec);
+      if (ec) throw_write_error(name, ec.value());
+      p = target.is_absolute() ? target.string() : (std::filesystem::path(p).parent_path() / target).string();
+      continue;
+    }
+    if (S_ISDIR(st.st_mode)) throw InputError(str(name, ": cannot write the output file (it is a directory)"));
+    final_path = p;
+    return S_ISREG(st.st_mode) && !alias ? OutputKind::Regular : OutputKind::Direct;
+  }
+}
+
+/// Writes all of `content` to `fd`; returns 0 or the errno of the failing write.
+int write_all(int fd, const std::string& content) {
+  const char* data = content.data();
+  size_t left = content.size();
+  while (left > 0) {
+    const ssize_t k = ::write(fd, data, left);
+    if (k < 0) {
+      if (errno == EINTR) continue;
+      return errno;
+    }
+    data += k;
+    left -= static_cast<size_t>(k);
+  }
+  return 0;
+}
+
+/// The writer behind Outputs, write_file_atomic and write_files_atomic. Reads the file system.
+/// Writes: regular files via temporary files and rename (all or nothing), the others directly.
+void write_outputs(const std::vector<OutputSpec>& outputs) {
+  // 1. what each output is (nothing is written when one of them cannot be)
+  std::vector<OutputKind> kinds;
+  std::vector<std::string> finals(outputs.size());
+  const OutputSpec* to_stdout = nullptr;
+  for (size_t i = 0; i < outputs.size(); ++i) {
+    kinds.push_back(resolve_output(outputs[i].path, output_name(outputs[i]), finals[i]));
+    if (kinds.back() != OutputKind::Stdout) continue;
+    if (to_stdout != nullptr)
+      throw InputError(str(output_name(*to_stdout), " and ", output_name(outputs[i]),
+                           ": only one output can go to standard output"));
+    to_stdout = &outputs[i];
+  }
+  // 2. regular files: temporary files next to their targets
+  std::vector<std::string> tmps(outputs.size());
+  auto remove_tmps = [&tmps] {
+    for (const auto& t : tmps)
+      if (!t.empty()) ::unlink(t.c_str());
   };
-  for (const auto& [path, content] : files) {
-    const std::string tmp = path + ".tmp-" + std::to_string(rd());
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) {
-      remove_tmps(0);
-      throw InputError(str(path, ": cannot write the output file"));
+  std::random_device rd;
+  for (size_t i = 0; i < outputs.size(); ++i) {
+    if (kinds[i] != OutputKind::Regular) continue;
+    int fd = -1;
+    for (int attempt = 0; fd < 0 && attempt < 100; ++attempt) {
+      tmps[i] = finals[i] + ".tmp-" + std::to_string(rd());
+      fd = ::open(tmps[i].c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+      if (fd < 0 && errno != EEXIST) break;
     }
-    tmps.push_back(tmp);
-    out << content;
-    out.flush();
-    if (!out) {
-      out.close();
-      remove_tmps(0);
-      throw InputError(str(path, ": cannot write the output file"));
+    if (fd < 0) {
+      const int err = errno;
+      tmps[i].clear();
+      remove_tmps();
+      throw_write_error(output_name(outputs[i]), err);
     }
-  }
-  // a directory cannot be replaced by a file: check them all before renaming any
-  for (const auto& f : files) {
-    std::error_code ec;
-    if (std::filesystem::is_directory(f.first, ec)) {
-      remove_tmps(0);
-      throw InputError(str(f.first, ": cannot write the output file (it is a directory)"));
-    }
-  }
-  for (size_t i = 0; i < files.size(); ++i) {
-    if (std::rename(tmps[i].c_str(), files[i].first.c_str()) != 0) {
-      remove_tmps(i);
-      throw InputError(str(files[i].first, ": cannot write the output file (rename failed)"));
+    struct stat st {};
+    if (::stat(finals[i].c_str(), &st) == 0) (void)::fchmod(fd, st.st_mode & 07777);  // keep the mode
+    int err = write_all(fd, *outputs[i].content);
+    if (::close(fd) != 0 && err == 0) err = errno;
+    if (err != 0) {
+      remove_tmps();
+      throw_write_error(output_name(outputs[i]), err);
     }
   }
+  // 3. standard output, FIFOs, devices: written directly, never replaced
+  for (size_t i = 0; i < outputs.size(); ++i) {
+    if (kinds[i] == OutputKind::Regular) continue;
+    int fd = 1, err = 0;
+    if (kinds[i] == OutputKind::Stdout) {
+      std::cout.flush();
+      std::fflush(stdout);
+    } else {
+      fd = ::open(finals[i].c_str(), O_WRONLY | O_NOCTTY | O_CLOEXEC);
+      if (fd < 0) err = errno;
+    }
+    if (err == 0) err = write_all(fd, *outputs[i].content);
+    if (fd != 1 && fd >= 0 && ::close(fd) != 0 && err == 0) err = errno;
+    if (err != 0) {
+      remove_tmps();
+      throw_write_error(output_name(outputs[i]), err);
+    }
+  }
+  // 4. the renames
+  for (size_t i = 0; i < outputs.size(); ++i) {
+    if (kinds[i] != OutputKind::Regular) continue;
+    if (::rename(tmps[i].c_str(), finals[i].c_str()) != 0) {
+      const int err = errno;
+      remove_tmps();
+      throw_write_error(output_name(outputs[i]), err, "cannot write the output file (rename failed)");
+    }
+    tmps[i].clear();
+  }
+}
+
+}  // namespace
+
+bool is_stdout_name(const std::string& path) {
+  return path == "-" || path == "/dev/stdout" || path == "/dev/fd/1" || path == "/proc/self/fd/1";
+}
+
+void Outputs::add(const std::string& flag, const std::string& path) {
+  if (path.empty()) return;
+  if (is_stdout_name(path)) claim_stdout(flag + " " + path);
+  items_.push_back({flag, path, {}, false});
+}
+
+void Outputs::claim_stdout(const std::string& flag) {
+  if (!stdout_flag_.empty())
+    throw InputError(str(stdout_flag_, " and ", flag, ": only one output can go to standard output"));
+  stdout_flag_ = flag;
+}
+
+bool Outputs::requested(const std::string& flag) const {
+  for (const auto& it : items_)
+    if (it.flag == flag) return true;
+  return false;
+}
+
+std::ostream& Outputs::table() const { return uses_stdout() ? std::cerr : std::cout; }
+
+void Outputs::set(const std::string& flag, std::string content) {
+  for (auto& it : items_)
+    if (it.flag == flag) {
+      it.content = std::move(content);
+      it.has_content = true;
+    }
+}
+
+void Outputs::write() const {
+  std::vector<OutputSpec> specs;
+  for (const auto& it : items_)
+    if (it.has_content) specs.push_back({it.flag, it.path, &it.content});
+  write_outputs(specs);
+}
+
+void write_file_atomic(const std::string& path, const std::string& content) { write_outputs({{"", path, &content}}); }
+
+void write_files_atomic(const std::vector<std::pair<std::string, std::string>>& files) {
+  std::vector<OutputSpec> specs;
+  for (const auto& [path, content] : files) specs.push_back({"", path, &content});
+  write_outputs(specs);
+}
+
+void flush_stdout() {
+  errno = 0;
+  std::cout.flush();
+  const bool failed = !std::cout || std::fflush(stdout) != 0 || std::ferror(stdout);
+  if (failed) {
+    // errno names the cause when this flush failed; an earlier failed write may have lost it
+    if (errno == 0) throw InputError("standard output: cannot write (a closed pipe, a full disk or an I/O error)");
+    throw_write_error("standard output", errno, "cannot write");
+  }
+}
+
+Progress::Progress(std::string label_, bool quiet, std::string unit_)
+    : label(std::move(label_)), unit(std::move(unit_)), start(std::chrono::steady_clock::now()), enabled(!quiet && isatty(fileno(stderr)) != 0) {}
+
+void Progress::operator()(double fraction) {
+  if (!enabled) return;
+  const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (s < 1.0 && !shown) return;
+  shown = true;
+  std::fprintf(stderr, "\rffsr-optimize: %s run %3.0f%%", label.c_str(), fraction * 100.0);
+  if (fraction >= 1.0) std::fprintf(stderr, "\n");
+}
+
+void Progress::operator()(unsigned long long done, unsigned long long total) {
+  if (!enabled) return;
+  const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (s < 1.0 && !shown) return;
+  shown = true;
+  const double rate = s > 0 ? static_cast<double>(done) / s : 0.0;
+  const double left = rate > 0 ? static_cast<double>(total - done) / rate : 0.0;
+  std::fprintf(stderr, "\rffsr-optimize: %s %llu/%llu %s (%3.0f%%), %.3g %s/s, %.0f s left   ", label.c_str(),
+               done, total, unit.c_str(), total ? 100.0 * static_cast<double>(done) / static_cast<double>(total) : 100.0, rate, unit.c_str(), left);
+  if (done >= total) std::fprintf(stderr, "\n");
 }
 
 nlohmann::json to_json(const Eigen::MatrixXd& m) {

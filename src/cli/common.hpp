@@ -1,19 +1,25 @@
 // src/cli/common.hpp -- options shared by the subcommands, parsing helpers and output files.
 #pragma once
 
+#include "ffsr/contact/contact_law.hpp"
 #include "ffsr/ffsr.hpp"
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include <chrono>
+#include <ostream>
 #include <string>
 #include <vector>
 
 namespace ffsr::cli {
 
-/// Exit codes: 2 for bad input (arguments, files, models), 3 for a numerical failure.
+/// Exit codes: 2 for bad input (arguments, files, models) and for an output that cannot be written
+/// (including a reader that closed the pipe), 3 for a numerical failure, 4 when the result moved away
+/// from the --expect baseline.
 constexpr int kExitInput = 2;
 constexpr int kExitNumerical = 3;
+constexpr int kExitRegression = 4;
 
 /// Parses "a,b,c" into numbers; throws InputError naming `flag` on a bad or non-finite number or
 /// when the count is not one of `counts` (empty: any count >= 1).
@@ -45,6 +51,24 @@ struct TargetOptions {
   Target build() const;
 };
 
+/// --model, --stiffness, --exponent, --restitution, --approach-speed, --target-angular-velocity-deg,
+/// --target-velocity: the contact law and the relative motion at the first touch (contact, map).
+struct ContactLawOptions {
+  double stiffness = 1e9;
+  double exponent = 1.5;
+  double restitution = 0.9;
+  std::string model = "herbert-mcwhannell";
+  double approach_speed = 0.2;
+  std::string target_angular_velocity_deg = "0,0,2";
+  std::string target_velocity = "0,0,0";
+  /// `model_help` describes --model (contact accepts 'all', map one law).
+  void add_to(CLI::App& app, const std::string& model_help);
+  /// K, alpha, c_r, validated (InputError naming the flags).
+  ContactParams params() const;
+  /// Sets the target's velocity and spin from the flags. Throws InputError naming the flag.
+  void set_target_motion(Target& target) const;
+};
+
 /// A robot loaded from --urdf at the configuration of the flags.
 struct Robot {
   Model model;
@@ -57,13 +81,74 @@ Robot load_robot(const RobotOptions& options);
 /// Parses an inertia given as "Ixx,Iyy,Izz" or "Ixx,Iyy,Izz,Ixy,Ixz,Iyz".
 Matrix3 parse_inertia(const std::string& text, const std::string& flag);
 
-/// Writes a file atomically: a temporary file in the same directory, then rename. Throws InputError
-/// naming the path when it cannot be written; never leaves a partial file behind.
+/// Output files, as people name them in a shell. Every subcommand writes its outputs through
+/// `Outputs` (or the two functions below, which use the same writer):
+///  - "-" (also /dev/stdout, /dev/fd/1, /proc/self/fd/1) is standard output; at most one output of a
+///    run may be standard output, and the human-readable table then goes to standard error;
+///  - a path that is not a regular file (a FIFO, a device such as /dev/null, anything under /proc or
+///    /dev/fd) is opened and written directly, never replaced;
+///  - a symbolic link is followed and its final target is replaced atomically (a temporary file in
+///    the target's directory, then rename), so the link stays a link;
+///  - a regular file (or a new path) is written to a temporary file next to it and renamed into place
+///    when every output of the run is written: all or nothing.
+/// Every failure (missing directory, a directory in the way, full disk, I/O error, a reader that
+/// closed the pipe: SIGPIPE is ignored by main) throws InputError naming the flag and the file and
+/// leaves no partial regular file and no temporary file behind.
+class Outputs {
+ public:
+  /// Registers the output of `flag` (for example "--json") at `path`; an empty path: not requested.
+  /// Throws InputError naming both flags when a second output names standard output.
+  void add(const std::string& flag, const std::string& path);
+  /// `flag` prints on standard output itself (for example `contact --json`); same check as add.
+  void claim_stdout(const std::string& flag);
+  bool requested(const std::string& flag) const;
+  /// True when an output goes to standard output.
+  bool uses_stdout() const { return !stdout_flag_.empty(); }
+  /// Where the human-readable table goes: standard error when an output is standard output.
+  std::ostream& table() const;
+  /// Sets the content of the output registered by `flag` (ignored when the flag was not requested).
+  void set(const std::string& flag, std::string content);
+  /// Writes every registered output that has content: regular files to temporary files first, then
+  /// the direct outputs (standard output, FIFOs, devices), then the renames.
+  void write() const;
+
+ private:
+  struct Item {
+    std::string flag, path, content;
+    bool has_content = false;
+  };
+  std::vector<Item> items_;
+  std::string stdout_flag_;
+};
+
+/// True for "-" and the names of the standard output file descriptor.
+bool is_stdout_name(const std::string& path);
+/// Writes a file (see Outputs for "-", FIFOs, devices and symbolic links); a regular file atomically.
+/// Throws InputError naming the path when it cannot be written; never leaves a partial file behind.
 void write_file_atomic(const std::string& path, const std::string& content);
-/// Writes several files all or nothing: every content goes to a temporary file next to its path
-/// first, and only when all of them are written are they renamed into place. A failure removes the
-/// temporary files and throws InputError naming the path, so no output of the run is left behind.
+/// Writes several files all or nothing (see Outputs); at most one may be standard output. A failure
+/// removes the temporary files and throws InputError naming the path, so no regular output file of
+/// the run is left behind.
 void write_files_atomic(const std::vector<std::pair<std::string, std::string>>& files);
+/// Flushes standard output and throws InputError ("standard output: cannot write ...") when a write to
+/// it failed (a closed pipe, a full disk). main calls it after every successful action.
+void flush_stdout();
+
+/// A progress line on stderr when it is a terminal, shown once a run has lasted a second
+/// (`label` names the run). Call from one thread only.
+struct Progress {
+  explicit Progress(std::string label_, bool quiet = false, std::string unit_ = "points");
+  /// "label run  42%".
+  void operator()(double fraction);
+  /// "label 1234/5678 points, 1.2e+06/s, 3 s left" (`unit` instead of "points").
+  void operator()(unsigned long long done, unsigned long long total);
+
+ private:
+  std::string label, unit;
+  std::chrono::steady_clock::time_point start;
+  bool shown = false;
+  bool enabled;
+};
 
 /// Matrix -> JSON array of rows.
 nlohmann::json to_json(const Eigen::MatrixXd& m);

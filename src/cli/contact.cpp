@@ -15,13 +15,7 @@ namespace {
 struct ContactOptions {
   RobotOptions robot;
   TargetOptions target;
-  double stiffness = 1e9;
-  double exponent = 1.5;
-  double restitution = 0.9;
-  std::string model = "herbert-mcwhannell";
-  double approach_speed = 0.2;
-  std::string target_angular_velocity_deg = "0,0,2";
-  std::string target_velocity = "0,0,0";
+  ContactLawOptions law;
   std::string series;
   bool json = false;
 };
@@ -33,11 +27,11 @@ struct Row {
 };
 
 Row evaluate(const Robot& r, const Target& target, const ContactOptions& o, const std::string& law_name) {
-  const ContactParams p{o.stiffness, o.exponent, o.restitution};
+  const ContactParams p{o.law.stiffness, o.law.exponent, o.law.restitution};
   MultibodyContactOptions mo;
   mo.record_series = !o.series.empty();
   MultibodyContactResult mb =
-      simulate_contact(r.model, r.base, r.theta, r.end_effector, target, o.approach_speed, p, law_name, mo);
+      simulate_contact(r.model, r.base, r.theta, r.end_effector, target, o.law.approach_speed, p, law_name, mo);
   const AnyContactLaw law = make_contact_law(law_name, p, mb.approach_velocity);
   Row row{law_name, mb.integrated_effective_mass, mb.approach_velocity,
           max_force_closed_form(law, mb.integrated_effective_mass), max_force_exact(law, mb.integrated_effective_mass),
@@ -63,26 +57,24 @@ nlohmann::json row_json(const Row& r) {
 }
 
 int run_contact(const ContactOptions& o) {
+  Outputs outputs;  // --series '-' and --json both print on standard output: one of them only
+  if (o.json) outputs.claim_stdout("--json");
+  outputs.add("--series", o.series);
   const Robot r = load_robot(o.robot);
   Target target = o.target.build();
-  target.angular_velocity = parse_vec3(o.target_angular_velocity_deg, "--target-angular-velocity-deg") * (M_PI / 180.0);
-  target.velocity = parse_vec3(o.target_velocity, "--target-velocity");
-  if (!std::isfinite(o.approach_speed)) throw InputError("--approach-speed: must be finite");
-  try {
-    validate(ContactParams{o.stiffness, o.exponent, o.restitution}, "contact");
-  } catch (const InputError& e) {
-    throw InputError(std::string("--stiffness/--exponent/--restitution: ") + e.what());
-  }
+  o.law.set_target_motion(target);
+  if (!std::isfinite(o.law.approach_speed)) throw InputError("--approach-speed: must be finite");
+  const ContactParams params = o.law.params();
   std::vector<std::string> names;
-  if (o.model == "all") {
+  if (o.law.model == "all") {
     for (auto n : contact_law_names()) names.emplace_back(n);
   } else {
     try {
-      make_contact_law(o.model, {o.stiffness, o.exponent, o.restitution}, 1.0);  // unknown name: lists the laws
+      make_contact_law(o.law.model, params, 1.0);  // unknown name: lists the laws
     } catch (const InputError& e) {
       throw InputError(std::string("--model: ") + e.what());
     }
-    names.push_back(o.model);
+    names.push_back(o.law.model);
   }
   std::vector<Row> rows;
   for (const auto& n : names) rows.push_back(evaluate(r, target, o, n));
@@ -92,34 +84,36 @@ int run_contact(const ContactOptions& o) {
     csv << std::setprecision(12) << "model,t_s,force_N,delta_m\n";
     for (const auto& row : rows)
       for (const auto& s : row.series) csv << row.model << "," << s.t << "," << s.force << "," << s.delta << "\n";
-    write_file_atomic(o.series, csv.str());
+    outputs.set("--series", csv.str());
+    outputs.write();
   }
   if (o.json) {
-    nlohmann::json j = o.model == "all" ? nlohmann::json::object() : row_json(rows.front());
-    if (o.model == "all") {
+    nlohmann::json j = o.law.model == "all" ? nlohmann::json::object() : row_json(rows.front());
+    if (o.law.model == "all") {
       j["integrated_effective_mass"] = rows.front().M_ie;
       j["approach_velocity"] = rows.front().v_in;
       j["laws"] = nlohmann::json::array();
       for (const auto& row : rows) j["laws"].push_back(row_json(row));
     }
-    j["parameters"] = {{"stiffness", o.stiffness}, {"exponent", o.exponent}, {"restitution", o.restitution},
-                       {"approach_speed", o.approach_speed}, {"urdf", o.robot.urdf}, {"joints_deg", o.robot.joints_deg}};
+    j["parameters"] = {{"stiffness", o.law.stiffness}, {"exponent", o.law.exponent}, {"restitution", o.law.restitution},
+                       {"approach_speed", o.law.approach_speed}, {"urdf", o.robot.urdf}, {"joints_deg", o.robot.joints_deg}};
     j["version"] = FFSR_VERSION;
     std::cout << j.dump(2) << "\n";
     return 0;
   }
-  std::cout << std::setprecision(6) << "integrated effective mass M_ie = " << rows.front().M_ie << " kg (Eq. 14)\n"
-            << "approach velocity delta_dot^-  = " << rows.front().v_in << " m/s (Eq. 10-12)\n\n";
-  std::cout << std::left << std::setw(20) << "model" << std::right << std::setw(13) << "closed (N)" << std::setw(13)
-            << "exact (N)" << std::setw(15) << "multibody (N)" << std::setw(13) << "accuracy %" << std::setw(10)
-            << "xi %" << std::setw(13) << "duration ms" << std::setw(11) << "c_r real" << "\n";
+  std::ostream& out = outputs.table();  // standard error when --series is '-'
+  out << std::setprecision(6) << "integrated effective mass M_ie = " << rows.front().M_ie << " kg (Eq. 14)\n"
+      << "approach velocity delta_dot^-  = " << rows.front().v_in << " m/s (Eq. 10-12)\n\n";
+  out << std::left << std::setw(20) << "model" << std::right << std::setw(13) << "closed (N)" << std::setw(13)
+      << "exact (N)" << std::setw(15) << "multibody (N)" << std::setw(13) << "accuracy %" << std::setw(10)
+      << "xi %" << std::setw(13) << "duration ms" << std::setw(11) << "c_r real" << "\n";
   for (const auto& row : rows)
-    std::cout << std::left << std::setw(20) << row.model << std::right << std::fixed << std::setprecision(2)
-              << std::setw(13) << row.f_closed << std::setw(13) << row.f_exact << std::setw(15) << row.f_multibody
-              << std::setw(13) << row.accuracy << std::setw(10) << row.xi << std::setw(13) << row.duration * 1e3
-              << std::setw(11) << std::setprecision(4) << row.restitution << "\n";
-  std::cout << "\nclosed: Eq. 24 (F at the maximum deformation); exact: peak of the single-body model Eq. 16;\n"
-               "multibody: CVODE integration of robot + target (Figure 2); accuracy: Eq. 32, closed vs multibody.\n";
+    out << std::left << std::setw(20) << row.model << std::right << std::fixed << std::setprecision(2)
+        << std::setw(13) << row.f_closed << std::setw(13) << row.f_exact << std::setw(15) << row.f_multibody
+        << std::setw(13) << row.accuracy << std::setw(10) << row.xi << std::setw(13) << row.duration * 1e3
+        << std::setw(11) << std::setprecision(4) << row.restitution << "\n";
+  out << "\nclosed: Eq. 24 (F at the maximum deformation); exact: peak of the single-body model Eq. 16;\n"
+         "multibody: CVODE integration of robot + target (Figure 2); accuracy: Eq. 32, closed vs multibody.\n";
   return 0;
 }
 
@@ -130,17 +124,8 @@ void register_contact(CLI::App& app, Action& action) {
   CLI::App* sub = app.add_subcommand("contact", "Maximum contact force: closed form, exact, and CVODE multibody reference");
   o->robot.add_to(*sub);
   o->target.add_to(*sub);
-  sub->add_option("--stiffness", o->stiffness, "Contact stiffness K, N/m^alpha")->capture_default_str();
-  sub->add_option("--exponent", o->exponent, "Contact exponent alpha")->capture_default_str();
-  sub->add_option("--restitution", o->restitution, "Coefficient of restitution c_r, 0 < c_r <= 1")->capture_default_str();
-  sub->add_option("--model", o->model, "Hysteresis damping law (Table 1) or 'all'")->capture_default_str();
-  sub->add_option("--approach-speed", o->approach_speed, "End-effector speed along the normal at first touch, m/s")
-      ->capture_default_str();
-  sub->add_option("--target-angular-velocity-deg", o->target_angular_velocity_deg,
-                  "Target spin (target frame), deg/s")->capture_default_str();
-  sub->add_option("--target-velocity", o->target_velocity, "Target linear velocity (inertial frame), m/s")
-      ->capture_default_str();
-  sub->add_option("--series", o->series, "Write F(t), delta(t) of the multibody run(s) to this CSV file");
+  o->law.add_to(*sub, "Hysteresis damping law (Table 1) or 'all'");
+  sub->add_option("--series", o->series, "Write F(t), delta(t) of the multibody run(s) to this CSV file ('-': standard output)");
   sub->add_flag("--json", o->json, "Print one JSON object on stdout");
   sub->callback([o, &action] { action = [o] { return run_contact(*o); }; });
 }

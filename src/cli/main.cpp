@@ -1,19 +1,27 @@
 // ffsr-optimize: plan the capture configuration of a free-floating space robot.
 // Parses the command line, runs the chosen action and maps exceptions to one error line and an exit
-// code (2: bad input, 3: numerical failure). The library itself never prints.
+// code (2: bad input or an output that cannot be written, 3: numerical failure, 4: the result moved
+// away from the --expect baseline). The library itself never prints.
 #include "common.hpp"
 #include "subcommands.hpp"
 
+#include <csignal>
 #include <iostream>
 
 int main(int argc, char** argv) {
   using namespace ffsr::cli;
+  // A reader that closes the pipe early (`ffsr-optimize --json - | head -c 10`) makes a write fail
+  // with EPIPE, reported like any other write error (one line, exit 2), instead of killing the
+  // process with SIGPIPE.
+  std::signal(SIGPIPE, SIG_IGN);
   CLI::App app{"ffsr-optimize: capture-configuration optimization for free-floating space robots (ffsr " FFSR_VERSION ")",
                "ffsr-optimize"};
   app.set_version_flag("--version", FFSR_VERSION);
   Action action;
   register_inspect(app, action);
   register_contact(app, action);
+  register_map(app, action);
+  register_robust(app, action);
   register_run(app, action, argc, argv);
   app.require_subcommand(0, 1);
   try {
@@ -32,7 +40,9 @@ int main(int argc, char** argv) {
     return kExitInput;
   }
   try {
-    return action();
+    const int code = action();
+    flush_stdout();  // a table or JSON printed on a closed pipe or a full disk is an error too
+    return code;
   } catch (const ffsr::InputError& e) {
     std::cerr << "ffsr-optimize: error: " << e.what() << "\n";
     return kExitInput;

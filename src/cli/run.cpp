@@ -1,8 +1,10 @@
 // ffsr-optimize [--config SCENARIO.toml] [flags]: the main job. Plans the approach of the robot to
 // the tumbling target twice -- plain (rho = 0) and optimized (rho of the scenario) -- and reports
 // how much the capture configuration lowers M_ie and the maximum contact force (Tables 4 and 7).
+#include "baseline.hpp"
 #include "common.hpp"
 #include "embedded.hpp"
+#include "scenario.hpp"
 #include "subcommands.hpp"
 
 #include "ffsr/io/urdf.hpp"
@@ -25,26 +27,6 @@ namespace {
 
 using detail::str;
 
-struct RunOptions {
-  std::string config;
-  std::string urdf, end_effector;
-  std::vector<double> joints_deg, base_position{0, 0, 0}, base_rpy_deg{0, 0, 0};
-  double target_mass = 0;
-  std::vector<double> target_inertia, target_position, target_rpy_deg{0, 0, 0}, target_angular_velocity_deg,
-      target_velocity{0, 0, 0}, contact_offset, normal;
-  std::string model;
-  double stiffness = 0, exponent = 0, restitution = 0, approach_speed = 0;
-  std::string task, task_axes = "xyz", baseline_task;
-  std::vector<double> final_rpy_deg;
-  double duration = 0, step = 0, gain = 0, feedback = 1.0, tolerance = 0, orientation_tolerance_deg = 0.5;
-  std::string objective = "mass";
-  bool global = true;                 // the third row: global capture optimization (issue 9)
-  std::string seed = "1";             // parsed here, so that a bad value gets a one-line error naming the key
-  double max_joint_rate_deg = 0;      // 0: not set (the global run is then not rate limited)
-  int global_starts = 32;
-  std::string json, csv;
-  bool quiet = false;
-};
 
 /// Keys a scenario file must name (the others have defaults).
 const char* const kRequired[] = {"urdf", "joints-deg", "target-mass", "target-inertia", "target-position",
@@ -90,6 +72,13 @@ std::string deg_list(const Eigen::VectorXd& theta, int precision = 2) {
   return os.str();
 }
 
+/// --seed as a non-negative integer (a string key, so that a bad value gets a one-line error naming it).
+std::uint64_t parse_seed(const std::string& sd) {
+  if (sd.empty() || sd.size() > 19 || sd.find_first_not_of("0123456789") != std::string::npos)
+    throw InputError(str("--seed: expected a non-negative integer (at most 19 digits), got '", sd, "'"));
+  return std::stoull(sd);
+}
+
 nlohmann::json result_json(const CaptureResult& r, const CaptureTask& task, double gain) {
   const Eigen::Vector4d q = r.base.orientation.coeffs();
   return {{"task", task.kind == CaptureTask::Kind::Pose ? "pose" : "position"},
@@ -117,21 +106,138 @@ nlohmann::json result_json(const CaptureResult& r, const CaptureTask& task, doub
           {"steps", r.steps}};
 }
 
-/// Progress on a terminal for runs longer than a second.
-struct Progress {
-  std::string label;
-  std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
-  bool shown = false;
-  bool enabled = isatty(fileno(stderr)) != 0;
-  void operator()(double fraction) {
-    if (!enabled) return;
-    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    if (s < 1.0 && !shown) return;
-    shown = true;
-    std::fprintf(stderr, "\rffsr-optimize: %s run %3.0f%%", label.c_str(), fraction * 100.0);
-    if (fraction >= 1.0) std::fprintf(stderr, "\n");
-  }
+
+/// Which keys came from the command line: they are not resolved against the scenario's folder.
+struct FromCommandLine {
+  bool urdf = false, expect = false;
 };
+
+/// Top-level keys of the result that --expect does not compare: inputs, not results (the resolved
+/// scenario holds paths that differ between machines; the version changes with every release).
+const std::vector<std::string> kNotCompared = {"version", "scenario"};
+
+}  // namespace
+
+Scenario prepare_scenario(RunOptions o, const CLI::App& app, bool urdf_on_command_line) {
+  // --- the scenario: a file, or the built-in default (the paper's 3-DOF robot) -----------------
+  const bool builtin = o.config.empty();
+  const std::string where = builtin ? std::string("built-in scenario") : "scenario " + o.config;
+  if (!builtin) {
+    for (const char* key : kRequired)
+      if (app.get_option(std::string("--") + key)->count() == 0)
+        throw InputError(str(where, ": missing key '", key, "'"));
+  }
+  // a path in a scenario file is relative to the file
+  auto next_to_config = [&](const std::string& path, bool on_command_line) {
+    if (builtin || on_command_line || path.empty() || path.front() == '/') return path;
+    const size_t slash = o.config.find_last_of('/');
+    return slash == std::string::npos ? path : o.config.substr(0, slash + 1) + path;
+  };
+  auto model_ptr = std::make_unique<Model>([&] {
+    if (builtin && !urdf_on_command_line && o.urdf == "paper_3dof.urdf")
+      return model_from_urdf_string(kPaper3dofUrdf, "built-in paper_3dof.urdf", o.end_effector);
+    o.urdf = next_to_config(o.urdf, urdf_on_command_line);
+    return model_from_urdf_file(o.urdf, o.end_effector);
+  }());
+  const Model& model = *model_ptr;
+
+  CaptureProblem pb;
+  pb.model = &model;
+  pb.frame = model.end_effector();
+  if (static_cast<int>(o.joints_deg.size()) != model.n())
+    throw InputError(str("--joints-deg: got ", o.joints_deg.size(), " angles, the robot has ", model.n(), " joints"));
+  pb.theta = Eigen::Map<const Eigen::VectorXd>(o.joints_deg.data(), model.n()) * (M_PI / 180.0);
+  for (double x : o.joints_deg) finite(x, "joints-deg");
+  pb.base.position = vec3(o.base_position, "base-position");
+  pb.base.orientation = Quaternion(rotation_from_rpy(vec3(o.base_rpy_deg, "base-rpy-deg") * (M_PI / 180.0)));
+  Target& t = pb.target;
+  t.mass = finite(o.target_mass, "target-mass");
+  if (o.target_inertia.size() != 3 && o.target_inertia.size() != 6)
+    throw InputError(str("--target-inertia: expected 3 or 6 numbers, got ", o.target_inertia.size()));
+  {
+    std::ostringstream s;
+    for (size_t i = 0; i < o.target_inertia.size(); ++i) s << (i ? "," : "") << std::setprecision(17) << o.target_inertia[i];
+    t.inertia = parse_inertia(s.str(), "--target-inertia");
+  }
+  t.position = vec3(o.target_position, "target-position");
+  t.attitude = Quaternion(rotation_from_rpy(vec3(o.target_rpy_deg, "target-rpy-deg") * (M_PI / 180.0)));
+  t.angular_velocity = vec3(o.target_angular_velocity_deg, "target-angular-velocity-deg") * (M_PI / 180.0);
+  t.velocity = vec3(o.target_velocity, "target-velocity");
+  t.contact_offset = vec3(o.contact_offset, "contact-offset");
+  const Vector3 nrm = vec3(o.normal, "normal");
+  if (nrm.norm() < 1e-12) throw InputError("--normal: the contact normal must be a non-zero vector");
+  t.normal = nrm.normalized();
+  try {
+    t.validate("target");
+  } catch (const InputError& e) {
+    throw InputError(str("--target-mass/--target-inertia: ", e.what()));
+  }
+  pb.contact = {finite(o.stiffness, "stiffness"), finite(o.exponent, "exponent"), finite(o.restitution, "restitution")};
+  try {
+    validate(pb.contact, "contact");
+  } catch (const InputError& e) {
+    throw InputError(str("--stiffness/--exponent/--restitution: ", e.what()));
+  }
+  try {
+    make_contact_law(o.model, pb.contact, 1.0);  // an unknown --model lists the laws
+  } catch (const InputError& e) {
+    throw InputError(str("--model: ", e.what()));
+  }
+  pb.law = o.model;
+  pb.approach_speed = finite(o.approach_speed, "approach-speed");
+  if (pb.approach_speed <= 0) throw InputError(str("--approach-speed: must be positive, got ", pb.approach_speed));
+
+  const CaptureTask task = parse_task(o.task, o.task_axes, o.final_rpy_deg, "task");
+  const CaptureTask baseline_task =
+      o.baseline_task.empty() ? task : parse_task(o.baseline_task, o.task_axes, o.final_rpy_deg, "baseline-task");
+  CaptureOptions opt;
+  opt.duration = finite(o.duration, "duration");
+  opt.step = finite(o.step, "step");
+  opt.gain = finite(o.gain, "gain");
+  opt.feedback = finite(o.feedback, "feedback");
+  opt.tolerance = finite(o.tolerance, "tolerance");
+  opt.orientation_tolerance = finite(o.orientation_tolerance_deg, "orientation-tolerance-deg") * M_PI / 180.0;
+  if (o.duration <= 0) throw InputError(str("--duration: must be positive, got ", o.duration));
+  if (o.step <= 0 || o.step > o.duration) throw InputError(str("--step: must be in (0, duration], got ", o.step));
+  if (o.tolerance <= 0) throw InputError(str("--tolerance: must be positive, got ", o.tolerance));
+  // multibody-force has no gradient: the paper's method descends M_ie, the global search ranks by the CVODE peak
+  if (o.objective == "mass" || o.objective == "multibody-force") opt.objective = CaptureObjective::IntegratedEffectiveMass;
+  else if (o.objective == "exact-force") opt.objective = CaptureObjective::ExactMaxForce;
+  else throw InputError(str("--objective: unknown objective '", o.objective, "'; expected 'mass', 'exact-force' or 'multibody-force'"));
+  parse_seed(o.seed);
+  if (o.global_starts < 1) throw InputError(str("--global-starts: must be >= 1, got ", o.global_starts));
+  if (app.get_option("--max-joint-rate-deg")->count() > 0 && !(finite(o.max_joint_rate_deg, "max-joint-rate-deg") > 0))
+    throw InputError(str("--max-joint-rate-deg: must be positive, got ", o.max_joint_rate_deg));
+  if (opt.gain != 0.0 && task.rows() >= model.n())
+    throw InputError(str("--gain: the ", o.task, " task has ", task.rows(), " rows and the robot ", model.n(),
+                         " joints: no null space to optimize in (set gain = 0 or constrain fewer axes)"));
+  Scenario sc{std::move(o), where, builtin, std::move(model_ptr), pb, task, baseline_task, opt};
+  sc.problem.model = sc.model.get();
+  return sc;
+}
+
+std::pair<CaptureResult, CaptureResult> plan_plain_and_optimized(const Scenario& sc, bool quiet) {
+  CaptureOptions opt = sc.capture;
+  CaptureOptions plain = opt;
+  plain.gain = 0.0;
+  Progress p1{"plain"}, p2{"optimized"};
+  if (!quiet) {
+    plain.progress = std::ref(p1);
+    opt.progress = std::ref(p2);
+  }
+  auto labelled = [](const char* label, auto&& f) {
+    try {
+      return f();
+    } catch (const NumericalError& e) {
+      throw NumericalError(str(label, " run: ", e.what()));
+    }
+  };
+  CaptureResult base_run = labelled("plain", [&] { return plan_capture(sc.problem, sc.baseline_task, plain); });
+  CaptureResult opt_run = labelled("optimized", [&] { return plan_capture(sc.problem, sc.task, opt); });
+  return {std::move(base_run), std::move(opt_run)};
+}
+
+namespace {
 
 /// The global run (issue 9) and what the outputs need beside it.
 struct GlobalRun {
@@ -221,130 +327,51 @@ void print_global_notes(std::ostream& out, const GlobalRun& g, const CaptureResu
       << ")\n";
 }
 
-int run_scenario(RunOptions o, const CLI::App& app, bool urdf_on_command_line) {
-  // --- the scenario: a file, or the built-in default (the paper's 3-DOF robot) -----------------
-  const bool builtin = o.config.empty();
-  const std::string where = builtin ? std::string("built-in scenario") : "scenario " + o.config;
-  if (!builtin) {
-    for (const char* key : kRequired)
-      if (app.get_option(std::string("--") + key)->count() == 0)
-        throw InputError(str(where, ": missing key '", key, "'"));
+int run_scenario(RunOptions options, const CLI::App& app, FromCommandLine cli) {
+  const bool expect_builtin = options.config.empty();
+  const std::string config_path = options.config;
+  // a path in a scenario file is relative to the file
+  auto next_to_config = [&](const std::string& path, bool on_command_line) {
+    if (expect_builtin || on_command_line || path.empty() || path.front() == '/') return path;
+    const size_t slash = config_path.find_last_of('/');
+    return slash == std::string::npos ? path : config_path.substr(0, slash + 1) + path;
+  };
+  Scenario sc = prepare_scenario(std::move(options), app, cli.urdf);
+  RunOptions& o = sc.options;
+  // outputs and baseline first: a conflict or an unreadable baseline is found before the work
+  Outputs outputs;
+  outputs.add("--json", o.json);
+  outputs.add("--csv", o.csv);
+  nlohmann::json expected;
+  Tolerance tol{o.rtol, o.atol};
+  if (!std::isfinite(o.rtol) || o.rtol < 0) throw InputError(str("--rtol: must be finite and >= 0, got ", o.rtol));
+  if (!std::isfinite(o.atol) || o.atol < 0) throw InputError(str("--atol: must be finite and >= 0, got ", o.atol));
+  if (!o.expect.empty()) {
+    o.expect = next_to_config(o.expect, cli.expect);
+    expected = load_baseline(o.expect, "--expect");
   }
-  Model model = [&] {
-    if (builtin && !urdf_on_command_line && o.urdf == "paper_3dof.urdf")
-      return model_from_urdf_string(kPaper3dofUrdf, "built-in paper_3dof.urdf", o.end_effector);
-    std::string path = o.urdf;
-    if (!builtin && !urdf_on_command_line && !path.empty() && path.front() != '/') {
-      const size_t slash = o.config.find_last_of('/');
-      if (slash != std::string::npos) path = o.config.substr(0, slash + 1) + path;
-    }
-    o.urdf = path;
-    return model_from_urdf_file(path, o.end_effector);
-  }();
-
-  CaptureProblem pb;
-  pb.model = &model;
-  pb.frame = model.end_effector();
-  if (static_cast<int>(o.joints_deg.size()) != model.n())
-    throw InputError(str("--joints-deg: got ", o.joints_deg.size(), " angles, the robot has ", model.n(), " joints"));
-  pb.theta = Eigen::Map<const Eigen::VectorXd>(o.joints_deg.data(), model.n()) * (M_PI / 180.0);
-  for (double x : o.joints_deg) finite(x, "joints-deg");
-  pb.base.position = vec3(o.base_position, "base-position");
-  pb.base.orientation = Quaternion(rotation_from_rpy(vec3(o.base_rpy_deg, "base-rpy-deg") * (M_PI / 180.0)));
-  Target& t = pb.target;
-  t.mass = finite(o.target_mass, "target-mass");
-  if (o.target_inertia.size() != 3 && o.target_inertia.size() != 6)
-    throw InputError(str("--target-inertia: expected 3 or 6 numbers, got ", o.target_inertia.size()));
-  {
-    std::ostringstream s;
-    for (size_t i = 0; i < o.target_inertia.size(); ++i) s << (i ? "," : "") << std::setprecision(17) << o.target_inertia[i];
-    t.inertia = parse_inertia(s.str(), "--target-inertia");
-  }
-  t.position = vec3(o.target_position, "target-position");
-  t.attitude = Quaternion(rotation_from_rpy(vec3(o.target_rpy_deg, "target-rpy-deg") * (M_PI / 180.0)));
-  t.angular_velocity = vec3(o.target_angular_velocity_deg, "target-angular-velocity-deg") * (M_PI / 180.0);
-  t.velocity = vec3(o.target_velocity, "target-velocity");
-  t.contact_offset = vec3(o.contact_offset, "contact-offset");
-  const Vector3 nrm = vec3(o.normal, "normal");
-  if (nrm.norm() < 1e-12) throw InputError("--normal: the contact normal must be a non-zero vector");
-  t.normal = nrm.normalized();
-  try {
-    t.validate("target");
-  } catch (const InputError& e) {
-    throw InputError(str("--target-mass/--target-inertia: ", e.what()));
-  }
-  pb.contact = {finite(o.stiffness, "stiffness"), finite(o.exponent, "exponent"), finite(o.restitution, "restitution")};
-  try {
-    validate(pb.contact, "contact");
-  } catch (const InputError& e) {
-    throw InputError(str("--stiffness/--exponent/--restitution: ", e.what()));
-  }
-  try {
-    make_contact_law(o.model, pb.contact, 1.0);  // an unknown --model lists the laws
-  } catch (const InputError& e) {
-    throw InputError(str("--model: ", e.what()));
-  }
-  pb.law = o.model;
-  pb.approach_speed = finite(o.approach_speed, "approach-speed");
-  if (pb.approach_speed <= 0) throw InputError(str("--approach-speed: must be positive, got ", pb.approach_speed));
-
-  const CaptureTask task = parse_task(o.task, o.task_axes, o.final_rpy_deg, "task");
-  const CaptureTask baseline_task =
-      o.baseline_task.empty() ? task : parse_task(o.baseline_task, o.task_axes, o.final_rpy_deg, "baseline-task");
-  CaptureOptions opt;
-  opt.duration = finite(o.duration, "duration");
-  opt.step = finite(o.step, "step");
-  opt.gain = finite(o.gain, "gain");
-  opt.feedback = finite(o.feedback, "feedback");
-  opt.tolerance = finite(o.tolerance, "tolerance");
-  opt.orientation_tolerance = finite(o.orientation_tolerance_deg, "orientation-tolerance-deg") * M_PI / 180.0;
-  if (o.duration <= 0) throw InputError(str("--duration: must be positive, got ", o.duration));
-  if (o.step <= 0 || o.step > o.duration) throw InputError(str("--step: must be in (0, duration], got ", o.step));
-  if (o.tolerance <= 0) throw InputError(str("--tolerance: must be positive, got ", o.tolerance));
-  // multibody-force has no gradient: the paper's method descends M_ie, the global search ranks by the CVODE peak
-  GlobalObjective gobj = GlobalObjective::Mass;
-  if (o.objective == "mass") opt.objective = CaptureObjective::IntegratedEffectiveMass;
-  else if (o.objective == "exact-force") opt.objective = CaptureObjective::ExactMaxForce, gobj = GlobalObjective::ExactForce;
-  else if (o.objective == "multibody-force") gobj = GlobalObjective::MultibodyForce;
-  else throw InputError(str("--objective: unknown objective '", o.objective, "'; expected 'mass', 'exact-force' or 'multibody-force'"));
-  std::uint64_t seed = 0;
-  {
-    const std::string& sd = o.seed;
-    if (sd.empty() || sd.size() > 19 || sd.find_first_not_of("0123456789") != std::string::npos)
-      throw InputError(str("--seed: expected a non-negative integer (at most 19 digits), got '", sd, "'"));
-    seed = std::stoull(sd);
-  }
-  if (o.global_starts < 1) throw InputError(str("--global-starts: must be >= 1, got ", o.global_starts));
-  if (app.get_option("--max-joint-rate-deg")->count() > 0 && !(finite(o.max_joint_rate_deg, "max-joint-rate-deg") > 0))
-    throw InputError(str("--max-joint-rate-deg: must be positive, got ", o.max_joint_rate_deg));
-  if (opt.gain != 0.0 && task.rows() >= model.n())
-    throw InputError(str("--gain: the ", o.task, " task has ", task.rows(), " rows and the robot ", model.n(),
-                         " joints: no null space to optimize in (set gain = 0 or constrain fewer axes)"));
+  const Model& model = *sc.model;
+  const CaptureProblem& pb = sc.problem;
+  const CaptureTask& task = sc.task;
+  const CaptureTask& baseline_task = sc.baseline_task;
+  const CaptureOptions& opt = sc.capture;
+  const bool builtin = sc.builtin;
+  const std::string& where = sc.where;
   const bool want_series = !o.csv.empty();
-  opt.record_series = want_series;
+  sc.capture.record_series = want_series;
 
   // --- the two runs ------------------------------------------------------------------------------
-  CaptureOptions plain = opt;
-  plain.gain = 0.0;
-  Progress p1{"plain"}, p2{"optimized"};
-  if (!o.quiet) {
-    plain.progress = std::ref(p1);
-    opt.progress = std::ref(p2);
-  }
-  auto labelled = [](const char* label, auto&& f) {
-    try {
-      return f();
-    } catch (const NumericalError& e) {
-      throw NumericalError(str(label, " run: ", e.what()));
-    }
-  };
-  const CaptureResult base_run = labelled("plain", [&] { return plan_capture(pb, baseline_task, plain); });
-  const CaptureResult opt_run = labelled("optimized", [&] { return plan_capture(pb, task, opt); });
+  const auto [base_run, opt_run] = plan_plain_and_optimized(sc, o.quiet);
   const double mass_red = 100.0 * (base_run.M_ie - opt_run.M_ie) / base_run.M_ie;
   const double force_red = 100.0 * (base_run.f_max_closed_form - opt_run.f_max_closed_form) / base_run.f_max_closed_form;
   const double exact_red = 100.0 * (base_run.f_max_exact - opt_run.f_max_exact) / base_run.f_max_exact;
   std::optional<GlobalRun> global;
-  if (o.global) global = run_global(pb, task, opt, gobj, seed, o, opt_run);
+  if (o.global) {
+    const GlobalObjective gobj = o.objective == "exact-force"       ? GlobalObjective::ExactForce
+                                 : o.objective == "multibody-force" ? GlobalObjective::MultibodyForce
+                                                                    : GlobalObjective::Mass;
+    global = run_global(pb, task, sc.capture, gobj, parse_seed(o.seed), o, opt_run);
+  }
 
   // --- outputs: all built first, then written atomically ------------------------------------------
   nlohmann::json j;
@@ -410,12 +437,11 @@ int run_scenario(RunOptions o, const CLI::App& app, bool urdf_on_command_line) {
     }
     csv = c.str();
   }
-  std::vector<std::pair<std::string, std::string>> files;  // all or nothing: no partial output
-  if (!o.json.empty()) files.emplace_back(o.json, j.dump(2) + "\n");
-  if (!o.csv.empty()) files.emplace_back(o.csv, csv);
-  if (!files.empty()) write_files_atomic(files);
+  outputs.set("--json", j.dump(2) + "\n");
+  outputs.set("--csv", csv);
+  outputs.write();  // all or nothing: no partial output
 
-  std::ostream& out = std::cout;
+  std::ostream& out = outputs.table();  // standard error when --json or --csv is '-'
   out << "ffsr-optimize " << FFSR_VERSION << ": " << where << " (" << model.n() << " joints, " << o.model
       << ", T = " << o.duration << " s, step " << o.step << " s, rho = " << opt.gain << ")\n\n";
   const int w = 8 * model.n() + 4;
@@ -454,69 +480,94 @@ int run_scenario(RunOptions o, const CLI::App& app, bool urdf_on_command_line) {
     out << "note: near a singularity the pseudo-inverse was damped in " << base_run.damped_steps + opt_run.damped_steps
         << " evaluations (smallest singular value " << std::min(base_run.min_singular_value, opt_run.min_singular_value)
         << ")\n";
+
+  // --- regression run: every number of the result against the stored one -------------------------
+  if (!o.expect.empty()) {
+    const auto moved = compare_results(expected, j, tol, kNotCompared);
+    if (!moved.empty()) {
+      for (const auto& line : moved) std::cerr << line << "\n";
+      std::cerr << "ffsr-optimize: error: --expect " << o.expect << ": " << moved.size()
+                << (moved.size() == 1 ? " value differs" : " values differ") << " from the baseline (rtol "
+                << tol.rtol << ", atol " << tol.atol << "; regenerate it with --json FILE)\n";
+      return kExitRegression;
+    }
+  }
   return 0;
 }
 
 }  // namespace
 
-void register_run(CLI::App& app, Action& action, int argc, char** argv) {
-  auto o = std::make_shared<RunOptions>();
-  bool urdf_cli = false;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--urdf" || a.rfind("--urdf=", 0) == 0) urdf_cli = true;
-    if (a == "inspect" || a == "contact") break;
-  }
-  app.set_config("--config", "", "Scenario file (TOML); every key is also a flag. Default: the built-in paper 3-DOF scenario");
-  app.get_config_ptr()->check(CLI::ExistingFile);
-  app.allow_config_extras(CLI::config_extras_mode::error);  // an unknown key in a scenario is an error
+void add_scenario_options(CLI::App& app, RunOptions& o) {
   auto vec = [&](const char* name, std::vector<double>& v, const char* help) {
     return app.add_option(name, v, help)->delimiter(',')->allow_extra_args(false);
   };
-  app.add_option("--urdf", o->urdf, "Robot URDF (relative to the scenario file)");
-  app.add_option("--end-effector", o->end_effector, "End-effector frame (default: the single leaf link)");
-  vec("--joints-deg", o->joints_deg, "Initial joint angles, deg");
-  vec("--base-position", o->base_position, "Initial base position, m");
-  vec("--base-rpy-deg", o->base_rpy_deg, "Initial base attitude (roll, pitch, yaw), deg");
-  app.add_option("--target-mass", o->target_mass, "Target mass, kg");
-  vec("--target-inertia", o->target_inertia, "Target inertia: Ixx,Iyy,Izz[,Ixy,Ixz,Iyz], kg m^2 (target frame)");
-  vec("--target-position", o->target_position, "Target centre of mass at t = 0, m");
-  vec("--target-rpy-deg", o->target_rpy_deg, "Target attitude at t = 0, deg");
-  vec("--target-angular-velocity-deg", o->target_angular_velocity_deg, "Target spin (target frame), deg/s");
-  vec("--target-velocity", o->target_velocity, "Target linear velocity, m/s");
-  vec("--contact-offset", o->contact_offset, "r_tp: contact point from the target centre of mass (target frame), m");
-  vec("--normal", o->normal, "u_n: contact normal (target frame)");
-  app.add_option("--model", o->model, "Hysteresis damping law (Table 1)");
-  app.add_option("--stiffness", o->stiffness, "K, N/m^alpha");
-  app.add_option("--exponent", o->exponent, "alpha");
-  app.add_option("--restitution", o->restitution, "c_r, 0 < c_r <= 1");
-  app.add_option("--approach-speed", o->approach_speed, "End-effector speed along the normal at the capture, m/s");
-  app.add_option("--task", o->task, "Optimized run's task: position or pose");
-  app.add_option("--task-axes", o->task_axes, "Position task: constrained inertial axes, e.g. xy")->capture_default_str();
-  app.add_option("--baseline-task", o->baseline_task, "Plain run's task (default: the optimized run's)");
-  vec("--final-rpy-deg", o->final_rpy_deg, "Pose task: final end-effector orientation (default: hold the initial)");
-  app.add_option("--duration", o->duration, "Task time T, s");
-  app.add_option("--step", o->step, "RK4 step, s");
-  app.add_option("--gain", o->gain, "rho of Eq. 30 (< 0 lowers the objective)");
-  app.add_option("--feedback", o->feedback, "Tracking feedback gain, 1/s")->capture_default_str();
-  app.add_option("--tolerance", o->tolerance, "Required capture-point accuracy, m");
-  app.add_option("--orientation-tolerance-deg", o->orientation_tolerance_deg, "Pose task: required orientation accuracy, deg")
+  app.add_option("--urdf", o.urdf, "Robot URDF (relative to the scenario file)");
+  app.add_option("--end-effector", o.end_effector, "End-effector frame (default: the single leaf link)");
+  vec("--joints-deg", o.joints_deg, "Initial joint angles, deg");
+  vec("--base-position", o.base_position, "Initial base position, m");
+  vec("--base-rpy-deg", o.base_rpy_deg, "Initial base attitude (roll, pitch, yaw), deg");
+  app.add_option("--target-mass", o.target_mass, "Target mass, kg");
+  vec("--target-inertia", o.target_inertia, "Target inertia: Ixx,Iyy,Izz[,Ixy,Ixz,Iyz], kg m^2 (target frame)");
+  vec("--target-position", o.target_position, "Target centre of mass at t = 0, m");
+  vec("--target-rpy-deg", o.target_rpy_deg, "Target attitude at t = 0, deg");
+  vec("--target-angular-velocity-deg", o.target_angular_velocity_deg, "Target spin (target frame), deg/s");
+  vec("--target-velocity", o.target_velocity, "Target linear velocity, m/s");
+  vec("--contact-offset", o.contact_offset, "r_tp: contact point from the target centre of mass (target frame), m");
+  vec("--normal", o.normal, "u_n: contact normal (target frame)");
+  app.add_option("--model", o.model, "Hysteresis damping law (Table 1)");
+  app.add_option("--stiffness", o.stiffness, "K, N/m^alpha");
+  app.add_option("--exponent", o.exponent, "alpha");
+  app.add_option("--restitution", o.restitution, "c_r, 0 < c_r <= 1");
+  app.add_option("--approach-speed", o.approach_speed, "End-effector speed along the normal at the capture, m/s");
+  app.add_option("--task", o.task, "Optimized run's task: position or pose");
+  app.add_option("--task-axes", o.task_axes, "Position task: constrained inertial axes, e.g. xy")->capture_default_str();
+  app.add_option("--baseline-task", o.baseline_task, "Plain run's task (default: the optimized run's)");
+  vec("--final-rpy-deg", o.final_rpy_deg, "Pose task: final end-effector orientation (default: hold the initial)");
+  app.add_option("--duration", o.duration, "Task time T, s");
+  app.add_option("--step", o.step, "RK4 step, s");
+  app.add_option("--gain", o.gain, "rho of Eq. 30 (< 0 lowers the objective)");
+  app.add_option("--feedback", o.feedback, "Tracking feedback gain, 1/s")->capture_default_str();
+  app.add_option("--tolerance", o.tolerance, "Required capture-point accuracy, m");
+  app.add_option("--orientation-tolerance-deg", o.orientation_tolerance_deg, "Pose task: required orientation accuracy, deg")
       ->capture_default_str();
-  app.add_option("--objective", o->objective,
+  app.add_option("--objective", o.objective,
                  "mass (M_ie, the paper's), exact-force, or multibody-force (CVODE peak; global search only, the "
                  "paper's method then descends M_ie)")
       ->capture_default_str();
-  app.add_option("--global", o->global, "Also run the global capture optimization (true/false)")->capture_default_str();
-  app.add_option("--seed", o->seed, "Seed of the global search's random starts (non-negative integer)")->capture_default_str();
-  app.add_option("--max-joint-rate-deg", o->max_joint_rate_deg,
+  app.add_option("--global", o.global, "Also run the global capture optimization (true/false)")->capture_default_str();
+  if (!app.get_option_no_throw("--seed"))  // robust registers its own (Monte Carlo) --seed first
+    app.add_option("--seed", o.seed, "Seed of the global search's random starts (non-negative integer)")->capture_default_str();
+  app.add_option("--max-joint-rate-deg", o.max_joint_rate_deg,
                  "Global run: largest joint rate, deg/s (> 0; default: not limited; the paper's method is not limited)");
-  app.add_option("--global-starts", o->global_starts, "Global search: random starts (>= 1)")->capture_default_str();
-  app.add_option("--json", o->json, "Write the result (with the resolved scenario and the version) to this JSON file");
-  app.add_option("--csv", o->csv, "Write the time series of both runs to this CSV file");
+  app.add_option("--global-starts", o.global_starts, "Global search: random starts (>= 1)")->capture_default_str();
+}
+
+void register_run(CLI::App& app, Action& action, int argc, char** argv) {
+  auto o = std::make_shared<RunOptions>();
+  FromCommandLine from_cli;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--urdf" || a.rfind("--urdf=", 0) == 0) from_cli.urdf = true;
+    if (a == "--expect" || a.rfind("--expect=", 0) == 0) from_cli.expect = true;
+    if (a == "inspect" || a == "contact" || a == "robust") break;
+  }
+  app.set_config("--config", "", "Scenario file (TOML); every key is also a flag. Default: the built-in paper 3-DOF scenario");
+  app.config_formatter(std::make_shared<ScenarioConfig>());  // [uncertainty] is the robust command's
+  app.get_config_ptr()->check(CLI::ExistingFile);
+  app.allow_config_extras(CLI::config_extras_mode::error);  // an unknown key in a scenario is an error
+  add_scenario_options(app, *o);
+  app.add_option("--json", o->json,
+                 "Write the result (with the resolved scenario and the version) to this JSON file ('-': standard output)");
+  app.add_option("--csv", o->csv, "Write the time series of both runs to this CSV file ('-': standard output)");
+  app.add_option("--expect", o->expect,
+                 "Regression run: compare every number of the result with this stored --json result; exit 4 "
+                 "when one moved (relative to the scenario file)");
+  app.add_option("--rtol", o->rtol, "--expect: relative tolerance")->capture_default_str();
+  app.add_option("--atol", o->atol, "--expect: absolute floor for values near zero")->capture_default_str();
   app.add_flag("--quiet", o->quiet, "No progress line");
-  app.callback([o, &app, &action, urdf_cli] {
+  app.callback([o, &app, &action, from_cli] {
     if (!app.get_subcommands().empty()) return;
-    action = [o, &app, urdf_cli] {
+    action = [o, &app, from_cli] {
       if (o->config.empty()) {
         // the built-in default scenario fills every key not given on the command line
         std::istringstream in(kPaper3dofScenario);
@@ -528,7 +579,7 @@ void register_run(CLI::App& app, Action& action, int argc, char** argv) {
           }
         }
       }
-      return run_scenario(*o, app, urdf_cli);
+      return run_scenario(*o, app, from_cli);
     };
   });
   app.get_config_ptr()->each([o](const std::string& s) { o->config = s; });

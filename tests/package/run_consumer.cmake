@@ -1,7 +1,9 @@
 # ctest case package_consumer: install the built ffsr into a fresh prefix, then configure, build and
 # run the consumer project tests/package against that prefix only, as a user would; finally
 # configure it once more with urdfdom and SUNDIALS hidden, where find_package(ffsr) must give
-# ffsr::ffsr alone (a user of the dynamics needs only Eigen).
+# ffsr::ffsr alone (a user of the dynamics needs only Eigen). With -DFFSR_SOURCE_DIR it also
+# registers robots/paper_3dof.toml with ffsr_add_scenario_test against a copy of its stored
+# baseline and runs ctest twice: it must pass, then fail naming the value moved in the baseline.
 #
 #   cmake -DFFSR_BINARY_DIR=<ffsr build dir> -DCONSUMER_SOURCE_DIR=<tests/package>
 #         -DWORK_DIR=<scratch dir> [-DCONFIG=Release] [-DGENERATOR=Ninja]
@@ -52,7 +54,13 @@ endif()
 if(CONFIG)
   list(APPEND configure_args "-DCMAKE_BUILD_TYPE=${CONFIG}")
 endif()
-run_step("configuring the consumer" "${CMAKE_COMMAND}" ${configure_args} -B "${build}")
+set(scenario_args)
+if(FFSR_SOURCE_DIR)
+  configure_file("${FFSR_SOURCE_DIR}/tests/data/baselines/paper_3dof.json" "${WORK_DIR}/baseline.json" COPYONLY)
+  set(scenario_args "-DCONSUMER_SCENARIO=${FFSR_SOURCE_DIR}/robots/paper_3dof.toml"
+                    "-DCONSUMER_BASELINE=${WORK_DIR}/baseline.json")
+endif()
+run_step("configuring the consumer" "${CMAKE_COMMAND}" ${configure_args} ${scenario_args} -B "${build}")
 file(STRINGS "${build}/CMakeCache.txt" ffsr_dir REGEX "^ffsr_DIR:")
 string(REGEX REPLACE "^ffsr_DIR:[A-Z]*=" "" ffsr_dir "${ffsr_dir}")
 file(REAL_PATH "${prefix}" real_prefix)
@@ -79,7 +87,30 @@ foreach(exe consumer_dynamics consumer_urdf consumer_cvode)
   message(STATUS "${exe}:\n${step_output}")
 endforeach()
 
-# 5. without urdfdom and SUNDIALS: configure only
+# 5. ffsr_add_scenario_test: the stored baseline passes, a moved value fails and is named
+if(FFSR_SOURCE_DIR)
+  set(ctest_args "${CMAKE_CTEST_COMMAND}" --output-on-failure -R "^consumer_scenario$")
+  if(CONFIG)
+    list(APPEND ctest_args -C "${CONFIG}")
+  endif()
+  execute_process(COMMAND ${ctest_args} WORKING_DIRECTORY "${build}" RESULT_VARIABLE rc OUTPUT_VARIABLE out
+                  ERROR_VARIABLE err)
+  if(NOT rc EQUAL 0 OR NOT out MATCHES "1 tests passed|100% tests passed")
+    message(FATAL_ERROR "package consumer: the scenario test against its stored baseline failed (${rc}):\n${out}\n${err}")
+  endif()
+  file(READ "${WORK_DIR}/baseline.json" baseline)
+  string(JSON baseline SET "${baseline}" optimized integrated_effective_mass "1.5")
+  file(WRITE "${WORK_DIR}/baseline.json" "${baseline}")
+  execute_process(COMMAND ${ctest_args} WORKING_DIRECTORY "${build}" RESULT_VARIABLE rc OUTPUT_VARIABLE out
+                  ERROR_VARIABLE err)
+  if(rc EQUAL 0 OR NOT out MATCHES "optimized\\.integrated_effective_mass: stored 1\\.5, now [0-9]")
+    message(FATAL_ERROR "package consumer: the scenario test against a moved baseline did not fail naming "
+                        "optimized.integrated_effective_mass (${rc}):\n${out}\n${err}")
+  endif()
+  message(STATUS "ffsr_add_scenario_test: passes on the stored baseline, fails on a moved value as expected")
+endif()
+
+# 6. without urdfdom and SUNDIALS: configure only
 run_step("configuring the consumer without urdfdom and SUNDIALS" "${CMAKE_COMMAND}"
          ${configure_args} -B "${WORK_DIR}/build_dynamics_only" -DCONSUMER_DYNAMICS_ONLY=ON
          -DCMAKE_DISABLE_FIND_PACKAGE_urdfdom=ON -DCMAKE_DISABLE_FIND_PACKAGE_SUNDIALS=ON)

@@ -17,7 +17,7 @@
 // s* in (0, 1), where d ln F/ds = 0; with g'(s) = -f² s/(1+fs) this is
 //     (α+1) g(s) - α f s = 0,   i.e.  φ(s) = (α+1) f G(s) - α s = 0.
 // φ(0) = (α+1) f G(0) > 0, φ(1) = -α < 0, and φ is decreasing and concave on [0, 1], so the root
-// is unique; it is found by a bracketed Newton iteration (detail::contact_peak_rate).
+// is unique; it is found by a bracketed Newton iteration in s or in t = 1 - s (detail::contact_peak).
 #pragma once
 
 #include <ffsr/contact/damping.hpp>
@@ -161,12 +161,20 @@ inline double model_accuracy(double F_model, double F_exact);
 
 namespace detail {
 
-/// G(s) = g(s)/f² of Eq. 19 (see the file comment), for f >= 0 and s with 1 + f s > 0.
-/// With u = (1-s)/(1+f) and w = f u: g = (1+f) w + ln(1-w), so G = u - Σ_{k>=2} f^(k-2) u^k / k.
+/// ln(1 - w) for w = f t/(1+f) (t = 1 - s): log1p(-w) while w < 1/2, else ln(1 + f s) - ln(1 + f),
+/// which stays exact where w rounds to 1 (f ~ 1e17 at t = 1: ln(1-w) = -ln(1+f), not -inf).
+inline double contact_log1m_w(double f, double t, double w) {
+  return w < 0.5 ? std::log1p(-w) : std::log1p(f * (1.0 - t)) - std::log1p(f);
+}
+
+/// G = g/f² of Eq. 19 (see the file comment) as a function of t = 1 - s, the rate lost since first
+/// touch, for f >= 0 and 0 <= t < 1 + 1/f. Taking t rather than s keeps full relative precision
+/// next to first touch (s -> 1), where the force peak sits when α is tiny or f huge.
+/// With u = t/(1+f) and w = f u: g = (1+f) w + ln(1-w), so G = u - Σ_{k>=2} f^(k-2) u^k / k.
 /// The series (used when f u <= 1/4, always when f is small) has no cancellation and gives the
 /// f -> 0 limit (1-s²)/2 exactly; otherwise log1p is accurate (f u > 1/4 means f > 1/3).
-inline double contact_G(double f, double s) {
-  const double u = (1.0 - s) / (1.0 + f);
+inline double contact_G_lost(double f, double t) {
+  const double u = t / (1.0 + f);
   const double w = f * u;
   if (w <= 0.25) {
     double p = u * u;  // f^(k-2) u^k for k = 2
@@ -179,31 +187,89 @@ inline double contact_G(double f, double s) {
     }
     return u - sum;
   }
-  return ((1.0 + f) * w + std::log1p(-w)) / (f * f);
+  return ((1.0 + f) * w + contact_log1m_w(f, t, w)) / (f * f);
 }
 
-/// The dimensionless rate s* in (0, 1) of the force maximum: the root of
-/// φ(s) = (α+1) f G(s) - α s (file comment). φ is decreasing and concave on [0, 1], so Newton's
-/// method started right of the root (at φ(0)/α, where φ <= 0 by concavity) decreases monotonically
-/// onto it; a bisection step guards the bracket anyway. At most 100 iterations; NumericalError if
-/// not converged (not expected). f = 0 gives s* = 0 (pure Hertz: the peak is at δ_max).
-inline double contact_peak_rate(double f, double alpha) {
-  if (f == 0.0) return 0.0;
-  auto phi = [&](double s) { return (alpha + 1.0) * f * contact_G(f, s) - alpha * s; };
-  auto dphi = [&](double s) { return -(alpha + 1.0) * f * s / (1.0 + f * s) - alpha; };
-  double lo = 0.0, hi = 1.0;  // φ(lo) > 0 > φ(hi)
-  double s = std::min(phi(0.0) / alpha, 0.5);
-  for (int it = 0; it < 100; ++it) {
-    const double ph = phi(s);
-    if (ph == 0.0) return s;
-    if (ph > 0.0) lo = s; else hi = s;
-    double next = s - ph / dphi(s);
-    if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
-    if (std::abs(next - s) <= 2.0 * std::numeric_limits<double>::epsilon() * s) return next;
-    s = next;
+/// f·G as a function of t (see contact_G_lost), f > 0: the term of the peak condition. Written with
+/// w = f t/(1+f), which stays representable where G itself underflows (t ~ 1e-320 with f ~ 1e17):
+/// f G = w - u Σ_{k>=2} w^(k-1)/k (series, w <= 1/4), else ((1+f) w + ln(1-w))/f.
+inline double contact_fG_lost(double f, double t) {
+  const double u = t / (1.0 + f);
+  const double w = f / (1.0 + f) * t;
+  if (w <= 0.25) {
+    double p = w;  // w^(k-1) for k = 2
+    double sum = 0.5 * p;
+    for (int k = 3; k < 64 && p != 0.0; ++k) {
+      p *= w;
+      const double term = p / k;
+      sum += term;
+      if (term <= 1e-18 * sum) break;
+    }
+    return w - u * sum;
   }
-  throw NumericalError(str("contact_peak_rate: no convergence for f = ", f, ", alpha = ", alpha));
+  return ((1.0 + f) * w + contact_log1m_w(f, t, w)) / f;
 }
+
+/// G(s) = contact_G_lost(f, 1 - s), for s with 1 + f s > 0.
+inline double contact_G(double f, double s) { return contact_G_lost(f, 1.0 - s); }
+
+/// ln G as a function of t = 1 - s (t > 0): log of contact_G_lost, and where G underflows the
+/// double range (t below ~1e-300: a peak within rounding of first touch) ln u + ln(1 - u/2 ...)
+/// with ln u = ln t - ln(1+f), so that ratios of G stay finite.
+inline double contact_log_G_lost(double f, double t) {
+  const double G = contact_G_lost(f, t);
+  if (G >= std::numeric_limits<double>::min()) return std::log(G);
+  const double u = t / (1.0 + f);            // G = u (1 - u/2 - ...), u tiny here
+  return std::log(t) - std::log1p(f) + std::log1p(-0.5 * u);
+}
+
+/// Where the force maximum lies: s* = δ̇/δ̇⁻ at the peak and t* = 1 - s*, the rate lost since first
+/// touch, each to full relative precision (whichever is below 1/2 is the one solved for, the other
+/// is 1 minus it, exact to rounding).
+struct PeakRate {
+  double s;  ///< s* in [0, 1)
+  double t;  ///< t* = 1 - s* in (0, 1]
+};
+
+/// The root of φ(s) = (α+1) f G(s) - α s (file comment). φ is decreasing and concave in s on [0, 1]
+/// (φ(0) > 0 > φ(1) = -α), so the root is unique. It is solved in s when it lies in s <= 1/2, and in
+/// t = 1 - s otherwise, where ψ(t) = φ(1 - t) is increasing and concave: a root next to first touch
+/// (t* ~ α(1+f)/((α+1)f) for tiny α) would round to s = 1 (G = 0, F = 0: a lost peak) if solved in s.
+/// Newton's method started on the side where the tangent stays on the near side of the root (right
+/// of it in s, at φ(0)/α or 1/2; left of it in t, at 0) moves monotonically onto it; a bisection step
+/// guards the bracket anyway. At most 200 iterations; NumericalError if not converged (not expected).
+/// f = 0 gives s* = 0 (pure Hertz: the peak is at δ_max).
+inline PeakRate contact_peak(double f, double alpha) {
+  if (f == 0.0) return {0.0, 1.0};
+  // dG/ds = -s/(1+fs): φ'(s) = -(α+1) f s/(1+fs) - α, ψ'(t) = -φ'(1-t).
+  auto phi = [&](double s, double t) { return (alpha + 1.0) * contact_fG_lost(f, t) - alpha * s; };
+  auto slope = [&](double s) { return (alpha + 1.0) * f * s / (1.0 + f * s) + alpha; };  // |φ'(s)|
+  const bool near_touch = phi(0.5, 0.5) > 0.0;  // φ(1/2) > 0: the root is at s > 1/2, t < 1/2
+  // x is the variable solved for (t near touch, else s); v(x) its φ with the sign that makes it
+  // increasing in x: near touch ψ(t), else -φ(s). Bracket [lo, hi] with v(lo) < 0 < v(hi).
+  auto v = [&](double x) { return near_touch ? phi(1.0 - x, x) : -phi(x, 1.0 - x); };
+  double lo = 0.0, hi = 0.5;
+  double x = near_touch ? 0.0 : std::min(phi(0.0, 1.0) / alpha, 0.5);
+  for (int it = 0; it < 200; ++it) {
+    const double vx = v(x);
+    if (vx == 0.0) break;
+    if (vx < 0.0) lo = x; else hi = x;
+    const double dv = slope(near_touch ? 1.0 - x : x);
+    double next = x - vx / dv;
+    if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
+    // converged to rounding (a few units of the last place also among subnormals, for tiny α)
+    const bool done = std::abs(next - x) <= 2.0 * std::numeric_limits<double>::epsilon() * next +
+                                                4.0 * std::numeric_limits<double>::denorm_min();
+    x = next;
+    if (done) return near_touch ? PeakRate{1.0 - x, x} : PeakRate{x, 1.0 - x};
+  }
+  if (v(x) != 0.0)
+    throw NumericalError(str("contact_peak: no convergence for f = ", f, ", alpha = ", alpha));
+  return near_touch ? PeakRate{1.0 - x, x} : PeakRate{x, 1.0 - x};
+}
+
+/// The dimensionless rate s* in [0, 1) of the force maximum (see contact_peak).
+inline double contact_peak_rate(double f, double alpha) { return contact_peak(f, alpha).s; }
 
 /// Returns x; throws NumericalError when a result computed from finite, valid arguments is not finite
 /// (it overflows double precision, e.g. M_ie = 1e300 kg).
@@ -328,11 +394,15 @@ double HertzDamped<Damping>::max_force_closed_form(double M_ie) const {
 template <class Damping>
 ForcePeak HertzDamped<Damping>::exact_peak(double M_ie) const {
   detail::require_positive_mass(M_ie, name);
-  const double s = detail::contact_peak_rate(f_, p_.alpha);
+  const auto [s, t] = detail::contact_peak(f_, p_.alpha);
   ForcePeak pk;
-  pk.deformation = delta_from_G(M_ie, detail::contact_G(f_, s));
+  pk.deformation = delta_from_G(M_ie, detail::contact_G_lost(f_, t));
   pk.deformation_rate = s * v0_;
   pk.force = p_.K * std::pow(pk.deformation, p_.alpha) * (1.0 + f_ * s);
+  // δ(t*) underflowing to 0 (a peak within ~1e-300 of first touch) would report F = 0: not an answer.
+  if (!(pk.deformation > 0.0))
+    throw NumericalError(detail::str(name, ": the force peak is too close to first touch to be represented (f = ",
+                                     f_, ", alpha = ", p_.alpha, ", M_ie = ", M_ie, " kg)"));
   detail::require_finite_result(pk.deformation, name, "deformation at the force peak", M_ie);
   detail::require_finite_result(pk.force, name, "exact F_max", M_ie);
   return pk;
@@ -341,11 +411,19 @@ ForcePeak HertzDamped<Damping>::exact_peak(double M_ie) const {
 template <class Damping>
 double HertzDamped<Damping>::relative_error() const {
   // ξ = 1 - F'/F = 1 - (G(0)/G(s*))^(α/(α+1)) / (1 + f s*), as -expm1(ln) for accuracy near f = 0.
+  // ln(G(0)/G(s*)) as log1p of the relative difference while G(s*) is a normal number; from the
+  // logarithms when the peak is so close to first touch that G(s*) underflows (tiny α).
   const double a = p_.alpha;
-  const double s = detail::contact_peak_rate(f_, a);
-  const double Gs = detail::contact_G(f_, s);
-  const double ln_ratio = a / (a + 1.0) * std::log1p((G0_ - Gs) / Gs) - std::log1p(f_ * s);
-  return -100.0 * std::expm1(ln_ratio);
+  const auto [s, t] = detail::contact_peak(f_, a);
+  const double Gs = detail::contact_G_lost(f_, t);
+  const double ln_G_ratio = Gs >= std::numeric_limits<double>::min()
+                                ? std::log1p((G0_ - Gs) / Gs)
+                                : std::log(G0_) - detail::contact_log_G_lost(f_, t);
+  const double ln_ratio = a / (a + 1.0) * ln_G_ratio - std::log1p(f_ * s);
+  const double xi = -100.0 * std::expm1(ln_ratio);
+  if (!std::isfinite(xi))
+    throw NumericalError(detail::str(name, ": xi is not representable for f = ", f_, ", alpha = ", a));
+  return xi;
 }
 
 constexpr std::array<std::string_view, num_contact_laws> contact_law_names() {

@@ -420,7 +420,10 @@ CaptureResult integrate_capture(const CaptureProblem& pb, const CaptureTask& tas
   BasePose base = pb.base;
   base.orientation.normalize();
   Eigen::VectorXd theta = pb.theta;
-  const long nsteps = static_cast<long>(std::ceil(opt.duration / opt.step - 1e-9));
+  // At least one step: the 1e-9 slack (a duration that is a whole number of steps up to rounding)
+  // must not round a duration shorter than 1e-9 steps down to none -- a run without a step would
+  // return the initial state with no Jacobian ever evaluated (min_singular_value = inf).
+  const long nsteps = std::max(1L, static_cast<long>(std::ceil(opt.duration / opt.step - 1e-9)));
   const double h = opt.duration / static_cast<double>(nsteps);
   Eigen::VectorXd k_th[4] = {Eigen::VectorXd(n), Eigen::VectorXd(n), Eigen::VectorXd(n), Eigen::VectorXd(n)};
   Vector6 k_b[4];
