@@ -7,7 +7,8 @@
 // batches of the mean time per call (std::chrono::steady_clock; a batch lasts about 5 ms), and the
 // heap allocations per call after set-up, of: forward_kinematics, crba, J_f (frame_jacobian +
 // generalized_jacobian), crba + J_f, M_ie (integrated_effective_mass: H, J, the solve), its
-// analytic gradient, and rnea. Then the contact benchmarks (bench_contact.hpp), one multibody
+// analytic gradient, and rnea; one point of `ffsr-optimize map` (M_ie, F_max and its CSV row) in
+// points per second. Then the contact benchmarks (bench_contact.hpp), one multibody
 // CVODE contact run per robot, and the paper's capture scenarios (plan_capture, plain and
 // optimized). The targets of issues 2-4 are printed beside the figures.
 //
@@ -23,11 +24,15 @@
 #include <ffsr/io/urdf.hpp>
 #include <ffsr/optimize/capture.hpp>
 #include <ffsr/simulate/multibody.hpp>
+#ifdef FFSR_HAVE_GLOBAL
+#include <ffsr/optimize/global.hpp>
+#endif
 
 #include "bench_contact.hpp"
 
 #include <algorithm>
 #include <atomic>
+#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -385,6 +390,99 @@ void bench_hot_paths(const Settings& s, const Robot& r, AllocCheck& check) {
   check.require_zero(r.name, "rnea", id);
 }
 
+/// One point of `ffsr-optimize map` (src/cli/map.cpp): crba, the inverse effective mass, M_ie
+/// (Eq. 14), the closed-form F_max (Eq. 24) and the CSV row formatted with std::to_chars, on a grid
+/// walked in the map's order (last joint fastest, 2 deg steps). Reports points per second on one
+/// thread beside the target of issue 10 (5.83 million points in 10 s on 2 threads: 292k/s each).
+void bench_map(const Settings& s, const Robot& r, AllocCheck& check) {
+  using namespace ffsr;
+  const Model& model = r.model;
+  Data data(model);
+  const Vector3 u = r.target.normal_world();
+  const double target_inv_mass = r.target.inverse_mass_along_normal();
+  const double v_in = approach_velocity(u, Vector3(kApproachSpeed * u), r.target.velocity,
+                                        r.target.angular_velocity_world(), r.target.offset_world());
+  const AnyContactLaw law = make_contact_law(kLaw, kContact, v_in);
+  Eigen::VectorXd theta = r.theta_contact;
+  const BasePose base;
+  std::vector<char> row(64 * static_cast<size_t>(model.n() + 2));
+  const Timing t = measure(s, [&](long i) {
+    long rest = i;
+    char* p = row.data();
+    char* const end = row.data() + row.size();
+    for (int j = model.n(); j-- > 0;) {
+      const double deg = -180.0 + 2.0 * static_cast<double>(rest % 180);
+      rest /= 180;
+      theta(j) = deg * kDeg;
+      const auto c = std::to_chars(p, end, deg);
+      p = c.ptr;
+      *p++ = ',';
+    }
+    crba(model, data, base, theta);
+    const double M = 1.0 / (inverse_effective_mass(model, data, r.ee, u) + target_inv_mass);
+    const double F = max_force_closed_form(law, M);
+    p = std::to_chars(p, end, M).ptr;
+    *p++ = ',';
+    p = std::to_chars(p, end, F).ptr;
+    *p++ = '\n';
+    escape(row.data());
+    return static_cast<double>(p - row.data());
+  });
+  char target[96];
+  std::snprintf(target, sizeof target, "%.3g points/s (>= 292k/s a thread), 0 allocs", 1.0 / t.median);
+  print_row(r.name, "map point: M_ie + F_max + CSV row (to_chars)", t, target, r.model.n() == 3 ? 1.0 / 292e3 : 0);
+  check.require_zero(r.name, "map point", t);
+}
+
+/// A serial chain of n revolute joints (axes, offsets and inertias varied deterministically).
+ffsr::Model bench_chain(int n) {
+  using namespace ffsr;
+  ModelBuilder b("base", Inertia{400, Vector3(0.05, -0.02, 0.1), Vector3(90, 110, 100).asDiagonal()});
+  std::string parent = "base";
+  for (int i = 1; i <= n; ++i) {
+    const std::string child = "l" + std::to_string(i);
+    const double s = std::sin(1.7 * i), c = std::cos(2.3 * i);
+    b.add_joint("j" + std::to_string(i), JointType::Revolute, parent,
+                Pose::from_xyz_rpy(Vector3(0.3 + 0.1 * s, 0.1 * c, 0.05), Vector3(0.3 * c, 0.2 * s, 0.7 * i)),
+                Vector3(s, c, 1.5), child, Inertia{3 + 2 * s, Vector3(0.15, 0.01 * c, 0), Vector3(0.1, 0.4, 0.4).asDiagonal()});
+    parent = child;
+  }
+  b.add_fixed("tip_mount", parent, Pose{Vector3(0.2, 0, 0)}, "tip", Inertia{});
+  b.set_end_effector("tip");
+  return b.build();
+}
+
+/// The inverse effective mass by crba + dense Cholesky and by the articulated-body recursion, on
+/// serial chains of growing size: where the recursion starts to win (kArticulatedMinJoints).
+void bench_crossover(const Settings& s, AllocCheck& check) {
+  using namespace ffsr;
+  for (int n : {3, 5, 6, 7, 8, 10, 12, 14, 28, 56}) {
+    const Model model = bench_chain(n);
+    Data data(model);
+    const int ee = model.end_effector();
+    constexpr int K = 16;
+    std::vector<Eigen::VectorXd> thetas;
+    for (int k = 0; k < K; ++k) thetas.push_back(Eigen::VectorXd::LinSpaced(n, -1.0 + 0.1 * k, 2.0 - 0.05 * k));
+    const Vector3 u = Vector3(1, 2, -0.5).normalized();
+    const BasePose base;
+    const std::string name = "chain " + std::to_string(n);
+    const Timing dense = measure(s, [&](long i) {
+      crba(model, data, base, thetas[static_cast<size_t>(i % K)]);
+      return inverse_effective_mass(model, data, ee, u);
+    });
+    const Timing aba = measure(s, [&](long i) {
+      forward_kinematics(model, data, base, thetas[static_cast<size_t>(i % K)]);
+      return inverse_effective_mass_articulated(model, data, ee, u);
+    });
+    char ratio[64];
+    std::snprintf(ratio, sizeof ratio, "articulated/dense %.2f (fast path: %s)", aba.median / dense.median,
+                  n >= kArticulatedMinJoints ? "articulated" : "dense");
+    print_row(name, "1/m_e: crba + dense Cholesky", dense, "");
+    print_row(name, "1/m_e: articulated-body recursion, O(n)", aba, ratio);
+    check.require_zero(name, "inverse_effective_mass_articulated", aba);
+  }
+}
+
 // ---------------------------------------------------------------------------------------------
 // Whole runs: the multibody CVODE contact and the capture scenarios
 // ---------------------------------------------------------------------------------------------
@@ -457,6 +555,56 @@ void bench_scenarios(const Settings& s, const Robot& r3, const Robot& r7) {
   print_row(r7.name, "scenario position: plain + optimized (xyz)", {plain7 + pos7, plain7 + pos7, -1, 1}, "< 2 s", 2.0);
 }
 
+#ifdef FFSR_HAVE_GLOBAL
+/// Global capture optimization (issue 9): the whole plan_capture_global (task-only run, search,
+/// reaching run, search at the reached base pose, ...) with the scenario files' 3 deg/s limit; and
+/// the multibody-force search (CVODE ranking of the local optima) at c_r = 0.3.
+void bench_global(const Settings& s, const Robot& r3, const Robot& r7) {
+  using namespace ffsr;
+  auto run = [&](const Robot& r, double T, const CaptureTask& task, const char* target, double limit) {
+    CaptureProblem pb;
+    pb.model = &r.model;
+    pb.frame = r.ee;
+    pb.theta = r.theta_start;
+    pb.target = r.target;
+    pb.contact = kContact;
+    pb.law = kLaw;
+    pb.approach_speed = kApproachSpeed;
+    CaptureOptions opt;
+    opt.duration = T;
+    opt.step = 0.1;
+    opt.max_joint_rate = 3.0 * M_PI / 180.0;
+    GlobalCaptureResult last;
+    const Timing t = measure_runs(s.capture_runs, [&] {
+      last = plan_capture_global(pb, task, opt, GlobalCaptureOptions{});
+      return last.run.M_ie;
+    });
+    print_row(r.name, "plan_capture_global (search + reaching plan)", t, target, limit);
+    std::printf("%-11s   M_ie = %.4f kg, gap %.3f %%, %d shooting iteration(s), %ld SLSQP evaluations, search %.3f s\n",
+                "", last.run.M_ie, last.optimality_gap_percent, last.shooting_iterations, last.evaluations,
+                last.search_seconds);
+    return pb;
+  };
+  run(r3, 180.0, position_task(true, true, false), "< 1 s", 1.0);
+  CaptureProblem pb = run(r7, 157.0, position_task(true, true, true), "< 3 s", 3.0);
+  pb.contact.c_r = 0.3;
+  CaptureOptions opt;
+  opt.duration = 157.0;
+  const CaptureTask task = position_task(true, true, true);
+  const CaptureSetup setup = prepare_capture(pb, task, opt);
+  ManifoldSearchOptions so;
+  so.objective = GlobalObjective::MultibodyForce;
+  ManifoldSearchResult last;
+  const Timing t = measure_runs(s.capture_runs, [&] {
+    last = search_capture_manifold(pb, task, setup, pb.base, so);
+    return last.best.objective;
+  });
+  print_row(r7.name, "multibody-force search (c_r = 0.3, xyz)", t, "", 0);
+  std::printf("%-11s   CVODE F_max = %.1f N at M_ie = %.4f kg; %ld SLSQP evaluations, %ld CVODE runs\n", "",
+              last.best.objective, last.best.M_ie, last.evaluations, last.objective_evaluations);
+}
+#endif
+
 std::string robots_dir(const std::string& arg) {
   auto exists = [](const std::string& p) { return std::ifstream(p).good(); };
   const std::string base = arg.empty() ? std::string(FFSR_SOURCE_DIR) + "/robots" : arg;
@@ -509,6 +657,11 @@ int main(int argc, char** argv) {
                  "16 nearby poses cycled)");
     bench_hot_paths(s, r3, check);
     bench_hot_paths(s, r7, check);
+    print_header("map (ffsr-optimize map, one thread; 3-DOF grid at 2 deg)");
+    bench_map(s, r3, check);
+    bench_map(s, r7, check);
+    print_header("inverse effective mass: dense against articulated-body recursion (serial chains)");
+    bench_crossover(s, check);
 
     std::printf("\ncontact (bench_contact.hpp; targets: closed form < 1 us, exact < 20 us)\n");
     std::fflush(stdout);
@@ -524,6 +677,10 @@ int main(int argc, char** argv) {
 
     print_header("capture scenarios: whole plan_capture runs (RK4, step 0.1 s; 3-DOF T = 180 s, 7-DOF T = 157 s)");
     bench_scenarios(s, r3, r7);
+#ifdef FFSR_HAVE_GLOBAL
+    print_header("global capture optimization (optimize/global.hpp; 3 deg/s joint-rate limit)");
+    bench_global(s, r3, r7);
+#endif
 
     if (!check.failures.empty()) {
       std::printf("\nFAIL: hot paths allocate per call:\n");

@@ -36,7 +36,7 @@ inline void prepare_scenario_dir(const std::string& dir) {
 
 /// The arguments after the program name: the scenario in `dir`, a bounded run, outputs in `dir`.
 inline std::vector<std::string> scenario_arguments(const std::string& dir) {
-  return {"--config", dir + "/scenario.toml", "--quiet", "--duration", "2", "--step", "0.1",
+  return {"--config", dir + "/scenario.toml", "--quiet", "--global", "false", "--duration", "2", "--step", "0.1",
           "--json", dir + "/out.json", "--csv", dir + "/out.csv"};
 }
 

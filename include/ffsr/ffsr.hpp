@@ -14,3 +14,4 @@
 #include "ffsr/algorithm/jacobian.hpp"
 #include "ffsr/algorithm/momentum.hpp"
 #include "ffsr/algorithm/effective_mass.hpp"
+#include "ffsr/algorithm/articulated_effective_mass.hpp"

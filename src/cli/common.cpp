@@ -17,6 +17,8 @@
 #include <random>
 #include <sstream>
 
+#include <unistd.h>
+
 namespace ffsr::cli {
 
 using detail::str;
@@ -106,6 +108,34 @@ Target TargetOptions::build() const {
     throw InputError(str("--target-inertia/--target-mass: ", e.what()));
   }
   return t;
+}
+
+void ContactLawOptions::add_to(CLI::App& app, const std::string& model_help) {
+  app.add_option("--stiffness", stiffness, "Contact stiffness K, N/m^alpha")->capture_default_str();
+  app.add_option("--exponent", exponent, "Contact exponent alpha")->capture_default_str();
+  app.add_option("--restitution", restitution, "Coefficient of restitution c_r, 0 < c_r <= 1")->capture_default_str();
+  app.add_option("--model", model, model_help)->capture_default_str();
+  app.add_option("--approach-speed", approach_speed, "End-effector speed along the normal at first touch, m/s")
+      ->capture_default_str();
+  app.add_option("--target-angular-velocity-deg", target_angular_velocity_deg, "Target spin (target frame), deg/s")
+      ->capture_default_str();
+  app.add_option("--target-velocity", target_velocity, "Target linear velocity (inertial frame), m/s")
+      ->capture_default_str();
+}
+
+ContactParams ContactLawOptions::params() const {
+  const ContactParams p{stiffness, exponent, restitution};
+  try {
+    validate(p, "contact");
+  } catch (const InputError& e) {
+    throw InputError(std::string("--stiffness/--exponent/--restitution: ") + e.what());
+  }
+  return p;
+}
+
+void ContactLawOptions::set_target_motion(Target& target) const {
+  target.angular_velocity = parse_vec3(target_angular_velocity_deg, "--target-angular-velocity-deg") * (M_PI / 180.0);
+  target.velocity = parse_vec3(target_velocity, "--target-velocity");
 }
 
 Robot load_robot(const RobotOptions& o) {
@@ -324,6 +354,30 @@ void flush_stdout() {
     if (errno == 0) throw InputError("standard output: cannot write (a closed pipe, a full disk or an I/O error)");
     throw_write_error("standard output", errno, "cannot write");
   }
+}
+
+Progress::Progress(std::string label_, bool quiet, std::string unit_)
+    : label(std::move(label_)), unit(std::move(unit_)), start(std::chrono::steady_clock::now()), enabled(!quiet && isatty(fileno(stderr)) != 0) {}
+
+void Progress::operator()(double fraction) {
+  if (!enabled) return;
+  const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (s < 1.0 && !shown) return;
+  shown = true;
+  std::fprintf(stderr, "\rffsr-optimize: %s run %3.0f%%", label.c_str(), fraction * 100.0);
+  if (fraction >= 1.0) std::fprintf(stderr, "\n");
+}
+
+void Progress::operator()(unsigned long long done, unsigned long long total) {
+  if (!enabled) return;
+  const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (s < 1.0 && !shown) return;
+  shown = true;
+  const double rate = s > 0 ? static_cast<double>(done) / s : 0.0;
+  const double left = rate > 0 ? static_cast<double>(total - done) / rate : 0.0;
+  std::fprintf(stderr, "\rffsr-optimize: %s %llu/%llu %s (%3.0f%%), %.3g %s/s, %.0f s left   ", label.c_str(),
+               done, total, unit.c_str(), total ? 100.0 * static_cast<double>(done) / static_cast<double>(total) : 100.0, rate, unit.c_str(), left);
+  if (done >= total) std::fprintf(stderr, "\n");
 }
 
 nlohmann::json to_json(const Eigen::MatrixXd& m) {

@@ -1,11 +1,13 @@
 // src/cli/common.hpp -- options shared by the subcommands, parsing helpers and output files.
 #pragma once
 
+#include "ffsr/contact/contact_law.hpp"
 #include "ffsr/ffsr.hpp"
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include <chrono>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -47,6 +49,24 @@ struct TargetOptions {
   void add_to(CLI::App& app);
   /// The target (attitude, inertia, offset, normal, mass), validated.
   Target build() const;
+};
+
+/// --model, --stiffness, --exponent, --restitution, --approach-speed, --target-angular-velocity-deg,
+/// --target-velocity: the contact law and the relative motion at the first touch (contact, map).
+struct ContactLawOptions {
+  double stiffness = 1e9;
+  double exponent = 1.5;
+  double restitution = 0.9;
+  std::string model = "herbert-mcwhannell";
+  double approach_speed = 0.2;
+  std::string target_angular_velocity_deg = "0,0,2";
+  std::string target_velocity = "0,0,0";
+  /// `model_help` describes --model (contact accepts 'all', map one law).
+  void add_to(CLI::App& app, const std::string& model_help);
+  /// K, alpha, c_r, validated (InputError naming the flags).
+  ContactParams params() const;
+  /// Sets the target's velocity and spin from the flags. Throws InputError naming the flag.
+  void set_target_motion(Target& target) const;
 };
 
 /// A robot loaded from --urdf at the configuration of the flags.
@@ -113,6 +133,22 @@ void write_files_atomic(const std::vector<std::pair<std::string, std::string>>& 
 /// Flushes standard output and throws InputError ("standard output: cannot write ...") when a write to
 /// it failed (a closed pipe, a full disk). main calls it after every successful action.
 void flush_stdout();
+
+/// A progress line on stderr when it is a terminal, shown once a run has lasted a second
+/// (`label` names the run). Call from one thread only.
+struct Progress {
+  explicit Progress(std::string label_, bool quiet = false, std::string unit_ = "points");
+  /// "label run  42%".
+  void operator()(double fraction);
+  /// "label 1234/5678 points, 1.2e+06/s, 3 s left" (`unit` instead of "points").
+  void operator()(unsigned long long done, unsigned long long total);
+
+ private:
+  std::string label, unit;
+  std::chrono::steady_clock::time_point start;
+  bool shown = false;
+  bool enabled;
+};
 
 /// Matrix -> JSON array of rows.
 nlohmann::json to_json(const Eigen::MatrixXd& m);

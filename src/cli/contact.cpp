@@ -16,13 +16,7 @@ namespace {
 struct ContactOptions {
   RobotOptions robot;
   TargetOptions target;
-  double stiffness = 1e9;
-  double exponent = 1.5;
-  double restitution = 0.9;
-  std::string model = "herbert-mcwhannell";
-  double approach_speed = 0.2;
-  std::string target_angular_velocity_deg = "0,0,2";
-  std::string target_velocity = "0,0,0";
+  ContactLawOptions law;
   std::string series, plot, plot_format = "png";
   bool json = false;
 };
@@ -35,11 +29,11 @@ struct Row {
 };
 
 Row evaluate(const Robot& r, const Target& target, const ContactOptions& o, const std::string& law_name) {
-  const ContactParams p{o.stiffness, o.exponent, o.restitution};
+  const ContactParams p{o.law.stiffness, o.law.exponent, o.law.restitution};
   MultibodyContactOptions mo;
   mo.record_series = !o.series.empty() || !o.plot.empty();
   MultibodyContactResult mb =
-      simulate_contact(r.model, r.base, r.theta, r.end_effector, target, o.approach_speed, p, law_name, mo);
+      simulate_contact(r.model, r.base, r.theta, r.end_effector, target, o.law.approach_speed, p, law_name, mo);
   const AnyContactLaw law = make_contact_law(law_name, p, mb.approach_velocity);
   Row row{law_name, mb.integrated_effective_mass, mb.approach_velocity,
           max_force_closed_form(law, mb.integrated_effective_mass), max_force_exact(law, mb.integrated_effective_mass),
@@ -72,29 +66,24 @@ int run_contact(const ContactOptions& o) {
   outputs.add("--series", o.series);
   const Robot r = load_robot(o.robot);
   Target target = o.target.build();
-  target.angular_velocity = parse_vec3(o.target_angular_velocity_deg, "--target-angular-velocity-deg") * (M_PI / 180.0);
-  target.velocity = parse_vec3(o.target_velocity, "--target-velocity");
-  if (!std::isfinite(o.approach_speed)) throw InputError("--approach-speed: must be finite");
-  try {
-    validate(ContactParams{o.stiffness, o.exponent, o.restitution}, "contact");
-  } catch (const InputError& e) {
-    throw InputError(std::string("--stiffness/--exponent/--restitution: ") + e.what());
-  }
+  o.law.set_target_motion(target);
+  if (!std::isfinite(o.law.approach_speed)) throw InputError("--approach-speed: must be finite");
+  const ContactParams params = o.law.params();
   const plot::Format plot_format = plot::parse_format(o.plot_format, "--plot-format");
   if (!o.plot.empty()) {
     plot::require_available("--plot");
     plot::check_folder(o.plot, "--plot");
   }
   std::vector<std::string> names;
-  if (o.model == "all") {
+  if (o.law.model == "all") {
     for (auto n : contact_law_names()) names.emplace_back(n);
   } else {
     try {
-      make_contact_law(o.model, {o.stiffness, o.exponent, o.restitution}, 1.0);  // unknown name: lists the laws
+      make_contact_law(o.law.model, params, 1.0);  // unknown name: lists the laws
     } catch (const InputError& e) {
       throw InputError(std::string("--model: ") + e.what());
     }
-    names.push_back(o.model);
+    names.push_back(o.law.model);
   }
   std::vector<Row> rows;
   for (const auto& n : names) rows.push_back(evaluate(r, target, o, n));
@@ -109,7 +98,7 @@ int run_contact(const ContactOptions& o) {
         c.delta.push_back(s.delta);
         c.force.push_back(s.force);
       }
-      const AnyContactLaw law = make_contact_law(row.model, {o.stiffness, o.exponent, o.restitution}, row.v_in);
+      const AnyContactLaw law = make_contact_law(row.model, params, row.v_in);
       c.delta_max = row.mb_delta_max;
       c.force_at_delta_max = force(law, row.mb_delta_max, 0.0);  // delta_dot = 0 at the largest deformation
       c.delta_at_f_max = row.mb_delta_at_f_max;
@@ -127,15 +116,15 @@ int run_contact(const ContactOptions& o) {
     outputs.write();
   }
   if (o.json) {
-    nlohmann::json j = o.model == "all" ? nlohmann::json::object() : row_json(rows.front());
-    if (o.model == "all") {
+    nlohmann::json j = o.law.model == "all" ? nlohmann::json::object() : row_json(rows.front());
+    if (o.law.model == "all") {
       j["integrated_effective_mass"] = rows.front().M_ie;
       j["approach_velocity"] = rows.front().v_in;
       j["laws"] = nlohmann::json::array();
       for (const auto& row : rows) j["laws"].push_back(row_json(row));
     }
-    j["parameters"] = {{"stiffness", o.stiffness}, {"exponent", o.exponent}, {"restitution", o.restitution},
-                       {"approach_speed", o.approach_speed}, {"urdf", o.robot.urdf}, {"joints_deg", o.robot.joints_deg}};
+    j["parameters"] = {{"stiffness", o.law.stiffness}, {"exponent", o.law.exponent}, {"restitution", o.law.restitution},
+                       {"approach_speed", o.law.approach_speed}, {"urdf", o.robot.urdf}, {"joints_deg", o.robot.joints_deg}};
     j["version"] = FFSR_VERSION;
     std::cout << j.dump(2) << "\n";
     return 0;
@@ -163,16 +152,7 @@ void register_contact(CLI::App& app, Action& action) {
   CLI::App* sub = app.add_subcommand("contact", "Maximum contact force: closed form, exact, and CVODE multibody reference");
   o->robot.add_to(*sub);
   o->target.add_to(*sub);
-  sub->add_option("--stiffness", o->stiffness, "Contact stiffness K, N/m^alpha")->capture_default_str();
-  sub->add_option("--exponent", o->exponent, "Contact exponent alpha")->capture_default_str();
-  sub->add_option("--restitution", o->restitution, "Coefficient of restitution c_r, 0 < c_r <= 1")->capture_default_str();
-  sub->add_option("--model", o->model, "Hysteresis damping law (Table 1) or 'all'")->capture_default_str();
-  sub->add_option("--approach-speed", o->approach_speed, "End-effector speed along the normal at first touch, m/s")
-      ->capture_default_str();
-  sub->add_option("--target-angular-velocity-deg", o->target_angular_velocity_deg,
-                  "Target spin (target frame), deg/s")->capture_default_str();
-  sub->add_option("--target-velocity", o->target_velocity, "Target linear velocity (inertial frame), m/s")
-      ->capture_default_str();
+  o->law.add_to(*sub, "Hysteresis damping law (Table 1) or 'all'");
   sub->add_option("--series", o->series, "Write F(t), delta(t) of the multibody run(s) to this CSV file ('-': standard output)");
   sub->add_flag("--json", o->json, "Print one JSON object on stdout");
   sub->add_option("--plot", o->plot, "Draw the F-delta loop(s) and F(t) (Figure 3) into this (existing) folder");

@@ -21,6 +21,8 @@ int main(int argc, char** argv) {
   register_inspect(app, action);
   register_contact(app, action);
   register_xi(app, action);
+  register_map(app, action);
+  register_robust(app, action);
   register_run(app, action, argc, argv);
   app.require_subcommand(0, 1);
   try {

@@ -5,10 +5,12 @@
 #include "common.hpp"
 #include "embedded.hpp"
 #include "figures.hpp"
+#include "scenario.hpp"
 #include "subcommands.hpp"
 
 #include "ffsr/io/urdf.hpp"
 #include "ffsr/optimize/capture.hpp"
+#include "ffsr/optimize/global.hpp"
 
 #include <unistd.h>
 
@@ -17,6 +19,7 @@
 #include <iomanip>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <set>
 #include <sstream>
 
@@ -25,24 +28,6 @@ namespace {
 
 using detail::str;
 
-struct RunOptions {
-  std::string config;
-  std::string urdf, end_effector;
-  std::vector<double> joints_deg, base_position{0, 0, 0}, base_rpy_deg{0, 0, 0};
-  double target_mass = 0;
-  std::vector<double> target_inertia, target_position, target_rpy_deg{0, 0, 0}, target_angular_velocity_deg,
-      target_velocity{0, 0, 0}, contact_offset, normal;
-  std::string model;
-  double stiffness = 0, exponent = 0, restitution = 0, approach_speed = 0;
-  std::string task, task_axes = "xyz", baseline_task;
-  std::vector<double> final_rpy_deg;
-  double duration = 0, step = 0, gain = 0, feedback = 1.0, tolerance = 0, orientation_tolerance_deg = 0.5;
-  std::string objective = "mass";
-  std::string json, csv, plot, plot_format = "png";
-  std::string expect;  ///< a stored result to compare with (regression run)
-  double rtol = 1e-6, atol = 1e-9;
-  bool quiet = false;
-};
 
 /// Keys a scenario file must name (the others have defaults).
 const char* const kRequired[] = {"urdf", "joints-deg", "target-mass", "target-inertia", "target-position",
@@ -88,9 +73,17 @@ std::string deg_list(const Eigen::VectorXd& theta, int precision = 2) {
   return os.str();
 }
 
+/// --seed as a non-negative integer (a string key, so that a bad value gets a one-line error naming it).
+std::uint64_t parse_seed(const std::string& sd) {
+  if (sd.empty() || sd.size() > 19 || sd.find_first_not_of("0123456789") != std::string::npos)
+    throw InputError(str("--seed: expected a non-negative integer (at most 19 digits), got '", sd, "'"));
+  return std::stoull(sd);
+}
+
 nlohmann::json result_json(const CaptureResult& r, const CaptureTask& task, double gain) {
   const Eigen::Vector4d q = r.base.orientation.coeffs();
   return {{"task", task.kind == CaptureTask::Kind::Pose ? "pose" : "position"},
+          {"max_joint_rate_deg", r.max_joint_rate * 180.0 / M_PI},
           {"gain", gain},
           {"capture_configuration_deg", to_json(Eigen::VectorXd(r.theta * (180.0 / M_PI)))},
           {"integrated_effective_mass", r.M_ie},
@@ -114,21 +107,6 @@ nlohmann::json result_json(const CaptureResult& r, const CaptureTask& task, doub
           {"steps", r.steps}};
 }
 
-/// Progress on a terminal for runs longer than a second.
-struct Progress {
-  std::string label;
-  std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
-  bool shown = false;
-  bool enabled = isatty(fileno(stderr)) != 0;
-  void operator()(double fraction) {
-    if (!enabled) return;
-    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    if (s < 1.0 && !shown) return;
-    shown = true;
-    std::fprintf(stderr, "\rffsr-optimize: %s run %3.0f%%", label.c_str(), fraction * 100.0);
-    if (fraction >= 1.0) std::fprintf(stderr, "\n");
-  }
-};
 
 /// Which keys came from the command line: they are not resolved against the scenario's folder.
 struct FromCommandLine {
@@ -139,8 +117,9 @@ struct FromCommandLine {
 /// scenario holds paths that differ between machines; the version changes with every release).
 const std::vector<std::string> kNotCompared = {"version", "scenario"};
 
-int run_scenario(RunOptions o, const CLI::App& app, FromCommandLine cli) {
-  const bool urdf_on_command_line = cli.urdf;
+}  // namespace
+
+Scenario prepare_scenario(RunOptions o, const CLI::App& app, bool urdf_on_command_line) {
   // --- the scenario: a file, or the built-in default (the paper's 3-DOF robot) -----------------
   const bool builtin = o.config.empty();
   const std::string where = builtin ? std::string("built-in scenario") : "scenario " + o.config;
@@ -155,24 +134,13 @@ int run_scenario(RunOptions o, const CLI::App& app, FromCommandLine cli) {
     const size_t slash = o.config.find_last_of('/');
     return slash == std::string::npos ? path : o.config.substr(0, slash + 1) + path;
   };
-  // outputs and baseline first: a conflict or an unreadable baseline is found before the work
-  Outputs outputs;
-  outputs.add("--json", o.json);
-  outputs.add("--csv", o.csv);
-  nlohmann::json expected;
-  Tolerance tol{o.rtol, o.atol};
-  if (!std::isfinite(o.rtol) || o.rtol < 0) throw InputError(str("--rtol: must be finite and >= 0, got ", o.rtol));
-  if (!std::isfinite(o.atol) || o.atol < 0) throw InputError(str("--atol: must be finite and >= 0, got ", o.atol));
-  if (!o.expect.empty()) {
-    o.expect = next_to_config(o.expect, cli.expect);
-    expected = load_baseline(o.expect, "--expect");
-  }
-  Model model = [&] {
+  auto model_ptr = std::make_unique<Model>([&] {
     if (builtin && !urdf_on_command_line && o.urdf == "paper_3dof.urdf")
       return model_from_urdf_string(kPaper3dofUrdf, "built-in paper_3dof.urdf", o.end_effector);
     o.urdf = next_to_config(o.urdf, urdf_on_command_line);
     return model_from_urdf_file(o.urdf, o.end_effector);
-  }();
+  }());
+  const Model& model = *model_ptr;
 
   CaptureProblem pb;
   pb.model = &model;
@@ -233,25 +201,28 @@ int run_scenario(RunOptions o, const CLI::App& app, FromCommandLine cli) {
   if (o.duration <= 0) throw InputError(str("--duration: must be positive, got ", o.duration));
   if (o.step <= 0 || o.step > o.duration) throw InputError(str("--step: must be in (0, duration], got ", o.step));
   if (o.tolerance <= 0) throw InputError(str("--tolerance: must be positive, got ", o.tolerance));
-  if (o.objective == "mass") opt.objective = CaptureObjective::IntegratedEffectiveMass;
+  // multibody-force has no gradient: the paper's method descends M_ie, the global search ranks by the CVODE peak
+  if (o.objective == "mass" || o.objective == "multibody-force") opt.objective = CaptureObjective::IntegratedEffectiveMass;
   else if (o.objective == "exact-force") opt.objective = CaptureObjective::ExactMaxForce;
-  else throw InputError(str("--objective: unknown objective '", o.objective, "'; expected 'mass' or 'exact-force'"));
+  else throw InputError(str("--objective: unknown objective '", o.objective, "'; expected 'mass', 'exact-force' or 'multibody-force'"));
+  parse_seed(o.seed);
+  if (o.global_starts < 1) throw InputError(str("--global-starts: must be >= 1, got ", o.global_starts));
+  if (app.get_option("--max-joint-rate-deg")->count() > 0 && !(finite(o.max_joint_rate_deg, "max-joint-rate-deg") > 0))
+    throw InputError(str("--max-joint-rate-deg: must be positive, got ", o.max_joint_rate_deg));
   if (opt.gain != 0.0 && task.rows() >= model.n())
     throw InputError(str("--gain: the ", o.task, " task has ", task.rows(), " rows and the robot ", model.n(),
                          " joints: no null space to optimize in (set gain = 0 or constrain fewer axes)"));
-  const bool want_series = !o.csv.empty();
-  const plot::Format plot_format = plot::parse_format(o.plot_format, "--plot-format");
-  if (!o.plot.empty()) {
-    plot::require_available("--plot");
-    plot::check_folder(o.plot, "--plot");
-  }
-  opt.record_series = want_series || !o.plot.empty();
+  Scenario sc{std::move(o), where, builtin, std::move(model_ptr), pb, task, baseline_task, opt};
+  sc.problem.model = sc.model.get();
+  return sc;
+}
 
-  // --- the two runs ------------------------------------------------------------------------------
+std::pair<CaptureResult, CaptureResult> plan_plain_and_optimized(const Scenario& sc, bool quiet) {
+  CaptureOptions opt = sc.capture;
   CaptureOptions plain = opt;
   plain.gain = 0.0;
   Progress p1{"plain"}, p2{"optimized"};
-  if (!o.quiet) {
+  if (!quiet) {
     plain.progress = std::ref(p1);
     opt.progress = std::ref(p2);
   }
@@ -262,11 +233,151 @@ int run_scenario(RunOptions o, const CLI::App& app, FromCommandLine cli) {
       throw NumericalError(str(label, " run: ", e.what()));
     }
   };
-  const CaptureResult base_run = labelled("plain", [&] { return plan_capture(pb, baseline_task, plain); });
-  const CaptureResult opt_run = labelled("optimized", [&] { return plan_capture(pb, task, opt); });
+  CaptureResult base_run = labelled("plain", [&] { return plan_capture(sc.problem, sc.baseline_task, plain); });
+  CaptureResult opt_run = labelled("optimized", [&] { return plan_capture(sc.problem, sc.task, opt); });
+  return {std::move(base_run), std::move(opt_run)};
+}
+
+namespace {
+
+/// The global run (issue 9) and what the outputs need beside it.
+struct GlobalRun {
+  GlobalCaptureResult result;
+  double paper_objective = 0;  ///< the objective at the paper's-method run's capture configuration
+};
+
+/// Plans the global run: the optimized run's task, no gain, the joint-rate limit, the paper's-method
+/// capture configuration as an extra start (so the global row is never worse than it).
+GlobalRun run_global(const CaptureProblem& pb, const CaptureTask& task, CaptureOptions opt, GlobalObjective objective,
+                     std::uint64_t seed, const RunOptions& o, const CaptureResult& paper_run) {
+  opt.gain = 0.0;
+  opt.max_joint_rate = o.max_joint_rate_deg * M_PI / 180.0;
+  opt.progress = nullptr;
+  GlobalCaptureOptions g;
+  g.search.seed = seed;
+  g.search.starts = o.global_starts;
+  g.search.objective = objective;
+  g.extra_starts = {paper_run.theta};
+  GlobalRun r;
+  try {
+    r.result = plan_capture_global(pb, task, opt, g);
+  } catch (const InputError& e) {
+    if (std::string(e.what()).find("max joint rate") != std::string::npos)
+      throw InputError(str("--max-joint-rate-deg: ", e.what()));
+    throw InputError(str("global run: ", e.what()));
+  } catch (const NumericalError& e) {
+    throw NumericalError(str("global run: ", e.what()));
+  }
+  const CaptureSetup setup = prepare_capture(pb, task, opt);
+  r.paper_objective = evaluate_capture(pb, setup, paper_run.base, paper_run.theta, objective).objective;
+  return r;
+}
+
+void add_global_json(nlohmann::json& j, const GlobalRun& g, const CaptureResult& base_run, const CaptureTask& task,
+                     const RunOptions& o) {
+  const GlobalCaptureResult& r = g.result;
+  nlohmann::json x = result_json(r.run, task, 0.0);
+  x["objective"] = o.objective;
+  x["objective_value"] = r.objective;
+  x["manifold_optimum"] = r.manifold_optimum;
+  x["optimality_gap_percent"] = r.optimality_gap_percent;
+  x["shooting_iterations"] = r.shooting_iterations;
+  x["goals_tried"] = r.goals_tried;
+  x["reached_manifold_optimum"] = r.reached_manifold_optimum;
+  x["search"] = {{"method", r.search.method},
+                 {"starts", r.search.starts},
+                 {"evaluations", r.evaluations},
+                 {"multibody_evaluations", r.objective_evaluations},
+                 {"seconds", r.search_seconds}};
+  if (o.objective == "multibody-force") {
+    // the ranked local optima of M_ie at the reached base pose: how far the mass and force optima are apart
+    nlohmann::json ranked = nlohmann::json::array();
+    for (const ManifoldPoint& p : r.search.local_optima)
+      if (p.objective > 0) ranked.push_back({{"integrated_effective_mass", p.M_ie}, {"f_max_multibody", p.objective}});
+    x["search"]["ranked_local_optima"] = ranked;
+    x["f_max_multibody"] = r.objective;
+    j["optimized"]["f_max_multibody"] = g.paper_objective;
+  }
+  j["global"] = x;
+  j["global_mass_reduction_percent"] = 100.0 * (base_run.M_ie - r.run.M_ie) / base_run.M_ie;
+  j["global_force_reduction_percent"] =
+      100.0 * (base_run.f_max_closed_form - r.run.f_max_closed_form) / base_run.f_max_closed_form;
+  j["global_exact_force_reduction_percent"] = 100.0 * (base_run.f_max_exact - r.run.f_max_exact) / base_run.f_max_exact;
+}
+
+void print_global_notes(std::ostream& out, const GlobalRun& g, const CaptureResult& opt_run, const RunOptions& o) {
+  const GlobalCaptureResult& r = g.result;
+  const bool mb = o.objective == "multibody-force";
+  const double unit = mb || o.objective == "exact-force" ? 1e3 : 1.0;
+  const char* u = unit == 1.0 ? " kg" : " kN";
+  out << std::fixed << std::setprecision(3) << "global (" << o.objective << ", seed " << o.seed
+      << "): reached " << r.objective / unit << u << ", manifold optimum at the reached base pose "
+      << r.manifold_optimum / unit << u << " (gap " << r.optimality_gap_percent << " %), " << r.shooting_iterations
+      << " reaching run(s), " << r.goals_tried << " goal(s) tried; search: " << r.search.method << ", " << r.search.starts << " starts, "
+      << r.evaluations << " evaluations" << (mb ? ", " + std::to_string(r.objective_evaluations) + " CVODE runs" : "")
+      << ", " << r.search_seconds << " s\n";
+  if (!r.reached_manifold_optimum)
+    out << "note: the better optima at the reached base pose lie on other components of the self-motion manifold; "
+           "the servo reached none of them\n";
+  if (mb)
+    out << "CVODE multibody F_max: optimization " << g.paper_objective / 1e3 << " kN, global " << r.objective / 1e3
+        << " kN\n";
+  out << "largest joint rate: optimization " << opt_run.max_joint_rate * 180.0 / M_PI << " deg/s (not limited), global "
+      << r.run.max_joint_rate * 180.0 / M_PI << " deg/s ("
+      << (o.max_joint_rate_deg > 0 ? "limit " + std::to_string(o.max_joint_rate_deg) + " deg/s" : std::string("not limited"))
+      << ")\n";
+}
+
+int run_scenario(RunOptions options, const CLI::App& app, FromCommandLine cli) {
+  const bool expect_builtin = options.config.empty();
+  const std::string config_path = options.config;
+  // a path in a scenario file is relative to the file
+  auto next_to_config = [&](const std::string& path, bool on_command_line) {
+    if (expect_builtin || on_command_line || path.empty() || path.front() == '/') return path;
+    const size_t slash = config_path.find_last_of('/');
+    return slash == std::string::npos ? path : config_path.substr(0, slash + 1) + path;
+  };
+  Scenario sc = prepare_scenario(std::move(options), app, cli.urdf);
+  RunOptions& o = sc.options;
+  // outputs and baseline first: a conflict or an unreadable baseline is found before the work
+  Outputs outputs;
+  outputs.add("--json", o.json);
+  outputs.add("--csv", o.csv);
+  nlohmann::json expected;
+  Tolerance tol{o.rtol, o.atol};
+  if (!std::isfinite(o.rtol) || o.rtol < 0) throw InputError(str("--rtol: must be finite and >= 0, got ", o.rtol));
+  if (!std::isfinite(o.atol) || o.atol < 0) throw InputError(str("--atol: must be finite and >= 0, got ", o.atol));
+  if (!o.expect.empty()) {
+    o.expect = next_to_config(o.expect, cli.expect);
+    expected = load_baseline(o.expect, "--expect");
+  }
+  const Model& model = *sc.model;
+  const CaptureProblem& pb = sc.problem;
+  const CaptureTask& task = sc.task;
+  const CaptureTask& baseline_task = sc.baseline_task;
+  const CaptureOptions& opt = sc.capture;
+  const bool builtin = sc.builtin;
+  const std::string& where = sc.where;
+  const bool want_series = !o.csv.empty();
+  const plot::Format plot_format = plot::parse_format(o.plot_format, "--plot-format");
+  if (!o.plot.empty()) {
+    plot::require_available("--plot");
+    plot::check_folder(o.plot, "--plot");
+  }
+  sc.capture.record_series = want_series || !o.plot.empty();
+
+  // --- the two runs ------------------------------------------------------------------------------
+  const auto [base_run, opt_run] = plan_plain_and_optimized(sc, o.quiet);
   const double mass_red = 100.0 * (base_run.M_ie - opt_run.M_ie) / base_run.M_ie;
   const double force_red = 100.0 * (base_run.f_max_closed_form - opt_run.f_max_closed_form) / base_run.f_max_closed_form;
   const double exact_red = 100.0 * (base_run.f_max_exact - opt_run.f_max_exact) / base_run.f_max_exact;
+  std::optional<GlobalRun> global;
+  if (o.global) {
+    const GlobalObjective gobj = o.objective == "exact-force"       ? GlobalObjective::ExactForce
+                                 : o.objective == "multibody-force" ? GlobalObjective::MultibodyForce
+                                                                    : GlobalObjective::Mass;
+    global = run_global(pb, task, sc.capture, gobj, parse_seed(o.seed), o, opt_run);
+  }
 
   // --- outputs: all built first, then written atomically ------------------------------------------
   nlohmann::json j;
@@ -306,6 +417,11 @@ int run_scenario(RunOptions o, const CLI::App& app, FromCommandLine cli) {
   j["mass_reduction_percent"] = mass_red;
   j["force_reduction_percent"] = force_red;
   j["exact_force_reduction_percent"] = exact_red;
+  j["scenario"]["global"] = o.global;
+  j["scenario"]["seed"] = o.seed;
+  j["scenario"]["max-joint-rate-deg"] = o.max_joint_rate_deg;
+  j["scenario"]["global-starts"] = o.global_starts;
+  if (global) add_global_json(j, *global, base_run, task, o);
 
   std::string csv;
   if (want_series) {
@@ -313,9 +429,11 @@ int run_scenario(RunOptions o, const CLI::App& app, FromCommandLine cli) {
     c << std::setprecision(12) << "run,t";
     for (const auto& name : model.joint_names()) c << "," << name << "_deg";
     c << ",base_x,base_y,base_z,base_qw,base_qx,base_qy,base_qz,ee_x,ee_y,ee_z,M_ie,F_max_estimate\n";
-    for (const auto* run : {&base_run, &opt_run}) {
+    std::vector<const CaptureResult*> runs{&base_run, &opt_run};
+    if (global) runs.push_back(&global->result.run);
+    for (const auto* run : runs) {
       for (const CaptureSample& s : run->series) {
-        c << (run == &base_run ? "baseline" : "optimized") << "," << s.t;
+        c << (run == &base_run ? "baseline" : run == &opt_run ? "optimized" : "global") << "," << s.t;
         for (Eigen::Index i = 0; i < s.theta.size(); ++i) c << "," << s.theta(i) * 180.0 / M_PI;
         const auto& q = s.base.orientation;
         c << "," << s.base.position.x() << "," << s.base.position.y() << "," << s.base.position.z() << "," << q.w()
@@ -325,10 +443,11 @@ int run_scenario(RunOptions o, const CLI::App& app, FromCommandLine cli) {
     }
     csv = c.str();
   }
-  if (!o.plot.empty())  // the pictures of the same result structs; the runs are one vector entry each
-    plot::render(figures::capture(model, pb.frame, pb.target, opt.duration,
-                                  {{"plain", &base_run, baseline_task}, {"optimized", &opt_run, task}}),
-                 o.plot, plot_format);
+  if (!o.plot.empty()) {  // the pictures of the same result structs; the runs are one vector entry each
+    std::vector<figures::CaptureRun> runs{{"plain", &base_run, baseline_task}, {"optimized", &opt_run, task}};
+    if (global) runs.push_back({"global", &global->result.run, task});
+    plot::render(figures::capture(model, pb.frame, pb.target, opt.duration, runs), o.plot, plot_format);
+  }
   outputs.set("--json", j.dump(2) + "\n");
   outputs.set("--csv", csv);
   outputs.write();  // all or nothing: no partial output
@@ -348,8 +467,18 @@ int run_scenario(RunOptions o, const CLI::App& app, FromCommandLine cli) {
   };
   row("Without optimization", base_run);
   row("With optimization", opt_run);
-  out << std::left << std::setw(24 + w) << "Reduction" << std::right << std::fixed << std::setprecision(2)
-      << std::setw(10) << mass_red << "%" << std::setw(13) << force_red << "%" << std::setw(13) << exact_red << "%\n\n";
+  if (global) row("Global", global->result.run);
+  out << std::left << std::setw(24 + w) << "Reduction (optimization)" << std::right << std::fixed << std::setprecision(2)
+      << std::setw(10) << mass_red << "%" << std::setw(13) << force_red << "%" << std::setw(13) << exact_red << "%\n";
+  if (global) {
+    const CaptureResult& g = global->result.run;
+    out << std::left << std::setw(24 + w) << "Reduction (global)" << std::right << std::setw(10)
+        << 100.0 * (base_run.M_ie - g.M_ie) / base_run.M_ie << "%" << std::setw(13)
+        << 100.0 * (base_run.f_max_closed_form - g.f_max_closed_form) / base_run.f_max_closed_form << "%" << std::setw(13)
+        << 100.0 * (base_run.f_max_exact - g.f_max_exact) / base_run.f_max_exact << "%\n";
+    print_global_notes(out, *global, opt_run, o);
+  }
+  out << "\n";
   out << std::setprecision(4) << "capture point [" << base_run.capture_point.transpose().format(Eigen::IOFormat(4, 0, ", "))
       << "] m, approach velocity delta_dot^- = " << base_run.approach_velocity << " m/s\n"
       << "base drift: plain " << base_run.base_position_drift * 1e3 << " mm / "
@@ -379,6 +508,51 @@ int run_scenario(RunOptions o, const CLI::App& app, FromCommandLine cli) {
 
 }  // namespace
 
+void add_scenario_options(CLI::App& app, RunOptions& o) {
+  auto vec = [&](const char* name, std::vector<double>& v, const char* help) {
+    return app.add_option(name, v, help)->delimiter(',')->allow_extra_args(false);
+  };
+  app.add_option("--urdf", o.urdf, "Robot URDF (relative to the scenario file)");
+  app.add_option("--end-effector", o.end_effector, "End-effector frame (default: the single leaf link)");
+  vec("--joints-deg", o.joints_deg, "Initial joint angles, deg");
+  vec("--base-position", o.base_position, "Initial base position, m");
+  vec("--base-rpy-deg", o.base_rpy_deg, "Initial base attitude (roll, pitch, yaw), deg");
+  app.add_option("--target-mass", o.target_mass, "Target mass, kg");
+  vec("--target-inertia", o.target_inertia, "Target inertia: Ixx,Iyy,Izz[,Ixy,Ixz,Iyz], kg m^2 (target frame)");
+  vec("--target-position", o.target_position, "Target centre of mass at t = 0, m");
+  vec("--target-rpy-deg", o.target_rpy_deg, "Target attitude at t = 0, deg");
+  vec("--target-angular-velocity-deg", o.target_angular_velocity_deg, "Target spin (target frame), deg/s");
+  vec("--target-velocity", o.target_velocity, "Target linear velocity, m/s");
+  vec("--contact-offset", o.contact_offset, "r_tp: contact point from the target centre of mass (target frame), m");
+  vec("--normal", o.normal, "u_n: contact normal (target frame)");
+  app.add_option("--model", o.model, "Hysteresis damping law (Table 1)");
+  app.add_option("--stiffness", o.stiffness, "K, N/m^alpha");
+  app.add_option("--exponent", o.exponent, "alpha");
+  app.add_option("--restitution", o.restitution, "c_r, 0 < c_r <= 1");
+  app.add_option("--approach-speed", o.approach_speed, "End-effector speed along the normal at the capture, m/s");
+  app.add_option("--task", o.task, "Optimized run's task: position or pose");
+  app.add_option("--task-axes", o.task_axes, "Position task: constrained inertial axes, e.g. xy")->capture_default_str();
+  app.add_option("--baseline-task", o.baseline_task, "Plain run's task (default: the optimized run's)");
+  vec("--final-rpy-deg", o.final_rpy_deg, "Pose task: final end-effector orientation (default: hold the initial)");
+  app.add_option("--duration", o.duration, "Task time T, s");
+  app.add_option("--step", o.step, "RK4 step, s");
+  app.add_option("--gain", o.gain, "rho of Eq. 30 (< 0 lowers the objective)");
+  app.add_option("--feedback", o.feedback, "Tracking feedback gain, 1/s")->capture_default_str();
+  app.add_option("--tolerance", o.tolerance, "Required capture-point accuracy, m");
+  app.add_option("--orientation-tolerance-deg", o.orientation_tolerance_deg, "Pose task: required orientation accuracy, deg")
+      ->capture_default_str();
+  app.add_option("--objective", o.objective,
+                 "mass (M_ie, the paper's), exact-force, or multibody-force (CVODE peak; global search only, the "
+                 "paper's method then descends M_ie)")
+      ->capture_default_str();
+  app.add_option("--global", o.global, "Also run the global capture optimization (true/false)")->capture_default_str();
+  if (!app.get_option_no_throw("--seed"))  // robust registers its own (Monte Carlo) --seed first
+    app.add_option("--seed", o.seed, "Seed of the global search's random starts (non-negative integer)")->capture_default_str();
+  app.add_option("--max-joint-rate-deg", o.max_joint_rate_deg,
+                 "Global run: largest joint rate, deg/s (> 0; default: not limited; the paper's method is not limited)");
+  app.add_option("--global-starts", o.global_starts, "Global search: random starts (>= 1)")->capture_default_str();
+}
+
 void register_run(CLI::App& app, Action& action, int argc, char** argv) {
   auto o = std::make_shared<RunOptions>();
   FromCommandLine from_cli;
@@ -386,44 +560,13 @@ void register_run(CLI::App& app, Action& action, int argc, char** argv) {
     const std::string a = argv[i];
     if (a == "--urdf" || a.rfind("--urdf=", 0) == 0) from_cli.urdf = true;
     if (a == "--expect" || a.rfind("--expect=", 0) == 0) from_cli.expect = true;
-    if (a == "inspect" || a == "contact" || a == "xi") break;
+    if (a == "inspect" || a == "contact" || a == "xi" || a == "map" || a == "robust") break;
   }
   app.set_config("--config", "", "Scenario file (TOML); every key is also a flag. Default: the built-in paper 3-DOF scenario");
+  app.config_formatter(std::make_shared<ScenarioConfig>());  // [uncertainty] is the robust command's
   app.get_config_ptr()->check(CLI::ExistingFile);
   app.allow_config_extras(CLI::config_extras_mode::error);  // an unknown key in a scenario is an error
-  auto vec = [&](const char* name, std::vector<double>& v, const char* help) {
-    return app.add_option(name, v, help)->delimiter(',')->allow_extra_args(false);
-  };
-  app.add_option("--urdf", o->urdf, "Robot URDF (relative to the scenario file)");
-  app.add_option("--end-effector", o->end_effector, "End-effector frame (default: the single leaf link)");
-  vec("--joints-deg", o->joints_deg, "Initial joint angles, deg");
-  vec("--base-position", o->base_position, "Initial base position, m");
-  vec("--base-rpy-deg", o->base_rpy_deg, "Initial base attitude (roll, pitch, yaw), deg");
-  app.add_option("--target-mass", o->target_mass, "Target mass, kg");
-  vec("--target-inertia", o->target_inertia, "Target inertia: Ixx,Iyy,Izz[,Ixy,Ixz,Iyz], kg m^2 (target frame)");
-  vec("--target-position", o->target_position, "Target centre of mass at t = 0, m");
-  vec("--target-rpy-deg", o->target_rpy_deg, "Target attitude at t = 0, deg");
-  vec("--target-angular-velocity-deg", o->target_angular_velocity_deg, "Target spin (target frame), deg/s");
-  vec("--target-velocity", o->target_velocity, "Target linear velocity, m/s");
-  vec("--contact-offset", o->contact_offset, "r_tp: contact point from the target centre of mass (target frame), m");
-  vec("--normal", o->normal, "u_n: contact normal (target frame)");
-  app.add_option("--model", o->model, "Hysteresis damping law (Table 1)");
-  app.add_option("--stiffness", o->stiffness, "K, N/m^alpha");
-  app.add_option("--exponent", o->exponent, "alpha");
-  app.add_option("--restitution", o->restitution, "c_r, 0 < c_r <= 1");
-  app.add_option("--approach-speed", o->approach_speed, "End-effector speed along the normal at the capture, m/s");
-  app.add_option("--task", o->task, "Optimized run's task: position or pose");
-  app.add_option("--task-axes", o->task_axes, "Position task: constrained inertial axes, e.g. xy")->capture_default_str();
-  app.add_option("--baseline-task", o->baseline_task, "Plain run's task (default: the optimized run's)");
-  vec("--final-rpy-deg", o->final_rpy_deg, "Pose task: final end-effector orientation (default: hold the initial)");
-  app.add_option("--duration", o->duration, "Task time T, s");
-  app.add_option("--step", o->step, "RK4 step, s");
-  app.add_option("--gain", o->gain, "rho of Eq. 30 (< 0 lowers the objective)");
-  app.add_option("--feedback", o->feedback, "Tracking feedback gain, 1/s")->capture_default_str();
-  app.add_option("--tolerance", o->tolerance, "Required capture-point accuracy, m");
-  app.add_option("--orientation-tolerance-deg", o->orientation_tolerance_deg, "Pose task: required orientation accuracy, deg")
-      ->capture_default_str();
-  app.add_option("--objective", o->objective, "mass (M_ie, the paper's) or exact-force")->capture_default_str();
+  add_scenario_options(app, *o);
   app.add_option("--json", o->json,
                  "Write the result (with the resolved scenario and the version) to this JSON file ('-': standard output)");
   app.add_option("--csv", o->csv, "Write the time series of both runs to this CSV file ('-': standard output)");

@@ -14,6 +14,9 @@ void register_inspect(CLI::App& app, Action& action);
 void register_contact(CLI::App& app, Action& action);
 /// xi: the relative error of the closed-form maximum force against K, delta_dot^- and c_r.
 void register_xi(CLI::App& app, Action& action);
+void register_map(CLI::App& app, Action& action);
+/// `robust`: Monte Carlo of F_max over the scenario's [uncertainty] table (issue 12).
+void register_robust(CLI::App& app, Action& action);
 /// The main job (no subcommand): run a capture scenario. `argv` lets it tell which keys came from
 /// the command line (they override the scenario file and are not resolved against its folder).
 void register_run(CLI::App& app, Action& action, int argc, char** argv);

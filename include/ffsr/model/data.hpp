@@ -28,7 +28,13 @@ struct Data {
         F(static_cast<size_t>(model.n() + 1)),
         Xup(static_cast<size_t>(model.n() + 1)),
         tau(model.nv()),
-        HbInv_Hbm(6, model.n()) {
+        HbInv_Hbm(6, model.n()),
+        IA(static_cast<size_t>(model.n() + 1)),
+        pA(static_cast<size_t>(model.n() + 1)),
+        U(static_cast<size_t>(model.n() + 1)),
+        D(model.n()),
+        u(model.n()),
+        path(static_cast<size_t>(model.n() + 1)) {
     S.setZero();
     H.setZero();
     L.setZero();
@@ -55,6 +61,12 @@ struct Data {
   std::vector<Pose> Xup;  ///< pose of body i in its parent
   Eigen::VectorXd tau;
   Eigen::Matrix<double, 6, Eigen::Dynamic> HbInv_Hbm;  ///< H_b^-1 H_bm
+  // --- articulated-body recursion (RBDA 7.3; inertial axes about the base origin) -------------
+  std::vector<Matrix6> IA;  ///< articulated inertias
+  std::vector<Vector6> pA;  ///< articulated bias forces
+  std::vector<Vector6> U;   ///< IA_i S_i
+  Eigen::VectorXd D, u;     ///< S_i^T U_i and tau_i - S_i^T pA_i, one per joint
+  std::vector<int> path;    ///< bodies from a leaf to the base (scratch)
 };
 
 }  // namespace ffsr

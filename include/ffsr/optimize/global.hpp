@@ -1,0 +1,500 @@
+// ffsr/optimize/global.hpp -- the capture manifold search and the reaching planner (issue 9).
+//
+// The paper's law (Eq. 30) descends the gradient of the objective in the null space, so it ends in
+// the basin it starts in. Here the capture configuration is chosen first, globally, and the approach
+// is planned to reach it:
+//
+// 1. Capture manifold. With the base at a given pose B (the pose at T), the configurations that put
+//    the end-effector on the capture point (and, for a pose task, in the final orientation) are
+//      C(B) = { theta : c(theta) = 0, theta within the URDF's joint limits },
+//    c the task rows of [p_e(theta) - x_cap ; vee(skew(R_end R_e(theta)^T))]. The base is fixed
+//    there, so the constraint Jacobian is the task rows of J_m (the joint columns of J_bm, Eq. 2);
+//    for the orientation rows d vee(skew(R))/d omega = -1/2 (tr(R) E - R^T), R = R_end R_e^T (= -E at
+//    the solution).
+// 2. Search (search_capture_manifold). Multistart: `starts` configurations drawn uniformly within
+//    the limits ([-pi, pi] for a continuous joint) by std::mt19937_64 with our own mapping to
+//    [0, 1) (so a seed gives the same draws on every platform), each put on C(B) by damped Newton on
+//    c, then NLopt's SLSQP minimizes M_ie with its analytic gradient (effective_mass.hpp) under the
+//    equality constraints c = 0. The distinct local optima are kept, sorted. The global stage is the
+//    multistart itself (many SLSQP runs from spread-out points, the best kept); for the
+//    multibody-force objective, which has no gradient, the distinct local optima of M_ie are ranked
+//    by the CVODE multibody peak (simulate/multibody.hpp), evaluated directly at each of them.
+//    exact-force is a monotone function of M_ie (Eq. 16 scaling), so its optimum is M_ie's.
+// 3. Reaching (plan_capture_global). The same line reference and time law as the paper's method,
+//    the task first, and the null space servoing to the chosen configuration (ServoPolicy in
+//    capture.hpp), with the joint-rate limit. The base pose at T depends on the path, so it shoots:
+//    search at the base pose reached, plan again to the new optimum, until the reached objective is
+//    within `gap_percent` of the manifold optimum at the reached base pose.
+//
+// Needs NLopt (and SUNDIALS CVODE for the multibody objective): the CMake target ffsr::global.
+#pragma once
+
+#include "ffsr/optimize/capture.hpp"
+#include "ffsr/simulate/multibody.hpp"
+
+#include <nlopt.hpp>
+
+#include <chrono>
+#include <cstdint>
+#include <random>
+
+namespace ffsr {
+
+enum class GlobalObjective { Mass, ExactForce, MultibodyForce };
+
+/// The objective's name as the command spells it.
+inline const char* objective_name(GlobalObjective o) {
+  switch (o) {
+    case GlobalObjective::Mass: return "mass";
+    case GlobalObjective::ExactForce: return "exact-force";
+    case GlobalObjective::MultibodyForce: return "multibody-force";
+  }
+  return "?";
+}
+
+struct ManifoldSearchOptions {
+  int starts = 32;                        ///< random starts of the multistart
+  std::uint64_t seed = 1;                 ///< seed of std::mt19937_64
+  GlobalObjective objective = GlobalObjective::Mass;
+  double constraint_tolerance = 1e-10;    ///< |c| accepted as on the manifold (m, rad)
+  int max_local_evaluations = 300;        ///< SLSQP budget per start
+  MultibodyContactOptions multibody;      ///< for the multibody-force objective
+  int max_ranked = 8;                     ///< multibody-force: local optima ranked (the best by M_ie)
+};
+
+/// A configuration on the capture manifold with its M_ie and objective value.
+struct ManifoldPoint {
+  Eigen::VectorXd theta;
+  double M_ie = 0;
+  double objective = 0;  ///< kg (mass) or N (exact-force, multibody-force)
+};
+
+struct ManifoldSearchResult {
+  ManifoldPoint best;
+  std::vector<ManifoldPoint> local_optima;  ///< distinct, sorted by M_ie (multibody-force: objective 0 = not ranked)
+  std::string method;
+  int starts = 0;             ///< starts drawn (plus extra starts given)
+  int projected_starts = 0;   ///< starts that the projection put on the manifold
+  long evaluations = 0;       ///< objective (M_ie and gradient) evaluations of SLSQP
+  long objective_evaluations = 0;  ///< multibody-force: CVODE simulations
+  double seconds = 0;
+};
+
+/// The task residual c(theta) at a fixed base pose and its Jacobian (see the top of this file).
+/// Runs crba and frame_jacobian. Writes r (task rows) and, if J is given, J (rows x n).
+inline void capture_residual(const Model& model, Data& data, const CaptureProblem& pb, const CaptureTask& task,
+                             const CaptureSetup& s, const BasePose& base, const Eigen::VectorXd& theta,
+                             Eigen::VectorXd& r, Eigen::MatrixXd* J) {
+  const int n = model.n();
+  crba(model, data, base, theta);
+  const Pose ee = frame_pose(model, data, pb.frame);
+  Vector6 e;
+  e.head<3>() = ee.p - s.x_cap;
+  const Matrix3 R = s.R_end * ee.R.transpose();
+  const Matrix3 A = 0.5 * (R - R.transpose());
+  e.tail<3>() = Vector3(A(2, 1), A(0, 2), A(1, 0));
+  const int m = task.rows();
+  r.resize(m);
+  for (int i = 0; i < m; ++i) r(i) = e(s.rows[static_cast<size_t>(i)]);
+  if (!J) return;
+  frame_jacobian(model, data, pb.frame);
+  Eigen::MatrixXd Jm(6, n);
+  Jm.topRows<3>() = data.J.topRightCorner(3, n);
+  Jm.bottomRows<3>() = -0.5 * (R.trace() * Matrix3::Identity() - R.transpose()) * data.J.bottomRightCorner(3, n);
+  J->resize(m, n);
+  for (int i = 0; i < m; ++i) J->row(i) = Jm.row(s.rows[static_cast<size_t>(i)]);
+}
+
+namespace detail {
+
+/// Uniform double in [0, 1) from the 53 high bits of a 64-bit draw (portable, unlike
+/// std::uniform_real_distribution whose algorithm the standard leaves open).
+inline double unit_uniform(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x1.0p-53; }
+
+inline bool within_limits(const Model& model, const Eigen::VectorXd& theta) {
+  for (int k = 0; k < model.n(); ++k) {
+    const Joint& j = model.body(k + 1).joint;
+    if (theta(k) < j.lower - 1e-12 || theta(k) > j.upper + 1e-12) return false;
+  }
+  return true;
+}
+
+/// Damped Newton (Levenberg-Marquardt with step halving) on c(theta) = 0 at a fixed base pose.
+/// Returns true and the projected theta when |c| <= tol within the iteration budget.
+inline bool project_to_manifold(const Model& model, Data& data, const CaptureProblem& pb, const CaptureTask& task,
+                                const CaptureSetup& s, const BasePose& base, Eigen::VectorXd& theta, double tol,
+                                int max_iterations = 100) {
+  Eigen::VectorXd r, r2, trial;
+  Eigen::MatrixXd J;
+  capture_residual(model, data, pb, task, s, base, theta, r, &J);
+  double mu = 1e-4;
+  for (int it = 0; it < max_iterations; ++it) {
+    const double nr = r.norm();
+    if (!std::isfinite(nr)) return false;
+    if (nr <= tol) return true;
+    const Eigen::MatrixXd JJt = J * J.transpose() + mu * Eigen::MatrixXd::Identity(J.rows(), J.rows());
+    const Eigen::VectorXd step = -J.transpose() * JJt.ldlt().solve(r);
+    double a = 1.0;
+    bool improved = false;
+    for (int ls = 0; ls < 20; ++ls, a *= 0.5) {
+      trial = theta + a * step;
+      capture_residual(model, data, pb, task, s, base, trial, r2, nullptr);
+      if (r2.norm() < nr) {
+        improved = true;
+        break;
+      }
+    }
+    if (!improved) return false;
+    theta = trial;
+    mu = a == 1.0 ? std::max(1e-12, mu * 0.1) : std::min(1.0, mu * 10);
+    capture_residual(model, data, pb, task, s, base, theta, r, &J);
+  }
+  return r.norm() <= tol;
+}
+
+/// Joint-space distance with continuous joints compared modulo 2 pi.
+inline double configuration_distance(const Model& model, const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
+  double d = 0;
+  for (int k = 0; k < model.n(); ++k) {
+    const Joint& j = model.body(k + 1).joint;
+    double x = a(k) - b(k);
+    if (!std::isfinite(j.lower) && !std::isfinite(j.upper)) x = std::remainder(x, 2 * M_PI);
+    d = std::max(d, std::abs(x));
+  }
+  return d;
+}
+
+struct SlsqpContext {
+  const Model* model;
+  Data* data;
+  const CaptureProblem* pb;
+  const CaptureTask* task;
+  const CaptureSetup* setup;
+  const BasePose* base;
+  long evaluations = 0;
+  Eigen::VectorXd theta, g, r;
+  Eigen::MatrixXd J;
+};
+
+inline double slsqp_objective(unsigned n, const double* x, double* grad, void* p) {
+  auto& c = *static_cast<SlsqpContext*>(p);
+  ++c.evaluations;
+  c.theta = Eigen::Map<const Eigen::VectorXd>(x, n);
+  c.g.resize(n);
+  const double M = integrated_effective_mass_gradient(*c.model, *c.data, *c.base, c.theta, c.pb->frame,
+                                                      c.setup->u_cap, c.setup->target_inv_mass, c.g);
+  if (grad) Eigen::Map<Eigen::VectorXd>(grad, n) = c.g;
+  return M;
+}
+
+inline void slsqp_constraints(unsigned m, double* result, unsigned n, const double* x, double* grad, void* p) {
+  auto& c = *static_cast<SlsqpContext*>(p);
+  c.theta = Eigen::Map<const Eigen::VectorXd>(x, n);
+  capture_residual(*c.model, *c.data, *c.pb, *c.task, *c.setup, *c.base, c.theta, c.r, grad ? &c.J : nullptr);
+  Eigen::Map<Eigen::VectorXd>(result, m) = c.r;
+  if (grad)  // NLopt: grad[i * n + j] = d c_i / d x_j (row-major)
+    for (unsigned i = 0; i < m; ++i)
+      for (unsigned j = 0; j < n; ++j) grad[i * n + j] = c.J(i, j);
+}
+
+}  // namespace detail
+
+/// Value of the objective at a capture configuration (base at T). Mass: M_ie (kg); exact-force:
+/// the single-body peak (Eq. 16) at M_ie; multibody-force: the CVODE multibody peak. Runs crba
+/// (and CVODE for the multibody objective).
+inline ManifoldPoint evaluate_capture(const CaptureProblem& pb, const CaptureSetup& s, const BasePose& base,
+                                      const Eigen::VectorXd& theta, GlobalObjective objective,
+                                      const MultibodyContactOptions& mo = {}) {
+  const Model& model = *pb.model;
+  Data data(model);
+  crba(model, data, base, theta);
+  ManifoldPoint p{theta, 1.0 / (inverse_effective_mass(model, data, pb.frame, s.u_cap) + s.target_inv_mass), 0};
+  switch (objective) {
+    case GlobalObjective::Mass: p.objective = p.M_ie; break;
+    case GlobalObjective::ExactForce: p.objective = max_force_exact(s.law, p.M_ie); break;
+    case GlobalObjective::MultibodyForce:
+      p.objective = simulate_contact(model, base, theta, pb.frame, s.capture_target, pb.approach_speed, pb.contact,
+                                     pb.law, mo).f_max;
+      break;
+  }
+  return p;
+}
+
+/// Searches the capture manifold C(base) for the configuration of least objective (see the top of
+/// this file). `extra_starts` are tried first (projected like the random ones). Throws InputError
+/// for bad options or when no start can be put on the manifold (the capture point is out of reach
+/// from this base pose). Deterministic for a given seed.
+namespace detail {
+/// search_capture_manifold with `random_starts` random starts (0: the extra starts only, the local
+/// optima near them). Does not check the options.
+inline ManifoldSearchResult search_manifold(const CaptureProblem& pb, const CaptureTask& task, const CaptureSetup& s,
+                                            const BasePose& base, const ManifoldSearchOptions& so,
+                                            const std::vector<Eigen::VectorXd>& extra_starts, int random_starts);
+}  // namespace detail
+
+inline ManifoldSearchResult search_capture_manifold(const CaptureProblem& pb, const CaptureTask& task,
+                                                    const CaptureSetup& s, const BasePose& base,
+                                                    const ManifoldSearchOptions& so,
+                                                    const std::vector<Eigen::VectorXd>& extra_starts = {}) {
+  using detail::str;
+  if (!pb.model) throw InputError("search_capture_manifold: no model");
+  detail::check_configuration(*pb.model, base, pb.theta, "search_capture_manifold");
+  if (so.starts < 1) throw InputError(str("search_capture_manifold: starts must be >= 1, got ", so.starts));
+  if (!(so.constraint_tolerance > 0)) throw InputError("search_capture_manifold: constraint tolerance must be positive");
+  if (so.max_local_evaluations < 1) throw InputError("search_capture_manifold: max_local_evaluations must be >= 1");
+  if (so.max_ranked < 1) throw InputError("search_capture_manifold: max_ranked must be >= 1");
+  return detail::search_manifold(pb, task, s, base, so, extra_starts, so.starts);
+}
+
+inline ManifoldSearchResult detail::search_manifold(const CaptureProblem& pb, const CaptureTask& task,
+                                                    const CaptureSetup& s, const BasePose& base,
+                                                    const ManifoldSearchOptions& so,
+                                                    const std::vector<Eigen::VectorXd>& extra_starts,
+                                                    int random_starts) {
+  using detail::str;
+  const auto t0 = std::chrono::steady_clock::now();
+  const Model& model = *pb.model;
+  const int n = model.n();
+  Data data(model);
+  ManifoldSearchResult res;
+  res.method = so.objective == GlobalObjective::MultibodyForce
+                   ? "multistart NLopt SLSQP on M_ie, local optima ranked by the CVODE multibody peak"
+                   : "multistart NLopt SLSQP";
+  std::mt19937_64 rng(so.seed);
+  std::vector<Eigen::VectorXd> starts = extra_starts;
+  for (int i = 0; i < random_starts; ++i) {
+    Eigen::VectorXd q(n);
+    for (int k = 0; k < n; ++k) {
+      const Joint& j = model.body(k + 1).joint;
+      const double lo = std::isfinite(j.lower) ? j.lower : -M_PI, hi = std::isfinite(j.upper) ? j.upper : M_PI;
+      q(k) = lo + (hi - lo) * detail::unit_uniform(rng);
+    }
+    starts.push_back(std::move(q));
+  }
+  res.starts = static_cast<int>(starts.size());
+
+  detail::SlsqpContext ctx{&model, &data, &pb, &task, &s, &base, 0, {}, {}, {}, {}};
+  const int m = task.rows();
+  nlopt::opt local(nlopt::LD_SLSQP, static_cast<unsigned>(n));
+  local.set_min_objective(detail::slsqp_objective, &ctx);
+  local.add_equality_mconstraint(detail::slsqp_constraints, &ctx,
+                                 std::vector<double>(static_cast<size_t>(m), so.constraint_tolerance * 0.1));
+  std::vector<double> lb(static_cast<size_t>(n)), ub(static_cast<size_t>(n));
+  for (int k = 0; k < n; ++k) {
+    lb[static_cast<size_t>(k)] = model.body(k + 1).joint.lower;
+    ub[static_cast<size_t>(k)] = model.body(k + 1).joint.upper;
+  }
+  local.set_lower_bounds(lb);
+  local.set_upper_bounds(ub);
+  local.set_xtol_rel(1e-10);
+  local.set_ftol_rel(1e-12);
+  local.set_maxeval(so.max_local_evaluations);
+
+  std::vector<ManifoldPoint> found;
+  for (Eigen::VectorXd q : starts) {
+    if (q.size() != n || !q.allFinite()) throw InputError("search_capture_manifold: an extra start has the wrong size or is not finite");
+    if (!detail::project_to_manifold(model, data, pb, task, s, base, q, so.constraint_tolerance)) continue;
+    if (!detail::within_limits(model, q)) continue;
+    ++res.projected_starts;
+    std::vector<double> x(q.data(), q.data() + n);
+    double f = 0;
+    try {
+      local.optimize(x, f);
+    } catch (const nlopt::roundoff_limited&) {  // x holds the best point found: checked below
+    } catch (const std::runtime_error&) {       // NLopt failure: keep the projected start
+      x.assign(q.data(), q.data() + n);
+    }
+    Eigen::VectorXd th = Eigen::Map<const Eigen::VectorXd>(x.data(), n);
+    // SLSQP satisfies c = 0 to its tolerance; a few Newton steps put the point back exactly on C
+    if (!detail::project_to_manifold(model, data, pb, task, s, base, th, so.constraint_tolerance, 20)) continue;
+    if (!detail::within_limits(model, th)) continue;
+    crba(model, data, base, th);
+    const double M = 1.0 / (inverse_effective_mass(model, data, pb.frame, s.u_cap) + s.target_inv_mass);
+    if (!std::isfinite(M)) continue;
+    bool duplicate = false;
+    for (ManifoldPoint& p : found)
+      if (detail::configuration_distance(model, p.theta, th) < 1e-3) {
+        duplicate = true;
+        if (M < p.M_ie) p = {th, M, M};
+      }
+    if (!duplicate) found.push_back({th, M, M});
+  }
+  res.evaluations = ctx.evaluations;
+  if (found.empty())
+    throw InputError(str("search_capture_manifold: no configuration puts the end-effector on the capture point [",
+                         s.x_cap.transpose(), "] from the base pose at T (", res.starts,
+                         " starts); the capture point is out of reach"));
+  std::sort(found.begin(), found.end(), [](const ManifoldPoint& a, const ManifoldPoint& b) { return a.M_ie < b.M_ie; });
+  res.local_optima = found;
+  if (so.objective == GlobalObjective::MultibodyForce) {
+    // no gradient: evaluate the CVODE peak directly at the best local optima of M_ie
+    double best = std::numeric_limits<double>::infinity();
+    const size_t k = std::min(found.size(), static_cast<size_t>(so.max_ranked));
+    for (size_t i = 0; i < k; ++i) {
+      ManifoldPoint p = evaluate_capture(pb, s, base, found[i].theta, so.objective, so.multibody);
+      ++res.objective_evaluations;
+      res.local_optima[i].objective = p.objective;
+      if (p.objective < best) {
+        best = p.objective;
+        res.best = p;
+      }
+    }
+    for (size_t i = k; i < res.local_optima.size(); ++i) res.local_optima[i].objective = 0;  // not evaluated
+  } else {
+    res.best = evaluate_capture(pb, s, base, found.front().theta, so.objective);
+    for (ManifoldPoint& p : res.local_optima)
+      p.objective = so.objective == GlobalObjective::ExactForce ? max_force_exact(s.law, p.M_ie) : p.M_ie;
+  }
+  res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return res;
+}
+
+struct GlobalCaptureOptions {
+  ManifoldSearchOptions search;
+  int max_iterations = 8;      ///< shooting iterations per goal before the goal is given up
+  int max_goals = 6;           ///< local optima tried as goals, best first
+  double gap_percent = 1.0;    ///< required (reached - optimum) / optimum at the reached base pose, %
+  std::vector<Eigen::VectorXd> extra_starts;  ///< e.g. the paper's method's capture configuration
+};
+
+struct GlobalCaptureResult {
+  CaptureResult run;                 ///< the reaching run (its capture configuration and checks)
+  ManifoldSearchResult search;       ///< the last search, at the reached base pose
+  double objective = 0;              ///< objective at the reached capture configuration
+  double manifold_optimum = 0;       ///< objective at the optimum of C(reached base pose)
+  double optimality_gap_percent = 0; ///< 100 (objective - manifold_optimum) / manifold_optimum
+  /// false: no better optimum than the one reached could be reached (it lies on another component
+  /// of the self-motion manifold: the servo ended elsewhere); the gap then exceeds gap_percent
+  bool reached_manifold_optimum = true;
+  int shooting_iterations = 0;       ///< reaching runs over every goal tried
+  int goals_tried = 0;
+  long evaluations = 0;              ///< over every search
+  long objective_evaluations = 0;    ///< multibody simulations over every search
+  double search_seconds = 0;         ///< over every search
+};
+
+/// Global capture planning (see the top of this file). Goals are the local optima of the search at
+/// the base pose of the task-only run, best first. For each goal: plan the reaching run, re-optimize
+/// the goal locally at the reached base pose, repeat until the reached objective is within
+/// gap_percent of that local optimum (the goal is then reached) or the run ends away from it (the
+/// goal lies on another component of the self-motion manifold: next goal). A reached goal is checked
+/// against a full search at the reached base pose: within gap_percent of its optimum, done.
+/// Otherwise the best reached goal is returned with reached_manifold_optimum = false and the gap
+/// as measured. opt.gain is not used; opt.max_joint_rate limits the joint rates (0: not limited).
+/// Throws InputError for bad arguments (as plan_capture, plus a rate limit below what the task alone
+/// needs), NumericalError when a run fails the checks of integrate_capture or no goal is reached.
+inline GlobalCaptureResult plan_capture_global(const CaptureProblem& pb, const CaptureTask& task,
+                                               const CaptureOptions& opt, const GlobalCaptureOptions& g) {
+  using detail::str;
+  const char* where = "plan_capture_global";
+  CaptureOptions o = opt;
+  o.gain = 0.0;
+  o.progress = nullptr;
+  const CaptureSetup setup = prepare_capture(pb, task, o, where);
+  if (g.max_iterations < 1) throw InputError(str(where, ": max_iterations must be >= 1"));
+  if (g.max_goals < 1) throw InputError(str(where, ": max_goals must be >= 1"));
+  if (!(g.gap_percent > 0)) throw InputError(str(where, ": gap_percent must be positive"));
+  const Model& model = *pb.model;
+  CaptureOptions quiet = o;
+  quiet.record_series = false;
+
+  // the task alone (no null-space motion): a first base pose at T, and the rate it needs
+  ServoPolicy none;
+  const CaptureResult plain = integrate_capture(pb, task, quiet, setup, none, where);
+  if (o.max_joint_rate > 0 && plain.max_joint_rate > o.max_joint_rate)
+    throw InputError(str(where, ": max joint rate ", o.max_joint_rate * 180 / M_PI,
+                         " deg/s is below what the task alone needs (", plain.max_joint_rate * 180 / M_PI, " deg/s)"));
+
+  GlobalCaptureResult res;
+  auto account = [&](const ManifoldSearchResult& sr) {
+    res.evaluations += sr.evaluations;
+    res.objective_evaluations += sr.objective_evaluations;
+    res.search_seconds += sr.seconds;
+  };
+  std::vector<Eigen::VectorXd> extra = g.extra_starts;
+  extra.push_back(plain.theta);
+  const ManifoldSearchResult first = search_capture_manifold(pb, task, setup, plain.base, g.search, extra);
+  account(first);
+  std::vector<ManifoldPoint> goals;
+  for (const ManifoldPoint& p : first.local_optima)
+    if (p.objective > 0) goals.push_back(p);  // multibody-force: the ranked ones
+  auto by_objective = [](const ManifoldPoint& a, const ManifoldPoint& b) { return a.objective < b.objective; };
+  std::stable_sort(goals.begin(), goals.end(), by_objective);
+  if (goals.size() > static_cast<size_t>(g.max_goals)) goals.resize(static_cast<size_t>(g.max_goals));
+  // and the local optima next to the extra starts and to the task-only run's configuration: on the
+  // component of the self-motion manifold the arm is on, so reachable when the better ones are not
+  for (const Eigen::VectorXd& x : extra) {
+    try {
+      const ManifoldSearchResult near = detail::search_manifold(pb, task, setup, plain.base, g.search, {x}, 0);
+      account(near);
+      goals.push_back(near.best);
+    } catch (const InputError&) {
+    }
+  }
+  std::stable_sort(goals.begin(), goals.end(), by_objective);
+
+  std::optional<GlobalCaptureResult> fallback;
+  double last_gap = std::numeric_limits<double>::infinity();
+  for (const ManifoldPoint& target_goal : goals) {
+    ++res.goals_tried;
+    Eigen::VectorXd goal = target_goal.theta;
+    for (int it = 1; it <= g.max_iterations; ++it) {
+      ServoPolicy servo;
+      servo.theta_goal = goal;
+      CaptureOptions run_opt = quiet;
+      run_opt.record_series = opt.record_series;
+      CaptureResult run = integrate_capture(pb, task, run_opt, setup, servo, where);
+      ++res.shooting_iterations;
+      const ManifoldPoint reached = evaluate_capture(pb, setup, run.base, run.theta, g.search.objective, g.search.multibody);
+      if (g.search.objective == GlobalObjective::MultibodyForce) ++res.objective_evaluations;
+      // the goal re-optimized locally at the reached base pose
+      ManifoldSearchResult local;
+      try {
+        local = detail::search_manifold(pb, task, setup, run.base, g.search, {goal}, 0);
+      } catch (const InputError&) {
+        break;  // the goal cannot be put on the manifold at this base pose
+      }
+      account(local);
+      // ended elsewhere: more than 0.5 rad from it on some joint (the servo leaves ~e^-10 of the error; the
+      // rest is the move of the manifold with the base pose, small against the distance between components)
+      if (detail::configuration_distance(model, run.theta, local.best.theta) > 0.5) break;
+      const double local_gap = 100.0 * (reached.objective - local.best.objective) / local.best.objective;
+      if (!std::isfinite(local_gap)) throw NumericalError(str(where, ": the optimality gap is not finite"));
+      if (local_gap > g.gap_percent) {
+        goal = local.best.theta;
+        continue;
+      }
+      // the goal is reached: compare with the whole manifold at the reached base pose
+      std::vector<Eigen::VectorXd> ex = g.extra_starts;
+      ex.push_back(goal);
+      ex.push_back(run.theta);
+      ManifoldSearchResult full = search_capture_manifold(pb, task, setup, run.base, g.search, ex);
+      account(full);
+      const double gap = 100.0 * (reached.objective - full.best.objective) / full.best.objective;
+      last_gap = std::min(last_gap, gap);
+      GlobalCaptureResult r = res;
+      r.run = std::move(run);
+      r.search = std::move(full);
+      r.objective = reached.objective;
+      r.manifold_optimum = r.search.best.objective;
+      r.optimality_gap_percent = gap;
+      r.reached_manifold_optimum = gap <= g.gap_percent;
+      if (r.reached_manifold_optimum) return r;
+      if (!fallback || r.objective < fallback->objective) fallback = std::move(r);
+      break;
+    }
+  }
+  if (fallback) {
+    // the counters of every goal tried, the run of the best reached one
+    fallback->shooting_iterations = res.shooting_iterations;
+    fallback->goals_tried = res.goals_tried;
+    fallback->evaluations = res.evaluations;
+    fallback->objective_evaluations = res.objective_evaluations;
+    fallback->search_seconds = res.search_seconds;
+    return *fallback;
+  }
+  throw NumericalError(str(where, ": no capture configuration chosen by the search was reached (", res.goals_tried,
+                           " goals, ", res.shooting_iterations, " reaching runs)"));
+}
+
+}  // namespace ffsr

@@ -1,0 +1,251 @@
+// ffsr/uncertainty/sampling.hpp -- uncertain targets: distributions of the target and contact
+// quantities, a reproducible sampler, and the maximum contact force per sample (Eigen only).
+//
+// What is uncertain. The capture configuration (joint angles and base pose at the capture time T)
+// is planned for the nominal target; what is not known is the target as it is met at T and the
+// contact. A sample is the target at the capture -- its mass, inertia, contact offset r_tp, normal
+// u_n, spin omega_t (target frame), linear velocity v_t -- and the contact: approach speed,
+// stiffness K, restitution c_r, exponent alpha. The target's attitude at T is the nominal one
+// (propagated from t = 0 by the planner), so u = R_t u_n and r = R_t r_tp change through u_n and
+// r_tp only. Per sample (Eq. 10-14, 20-25):
+//   M_ie = 1 / (u^T G u + 1/m_t + (r_tp x u_n)^T I_t^-1 (r_tp x u_n)),  G = J_v H^-1 J_v^T (robot),
+//   delta_dot^- = v_a - u . (v_t + omega x r)   (the end-effector moves at v_a along u, Eq. 10-12),
+//   F_max = closed form (Eq. 24) or the exact peak of Eq. 16, or a multibody CVODE run
+//   (uncertainty/multibody.hpp).
+// G is a property of the configuration, computed once (robot_inverse_mass_matrix); a sample then
+// costs a 3x3 solve and the peak of Eq. 16 -- 1e5 samples take well under a second.
+//
+// The laws (Spread), with x0 the nominal value:
+//   normal      x = x0 + s z          s = std, or relative-std |x0|   z ~ N(0, 1)
+//   uniform     x ~ U[min, max], or U[x0 - h, x0 + h] with h = half-width, or relative |x0|
+//   log-normal  x = x0 exp(sigma z)   (median x0; the law for K, which is known to a decade)
+//   cone        the normal u_n: uniform on the spherical cap of half-angle a <= 90 deg about the
+//               nominal normal (cos of the angle uniform in [cos a, 1], azimuth uniform)
+// Any scalar law may carry bounds `min`/`max` (a bounded law: values outside are redrawn, i.e. the
+// law is truncated). Vectors (contact offset, spin, velocity) take normal or uniform laws per
+// component, added to the nominal vector, with absolute spreads. The inertia takes a relative
+// spread of its principal moments (each scaled by 1 + e, e normal or uniform) and, optionally, a
+// rotation of its principal axes by an angle uniform in [0, axes] about a uniformly random axis.
+//
+// Physical or redrawn -- the redraw rule of every quantity (a sample that breaks one rule draws
+// that quantity again from the same sample stream, at most kMaxRedraws times, then NumericalError):
+//   target-mass     m_t > 0 (and within min/max)
+//   target-inertia  principal moments > 0 and the triangle inequality I_max <= I_mid + I_min
+//   normal          unit by construction (renormalized), within the cone
+//   approach-speed  v_a > 0;  stiffness K > 0;  exponent alpha > 0;  restitution 0 < c_r <= 1
+//   the sample      delta_dot^- > 0 (the bodies approach): otherwise the whole sample is redrawn
+//                   (it depends on the target attitude only, not on the configuration, so the
+//                   sample set stays common to all configurations)
+//
+// Reproducible randomness. Sample i uses its own std::mt19937_64 seeded with
+// splitmix64(seed + splitmix64(i)), so it depends on (seed, i) only: shards, threads and
+// configurations draw the same numbers (common random numbers). mt19937_64 and its seeding are
+// fully specified by the C++ standard; the uniform and normal transforms are ours (53-bit
+// uniforms; Marsaglia's polar method; azimuths by rejection in the unit disc), because the
+// std:: distributions are implementation-defined. Only std::log, std::exp and std::sqrt are used
+// on the draws (sqrt is exact in IEEE 754; log and exp of a quality libm agree to the last bit on
+// the platforms we know, not by a guarantee).
+#pragma once
+
+#include "ffsr/algorithm/effective_mass.hpp"
+#include "ffsr/contact/contact_law.hpp"
+#include "ffsr/model/target.hpp"
+
+#include <Eigen/Eigenvalues>
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <functional>
+#include <limits>
+#include <optional>
+#include <random>
+#include <string>
+#include <string_view>
+#include <thread>
+#include <vector>
+
+namespace ffsr {
+
+/// The uncertain quantities, in the order they are drawn.
+enum class Quantity {
+  TargetMass,
+  TargetInertia,
+  ContactOffset,
+  Normal,
+  Spin,
+  TargetVelocity,
+  ApproachSpeed,
+  Stiffness,
+  Restitution,
+  Exponent
+};
+inline constexpr std::size_t kNumQuantities = 10;
+/// Scenario keys of the quantities ([uncertainty] table), in the order of Quantity.
+inline constexpr std::array<std::string_view, kNumQuantities> kQuantityNames{
+    "target-mass", "target-inertia", "contact-offset", "normal", "spin", "target-velocity",
+    "approach-speed", "stiffness", "restitution", "exponent"};
+
+/// The law of one uncertain quantity (see the top of this file). Units are the quantity's own, SI,
+/// except `spin` (rad/s here; the CLI takes deg/s) and the angles (rad).
+struct Spread {
+  enum class Law { Fixed, Normal, Uniform, LogNormal, Cone };
+  Law law = Law::Fixed;
+  double scale = 0;       ///< normal: std; uniform: half-width; log-normal: sigma; cone: half-angle (rad)
+  bool relative = false;  ///< normal/uniform: scale is a fraction of |x0| (inertia: always relative)
+  bool has_range = false; ///< uniform: support [min, max] (absolute) instead of x0 +- scale
+  double min = -std::numeric_limits<double>::infinity();  ///< bounds (all scalar laws): redraw outside
+  double max = std::numeric_limits<double>::infinity();
+  double axes = 0;        ///< inertia: largest rotation of the principal axes (rad)
+};
+
+/// One [uncertainty] entry per quantity (Fixed: not uncertain) plus the sample count and the seed.
+struct UncertaintySpec {
+  std::array<Spread, kNumQuantities> spread{};
+  std::uint64_t samples = 1000;
+  std::uint64_t seed = 1;
+  Spread& operator[](Quantity q) { return spread[static_cast<std::size_t>(q)]; }
+  const Spread& operator[](Quantity q) const { return spread[static_cast<std::size_t>(q)]; }
+};
+
+/// Throws InputError naming the quantity (`uncertainty.<name>`) for a spread that cannot be drawn:
+/// negative or non-finite scale, min > max, a cone over 90 deg, a law that does not fit the
+/// quantity (cone for a scalar, log-normal for a vector, ...), samples < 1.
+inline void validate(const UncertaintySpec& spec);
+
+/// The nominal quantities: the target at the capture time (attitude included), the contact
+/// parameters and the approach speed.
+struct UncertainNominal {
+  Target target;
+  ContactParams contact;
+  double approach_speed = 0.2;
+};
+
+/// A drawn sample. `target` is the target at the capture (nominal attitude). `score` says how
+/// extreme each quantity was: (x - x0)/std for normal laws, ln(x/x0)/sigma for log-normal, the
+/// position in the support scaled to [-1, 1] for uniform laws, |dx|/std (or /half-width) for
+/// vectors, angle/half-angle for the cone, the largest |e|/spread for the inertia; 0 if fixed.
+struct UncertainSample {
+  std::uint64_t index = 0;
+  Target target;
+  ContactParams contact;
+  double approach_speed = 0;
+  Vector3 normal_world = Vector3::UnitX();  ///< u = R_t u_n
+  double approach_velocity = 0;             ///< delta_dot^- (Eq. 10-12)
+  double target_inverse_mass = 0;           ///< 1/m_t + (r x u)^T I^-1 (r x u), target frame
+  int redraws = 0;                          ///< redrawn quantities and samples (physical rules)
+  std::array<double, kNumQuantities> score{};
+};
+
+inline constexpr int kMaxRedraws = 1000;
+
+namespace detail {
+
+/// SplitMix64 (Steele, Lea, Flood 2014): a bijective 64-bit mixer.
+constexpr std::uint64_t splitmix64(std::uint64_t x) {
+  x += 0x9E3779B97F4A7C15ULL;
+  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ULL;
+  x = (x ^ (x >> 27)) * 0x94D049BB133111EBULL;
+  return x ^ (x >> 31);
+}
+
+}  // namespace detail
+
+/// The random stream of sample `index`: mt19937_64 seeded from (seed, index) only, with our own
+/// transforms (same numbers on every platform, see the top of this file).
+class SampleStream {
+ public:
+  SampleStream(std::uint64_t seed, std::uint64_t index)
+      : engine_(detail::splitmix64(seed + detail::splitmix64(index))) {}
+  /// Uniform in [0, 1): the top 53 bits.
+  double uniform() { return static_cast<double>(engine_() >> 11) * 0x1.0p-53; }
+  /// Standard normal, Marsaglia's polar method (the second variate is discarded, so that a draw is
+  /// a function of the stream position alone).
+  double normal() {
+    for (;;) {
+      const double a = 2.0 * uniform() - 1.0, b = 2.0 * uniform() - 1.0;
+      const double s = a * a + b * b;
+      if (s > 0.0 && s < 1.0) return a * std::sqrt(-2.0 * std::log(s) / s);
+    }
+  }
+  /// A uniformly distributed unit 2-vector (cos, sin), by rejection in the unit disc.
+  void unit_circle(double& c, double& s) {
+    for (;;) {
+      const double a = 2.0 * uniform() - 1.0, b = 2.0 * uniform() - 1.0;
+      const double r2 = a * a + b * b;
+      if (r2 > 1e-12 && r2 < 1.0) {
+        const double r = std::sqrt(r2);
+        c = a / r;
+        s = b / r;
+        return;
+      }
+    }
+  }
+  /// A uniformly distributed unit 3-vector.
+  Vector3 unit_sphere() {
+    const double z = 2.0 * uniform() - 1.0;
+    double c, s;
+    unit_circle(c, s);
+    const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
+    return {r * c, r * s, z};
+  }
+
+ private:
+  std::mt19937_64 engine_;
+};
+
+/// Draws the sample `index` of `spec` around `nominal` (see the top of this file for the laws and
+/// the redraw rules). Reads spec, nominal. Pure: the same (spec, nominal, index) gives the same
+/// sample. NumericalError when a rule still fails after kMaxRedraws draws.
+inline UncertainSample draw_sample(const UncertaintySpec& spec, const UncertainNominal& nominal, std::uint64_t index);
+
+/// G = J_v H^-1 J_v^T, the robot's 3x3 inverse mass matrix at the origin of `frame` (its quadratic
+/// form u^T G u is the denominator of Eq. 4), from six calls of inverse_effective_mass by
+/// polarization. Runs crba. Writes data.
+inline Matrix3 robot_inverse_mass_matrix(const Model& model, Data& data, const BasePose& base,
+                                         const Eigen::Ref<const Eigen::VectorXd>& theta, int frame);
+
+/// How F_max is computed per sample: Eq. 24 (closed), the exact peak of Eq. 16 (exact), or the
+/// multibody CVODE reference (uncertainty/multibody.hpp; not available from this header).
+enum class ForceModel { Closed, Exact, Multibody };
+
+/// M_ie, delta_dot^- and F_max of one sample for a configuration with inverse mass matrix G
+/// (closed or exact force model). `law` names the damping law (Table 1).
+struct SampleForce {
+  double M_ie = 0, approach_velocity = 0, f_max = 0;
+};
+inline SampleForce sample_force(const Matrix3& G, const UncertainSample& s, std::string_view law, ForceModel model);
+
+/// Summary of F_max over a sample set: mean, standard deviation (n - 1), the 50th, 95th and 99th
+/// percentiles and the maximum. Percentiles are order statistics (nearest rank): p-th = the
+/// ceil(p n)-th smallest value. The mean and deviation sum in the order given (callers pass the
+/// values by sample index), so a merged set of shards gives the same digits as one run.
+struct ForceSummary {
+  std::size_t n = 0;
+  double mean = 0, std = 0, p50 = 0, p95 = 0, p99 = 0, max = 0;
+};
+inline ForceSummary summarize(const std::vector<double>& values_by_index);
+/// The nearest-rank percentile of `sorted` (ascending): the ceil(percent n / 100)-th smallest value,
+/// in integer arithmetic (no rounding question at p n = integer). percent in [1, 100].
+inline double nearest_rank(const std::vector<double>& sorted, int percent);
+
+/// Runs f(i) for i in [begin, end) on `threads` threads (an atomic counter hands out the
+/// indices). Exceptions are rethrown on the calling thread (the first by index). `progress`, if
+/// set, is called on the calling thread with the count done, about every 50 ms.
+inline void parallel_for(std::uint64_t begin, std::uint64_t end, int threads,
+                         const std::function<void(std::uint64_t)>& f,
+                         const std::function<void(std::uint64_t)>& progress = {});
+
+/// The robust objective: the 95th percentile (nearest rank) of the exact F_max over a fixed sample
+/// set, for the capture configuration (base, theta). Cost: one crba and the samples' peaks.
+/// A search that calls it with the same samples compares configurations on common random numbers.
+inline double robust_force_p95(const Model& model, Data& data, const BasePose& base,
+                               const Eigen::Ref<const Eigen::VectorXd>& theta, int frame,
+                               const std::vector<UncertainSample>& samples, std::string_view law);
+
+}  // namespace ffsr
+
+#include "ffsr/uncertainty/detail/sampling.hxx"

@@ -1,0 +1,388 @@
+// ffsr-optimize map: the integrated effective mass M_ie (Eq. 14) and the closed-form maximum contact
+// force F_max (Eq. 24) over a grid of joint angles (the paper's Figures 8 and 9), the joints not
+// varied held at --joints-deg.
+//
+// The grid. Varied joint j (1-based, URDF tree order) takes the angles lo_j + i step_j, i = 0, 1, ...,
+// below hi_j: the half-open range [lo_j, hi_j), so that -180,180 in steps of 2 gives 180 angles and
+// no angle twice. Points are numbered row-major: the last varied joint changes fastest; the CSV has
+// one row per point in that order.
+//
+// Shards. --shard K/N evaluates the K-th of N contiguous parts of that numbering (part k holds
+// points [k P/N, (k+1) P/N) up to rounding: the first P mod N parts hold one point more). Only shard
+// 0 writes the header line, so `cat` of the N shard files in the order k = 0..N-1 is, byte for byte,
+// the CSV of the whole grid.
+//
+// Speed. Each thread has its own Data and buffers (no heap allocation per point); blocks of points
+// are claimed in order, formatted with std::to_chars (the shortest text that reads back as the same
+// double) and appended to the output in order, so the output never has to fit in memory. The file
+// is written to a temporary next to the destination and renamed at the end: all or nothing.
+#include "common.hpp"
+#include "subcommands.hpp"
+
+#include <atomic>
+#include <charconv>
+#include <condition_variable>
+#include <cstdint>
+#include <cstdio>
+#include <exception>
+#include <filesystem>
+#include <iostream>
+#include <limits>
+#include <memory>
+#include <mutex>
+#include <random>
+#include <sstream>
+#include <thread>
+
+namespace ffsr::cli {
+namespace map_impl {  // named, not anonymous: the command is one unity translation unit
+
+using detail::str;
+
+struct MapOptions {
+  RobotOptions robot;
+  TargetOptions target;
+  ContactLawOptions law;
+  std::string vary;
+  std::string range_deg = "-180,180";
+  std::string step_deg = "2";
+  std::string csv;
+  std::string shard = "0/1";
+  unsigned threads = 0;
+  std::uint64_t max_points = 1000000000ULL;
+  bool quiet = false;
+};
+
+/// One varied joint: angles lo + i step (degrees), i = 0..count-1.
+struct Axis {
+  int joint = 0;  // 0-based joint index
+  double lo = 0, step = 0;
+  std::uint64_t count = 0;
+  double angle_deg(std::uint64_t i) const { return lo + static_cast<double>(i) * step; }
+};
+
+struct Grid {
+  std::vector<Axis> axes;
+  std::uint64_t size = 0;
+};
+
+/// Parses --vary, --range-deg, --step-deg and checks the size against --max-points.
+Grid parse_grid(const MapOptions& o, int n_joints) {
+  const auto joints = parse_list(o.vary, "--vary");
+  Grid g;
+  for (double j : joints) {
+    if (j != std::floor(j) || j < 1 || j > n_joints)
+      throw InputError(str("--vary: joint ", j, " is not one of 1..", n_joints, " (the robot in ", o.robot.urdf, " has ",
+                           n_joints, " joints, numbered from 1 in URDF tree order)"));
+    for (const Axis& a : g.axes)
+      if (a.joint == static_cast<int>(j) - 1) throw InputError(str("--vary: joint ", j, " is given twice"));
+    g.axes.push_back({static_cast<int>(j) - 1, 0, 0, 0});
+  }
+  const size_t k = g.axes.size();
+  const auto range = parse_list(o.range_deg, "--range-deg", k == 1 ? std::vector<size_t>{2} : std::vector<size_t>{2, 2 * k});
+  const auto step = parse_list(o.step_deg, "--step-deg", k == 1 ? std::vector<size_t>{1} : std::vector<size_t>{1, k});
+  double total = 1.0;
+  for (size_t i = 0; i < k; ++i) {
+    Axis& a = g.axes[i];
+    const double lo = range.size() == 2 ? range[0] : range[2 * i], hi = range.size() == 2 ? range[1] : range[2 * i + 1];
+    a.step = step.size() == 1 ? step[0] : step[i];
+    if (!(a.step > 0)) throw InputError(str("--step-deg: the step must be positive, got ", a.step));
+    if (!(lo < hi))
+      throw InputError(str("--range-deg: the range of joint ", a.joint + 1, " is ", lo == hi ? "empty" : "inverted",
+                           " (from ", lo, " to ", hi, "; expected lo < hi)"));
+    a.lo = lo;
+    const double r = (hi - lo) / a.step;
+    if (!(r < 9.0e15)) throw InputError(str("--step-deg: the step ", a.step, " is too small for the range ", lo, ",", hi));
+    a.count = static_cast<std::uint64_t>(std::ceil(r - 1e-9));  // half-open [lo, hi), tolerant of rounding
+    if (a.count == 0) a.count = 1;
+    total *= static_cast<double>(a.count);
+  }
+  if (total > static_cast<double>(o.max_points))
+    throw InputError(str("--max-points: the grid has ", total, " points, more than the limit ", o.max_points,
+                         "; pass a larger --max-points to run it"));
+  g.size = 1;
+  for (const Axis& a : g.axes) g.size *= a.count;
+  return g;
+}
+
+struct Shard {
+  std::uint64_t k = 0, n = 1;
+  /// The first point of part j of a grid of `size` points.
+  std::uint64_t begin(std::uint64_t size, std::uint64_t j) const { return j * (size / n) + std::min(j, size % n); }
+};
+
+Shard parse_shard(const std::string& text) {
+  auto fail = [&]() -> Shard {
+    throw InputError(str("--shard: expected K/N with integers 0 <= K < N (for example 0/4), got '", text, "'"));
+  };
+  const size_t slash = text.find('/');
+  if (slash == std::string::npos) return fail();
+  Shard s;
+  const std::string a = text.substr(0, slash), b = text.substr(slash + 1);
+  for (const auto* part : {&a, &b})
+    if (part->empty() || part->size() > 18 || part->find_first_not_of("0123456789") != std::string::npos) return fail();
+  s.k = std::stoull(a);
+  s.n = std::stoull(b);
+  if (s.n < 1 || s.k >= s.n) return fail();
+  return s;
+}
+
+/// The CSV output: a temporary file next to `path`, renamed onto it by commit(); removed if the
+/// run fails. "-" writes to stdout; an existing device or FIFO is written in place.
+class CsvOutput {
+ public:
+  explicit CsvOutput(const std::string& path) : path_(path) {
+    if (path == "-") {
+      file_ = stdout;
+      return;
+    }
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    const fs::path parent = fs::path(path).parent_path();
+    if (!parent.empty() && !fs::is_directory(parent, ec))
+      throw InputError(str("--csv: the folder '", parent.string(), "' of ", path, " does not exist"));
+    const fs::file_status st = fs::status(path, ec);
+    if (fs::is_directory(st)) throw InputError(str("--csv: ", path, " is a directory"));
+    if (fs::exists(st) && !fs::is_regular_file(st)) {
+      // a device or FIFO (/dev/null, a named pipe): write to it directly; renaming a temporary file
+      // onto it would replace the device with a regular file
+      file_ = std::fopen(path.c_str(), "wb");
+      if (!file_) throw InputError(str("--csv: cannot write the output file ", path));
+      return;
+    }
+    tmp_ = path + ".tmp-" + std::to_string(std::random_device{}());
+    file_ = std::fopen(tmp_.c_str(), "wb");
+    if (!file_) throw InputError(str("--csv: cannot write the output file ", path));
+  }
+  CsvOutput(const CsvOutput&) = delete;
+  CsvOutput& operator=(const CsvOutput&) = delete;
+  ~CsvOutput() {
+    if (file_ && file_ != stdout) std::fclose(file_);
+    if (!tmp_.empty() && !committed_) std::remove(tmp_.c_str());
+  }
+  void write(const char* data, size_t n) {
+    if (n && std::fwrite(data, 1, n, file_) != n) failed_ = true;
+  }
+  void commit() {
+    if (std::fflush(file_) != 0 || std::ferror(file_) || failed_)
+      throw InputError(str("--csv: cannot write the output file ", path_, " (disk full?)"));
+    if (file_ == stdout) return;
+    const int rc = std::fclose(file_);
+    file_ = nullptr;
+    if (rc != 0) throw InputError(str("--csv: cannot write the output file ", path_));
+    if (tmp_.empty()) return;  // written in place (a device or FIFO)
+    if (std::rename(tmp_.c_str(), path_.c_str()) != 0)
+      throw InputError(str("--csv: cannot write the output file ", path_, " (rename failed)"));
+    committed_ = true;
+  }
+
+ private:
+  std::string path_, tmp_;
+  std::FILE* file_ = nullptr;
+  bool failed_ = false, committed_ = false;
+};
+
+/// Appends the shortest round-trip text of x and a separator.
+inline char* put(char* p, char* end, double x, char sep) {
+  const auto r = std::to_chars(p, end, x);
+  *r.ptr = sep;
+  return r.ptr + 1;
+}
+
+/// What one thread needs: its own Data and joint vector; evaluates a block of points.
+struct Worker {
+  const Model& model;
+  const Grid& grid;
+  const AnyContactLaw& law;
+  const BasePose base;
+  const int frame;
+  const Vector3 u;
+  const double target_inverse_mass;
+  Data data;
+  Eigen::VectorXd theta;
+  std::vector<char> text;
+  std::vector<double> angles;
+  // the largest and smallest M_ie seen, and where (smallest point index on ties)
+  double max_M = -1, min_M = std::numeric_limits<double>::infinity();
+  std::uint64_t argmax = 0, argmin = 0;
+
+  Worker(const Model& m, const Grid& g, const AnyContactLaw& l, const Robot& r, const Vector3& u_, double tim,
+         size_t block)
+      : model(m), grid(g), law(l), base(r.base), frame(r.end_effector), u(u_), target_inverse_mass(tim), data(m),
+        theta(r.theta), text((g.axes.size() + 2) * 32 * block + 1), angles(g.axes.size()) {}
+
+  /// Evaluates points [first, last) and formats their rows into `text`; returns the byte count.
+  size_t run(std::uint64_t first, std::uint64_t last) {
+    char* p = text.data();
+    char* const end = text.data() + text.size();
+    const size_t k = grid.axes.size();
+    for (std::uint64_t idx = first; idx < last; ++idx) {
+      std::uint64_t rest = idx;
+      for (size_t a = k; a-- > 0;) {
+        const Axis& ax = grid.axes[a];
+        angles[a] = ax.angle_deg(rest % ax.count);
+        rest /= ax.count;
+        theta(ax.joint) = angles[a] * (M_PI / 180.0);  // as load_robot converts --joints-deg
+      }
+      const double M = integrated_effective_mass_fast(model, data, base, theta, frame, u, target_inverse_mass);  // Eq. 14
+      const double F = max_force_closed_form(law, M);                                                  // Eq. 24
+      if (M > max_M) max_M = M, argmax = idx;
+      if (M < min_M) min_M = M, argmin = idx;
+      for (size_t a = 0; a < k; ++a) p = put(p, end, angles[a], ',');
+      p = put(p, end, M, ',');
+      p = put(p, end, F, '\n');
+    }
+    return static_cast<size_t>(p - text.data());
+  }
+};
+
+std::string point_deg(const Grid& g, std::uint64_t idx) {
+  std::vector<double> a(g.axes.size());
+  for (size_t i = g.axes.size(); i-- > 0;) {
+    a[i] = g.axes[i].angle_deg(idx % g.axes[i].count);
+    idx /= g.axes[i].count;
+  }
+  std::ostringstream os;
+  os << "[";
+  for (size_t i = 0; i < a.size(); ++i) os << (i ? ", " : "") << a[i];
+  os << "]";
+  return os.str();
+}
+
+int run_map(const MapOptions& o) {
+  const Robot r = load_robot(o.robot);
+  Target target = o.target.build();
+  o.law.set_target_motion(target);
+  if (!std::isfinite(o.law.approach_speed)) throw InputError("--approach-speed: must be finite");
+  const ContactParams params = o.law.params();
+  if (o.law.model == "all") throw InputError("--model: map evaluates one law; 'all' is for the contact subcommand");
+  const Vector3 u = target.normal_world();
+  const double v_in = approach_velocity(u, Vector3(o.law.approach_speed * u), target.velocity,
+                                        target.angular_velocity_world(), target.offset_world());  // Eq. 10-12
+  if (!(v_in > 0))
+    throw InputError(str("--approach-speed: the end-effector does not approach the target (delta_dot^- = ", v_in,
+                         " m/s); increase the approach speed"));
+  const AnyContactLaw law = [&] {
+    try {
+      return make_contact_law(o.law.model, params, v_in);
+    } catch (const InputError& e) {
+      throw InputError(std::string("--model: ") + e.what());
+    }
+  }();
+  const Grid grid = parse_grid(o, r.model.n());
+  const Shard shard = parse_shard(o.shard);
+  const std::uint64_t first = shard.begin(grid.size, shard.k), last = shard.begin(grid.size, shard.k + 1);
+  const std::uint64_t count = last - first;
+
+  CsvOutput out(o.csv);
+  if (shard.k == 0) {
+    std::string header;
+    const auto names = r.model.joint_names();
+    for (const Axis& a : grid.axes) header += names[static_cast<size_t>(a.joint)] + "_deg,";
+    header += "M_ie_kg,F_max_N\n";
+    out.write(header.data(), header.size());
+  }
+
+  // blocks of points claimed in order; each is written once all blocks before it are
+  constexpr std::uint64_t kBlock = 2048;
+  const std::uint64_t blocks = (count + kBlock - 1) / kBlock;
+  unsigned threads = o.threads ? o.threads : std::max(1U, std::thread::hardware_concurrency());
+  threads = static_cast<unsigned>(std::max<std::uint64_t>(1, std::min<std::uint64_t>(threads, blocks)));
+  const double target_inverse_mass = target.inverse_mass_along_normal();
+  std::vector<std::unique_ptr<Worker>> workers;
+  for (unsigned t = 0; t < threads; ++t)
+    workers.push_back(std::make_unique<Worker>(r.model, grid, law, r, u, target_inverse_mass, kBlock));
+
+  std::atomic<std::uint64_t> next_block{0}, done{0};
+  std::mutex m;
+  std::condition_variable cv;
+  std::uint64_t next_write = 0;
+  unsigned running = threads;
+  bool failed = false;
+  std::exception_ptr error;
+  auto work = [&](Worker& w) {
+    try {
+      for (;;) {
+        const std::uint64_t b = next_block.fetch_add(1);
+        if (b >= blocks) break;
+        const std::uint64_t lo = first + b * kBlock, hi = std::min(last, lo + kBlock);
+        const size_t bytes = w.run(lo, hi);
+        std::unique_lock<std::mutex> lock(m);
+        cv.wait(lock, [&] { return next_write == b || failed; });
+        if (failed) break;
+        out.write(w.text.data(), bytes);
+        ++next_write;
+        done += hi - lo;
+        cv.notify_all();
+      }
+    } catch (...) {
+      std::lock_guard<std::mutex> lock(m);
+      if (!error) error = std::current_exception();
+      failed = true;
+    }
+    std::lock_guard<std::mutex> lock(m);
+    --running;
+    cv.notify_all();
+  };
+  const auto t0 = std::chrono::steady_clock::now();
+  Progress progress("map", o.quiet);
+  std::vector<std::thread> pool;
+  for (unsigned t = 0; t < threads; ++t) pool.emplace_back(work, std::ref(*workers[t]));
+  {
+    std::unique_lock<std::mutex> lock(m);
+    while (running > 0) {
+      cv.wait_for(lock, std::chrono::milliseconds(200), [&] { return running == 0; });
+      if (!failed) progress(done.load(), count);
+    }
+  }
+  for (auto& t : pool) t.join();
+  if (error) std::rethrow_exception(error);
+  out.commit();
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+
+  std::ostream& os = o.csv == "-" ? std::cerr : std::cout;
+  os << "map: " << count << " of " << grid.size << " points (shard " << shard.k << "/" << shard.n << ") in "
+     << seconds << " s, " << (seconds > 0 ? static_cast<double>(count) / seconds : 0.0) << " points/s on " << threads
+     << " thread" << (threads > 1 ? "s" : "") << "\n";
+  if (count > 0) {
+    const Worker* hi = workers[0].get();
+    const Worker* lo = workers[0].get();
+    for (const auto& w : workers) {
+      if (w->max_M > hi->max_M || (w->max_M == hi->max_M && w->argmax < hi->argmax)) hi = w.get();
+      if (w->min_M < lo->min_M || (w->min_M == lo->min_M && w->argmin < lo->argmin)) lo = w.get();
+    }
+    os << "max M_ie = " << hi->max_M << " kg at " << point_deg(grid, hi->argmax) << " deg; min M_ie = " << lo->min_M
+       << " kg at " << point_deg(grid, lo->argmin) << " deg\n";
+  }
+  if (o.csv != "-") os << "wrote " << o.csv << "\n";
+  return 0;
+}
+
+}  // namespace map_impl
+
+void register_map(CLI::App& app, Action& action) {
+  using namespace map_impl;
+  auto o = std::make_shared<MapOptions>();
+  CLI::App* sub = app.add_subcommand("map", "M_ie (Eq. 14) and closed-form F_max (Eq. 24) over a grid of joint angles");
+  o->robot.add_to(*sub);
+  o->target.add_to(*sub);
+  o->law.add_to(*sub, "Hysteresis damping law (Table 1) of the F_max column");
+  sub->add_option("--vary", o->vary, "Joints to vary, 1-based in URDF tree order, e.g. 1,2,3; the others stay at --joints-deg")
+      ->required();
+  sub->add_option("--range-deg", o->range_deg,
+                  "Half-open range lo,hi of every varied joint, or lo1,hi1,lo2,hi2,... one pair per varied joint, deg")
+      ->capture_default_str();
+  sub->add_option("--step-deg", o->step_deg, "Grid step, one for all or one per varied joint, deg")->capture_default_str();
+  sub->add_option("--csv", o->csv, "Output CSV (one row per point: varied angles deg, M_ie kg, F_max N); '-' for stdout")
+      ->required();
+  sub->add_option("--shard", o->shard,
+                  "Evaluate the K-th of N contiguous parts of the grid (K/N, 0 <= K < N); only part 0 writes the header, "
+                  "so the parts concatenated in order are the whole CSV")
+      ->capture_default_str();
+  sub->add_option("--threads", o->threads, "Worker threads; 0: all cores")->check(CLI::Range(0U, 1024U))->capture_default_str();
+  sub->add_option("--max-points", o->max_points, "Refuse grids with more points than this")->capture_default_str();
+  sub->add_flag("--quiet", o->quiet, "No progress line");
+  sub->callback([o, &action] { action = [o] { return run_map(*o); }; });
+}
+
+}  // namespace ffsr::cli

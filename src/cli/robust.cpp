@@ -1,0 +1,565 @@
+// ffsr-optimize robust --config SCENARIO.toml [flags]: Monte Carlo of the maximum contact force over
+// what is not known about the target (the scenario's [uncertainty] table), for the capture
+// configurations of the main job (plain and optimized, planned as the main job plans them) or one
+// given with --capture-joints-deg. Samples are common to all configurations and depend on
+// (seed, index) only, so --shard K/N runs can be merged exactly (--merge): a shard's JSON keeps every
+// sample's F_max, the merge concatenates them by index and recomputes the summary.
+//
+// The [uncertainty] table is read with toml++ (CLI11 2.1's reader does not parse its inline tables);
+// the other keys of the file go to the same options as the flags, and a flag overrides the file.
+#include "common.hpp"
+#include "scenario.hpp"
+#include "subcommands.hpp"
+
+#include "ffsr/uncertainty/multibody.hpp"
+#include "ffsr/uncertainty/sampling.hpp"
+
+#include <toml++/toml.h>
+
+#include <algorithm>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <map>
+#include <memory>
+#include <set>
+#include <sstream>
+#include <thread>
+
+namespace ffsr::cli {
+namespace {
+
+using detail::str;
+
+/// Tail samples kept per configuration (the largest F_max), in the summary and across a merge.
+constexpr std::size_t kTail = 5;
+
+struct RobustOptions {
+  RunOptions scenario;
+  std::string config;
+  std::string force_model = "exact";
+  std::string samples, seed, shard = "0/1";
+  int threads = std::max(1u, std::thread::hardware_concurrency());
+  std::vector<double> capture_joints_deg, capture_base_position{0, 0, 0}, capture_base_rpy_deg{0, 0, 0};
+  std::vector<std::string> merge;
+  std::string json, csv;
+  bool quiet = false;
+};
+
+/// A non-negative integer written in decimal digits (no sign, no exponent), or InputError naming `key`.
+std::uint64_t parse_count(const std::string& text, const std::string& key) {
+  if (text.empty() || text.size() > 19 || text.find_first_not_of("0123456789") != std::string::npos)
+    throw InputError(str(key, ": expected a non-negative integer, got '", text, "'"));
+  return std::stoull(text);
+}
+
+// --- the [uncertainty] table --------------------------------------------------------------------
+
+double number(const toml::node& n, const std::string& key) {
+  if (auto i = n.value_exact<int64_t>()) return static_cast<double>(*i);
+  if (auto d = n.value_exact<double>()) {
+    if (!std::isfinite(*d)) throw InputError(str(key, ": must be finite, got ", *d));
+    return *d;
+  }
+  throw InputError(str(key, ": expected a number"));
+}
+
+Spread parse_spread(Quantity q, const toml::table& t, const std::string& key) {
+  static const std::set<std::string> known{"law",  "std",   "relative-std", "half-width", "relative", "min",
+                                           "max",  "sigma", "angle-deg",    "axes-deg"};
+  for (const auto& [k, v] : t)
+    if (!known.count(std::string(k.str())))
+      throw InputError(str(key, ".", k.str(), ": unknown parameter; expected law, std, relative-std, half-width, ",
+                           "relative, min, max, sigma, angle-deg or axes-deg"));
+  const auto law = t["law"].value<std::string>();
+  if (!law) throw InputError(str(key, ": missing law (normal, uniform, log-normal or cone)"));
+  auto get = [&](const char* name) -> std::optional<double> {
+    if (const toml::node* n = t.get(name)) return number(*n, str(key, ".", name));
+    return std::nullopt;
+  };
+  Spread sp;
+  const auto sd = get("std"), rsd = get("relative-std"), hw = get("half-width"), rel = get("relative"),
+             lo = get("min"), hi = get("max"), sigma = get("sigma"), angle = get("angle-deg"), axes = get("axes-deg");
+  for (const auto& [name, v] : {std::pair{"std", sd}, {"relative-std", rsd}, {"half-width", hw}, {"relative", rel},
+                                {"sigma", sigma}, {"angle-deg", angle}, {"axes-deg", axes}})
+    if (v && *v < 0) throw InputError(str(key, ".", name, ": a spread must be non-negative, got ", detail::short_number(*v)));
+  // spin is given in deg/s, the library takes rad/s
+  const double unit = q == Quantity::Spin ? M_PI / 180.0 : 1.0;
+  auto one_of = [&](std::initializer_list<std::pair<const char*, std::optional<double>>> opts) {
+    int count = 0;
+    std::string names;
+    for (const auto& [n, v] : opts) {
+      count += v.has_value();
+      names += (names.empty() ? "" : " or ") + std::string(n);
+    }
+    if (count != 1) throw InputError(str(key, ": the ", *law, " law takes exactly one of ", names));
+  };
+  if (*law == "normal") {
+    sp.law = Spread::Law::Normal;
+    one_of({{"std", sd}, {"relative-std", rsd}});
+    sp.relative = rsd.has_value();
+    sp.scale = sd ? *sd * unit : *rsd;
+  } else if (*law == "uniform") {
+    sp.law = Spread::Law::Uniform;
+    const bool range = lo.has_value() && hi.has_value() && !hw && !rel;
+    if (!range) one_of({{"half-width", hw}, {"relative", rel}});
+    sp.has_range = range;
+    sp.relative = rel.has_value();
+    sp.scale = hw ? *hw * unit : rel ? *rel : 0.0;
+  } else if (*law == "log-normal") {
+    sp.law = Spread::Law::LogNormal;
+    if (!sigma) throw InputError(str(key, ": the log-normal law needs sigma (standard deviation of ln x)"));
+    sp.scale = *sigma;
+  } else if (*law == "cone") {
+    sp.law = Spread::Law::Cone;
+    if (!angle) throw InputError(str(key, ": the cone law needs angle-deg (half-angle)"));
+    sp.scale = *angle * M_PI / 180.0;
+  } else {
+    throw InputError(str(key, ".law: unknown law '", *law, "'; expected normal, uniform, log-normal or cone"));
+  }
+  if (q == Quantity::TargetInertia && sp.law != Spread::Law::Cone && !sp.relative)
+    throw InputError(str(key, ": the inertia takes a relative spread (relative-std or relative)"));
+  if (lo) sp.min = *lo * unit;
+  if (hi) sp.max = *hi * unit;
+  if (axes) sp.axes = *axes * M_PI / 180.0;
+  if (axes && q != Quantity::TargetInertia) throw InputError(str(key, ".axes-deg: only the inertia takes it"));
+  return sp;
+}
+
+/// Reads the [uncertainty] table of the scenario file into `spec` (samples and seed only if the
+/// flags did not set them).
+void parse_uncertainty(const toml::table& root, UncertaintySpec& spec, bool samples_set, bool seed_set,
+                       const std::string& where) {
+  const toml::node* node = root.get("uncertainty");
+  if (!node) throw InputError(str(where, ": no [uncertainty] table"));
+  const toml::table* u = node->as_table();
+  if (!u) throw InputError(str(where, ": 'uncertainty' must be a table"));
+  for (const auto& [k, v] : *u) {
+    const std::string name(k.str());
+    const std::string key = "uncertainty." + name;
+    if (name == "samples" || name == "seed") {
+      const auto i = v.value_exact<int64_t>();
+      if (!i) throw InputError(str(key, ": must be an integer"));
+      if (name == "samples" && *i < 1) throw InputError(str(key, ": must be at least 1, got ", *i));
+      if (name == "seed" && *i < 0) throw InputError(str(key, ": must be a non-negative integer, got ", *i));
+      if (name == "samples" && !samples_set) spec.samples = static_cast<std::uint64_t>(*i);
+      if (name == "seed" && !seed_set) spec.seed = static_cast<std::uint64_t>(*i);
+      continue;
+    }
+    const auto it = std::find(kQuantityNames.begin(), kQuantityNames.end(), name);
+    if (it == kQuantityNames.end()) {
+      std::string names;
+      for (auto n : kQuantityNames) names += (names.empty() ? "" : ", ") + std::string(n);
+      throw InputError(str(key, ": unknown uncertain quantity; expected one of ", names, ", samples, seed"));
+    }
+    const toml::table* t = v.as_table();
+    if (!t) throw InputError(str(key, ": expected a table such as { law = \"normal\", std = 0.01 }"));
+    const Quantity q = static_cast<Quantity>(it - kQuantityNames.begin());
+    spec[q] = parse_spread(q, *t, key);
+  }
+  validate(spec);
+}
+
+/// The file's other keys go to the options of `app` that the command line did not set.
+void apply_scenario_keys(const toml::table& root, CLI::App& app, const std::string& where) {
+  auto text = [&](const toml::node& n, const std::string& key) -> std::string {
+    if (auto s = n.value_exact<std::string>()) return *s;
+    if (auto i = n.value_exact<int64_t>()) return std::to_string(*i);
+    if (auto d = n.value_exact<double>()) {
+      std::ostringstream os;
+      os << std::setprecision(17) << *d;
+      return os.str();
+    }
+    if (auto b = n.value_exact<bool>()) return *b ? "true" : "false";
+    throw InputError(str(where, ": key '", key, "' has a value of an unsupported type"));
+  };
+  for (const auto& [k, v] : root) {
+    const std::string key(k.str());
+    if (key == "uncertainty") continue;
+    CLI::Option* opt = key == "config" || key == "help" ? nullptr : app.get_option_no_throw("--" + key);
+    if (!opt) throw InputError(str(where, ": unknown key '", key, "'"));
+    if (opt->count() > 0) continue;  // the flag overrides the file
+    std::vector<std::string> inputs;
+    if (const toml::array* a = v.as_array()) {
+      for (const auto& e : *a) inputs.push_back(text(e, key));
+    } else {
+      inputs.push_back(text(v, key));
+    }
+    opt->add_result(inputs);
+    opt->run_callback();
+  }
+}
+
+// --- evaluation ---------------------------------------------------------------------------------
+
+struct Configuration {
+  std::string name;
+  Eigen::VectorXd theta;
+  BasePose base;
+  SampleForce nominal;
+  std::vector<SampleForce> forces;  // by sample, shard-local
+};
+
+std::string quantity_label(std::size_t q) { return std::string(kQuantityNames[q]); }
+
+/// The parameters of a sample as JSON (the CSV columns, by name), SI units, spin in deg/s.
+nlohmann::json sample_json(const UncertainSample& s) {
+  const Matrix3& I = s.target.inertia;
+  return {{"target_mass", s.target.mass},
+          {"target_inertia", {I(0, 0), I(1, 1), I(2, 2), I(0, 1), I(0, 2), I(1, 2)}},
+          {"contact_offset", to_json(Eigen::VectorXd(s.target.contact_offset))},
+          {"normal", to_json(Eigen::VectorXd(s.target.normal))},
+          {"spin_deg", to_json(Eigen::VectorXd(s.target.angular_velocity * (180.0 / M_PI)))},
+          {"target_velocity", to_json(Eigen::VectorXd(s.target.velocity))},
+          {"approach_speed", s.approach_speed},
+          {"stiffness", s.contact.K},
+          {"exponent", s.contact.alpha},
+          {"restitution", s.contact.c_r}};
+}
+
+/// The three most extreme uncertain quantities of a sample, as "name score".
+nlohmann::json extremes(const UncertainSample& s, const UncertaintySpec& spec) {
+  std::vector<std::size_t> idx;
+  for (std::size_t q = 0; q < kNumQuantities; ++q)
+    if (spec.spread[q].law != Spread::Law::Fixed) idx.push_back(q);
+  std::stable_sort(idx.begin(), idx.end(),
+                   [&](std::size_t a, std::size_t b) { return std::abs(s.score[a]) > std::abs(s.score[b]); });
+  nlohmann::json out = nlohmann::json::array();
+  for (std::size_t k = 0; k < std::min<std::size_t>(3, idx.size()); ++k)
+    out.push_back({{"quantity", quantity_label(idx[k])}, {"score", s.score[idx[k]]}});
+  return out;
+}
+
+nlohmann::json summary_json(const ForceSummary& s) {
+  return {{"n", s.n}, {"mean", s.mean}, {"std", s.std}, {"p50", s.p50}, {"p95", s.p95}, {"p99", s.p99}, {"max", s.max}};
+}
+
+std::string extremes_text(const nlohmann::json& ex) {
+  std::ostringstream os;
+  os << std::showpos << std::fixed << std::setprecision(2);
+  for (std::size_t k = 0; k < ex.size(); ++k)
+    os << (k ? ", " : "") << ex[k]["quantity"].get<std::string>() << " " << ex[k]["score"].get<double>();
+  return os.str();
+}
+
+/// The terminal table of a summary JSON (a run or a merge: the same struct).
+void print_summary(const nlohmann::json& j, std::ostream& out) {
+  out << std::left << std::setw(14) << "configuration" << std::right << std::setw(12) << "nominal M_ie" << std::setw(11)
+      << "nominal F" << std::setw(10) << "mean" << std::setw(10) << "std" << std::setw(10) << "p50" << std::setw(10)
+      << "p95" << std::setw(10) << "p99" << std::setw(10) << "max" << "\n";
+  out << std::left << std::setw(14) << "" << std::right << std::setw(12) << "(kg)" << std::setw(11) << "(kN)"
+      << std::setw(60) << "F_max over the samples (kN)" << "\n";
+  for (const auto& c : j["configurations"]) {
+    const auto& s = c["summary"];
+    out << std::left << std::setw(14) << c["name"].get<std::string>() << std::right << std::fixed << std::setprecision(3)
+        << std::setw(12) << c["nominal"]["M_ie"].get<double>() << std::setw(11) << c["nominal"]["f_max"].get<double>() / 1e3;
+    for (const char* k : {"mean", "std", "p50", "p95", "p99", "max"}) out << std::setw(10) << s[k].get<double>() / 1e3;
+    out << "\n";
+  }
+  for (const auto& c : j["configurations"]) {
+    out << "\nlargest F_max, " << c["name"].get<std::string>() << " (score: z for normal laws, ln(x/x0)/sigma, "
+        << "[-1, 1] in a uniform range, angle/half-angle in the cone):\n";
+    for (const auto& t : c["tail"])
+      out << "  sample " << std::setw(7) << t["index"].get<std::uint64_t>() << "  F_max " << std::fixed
+          << std::setprecision(3) << t["f_max"].get<double>() / 1e3 << " kN  M_ie " << t["M_ie"].get<double>()
+          << " kg  delta_dot " << std::setprecision(4) << t["approach_velocity"].get<double>() << " m/s  extreme: "
+          << extremes_text(t["extreme"]) << "\n";
+  }
+}
+
+/// Summary JSON of the configurations from the per-sample F_max (by index) and the tail entries.
+void finish_summary(nlohmann::json& j) {
+  for (auto& c : j["configurations"]) {
+    const std::vector<double> f = c["f_max"].get<std::vector<double>>();
+    c["summary"] = summary_json(summarize(f));
+    auto tail = c["tail"];
+    std::vector<nlohmann::json> t(tail.begin(), tail.end());
+    std::stable_sort(t.begin(), t.end(), [](const nlohmann::json& a, const nlohmann::json& b) {
+      const double fa = a["f_max"].get<double>(), fb = b["f_max"].get<double>();
+      return fa != fb ? fa > fb : a["index"].get<std::uint64_t>() < b["index"].get<std::uint64_t>();
+    });
+    if (t.size() > kTail) t.resize(kTail);
+    c["tail"] = t;
+  }
+}
+
+int run_merge(const RobustOptions& o) {
+  std::vector<nlohmann::json> parts;
+  for (const auto& path : o.merge) {
+    std::ifstream in(path);
+    if (!in) throw InputError(str("--merge: cannot read '", path, "'"));
+    nlohmann::json j;
+    try {
+      j = nlohmann::json::parse(in);
+    } catch (const std::exception& e) {
+      throw InputError(str("--merge: '", path, "' is not JSON: ", e.what()));
+    }
+    if (!j.is_object() || j.value("kind", "") != "ffsr-robust")
+      throw InputError(str("--merge: '", path, "' is not a summary of ffsr-optimize robust"));
+    parts.push_back(std::move(j));
+  }
+  std::sort(parts.begin(), parts.end(), [](const nlohmann::json& a, const nlohmann::json& b) {
+    return a["shard"]["first"].get<std::uint64_t>() < b["shard"]["first"].get<std::uint64_t>();
+  });
+  const nlohmann::json& first = parts.front();
+  for (const char* key : {"seed", "samples", "uncertainty", "force_model", "law", "scenario"})
+    for (const auto& p : parts)
+      if (p[key] != first[key])
+        throw InputError(str("--merge: the summaries differ in '", key, "': they are not shards of one run"));
+  nlohmann::json m = first;
+  std::uint64_t next = 0;
+  for (std::size_t i = 0; i < parts.size(); ++i) {
+    const auto& p = parts[i];
+    const std::uint64_t a = p["shard"]["first"], b = p["shard"]["end"];
+    if (a != next)
+      throw InputError(str("--merge: samples ", next, " to ", a, " are ", a > next ? "missing" : "in two shards"));
+    next = b;
+    if (p["configurations"].size() != first["configurations"].size())
+      throw InputError("--merge: the summaries have different configurations");
+    if (i == 0) continue;
+    for (std::size_t c = 0; c < p["configurations"].size(); ++c) {
+      const auto& pc = p["configurations"][c];
+      auto& mc = m["configurations"][c];
+      if (pc["name"] != mc["name"] || pc["joints_deg"] != mc["joints_deg"])
+        throw InputError("--merge: the summaries have different configurations");
+      for (const auto& f : pc["f_max"]) mc["f_max"].push_back(f);
+      for (const auto& t : pc["tail"]) mc["tail"].push_back(t);
+    }
+  }
+  if (next != first["samples"].get<std::uint64_t>())
+    throw InputError(str("--merge: the shards cover samples 0 to ", next, " of ", first["samples"].get<std::uint64_t>()));
+  m["shard"] = {{"k", 0}, {"n", 1}, {"first", 0}, {"end", next}, {"merged_from", parts.size()}};
+  finish_summary(m);
+  if (!o.json.empty()) write_file_atomic(o.json, m.dump(1) + "\n");
+  std::cout << "ffsr-optimize " << FFSR_VERSION << " robust: merged " << parts.size() << " shard summaries, " << next
+            << " samples (seed " << m["seed"].get<std::uint64_t>() << ", " << m["force_model"].get<std::string>()
+            << " F_max)\n\n";
+  print_summary(m, std::cout);
+  return 0;
+}
+
+int run_robust(RobustOptions& o, CLI::App& app) {  // by reference: the file's keys land in o.scenario
+  if (!o.merge.empty()) return run_merge(o);
+  if (o.config.empty()) throw InputError("robust: --config SCENARIO.toml is required (or --merge FILES)");
+  // --- the scenario file: toml++ for the whole file, the keys into the scenario options ----------
+  const std::string where = "scenario " + o.config;
+  const bool urdf_cli = app.get_option("--urdf")->count() > 0;
+  toml::table root;
+  try {
+    root = toml::parse_file(o.config);
+  } catch (const toml::parse_error& e) {
+    throw InputError(str(where, ":", e.source().begin.line, ": ", e.description()));
+  }
+  UncertaintySpec spec;
+  if (!o.samples.empty()) spec.samples = parse_count(o.samples, "--samples");
+  if (!o.seed.empty()) spec.seed = parse_count(o.seed, "--seed");
+  if (!o.samples.empty() && spec.samples < 1) throw InputError("--samples: must be at least 1, got 0");
+  parse_uncertainty(root, spec, !o.samples.empty(), !o.seed.empty(), where);
+  apply_scenario_keys(root, app, where);
+
+  ForceModel force_model;
+  if (o.force_model == "closed") force_model = ForceModel::Closed;
+  else if (o.force_model == "exact") force_model = ForceModel::Exact;
+  else if (o.force_model == "multibody") force_model = ForceModel::Multibody;
+  else throw InputError(str("--force-model: unknown model '", o.force_model, "'; expected closed, exact or multibody"));
+  std::uint64_t shard_k = 0, shard_n = 1;
+  {
+    const size_t slash = o.shard.find('/');
+    if (slash == std::string::npos) throw InputError(str("--shard: expected K/N, got '", o.shard, "'"));
+    shard_k = parse_count(o.shard.substr(0, slash), "--shard");
+    shard_n = parse_count(o.shard.substr(slash + 1), "--shard");
+    if (shard_n < 1) throw InputError("--shard: N must be at least 1");
+    if (shard_k >= shard_n) throw InputError(str("--shard: K must be less than N (K counts from 0), got ", o.shard));
+  }
+  if (o.threads < 1 || o.threads > 1024) throw InputError(str("--threads: must be in [1, 1024], got ", o.threads));
+
+  o.scenario.config = o.config;
+  const Scenario sc = prepare_scenario(o.scenario, app, urdf_cli);
+  const Model& model = *sc.model;
+  const CaptureProblem& pb = sc.problem;
+  const RunOptions& so = sc.options;
+
+  // --- the configurations ---------------------------------------------------------------------
+  std::vector<Configuration> configs;
+  if (!o.capture_joints_deg.empty()) {
+    if (static_cast<int>(o.capture_joints_deg.size()) != model.n())
+      throw InputError(str("--capture-joints-deg: got ", o.capture_joints_deg.size(), " angles, the robot has ",
+                           model.n(), " joints"));
+    Configuration c;
+    c.name = "given";
+    c.theta = Eigen::Map<const Eigen::VectorXd>(o.capture_joints_deg.data(), model.n()) * (M_PI / 180.0);
+    for (double x : o.capture_joints_deg)
+      if (!std::isfinite(x)) throw InputError("--capture-joints-deg: values must be finite");
+    if (o.capture_base_position.size() != 3) throw InputError("--capture-base-position: expected 3 numbers");
+    if (o.capture_base_rpy_deg.size() != 3) throw InputError("--capture-base-rpy-deg: expected 3 numbers");
+    c.base.position = Vector3(o.capture_base_position[0], o.capture_base_position[1], o.capture_base_position[2]);
+    const Vector3 rpy(o.capture_base_rpy_deg[0], o.capture_base_rpy_deg[1], o.capture_base_rpy_deg[2]);
+    if (!c.base.position.allFinite() || !rpy.allFinite()) throw InputError("--capture-base-position/--capture-base-rpy-deg: values must be finite");
+    c.base.orientation = Quaternion(rotation_from_rpy(rpy * (M_PI / 180.0)));
+    configs.push_back(std::move(c));
+  } else {
+    const auto [plain, optimized] = plan_plain_and_optimized(sc, o.quiet);
+    for (const auto* r : {&plain, &optimized}) {
+      Configuration c;
+      c.name = r == &plain ? "plain" : "optimized";
+      c.theta = r->theta;
+      c.base = r->base;
+      configs.push_back(std::move(c));
+    }
+  }
+
+  // --- the samples of this shard (common to all configurations) --------------------------------
+  UncertainNominal nominal;
+  nominal.target = propagate_target(pb.target, sc.capture.duration);
+  nominal.contact = pb.contact;
+  nominal.approach_speed = pb.approach_speed;
+  const std::uint64_t first = spec.samples * shard_k / shard_n, end = spec.samples * (shard_k + 1) / shard_n;
+  const std::uint64_t count = end - first;
+  std::vector<UncertainSample> samples(count);
+  Progress progress("robust", o.quiet, "evaluations");
+  const std::uint64_t total_work = count * (1 + configs.size());
+  std::atomic<std::uint64_t> work_done{0};
+  auto report = [&](std::uint64_t) { progress(work_done.load(), total_work); };
+  parallel_for(0, count, o.threads, [&](std::uint64_t i) {
+    samples[i] = draw_sample(spec, nominal, first + i);
+    work_done.fetch_add(1);
+  }, report);
+  Data data(model);
+  UncertaintySpec fixed;  // the nominal sample: no spread
+  fixed.seed = spec.seed;
+  const UncertainSample nominal_sample = draw_sample(fixed, nominal, 0);
+  for (auto& c : configs) {
+    c.forces.resize(count);
+    const Matrix3 G = robot_inverse_mass_matrix(model, data, c.base, c.theta, pb.frame);
+    if (force_model == ForceModel::Multibody) {
+      c.nominal = sample_force_multibody(model, c.base, c.theta, pb.frame, nominal_sample, pb.law);
+      parallel_for(0, count, o.threads, [&](std::uint64_t i) {
+        c.forces[i] = sample_force_multibody(model, c.base, c.theta, pb.frame, samples[i], pb.law);
+        work_done.fetch_add(1);
+      }, report);
+    } else {
+      c.nominal = sample_force(G, nominal_sample, pb.law, force_model);
+      parallel_for(0, count, o.threads, [&](std::uint64_t i) {
+        c.forces[i] = sample_force(G, samples[i], pb.law, force_model);
+        work_done.fetch_add(1);
+      }, report);
+    }
+  }
+  progress(total_work, total_work);  // ends the line if one was shown
+
+  // --- outputs: built first, then written all or nothing ---------------------------------------
+  nlohmann::json j;
+  j["kind"] = "ffsr-robust";
+  j["version"] = FFSR_VERSION;
+  j["scenario"] = {{"source", o.config}, {"urdf", so.urdf}, {"model", so.model}, {"duration", so.duration}};
+  j["force_model"] = o.force_model;
+  j["law"] = pb.law;
+  j["seed"] = spec.seed;
+  j["samples"] = spec.samples;
+  j["shard"] = {{"k", shard_k}, {"n", shard_n}, {"first", first}, {"end", end}};
+  {
+    nlohmann::json u = nlohmann::json::object();
+    for (std::size_t q = 0; q < kNumQuantities; ++q) {
+      const Spread& sp = spec.spread[q];
+      if (sp.law == Spread::Law::Fixed) continue;
+      static const char* laws[] = {"fixed", "normal", "uniform", "log-normal", "cone"};
+      u[quantity_label(q)] = {{"law", laws[static_cast<int>(sp.law)]}, {"scale", sp.scale}, {"relative", sp.relative},
+                              {"range", sp.has_range}, {"min", std::isfinite(sp.min) ? nlohmann::json(sp.min) : nlohmann::json()},
+                              {"max", std::isfinite(sp.max) ? nlohmann::json(sp.max) : nlohmann::json()}, {"axes", sp.axes}};
+    }
+    j["uncertainty"] = u;
+  }
+  j["configurations"] = nlohmann::json::array();
+  std::uint64_t redraws = 0;
+  for (const auto& s : samples) redraws += static_cast<std::uint64_t>(s.redraws);
+  j["redraws"] = redraws;
+  for (const auto& c : configs) {
+    nlohmann::json cj;
+    cj["name"] = c.name;
+    cj["joints_deg"] = to_json(Eigen::VectorXd(c.theta * (180.0 / M_PI)));
+    cj["base_position"] = to_json(Eigen::VectorXd(c.base.position));
+    const Eigen::Vector4d q = c.base.orientation.coeffs();
+    cj["base_quaternion_wxyz"] = {q(3), q(0), q(1), q(2)};
+    cj["nominal"] = {{"M_ie", c.nominal.M_ie}, {"approach_velocity", c.nominal.approach_velocity}, {"f_max", c.nominal.f_max}};
+    std::vector<double> f(count);
+    for (std::uint64_t i = 0; i < count; ++i) f[i] = c.forces[i].f_max;
+    cj["f_max"] = f;
+    std::vector<std::uint64_t> order(count);
+    for (std::uint64_t i = 0; i < count; ++i) order[i] = i;
+    const std::size_t k = std::min<std::size_t>(kTail, count);
+    std::partial_sort(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(k), order.end(),
+                      [&](std::uint64_t a, std::uint64_t b) { return f[a] != f[b] ? f[a] > f[b] : a < b; });
+    cj["tail"] = nlohmann::json::array();
+    for (std::size_t t = 0; t < k; ++t) {
+      const auto i = order[t];
+      cj["tail"].push_back({{"index", first + i}, {"f_max", f[i]}, {"M_ie", c.forces[i].M_ie},
+                            {"approach_velocity", c.forces[i].approach_velocity},
+                            {"extreme", extremes(samples[i], spec)}, {"parameters", sample_json(samples[i])}});
+    }
+    j["configurations"].push_back(std::move(cj));
+  }
+  finish_summary(j);
+
+  std::vector<std::pair<std::string, std::string>> files;
+  if (!o.json.empty()) files.emplace_back(o.json, j.dump(1) + "\n");
+  if (!o.csv.empty()) {
+    std::ostringstream c;
+    c << std::setprecision(12)
+      << "configuration,sample,target_mass,Ixx,Iyy,Izz,Ixy,Ixz,Iyz,offset_x,offset_y,offset_z,normal_x,normal_y,"
+         "normal_z,spin_x_deg,spin_y_deg,spin_z_deg,velocity_x,velocity_y,velocity_z,approach_speed,stiffness,"
+         "exponent,restitution,M_ie,delta_dot,F_max\n";
+    for (const auto& cf : configs)
+      for (std::uint64_t i = 0; i < count; ++i) {
+        const UncertainSample& s = samples[i];
+        const Matrix3& I = s.target.inertia;
+        const Vector3 w = s.target.angular_velocity * (180.0 / M_PI);
+        c << cf.name << "," << first + i << "," << s.target.mass << "," << I(0, 0) << "," << I(1, 1) << "," << I(2, 2)
+          << "," << I(0, 1) << "," << I(0, 2) << "," << I(1, 2);
+        for (const Vector3* v : {&s.target.contact_offset, &s.target.normal, &w, &s.target.velocity})
+          c << "," << (*v)(0) << "," << (*v)(1) << "," << (*v)(2);
+        c << "," << s.approach_speed << "," << s.contact.K << "," << s.contact.alpha << "," << s.contact.c_r << ","
+          << cf.forces[i].M_ie << "," << cf.forces[i].approach_velocity << "," << cf.forces[i].f_max << "\n";
+      }
+    files.emplace_back(o.csv, c.str());
+  }
+  if (!files.empty()) write_files_atomic(files);
+
+  std::cout << "ffsr-optimize " << FFSR_VERSION << " robust: " << where << " (" << model.n() << " joints, " << pb.law
+            << ", " << o.force_model << " F_max)\n"
+            << spec.samples << " samples, seed " << spec.seed << "; this run: samples " << first << " to " << end
+            << " (shard " << shard_k << "/" << shard_n << "), " << redraws << " redraws by the physical rules\n\n";
+  print_summary(j, std::cout);
+  return 0;
+}
+
+}  // namespace
+
+void register_robust(CLI::App& app, Action& action) {
+  auto o = std::make_shared<RobustOptions>();
+  CLI::App* sub = app.add_subcommand(
+      "robust", "Monte Carlo of F_max over the scenario's [uncertainty] table, for the planned capture configurations");
+  sub->add_option("--config", o->config, "Scenario file (TOML) with an [uncertainty] table")->check(CLI::ExistingFile);
+  // before the scenario's keys: here --seed (and a scenario's `seed`) is the Monte Carlo seed, not the
+  // global search's (add_scenario_options leaves an existing --seed alone)
+  sub->add_option("--seed", o->seed, "Seed, a non-negative integer (overrides uncertainty.seed)");
+  add_scenario_options(*sub, o->scenario);
+  sub->add_option("--force-model", o->force_model, "F_max per sample: closed (Eq. 24), exact (Eq. 16) or multibody (CVODE)")
+      ->capture_default_str();
+  sub->add_option("--samples", o->samples, "Number of samples (overrides uncertainty.samples)");
+  sub->add_option("--threads", o->threads, "Worker threads")->capture_default_str();
+  sub->add_option("--shard", o->shard, "Evaluate only shard K of N (K = 0..N-1) of the samples")->capture_default_str();
+  sub->add_option("--capture-joints-deg", o->capture_joints_deg,
+                  "Evaluate this capture configuration instead of planning (deg; --joints-deg is the scenario's start)")
+      ->delimiter(',')->allow_extra_args(false);
+  sub->add_option("--capture-base-position", o->capture_base_position, "Base position of that configuration, m")
+      ->delimiter(',')->allow_extra_args(false);
+  sub->add_option("--capture-base-rpy-deg", o->capture_base_rpy_deg, "Base attitude of that configuration, deg")
+      ->delimiter(',')->allow_extra_args(false);
+  sub->add_option("--merge", o->merge, "Merge these shard summaries (JSON files of --json) exactly; no scenario needed");
+  sub->add_option("--json", o->json, "Write the summary (with every sample's F_max, for merging) to this JSON file");
+  sub->add_option("--csv", o->csv, "Write one row per sample and configuration to this CSV file");
+  sub->add_flag("--quiet", o->quiet, "No progress line");
+  sub->callback([o, sub, &action] { action = [o, sub] { return run_robust(*o, *sub); }; });
+}
+
+}  // namespace ffsr::cli

@@ -1,0 +1,335 @@
+// Global capture optimization (optimize/global.hpp, issue 9): the capture-manifold search, the
+// reaching planner, an optimality check that does not use the search, and the failure modes.
+// The expensive runs (one global plan per robot) are made once and shared by the checks.
+#include <catch2/catch.hpp>
+
+#include "support/paper.hpp"
+#include "support/run_command.hpp"
+
+#include "ffsr/ffsr.hpp"
+#include "ffsr/io/urdf.hpp"
+#include "ffsr/optimize/global.hpp"
+
+#include <algorithm>
+#include <cstdio>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <random>
+
+using namespace ffsr;
+using ffsr::test::deg;
+using ffsr::test::kRobots;
+
+namespace {
+
+constexpr double kRate = 3.0 * M_PI / 180.0;  // max-joint-rate-deg = 3 of the paper scenario files
+
+/// robots/paper_3dof.toml
+CaptureProblem problem_3dof(const Model& m) {
+  CaptureProblem pb;
+  pb.model = &m;
+  pb.frame = m.end_effector();
+  pb.theta = deg({0, 150, -100});
+  pb.target.position = Vector3(2.75, 1.45, 0);
+  pb.target.angular_velocity = Vector3(0, 0, 2) * (M_PI / 180);
+  return pb;
+}
+
+/// robots/paper_7dof_position.toml (and _pose.toml: the same robot and target)
+CaptureProblem problem_7dof(const Model& m) {
+  CaptureProblem pb;
+  pb.model = &m;
+  pb.frame = m.end_effector();
+  pb.theta = deg({0, 90, 90, -90, 90, 90, 0});
+  pb.target.position = Vector3(2.3, -0.8, 2);
+  pb.target.angular_velocity = Vector3(1, -0.5, 2) * (M_PI / 180);
+  pb.target.contact_offset = Vector3(-0.25, 0.15, 0.1);
+  return pb;
+}
+
+CaptureOptions options(double T) {
+  CaptureOptions o;
+  o.duration = T;
+  o.step = 0.1;
+  o.tolerance = 1e-3;
+  o.max_joint_rate = kRate;
+  return o;
+}
+
+CaptureTask position_task(bool planar) {
+  CaptureTask t;
+  if (planar) t.axes = {true, true, false};
+  return t;
+}
+
+struct Shared {
+  Model model;
+  CaptureProblem pb;
+  CaptureTask task;
+  CaptureOptions opt;
+  CaptureResult paper;  ///< the paper's method (rho of the scenario file)
+  GlobalCaptureResult global;
+};
+
+const Shared& shared_3dof() {
+  static const Shared s = [] {
+    Shared r{model_from_urdf_file(kRobots + "paper_3dof.urdf"), {}, position_task(true), options(180), {}, {}};
+    r.pb = problem_3dof(r.model);
+    CaptureOptions paper = r.opt;
+    paper.gain = -0.01;
+    paper.max_joint_rate = 0;
+    r.paper = plan_capture(r.pb, r.task, paper);
+    GlobalCaptureOptions g;
+    g.extra_starts = {r.paper.theta};
+    r.global = plan_capture_global(r.pb, r.task, r.opt, g);
+    return r;
+  }();
+  return s;
+}
+
+const Shared& shared_7dof_position() {
+  static const Shared s = [] {
+    Shared r{model_from_urdf_file(kRobots + "paper_7dof.urdf"), {}, position_task(false), options(157), {}, {}};
+    r.pb = problem_7dof(r.model);
+    CaptureOptions paper = r.opt;
+    paper.gain = -0.01;
+    paper.max_joint_rate = 0;
+    r.paper = plan_capture(r.pb, r.task, paper);
+    GlobalCaptureOptions g;
+    g.extra_starts = {r.paper.theta};
+    r.global = plan_capture_global(r.pb, r.task, r.opt, g);
+    return r;
+  }();
+  return s;
+}
+
+/// The checks every global run must pass, against the run's own records and the paper's method.
+void check_run(const Shared& s, double bound_M_ie) {
+  const GlobalCaptureResult& g = s.global;
+  INFO("global M_ie " << g.run.M_ie << " paper's method " << s.paper.M_ie << " optimum " << g.manifold_optimum
+                      << " gap " << g.optimality_gap_percent << " % iterations " << g.shooting_iterations);
+  CHECK(g.run.M_ie <= bound_M_ie);
+  CHECK(g.run.M_ie <= s.paper.M_ie);              // never worse than the paper's method
+  CHECK(g.reached_manifold_optimum);
+  CHECK(g.optimality_gap_percent <= 1.0);
+  CHECK(g.optimality_gap_percent >= -1e-6);       // the optimum is the best the search knows, the reached point among the starts
+  CHECK(g.shooting_iterations >= 1);
+  CHECK(g.shooting_iterations <= 8 * g.goals_tried);
+  CHECK(g.run.tracking_error <= s.opt.tolerance);
+  CHECK(g.run.max_joint_rate <= kRate * (1 + 1e-9));  // the limit of the scenario
+  // zero total momentum along the run (relative to the bodies' own momenta) and a still centre of mass
+  CHECK(g.run.max_momentum <= 1e-9 * g.run.max_body_momentum);
+  CHECK(g.run.max_com_drift <= 1e-6);
+  // the objective reported is M_ie at the reached configuration and base pose (independent recomputation)
+  Data d(s.model);
+  const Target cap = propagate_target(s.pb.target, s.opt.duration);
+  CHECK(g.objective == Approx(integrated_effective_mass(s.model, d, g.run.base, g.run.theta, s.pb.frame, cap)).epsilon(1e-9));
+  std::printf("\nglobal %d-DOF: M_ie %.3f kg (paper's method %.3f), F_max %.3f kN (%.3f), rate %.3f deg/s (%.3f), "
+              "gap %.3f %%, %d iterations, %ld SLSQP evaluations, search %.3f s\n",
+              s.model.n(), g.run.M_ie, s.paper.M_ie, g.run.f_max_closed_form / 1e3, s.paper.f_max_closed_form / 1e3,
+              g.run.max_joint_rate * 180 / M_PI, s.paper.max_joint_rate * 180 / M_PI, g.optimality_gap_percent,
+              g.shooting_iterations, g.evaluations, g.search_seconds);
+}
+
+/// A damped-Newton projection onto the capture manifold written here, apart from the library's
+/// (position rows only; plain Gauss-Newton with a fixed damping and no line search).
+bool test_projection(const Model& m, Data& d, int frame, const BasePose& base, const Vector3& x, const std::array<bool, 3>& axes,
+                     Eigen::VectorXd& q) {
+  for (int it = 0; it < 200; ++it) {
+    crba(m, d, base, q);
+    const Vector3 e = frame_pose(m, d, frame).p - x;
+    frame_jacobian(m, d, frame);
+    std::vector<int> rows;
+    for (int r = 0; r < 3; ++r)
+      if (axes[static_cast<size_t>(r)]) rows.push_back(r);
+    Eigen::MatrixXd J(rows.size(), m.n());
+    Eigen::VectorXd r(rows.size());
+    for (size_t i = 0; i < rows.size(); ++i) {
+      J.row(static_cast<Eigen::Index>(i)) = d.J.row(rows[i]).tail(m.n());
+      r(static_cast<Eigen::Index>(i)) = e(rows[i]);
+    }
+    if (r.norm() < 1e-11) return true;
+    const Eigen::MatrixXd A = J * J.transpose() + 1e-6 * Eigen::MatrixXd::Identity(J.rows(), J.rows());
+    Eigen::VectorXd step = J.transpose() * A.ldlt().solve(r);
+    if (step.norm() > 0.5) step *= 0.5 / step.norm();  // trust region: at most 0.5 rad per iteration
+    q -= step;
+  }
+  return false;
+}
+
+}  // namespace
+
+TEST_CASE("Global capture, 3-DOF (robots/paper_3dof.toml)", "[global][paper]") {
+  check_run(shared_3dof(), 1.26);  // issue 9: <= 1.26 kg (paper's method 1.22 in the paper, 1.31 here)
+}
+
+TEST_CASE("Global capture, 7-DOF position (robots/paper_7dof_position.toml)", "[global][paper]") {
+  const Shared& s = shared_7dof_position();
+  check_run(s, 1.35);  // issue 9: <= 1.35 kg (paper 2.70 kg)
+  CHECK(s.global.run.f_max_closed_form <= 800.0);  // issue 9: <= 0.80 kN (paper 1.17 kN)
+}
+
+TEST_CASE("Global optimum: no projected random configuration is more than 1 % lower", "[global]") {
+  // Independent of the search: 1000 random configurations (fixed seed) put on the capture manifold at
+  // the reached base pose by the projection above; M_ie at each must not be below optimum - 1 %.
+  for (const Shared* s : {&shared_3dof(), &shared_7dof_position()}) {
+    const Model& m = s->model;
+    Data d(m);
+    const Target cap = propagate_target(s->pb.target, s->opt.duration);
+    const Vector3 x = cap.contact_point();
+    std::mt19937_64 rng(20261122);
+    std::uniform_real_distribution<double> U(-M_PI, M_PI);
+    int on = 0;
+    double lowest = std::numeric_limits<double>::infinity();
+    for (int i = 0; i < 1000; ++i) {
+      Eigen::VectorXd q(m.n());
+      for (int k = 0; k < m.n(); ++k) q(k) = U(rng);
+      if (!test_projection(m, d, s->pb.frame, s->global.run.base, x, s->task.axes, q)) continue;
+      ++on;
+      lowest = std::min(lowest, integrated_effective_mass(m, d, s->global.run.base, q, s->pb.frame, cap));
+    }
+    INFO(m.n() << "-DOF: " << on << " of 1000 projected, lowest M_ie " << lowest << ", reported optimum "
+               << s->global.manifold_optimum);
+    CHECK(on >= 900);
+    CHECK(lowest >= 0.99 * s->global.manifold_optimum);
+    std::printf("%d-DOF: %d of 1000 random configurations projected, lowest M_ie %.4f kg >= optimum %.4f kg\n", m.n(),
+                on, lowest, s->global.manifold_optimum);
+  }
+}
+
+TEST_CASE("Manifold search: deterministic for a seed, exact-force has the mass optimum", "[global]") {
+  const Shared& s = shared_3dof();
+  const CaptureSetup setup = prepare_capture(s.pb, s.task, s.opt);
+  ManifoldSearchOptions so;
+  so.starts = 8;
+  so.seed = 42;
+  const ManifoldSearchResult a = search_capture_manifold(s.pb, s.task, setup, s.global.run.base, so);
+  const ManifoldSearchResult b = search_capture_manifold(s.pb, s.task, setup, s.global.run.base, so);
+  CHECK(a.best.theta == b.best.theta);  // bitwise: same draws, same SLSQP path
+  CHECK(a.evaluations == b.evaluations);
+  so.objective = GlobalObjective::ExactForce;
+  const ManifoldSearchResult f = search_capture_manifold(s.pb, s.task, setup, s.global.run.base, so);
+  CHECK(f.best.theta == a.best.theta);  // a monotone function of M_ie has the same minimizer
+  CHECK(f.best.objective == Approx(max_force_exact(setup.law, a.best.M_ie)).epsilon(1e-12));
+  // the optimum is on the manifold: the end-effector on the capture point in x and y
+  Data d(s.model);
+  crba(s.model, d, s.global.run.base, a.best.theta);
+  const Vector3 e = frame_pose(s.model, d, s.pb.frame).p - setup.x_cap;
+  CHECK(e.head<2>().norm() < 1e-9);
+}
+
+TEST_CASE("Capture residual: orientation rows' Jacobian equals central differences", "[global]") {
+  const Model m = model_from_urdf_file(kRobots + "paper_7dof.urdf");
+  CaptureProblem pb = problem_7dof(m);
+  CaptureTask task;
+  task.kind = CaptureTask::Kind::Pose;
+  task.final_orientation = Matrix3(Eigen::AngleAxisd(0.7, Vector3(1, 2, 3).normalized()));
+  const CaptureSetup s = prepare_capture(pb, task, options(157));
+  Data d(m);
+  BasePose b;
+  b.position = Vector3(0.1, -0.2, 0.05);
+  const Eigen::VectorXd q = deg({10, 80, 70, -60, 100, 80, 20});
+  Eigen::VectorXd r, rp, rm;
+  Eigen::MatrixXd J;
+  capture_residual(m, d, pb, task, s, b, q, r, &J);
+  for (int k = 0; k < m.n(); ++k) {
+    const double h = 1e-6;
+    Eigen::VectorXd qp = q, qm = q;
+    qp(k) += h;
+    qm(k) -= h;
+    capture_residual(m, d, pb, task, s, b, qp, rp, nullptr);
+    capture_residual(m, d, pb, task, s, b, qm, rm, nullptr);
+    const Eigen::VectorXd fd = (rp - rm) / (2 * h);
+    INFO("joint " << k << " analytic " << J.col(k).transpose() << " fd " << fd.transpose());
+    CHECK((J.col(k) - fd).norm() < 1e-7);  // central differences: O(h^2) + roundoff/h ~ 1e-9
+  }
+}
+
+TEST_CASE("Global capture: bad inputs", "[global]") {
+  const Model m = model_from_urdf_file(kRobots + "paper_3dof.urdf");
+  const CaptureProblem pb = problem_3dof(m);
+  const CaptureTask task = position_task(true);
+  CaptureOptions o = options(180);
+  GlobalCaptureOptions g;
+  g.search.starts = 0;
+  CHECK_THROWS_WITH(plan_capture_global(pb, task, o, g), Catch::Contains("starts must be >= 1"));
+  g.search.starts = 4;
+  o.max_joint_rate = -1;
+  CHECK_THROWS_AS(plan_capture_global(pb, task, o, g), InputError);
+  o.max_joint_rate = 0.01 * M_PI / 180;  // 0.01 deg/s: the line alone needs more
+  CHECK_THROWS_WITH(plan_capture_global(pb, task, o, g), Catch::Contains("below what the task alone needs"));
+  // a capture point out of reach from the base pose at T: no configuration on the manifold
+  o.max_joint_rate = kRate;
+  const CaptureSetup s = prepare_capture(pb, task, o);
+  BasePose far;
+  far.position = Vector3(-5, 0, 0);
+  CHECK_THROWS_WITH(search_capture_manifold(pb, task, s, far, g.search), Catch::Contains("out of reach"));
+}
+
+namespace {
+
+/// Runs ffsr-optimize in a temporary directory.
+ffsr::test::CommandResult cli(std::vector<std::string> args) {
+  args.insert(args.begin(), FFSR_CLI);
+  ffsr::test::TempDir tmp;
+  return ffsr::test::run_command(args, tmp.str());
+}
+
+}  // namespace
+
+TEST_CASE("ffsr-optimize: the global row and its JSON keys (7-DOF pose scenario)", "[global][cli][paper]") {
+  ffsr::test::TempDir tmp;
+  const std::string out = tmp.str() + "/r.json";
+  const auto r = cli({"--quiet", "--config", kRobots + "paper_7dof_pose.toml", "--json", out});
+  INFO(r.out << r.err);
+  REQUIRE(r.exit_code == 0);
+  CHECK(r.out.find("Global") != std::string::npos);
+  CHECK(r.out.find("Reduction (global)") != std::string::npos);
+  std::ifstream in(out);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  const auto& g = j["global"];
+  for (const char* key : {"capture_configuration_deg", "integrated_effective_mass", "f_max_closed_form", "f_max_exact",
+                          "tracking_error", "max_total_momentum", "max_center_of_mass_drift", "manifold_optimum",
+                          "optimality_gap_percent", "shooting_iterations", "max_joint_rate_deg", "search"})
+    CHECK(g.contains(key));
+  for (const char* key : {"method", "starts", "evaluations", "seconds"}) CHECK(g["search"].contains(key));
+  CHECK(j["baseline"].contains("max_joint_rate_deg"));
+  CHECK(j["optimized"].contains("max_joint_rate_deg"));
+  // issue 9: the pose task (one null-space direction) at most 15.70 kg, never worse than the paper's method
+  const double M = g["integrated_effective_mass"].get<double>();
+  std::printf("\n7-DOF pose: global M_ie %.3f kg (paper's method %.3f kg), gap %.3f %%, rate %.3f deg/s\n", M,
+              j["optimized"]["integrated_effective_mass"].get<double>(), g["optimality_gap_percent"].get<double>(),
+              g["max_joint_rate_deg"].get<double>());
+  CHECK(M <= 15.70);
+  CHECK(M <= j["optimized"]["integrated_effective_mass"].get<double>());
+  CHECK(g["tracking_error"].get<double>() <= 1e-3);
+  CHECK(g["orientation_error_deg"].get<double>() <= 0.5);
+  CHECK(g["max_joint_rate_deg"].get<double>() <= 3.0 + 1e-9);
+  // on the 1-D self-motion manifold of the pose task the optimum may lie on a component the arm cannot
+  // reach; the result says so, and the gap is then the honest distance to it
+  if (g["reached_manifold_optimum"].get<bool>()) CHECK(g["optimality_gap_percent"].get<double>() <= 1.0);
+  CHECK(g["optimality_gap_percent"].get<double>() >= -1e-6);
+}
+
+TEST_CASE("ffsr-optimize: bad global inputs give one error line naming the key", "[global][cli]") {
+  const std::string sc = kRobots + "paper_3dof.toml";
+  const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
+      {{"--max-joint-rate-deg", "0"}, "--max-joint-rate-deg"},
+      {{"--max-joint-rate-deg", "-3"}, "--max-joint-rate-deg"},
+      {{"--max-joint-rate-deg", "0.01"}, "--max-joint-rate-deg"},  // the line alone needs more
+      {{"--seed", "abc"}, "--seed"},
+      {{"--seed", "1.5"}, "--seed"},
+      {{"--global-starts", "0"}, "--global-starts"},
+      {{"--objective", "energy"}, "--objective"},
+  };
+  for (const auto& [extra, key] : cases) {
+    std::vector<std::string> args{"--quiet", "--config", sc};
+    args.insert(args.end(), extra.begin(), extra.end());
+    const auto r = cli(args);
+    INFO(extra[0] << " " << extra[1] << " -> " << r.err);
+    CHECK(r.exit_code == 2);
+    CHECK(r.out.empty());
+    CHECK(r.err.rfind("ffsr-optimize: error: " + key, 0) == 0);
+    CHECK(std::count(r.err.begin(), r.err.end(), '\n') == 1);
+  }
+}

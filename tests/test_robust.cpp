@@ -1,0 +1,203 @@
+// End-to-end tests of `ffsr-optimize robust` (issue 12) on robots/paper_7dof_position_uncertain.toml:
+// shards merged reproduce the unsharded summary exactly, sample i does not depend on the sample
+// count, the 95th percentile of 1e3 samples against 2e4, the CSV, flags over the file, and the bad
+// inputs (one error line naming the key, exit 2, no output file).
+//
+// To stay fast, the runs evaluate one given capture configuration (--capture-joints-deg) with the
+// exact single-body F_max instead of planning.
+#include "support/run_command.hpp"
+
+#include <catch2/catch.hpp>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace {
+
+using ffsr::test::CommandResult;
+using ffsr::test::run_command;
+using ffsr::test::TempDir;
+using Args = std::vector<std::string>;
+using nlohmann::json;
+
+const std::string kCli = FFSR_CLI;
+const std::string kSource = FFSR_SOURCE_DIR;
+const std::string kScenario = kSource + "/robots/paper_7dof_position_uncertain.toml";
+const Args kGiven{"--capture-joints-deg", "5,80,95,-85,92,88,3", "--quiet"};
+
+CommandResult robust(Args args, const std::string& cwd) {
+  Args full{kCli, "robust"};
+  full.insert(full.end(), args.begin(), args.end());
+  return run_command(full, cwd);
+}
+
+json read_json(const std::string& path) {
+  std::ifstream in(path);
+  REQUIRE(in.good());
+  return json::parse(in);
+}
+
+/// The example scenario with its URDF path made absolute and its [uncertainty] table replaced.
+std::string scenario_with(const std::string& uncertainty) {
+  std::ifstream in(kScenario);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  std::string s = ss.str();
+  s = s.substr(0, s.find("\n[uncertainty]") + 1);
+  const std::string key = "urdf = \"paper_7dof.urdf\"";
+  s.replace(s.find(key), key.size(), "urdf = \"" + kSource + "/robots/paper_7dof.urdf\"");
+  return s + "[uncertainty]\n" + uncertainty + "\n";
+}
+
+std::string write(const TempDir& dir, const std::string& name, const std::string& text) {
+  std::ofstream(dir / name) << text;
+  return dir / name;
+}
+
+double nearest_rank95(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v[(95 * v.size() + 99) / 100 - 1];
+}
+
+}  // namespace
+
+TEST_CASE("robust: 4 shards merged equal the unsharded run to the last digit", "[robust]") {
+  TempDir dir;
+  Args base{"--config", kScenario, "--samples", "4003", "--seed", "17"};
+  base.insert(base.end(), kGiven.begin(), kGiven.end());
+  Args whole = base;
+  whole.insert(whole.end(), {"--json", dir / "whole.json", "--threads", "2"});
+  const CommandResult w = robust(whole, dir.str());
+  INFO(w.err);
+  REQUIRE(w.exit_code == 0);
+  Args merge{"--merge"};
+  for (int k = 0; k < 4; ++k) {
+    Args a = base;
+    const std::string shard = std::to_string(k) + "/4", out = dir / ("shard" + std::to_string(k) + ".json");
+    a.insert(a.end(), {"--shard", shard, "--json", out, "--threads", k % 2 ? "1" : "2"});
+    const CommandResult r = robust(a, dir.str());
+    INFO(r.err);
+    REQUIRE(r.exit_code == 0);
+    merge.push_back(out);
+  }
+  std::reverse(merge.begin() + 1, merge.end());  // the order of the files does not matter
+  merge.insert(merge.end(), {"--json", dir / "merged.json"});
+  const CommandResult m = robust(merge, dir.str());
+  INFO(m.err);
+  REQUIRE(m.exit_code == 0);
+  const json a = read_json(dir / "whole.json"), b = read_json(dir / "merged.json");
+  REQUIRE(a["configurations"].size() == 1);
+  const json& ca = a["configurations"][0];
+  const json& cb = b["configurations"][0];
+  CHECK(ca["summary"] == cb["summary"]);  // every double bit for bit
+  CHECK(ca["f_max"] == cb["f_max"]);
+  CHECK(ca["tail"] == cb["tail"]);
+  CHECK(cb["summary"]["n"] == 4003);
+  // the printed tables agree line for line after the header
+  auto table = [](const std::string& out) { return out.substr(out.find("configuration")); };
+  CHECK(table(w.out) == table(m.out));
+  // a gap between shards is refused
+  const CommandResult gap = robust({"--merge", dir / "shard0.json", dir / "shard2.json"}, dir.str());
+  CHECK(gap.exit_code == 2);
+  CHECK(gap.err.find("--merge") != std::string::npos);
+}
+
+TEST_CASE("robust: sample i depends on (seed, i) only; p95 of 1e3 against 2e4 samples; no NaN", "[robust]") {
+  TempDir dir;
+  Args a{"--config", kScenario, "--samples", "20000", "--json", dir / "big.json", "--csv", dir / "big.csv"};
+  a.insert(a.end(), kGiven.begin(), kGiven.end());
+  const CommandResult big = robust(a, dir.str());
+  INFO(big.err);
+  REQUIRE(big.exit_code == 0);
+  Args b{"--config", kScenario, "--json", dir / "small.json"};  // samples = 1000 from the file
+  b.insert(b.end(), kGiven.begin(), kGiven.end());
+  const CommandResult small = robust(b, dir.str());
+  REQUIRE(small.exit_code == 0);
+  const json jb = read_json(dir / "big.json"), js = read_json(dir / "small.json");
+  const auto fb = jb["configurations"][0]["f_max"].get<std::vector<double>>();
+  const auto fs = js["configurations"][0]["f_max"].get<std::vector<double>>();
+  REQUIRE(fb.size() == 20000);
+  REQUIRE(fs.size() == 1000);
+  CHECK(std::equal(fs.begin(), fs.end(), fb.begin()));
+  for (double f : fb) REQUIRE(std::isfinite(f));
+  // our own nearest-rank percentile of the stored values equals the summary's
+  CHECK(nearest_rank95(fb) == jb["configurations"][0]["summary"]["p95"].get<double>());
+  // Convergence: the p95 estimate of 1e3 samples has a standard error of about 1.5 % here
+  // (ln F spread ~0.25: sqrt(0.95 * 0.05 / 1000) / density); 5 % is more than three of them.
+  const double p95_small = js["configurations"][0]["summary"]["p95"], p95_big = jb["configurations"][0]["summary"]["p95"];
+  CHECK(std::abs(p95_small / p95_big - 1) < 0.05);
+  // the CSV: a header and one row per sample, 28 columns, no NaN
+  std::ifstream csv(dir / "big.csv");
+  std::string line;
+  std::getline(csv, line);
+  CHECK(std::count(line.begin(), line.end(), ',') == 27);
+  long rows = 0;
+  while (std::getline(csv, line)) {
+    ++rows;
+    if (line.find("nan") != std::string::npos || line.find("inf") != std::string::npos) FAIL("non-finite value: " << line);
+  }
+  CHECK(rows == 20000);
+  CHECK(big.out.find("nan") == std::string::npos);
+}
+
+TEST_CASE("robust: bad inputs give one error line naming the key, exit 2, no output", "[robust]") {
+  TempDir dir;
+  struct Case {
+    std::string uncertainty;
+    Args flags;
+    std::string expected;
+  };
+  const std::vector<Case> cases{
+      {"target-mass = { law = \"normal\", relative-std = -0.1 }", {}, "uncertainty.target-mass.relative-std: a spread must be non-negative, got -0.1"},
+      {"spin = { law = \"normal\", std = -0.2 }", {}, "uncertainty.spin.std: a spread must be non-negative, got -0.2"},
+      {"restitution = { law = \"uniform\", min = 0.95, max = 0.6 }", {}, "uncertainty.restitution: min (0.95) is greater than max (0.6)"},
+      {"normal = { law = \"cone\", angle-deg = 95 }", {}, "uncertainty.normal: the cone half-angle must be at most 90 deg"},
+      {"colour = { law = \"normal\", std = 1 }", {}, "uncertainty.colour: unknown uncertain quantity"},
+      {"samples = 0", {}, "uncertainty.samples: must be at least 1"},
+      {"seed = 1.5", {}, "uncertainty.seed: must be an integer"},
+      {"seed = \"abc\"", {}, "uncertainty.seed: must be an integer"},
+      {"stiffness = { law = \"log-normal\", sigma = 0.5, scale = 2 }", {}, "uncertainty.stiffness.scale: unknown parameter"},
+      {"stiffness = { law = \"gamma\", sigma = 0.5 }", {}, "uncertainty.stiffness.law: unknown law 'gamma'"},
+      {"spin = { law = \"normal\", relative-std = 0.1 }", {}, "uncertainty.spin: a vector takes an absolute spread"},
+      {"samples = 10", {"--samples", "0"}, "--samples: must be at least 1"},
+      {"samples = 10", {"--seed", "-3"}, "--seed: expected a non-negative integer, got '-3'"},
+      {"samples = 10", {"--seed", "1e3"}, "--seed: expected a non-negative integer"},
+      {"samples = 10", {"--shard", "4/4"}, "--shard: K must be less than N"},
+      {"samples = 10", {"--force-model", "fem"}, "--force-model: unknown model 'fem'"},
+  };
+  for (const auto& c : cases) {
+    const std::string path = write(dir, "bad.toml", scenario_with(c.uncertainty));
+    Args a{"--config", path, "--json", dir / "out.json"};
+    a.insert(a.end(), kGiven.begin(), kGiven.end());
+    a.insert(a.end(), c.flags.begin(), c.flags.end());
+    const CommandResult r = robust(a, dir.str());
+    INFO(c.uncertainty << " " << (c.flags.empty() ? "" : c.flags[0]) << "\nstderr: " << r.err);
+    CHECK(r.exit_code == 2);
+    CHECK(r.err.find("ffsr-optimize: error: " + c.expected) == 0);
+    CHECK(std::count(r.err.begin(), r.err.end(), '\n') == 1);
+    CHECK(r.out.empty());
+    CHECK_FALSE(std::ifstream(dir / "out.json").good());
+  }
+  // an unknown top-level key stays an error; a flag overrides a key of the file
+  const std::string extra = write(dir, "extra.toml", "colour = 3\n" + scenario_with("samples = 10"));
+  Args e{"--config", extra};
+  e.insert(e.end(), kGiven.begin(), kGiven.end());
+  const CommandResult re = robust(e, dir.str());
+  CHECK(re.exit_code == 2);
+  CHECK(re.err.find("unknown key 'colour'") != std::string::npos);
+  const std::string ok = write(dir, "ok.toml", scenario_with("samples = 10\nseed = 4"));
+  Args f{"--config", ok, "--samples", "7", "--json", dir / "ok.json", "--stiffness", "2e9"};
+  f.insert(f.end(), kGiven.begin(), kGiven.end());
+  const CommandResult rf = robust(f, dir.str());
+  INFO(rf.err);
+  REQUIRE(rf.exit_code == 0);
+  const json j = read_json(dir / "ok.json");
+  CHECK(j["samples"] == 7);
+  CHECK(j["seed"] == 4);
+  CHECK(j["configurations"][0]["tail"][0]["parameters"]["stiffness"] == 2e9);  // no spread: the flag's value
+}

@@ -1,0 +1,254 @@
+// Uncertain targets (issue 12): the reproducible sampler, the laws and their physical redraw rules,
+// the per-sample M_ie / F_max against the library's direct computations, the summary statistics,
+// and the multibody force of a sample against simulate_contact.
+#include <catch2/catch.hpp>
+
+#include "support/paper.hpp"
+
+#include "ffsr/ffsr.hpp"
+#include "ffsr/io/urdf.hpp"
+#include "ffsr/uncertainty/multibody.hpp"
+#include "ffsr/uncertainty/sampling.hpp"
+
+#include <cmath>
+#include <random>
+#include <vector>
+
+using namespace ffsr;
+using ffsr::test::deg;
+using ffsr::test::kRobots;
+
+namespace {
+
+UncertainNominal paper_nominal() {
+  UncertainNominal n;  // the paper's target (Table 2 defaults of Target) and contact
+  n.target.angular_velocity = Vector3(0, 0, 2.0 * M_PI / 180.0);
+  n.target.attitude = Quaternion(Eigen::AngleAxisd(0.3, Vector3(1, 2, 3).normalized()));
+  n.contact = {1e9, 1.5, 0.9};
+  n.approach_speed = 0.2;
+  return n;
+}
+
+Spread law(Spread::Law l, double scale, bool relative = false) {
+  Spread s;
+  s.law = l;
+  s.scale = scale;
+  s.relative = relative;
+  return s;
+}
+
+}  // namespace
+
+TEST_CASE("sampler: splitmix64 test vector, mt19937_64 stream, sample i depends on (seed, i) only", "[uncertainty]") {
+  // SplitMix64 reference output for state 0 (Steele et al. 2014; the first output of the generator).
+  CHECK(detail::splitmix64(0) == 0xE220A8397B1DCDAFULL);
+  // our uniform is the top 53 bits of the standard engine seeded from (seed, i)
+  std::mt19937_64 ref(detail::splitmix64(7 + detail::splitmix64(42)));
+  SampleStream s(7, 42);
+  for (int k = 0; k < 5; ++k) CHECK(s.uniform() == static_cast<double>(ref() >> 11) / 9007199254740992.0);
+
+  UncertaintySpec spec;
+  spec.seed = 99;
+  spec[Quantity::TargetMass] = law(Spread::Law::Normal, 0.1, true);
+  spec[Quantity::Stiffness] = law(Spread::Law::LogNormal, 0.5);
+  const UncertainNominal nom = paper_nominal();
+  const UncertainSample a = draw_sample(spec, nom, 123), b = draw_sample(spec, nom, 123), c = draw_sample(spec, nom, 124);
+  CHECK(a.target.mass == b.target.mass);
+  CHECK(a.contact.K == b.contact.K);
+  CHECK(a.target.mass != c.target.mass);
+  spec.seed = 100;
+  CHECK(draw_sample(spec, nom, 123).target.mass != a.target.mass);
+}
+
+TEST_CASE("laws: moments of normal, uniform, log-normal and the cone within 5 standard errors", "[uncertainty]") {
+  UncertaintySpec spec;
+  spec.seed = 3;
+  spec[Quantity::TargetMass] = law(Spread::Law::Normal, 0.1, true);  // 200 kg +- 20 kg
+  spec[Quantity::ApproachSpeed] = law(Spread::Law::Uniform, 0.05);     // U[0.15, 0.25]
+  spec[Quantity::Stiffness] = law(Spread::Law::LogNormal, 0.6);       // median 1e9
+  spec[Quantity::Normal] = law(Spread::Law::Cone, 30 * M_PI / 180);
+  spec[Quantity::ContactOffset] = law(Spread::Law::Normal, 0.02);
+  REQUIRE_NOTHROW(validate(spec));
+  const UncertainNominal nom = paper_nominal();
+  const int N = 20000;
+  double m1 = 0, m2 = 0, v1 = 0, lnk = 0, cos1 = 0, off2 = 0, vmin = 1, vmax = 0, max_angle = 0;
+  for (int i = 0; i < N; ++i) {
+    const UncertainSample s = draw_sample(spec, nom, static_cast<std::uint64_t>(i));
+    m1 += s.target.mass;
+    m2 += s.target.mass * s.target.mass;
+    v1 += s.approach_speed;
+    vmin = std::min(vmin, s.approach_speed);
+    vmax = std::max(vmax, s.approach_speed);
+    lnk += std::log(s.contact.K / 1e9);
+    const double c = s.target.normal.dot(nom.target.normal);
+    cos1 += c;
+    max_angle = std::max(max_angle, std::acos(std::min(1.0, c)));
+    CHECK(std::abs(s.target.normal.norm() - 1.0) < 1e-15 * 4);
+    off2 += (s.target.contact_offset - nom.target.contact_offset).squaredNorm();
+  }
+  const double mean = m1 / N, sd = std::sqrt(m2 / N - mean * mean);
+  CHECK(std::abs(mean - 200.0) < 5 * 20.0 / std::sqrt(N));
+  CHECK(std::abs(sd - 20.0) < 5 * 20.0 / std::sqrt(2.0 * N));
+  CHECK(std::abs(v1 / N - 0.2) < 5 * (0.1 / std::sqrt(12.0)) / std::sqrt(N));  // U[a, b]: sd (b - a)/sqrt(12)
+  CHECK(vmin >= 0.15);
+  CHECK(vmax < 0.25);
+  CHECK(std::abs(lnk / N) < 5 * 0.6 / std::sqrt(N));  // ln K ~ N(ln 1e9, 0.6^2)
+  // uniform on the cap of half-angle a: cos(theta) ~ U[cos a, 1]
+  const double ca = std::cos(30 * M_PI / 180);
+  CHECK(std::abs(cos1 / N - (1 + ca) / 2) < 5 * ((1 - ca) / std::sqrt(12.0)) / std::sqrt(N));
+  CHECK(max_angle <= 30 * M_PI / 180 * (1 + 1e-12));
+  // three independent N(0, 0.02^2) components: E|d|^2 = 3 * 0.02^2 (sd of |d|^2: sqrt(6) 0.02^2)
+  CHECK(std::abs(off2 / N - 3 * 4e-4) < 5 * std::sqrt(6.0) * 4e-4 / std::sqrt(N));
+}
+
+TEST_CASE("physical or redrawn: inertia triangle inequality, 0 < c_r <= 1, mass > 0, bounds", "[uncertainty]") {
+  UncertaintySpec spec;
+  spec.seed = 11;
+  UncertainNominal nom = paper_nominal();
+  nom.target.inertia = Vector3(60, 100, 150).asDiagonal();  // close to the triangle limit (150 < 160)
+  spec[Quantity::TargetInertia] = law(Spread::Law::Normal, 0.3, true);
+  spec[Quantity::TargetInertia].axes = 20 * M_PI / 180;
+  spec[Quantity::TargetMass] = law(Spread::Law::Normal, 0.6, true);     // often negative before the rule
+  spec[Quantity::Restitution] = law(Spread::Law::Normal, 0.2);         // around 0.9: often > 1
+  spec[Quantity::Stiffness] = law(Spread::Law::LogNormal, 1.0);
+  spec[Quantity::Stiffness].min = 5e8;                                 // a bounded law
+  spec[Quantity::Stiffness].max = 2e9;
+  REQUIRE_NOTHROW(validate(spec));
+  int redraws = 0;
+  for (std::uint64_t i = 0; i < 3000; ++i) {
+    const UncertainSample s = draw_sample(spec, nom, i);
+    redraws += s.redraws;
+    REQUIRE_NOTHROW(s.target.validate("sample"));  // SPD, triangle inequality, mass > 0
+    CHECK(s.target.mass > 0);
+    CHECK(s.contact.c_r > 0);
+    CHECK(s.contact.c_r <= 1);
+    CHECK(s.contact.K >= 5e8);
+    CHECK(s.contact.K <= 2e9);
+    CHECK(s.approach_velocity > 0);
+    // the rotated inertia keeps the drawn moments: trace = sum of moments, symmetric
+    CHECK((s.target.inertia - s.target.inertia.transpose()).norm() == 0.0);
+  }
+  CHECK(redraws > 100);  // the rules were exercised
+}
+
+TEST_CASE("per-sample M_ie and F_max agree with the direct library computation", "[uncertainty]") {
+  const Model m = model_from_urdf_file(kRobots + "paper_7dof.urdf");
+  Data data(m);
+  BasePose base;
+  base.orientation = Quaternion(Eigen::AngleAxisd(0.2, Vector3(0, 1, 1).normalized()));
+  const Eigen::VectorXd theta = deg({10, 80, 95, -70, 85, 100, 5});
+  const int frame = m.end_effector();
+  const Matrix3 G = robot_inverse_mass_matrix(m, data, base, theta, frame);
+  CHECK((G - G.transpose()).norm() <= 1e-15 * G.norm());
+  UncertaintySpec spec;
+  spec.seed = 5;
+  spec[Quantity::Normal] = law(Spread::Law::Cone, 40 * M_PI / 180);
+  spec[Quantity::TargetInertia] = law(Spread::Law::Uniform, 0.2, true);
+  spec[Quantity::ContactOffset] = law(Spread::Law::Uniform, 0.05);
+  spec[Quantity::Restitution] = law(Spread::Law::Uniform, 0.0);
+  spec[Quantity::Restitution].has_range = true;
+  spec[Quantity::Restitution].min = 0.6;
+  spec[Quantity::Restitution].max = 0.95;
+  const UncertainNominal nom = paper_nominal();
+  for (std::uint64_t i = 0; i < 20; ++i) {
+    const UncertainSample s = draw_sample(spec, nom, i);
+    // Eq. 14 through the target's attitude, with a fresh crba: independent of G
+    const double M_ie = integrated_effective_mass(m, data, base, theta, frame, s.target);
+    const Vector3 u = s.target.normal_world();
+    const double v_in = approach_velocity(u, Vector3(s.approach_speed * u), s.target.velocity,
+                                          s.target.angular_velocity_world(), s.target.offset_world());
+    const SampleForce f = sample_force(G, s, "herbert-mcwhannell", ForceModel::Exact);
+    CHECK(f.M_ie == Approx(M_ie).epsilon(1e-12));
+    CHECK(f.approach_velocity == Approx(v_in).epsilon(1e-12));
+    CHECK(f.f_max == Approx(max_force_exact(make_contact_law("herbert-mcwhannell", s.contact, v_in), M_ie)).epsilon(1e-10));
+    const SampleForce c = sample_force(G, s, "herbert-mcwhannell", ForceModel::Closed);
+    CHECK(c.f_max == Approx(max_force_closed_form(make_contact_law("herbert-mcwhannell", s.contact, v_in), M_ie)).epsilon(1e-10));
+  }
+  // the robust objective is the nearest-rank 95th percentile of those forces
+  std::vector<UncertainSample> set;
+  std::vector<double> f;
+  for (std::uint64_t i = 0; i < 40; ++i) {
+    set.push_back(draw_sample(spec, nom, i));
+    f.push_back(sample_force(G, set.back(), "hunt-crossley", ForceModel::Exact).f_max);
+  }
+  std::sort(f.begin(), f.end());
+  CHECK(robust_force_p95(m, data, base, theta, frame, set, "hunt-crossley") == f[37]);  // ceil(0.95 * 40) = 38th
+}
+
+TEST_CASE("multibody force of a sample: same M_ie and delta_dot^- as the closed path, peak near the exact one",
+          "[uncertainty]") {
+  const Model m = model_from_urdf_file(kRobots + "paper_3dof.urdf");
+  Data data(m);
+  const BasePose base;
+  const Eigen::VectorXd theta = deg({30, 60, 45});
+  const int frame = m.end_effector();
+  UncertaintySpec spec;
+  spec.seed = 8;
+  spec[Quantity::TargetMass] = law(Spread::Law::Normal, 0.1, true);
+  spec[Quantity::Spin] = law(Spread::Law::Normal, 0.5 * M_PI / 180);
+  UncertainNominal nom = paper_nominal();
+  nom.target.attitude = Quaternion::Identity();  // the planar robot: normal in its plane
+  const Matrix3 G = robot_inverse_mass_matrix(m, data, base, theta, frame);
+  for (std::uint64_t i = 0; i < 2; ++i) {
+    const UncertainSample s = draw_sample(spec, nom, i);
+    const SampleForce mb = sample_force_multibody(m, base, theta, frame, s, "herbert-mcwhannell");
+    const SampleForce ex = sample_force(G, s, "herbert-mcwhannell", ForceModel::Exact);
+    CHECK(mb.M_ie == Approx(ex.M_ie).epsilon(1e-10));
+    CHECK(mb.approach_velocity == Approx(ex.approach_velocity).epsilon(1e-9));
+    // the paper's Table 3: single-body vs multibody agree to better than 1 % on this robot
+    CHECK(mb.f_max == Approx(ex.f_max).epsilon(0.01));
+  }
+}
+
+TEST_CASE("summary: nearest-rank percentiles, mean and deviation of 1..100; parallel_for = serial", "[uncertainty]") {
+  std::vector<double> v;
+  for (int k = 100; k >= 1; --k) v.push_back(k);
+  const ForceSummary s = summarize(v);
+  CHECK(s.n == 100);
+  CHECK(s.p50 == 50);
+  CHECK(s.p95 == 95);
+  CHECK(s.p99 == 99);
+  CHECK(s.max == 100);
+  CHECK(s.mean == 50.5);
+  CHECK(s.std == Approx(std::sqrt(100.0 * 101.0 / 12.0)).epsilon(1e-14));  // sd (n - 1) of 1..n: sqrt(n(n+1)/12)
+  CHECK(nearest_rank(std::vector<double>{1, 2, 3}, 50) == 2);               // ceil(1.5) = 2nd
+  CHECK_THROWS_AS(summarize({1.0, std::nan("")}), NumericalError);
+
+  UncertaintySpec spec;
+  spec[Quantity::TargetMass] = law(Spread::Law::Normal, 0.1, true);
+  const UncertainNominal nom = paper_nominal();
+  std::vector<double> serial(500), threaded(500);
+  parallel_for(0, 500, 1, [&](std::uint64_t i) { serial[i] = draw_sample(spec, nom, i).target.mass; });
+  parallel_for(0, 500, 2, [&](std::uint64_t i) { threaded[i] = draw_sample(spec, nom, i).target.mass; });
+  CHECK(serial == threaded);
+  CHECK_THROWS_AS(parallel_for(0, 100, 2, [](std::uint64_t i) { if (i == 37) throw InputError("x"); }), InputError);
+}
+
+TEST_CASE("validate: bad spreads name the key", "[uncertainty]") {
+  auto msg = [](const UncertaintySpec& s) {
+    try {
+      validate(s);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  UncertaintySpec s;
+  s[Quantity::TargetMass] = law(Spread::Law::Normal, -0.1, true);
+  CHECK_THAT(msg(s), Catch::Contains("uncertainty.target-mass") && Catch::Contains("non-negative"));
+  s = {};
+  s[Quantity::Restitution] = law(Spread::Law::Uniform, 0);
+  s[Quantity::Restitution].has_range = true;
+  s[Quantity::Restitution].min = 0.9;
+  s[Quantity::Restitution].max = 0.6;
+  CHECK_THAT(msg(s), Catch::Contains("uncertainty.restitution") && Catch::Contains("greater than max"));
+  s = {};
+  s[Quantity::Normal] = law(Spread::Law::Cone, 100 * M_PI / 180);
+  CHECK_THAT(msg(s), Catch::Contains("uncertainty.normal") && Catch::Contains("90 deg"));
+  s = {};
+  s.samples = 0;
+  CHECK_THAT(msg(s), Catch::Contains("uncertainty.samples"));
+  s = {};
+  s[Quantity::Spin] = law(Spread::Law::LogNormal, 0.1);
+  CHECK_THAT(msg(s), Catch::Contains("uncertainty.spin"));
+}
