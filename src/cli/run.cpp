@@ -41,6 +41,7 @@ struct RunOptions {
   std::string expect;  ///< a stored result to compare with (regression run)
   double rtol = 1e-6, atol = 1e-9;
   bool quiet = false;
+  ModelLoadOptions load;  ///< bus, locks, repairs, end-effector offset (model_options.hpp)
 };
 
 /// Keys a scenario file must name (the others have defaults).
@@ -166,18 +167,19 @@ int run_scenario(RunOptions o, const CLI::App& app, FromCommandLine cli) {
     o.expect = next_to_config(o.expect, cli.expect);
     expected = load_baseline(o.expect, "--expect");
   }
+  UrdfReport report;
   Model model = [&] {
     if (builtin && !urdf_on_command_line && o.urdf == "paper_3dof.urdf")
-      return model_from_urdf_string(kPaper3dofUrdf, "built-in paper_3dof.urdf", o.end_effector);
+      return model_from_urdf_string(kPaper3dofUrdf, "built-in paper_3dof.urdf", o.load.build(o.end_effector), &report);
     o.urdf = next_to_config(o.urdf, urdf_on_command_line);
-    return model_from_urdf_file(o.urdf, o.end_effector);
+    return model_from_urdf_file(o.urdf, o.load.build(o.end_effector), &report);
   }();
+  warn_repairs(report);
 
   CaptureProblem pb;
   pb.model = &model;
   pb.frame = model.end_effector();
-  if (static_cast<int>(o.joints_deg.size()) != model.n())
-    throw InputError(str("--joints-deg: got ", o.joints_deg.size(), " angles, the robot has ", model.n(), " joints"));
+  if (static_cast<int>(o.joints_deg.size()) != model.n()) throw InputError(joint_count_error(o.joints_deg.size(), model, ""));
   pb.theta = Eigen::Map<const Eigen::VectorXd>(o.joints_deg.data(), model.n()) * (M_PI / 180.0);
   for (double x : o.joints_deg) finite(x, "joints-deg");
   pb.base.position = vec3(o.base_position, "base-position");
@@ -294,6 +296,9 @@ int run_scenario(RunOptions o, const CLI::App& app, FromCommandLine cli) {
                    {"feedback", o.feedback},
                    {"tolerance", o.tolerance},
                    {"objective", o.objective}};
+  j["scenario"].update(o.load.to_json());
+  j["model_repairs"] = repairs_json(report);
+  j["model_load"] = report_json(report);  // merged links, mimic and locked joints, repairs
   j["capture_point"] = to_json(Eigen::VectorXd(base_run.capture_point));
   j["baseline"] = result_json(base_run, baseline_task, 0.0);
   j["optimized"] = result_json(opt_run, task, opt.gain);
@@ -423,6 +428,7 @@ void register_run(CLI::App& app, Action& action, int argc, char** argv) {
   app.add_option("--rtol", o->rtol, "--expect: relative tolerance")->capture_default_str();
   app.add_option("--atol", o->atol, "--expect: absolute floor for values near zero")->capture_default_str();
   app.add_flag("--quiet", o->quiet, "No progress line");
+  o->load.add_to(app);
   app.callback([o, &app, &action, from_cli] {
     if (!app.get_subcommands().empty()) return;
     action = [o, &app, from_cli] {

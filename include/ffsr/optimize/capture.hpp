@@ -279,7 +279,7 @@ inline CaptureResult plan_capture(const CaptureProblem& pb, const CaptureTask& t
       }
       // joint limits: repulsive gradient inside 10 % of the range
       for (int k = 0; k < n; ++k) {
-        const Joint& j = model.body(k + 1).joint;
+        const Joint& j = model.joint(k);
         if (!(std::isfinite(j.lower) && std::isfinite(j.upper))) continue;
         const double margin = 0.1 * (j.upper - j.lower), q = theta(k);
         const double scale = grad.cwiseAbs().maxCoeff() + 1.0;
@@ -379,7 +379,7 @@ inline CaptureResult plan_capture(const CaptureProblem& pb, const CaptureTask& t
     if (!theta.allFinite() || !base.position.allFinite())
       throw NumericalError(str("plan_capture: the state became non-finite at t = ", t + h, " s"));
     for (int j = 0; j < n; ++j) {
-      const Joint& jt = model.body(j + 1).joint;
+      const Joint& jt = model.joint(j);
       if (theta(j) < jt.lower - 1e-9 || theta(j) > jt.upper + 1e-9)
         throw NumericalError(str("plan_capture: joint '", jt.name, "' left its limits [", jt.lower, ", ", jt.upper,
                                  "] rad at t = ", t + h, " s (", theta(j), " rad)"));
