@@ -147,7 +147,7 @@ inline Inertia repaired_inertia(const Inertia& in, const std::string& link, cons
                                 std::vector<ModelRepair>& repairs) {
   Inertia out = in;
   if (!in.I.allFinite() || !std::isfinite(in.mass)) return out;  // validation reports it
-  if (out.mass < o.min_mass) {
+  if (o.min_mass > 0 && out.mass >= 0 && out.mass < o.min_mass) {  // a negative mass stays an error
     repairs.push_back({link, "mass raised to min-mass", {out.mass}, {o.min_mass}});
     out.mass = o.min_mass;
   }
