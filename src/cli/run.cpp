@@ -137,7 +137,8 @@ struct FromCommandLine {
 
 /// Top-level keys of the result that --expect does not compare: inputs, not results (the resolved
 /// scenario holds paths that differ between machines; the version changes with every release).
-const std::vector<std::string> kNotCompared = {"version", "scenario"};
+// model_repairs and model_load describe the model as loaded (inputs too), not results
+const std::vector<std::string> kNotCompared = {"version", "scenario", "model_repairs", "model_load"};
 
 int run_scenario(RunOptions o, const CLI::App& app, FromCommandLine cli) {
   const bool urdf_on_command_line = cli.urdf;
