@@ -67,6 +67,13 @@ void RobotOptions::add_to(CLI::App& app) {
   app.add_option("--end-effector", end_effector, "End-effector frame (a link name); default: the single leaf link");
   app.add_option("--base-position", base_position, "Base frame origin in the inertial frame, m")->capture_default_str();
   app.add_option("--base-rpy-deg", base_rpy_deg, "Base attitude, URDF roll,pitch,yaw in degrees")->capture_default_str();
+  load.add_to(app);
+}
+
+std::string joint_count_error(size_t got, const Model& model, const std::string& where) {
+  std::string names;
+  for (const auto& n : model.joint_names()) names += (names.empty() ? "" : ", ") + n;
+  return str("--joints-deg: got ", got, " angles, the robot", where, " has ", model.n(), " joints (", names, ")");
 }
 
 void TargetOptions::add_to(CLI::App& app) {
@@ -139,12 +146,13 @@ void ContactLawOptions::set_target_motion(Target& target) const {
 }
 
 Robot load_robot(const RobotOptions& o) {
-  Robot r{model_from_urdf_file(o.urdf, o.end_effector), 0, {}, {}};
+  UrdfReport report;
+  Robot r{model_from_urdf_file(o.urdf, o.load.build(o.end_effector), &report), 0, {}, {}, {}};
+  r.report = std::move(report);
+  warn_repairs(r.report);
   r.end_effector = r.model.end_effector();
   const auto q = parse_list(o.joints_deg, "--joints-deg");
-  if (static_cast<int>(q.size()) != r.model.n())
-    throw InputError(str("--joints-deg: got ", q.size(), " angles, the robot in ", o.urdf, " has ", r.model.n(),
-                         " joints"));
+  if (static_cast<int>(q.size()) != r.model.n()) throw InputError(joint_count_error(q.size(), r.model, " in " + o.urdf));
   r.theta = Eigen::Map<const Eigen::VectorXd>(q.data(), static_cast<Eigen::Index>(q.size())) * (M_PI / 180.0);
   r.base.position = parse_vec3(o.base_position, "--base-position");
   r.base.orientation = Quaternion(rotation_from_rpy(parse_vec3(o.base_rpy_deg, "--base-rpy-deg") * (M_PI / 180.0)));

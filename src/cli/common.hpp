@@ -3,6 +3,7 @@
 
 #include "ffsr/contact/contact_law.hpp"
 #include "ffsr/ffsr.hpp"
+#include "model_options.hpp"
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -35,6 +36,7 @@ struct RobotOptions {
   std::string end_effector;
   std::string base_position = "0,0,0";
   std::string base_rpy_deg = "0,0,0";
+  ModelLoadOptions load;  ///< bus, locks, repairs, end-effector offset (model_options.hpp)
   void add_to(CLI::App& app);
 };
 
@@ -75,8 +77,12 @@ struct Robot {
   int end_effector = 0;
   BasePose base;
   Eigen::VectorXd theta;
+  UrdfReport report;  ///< what the loader did to the file
 };
 Robot load_robot(const RobotOptions& options);
+
+/// "--joints-deg: got 3 angles, the robot has 7 joints (a, b, ...)": the joints in order.
+std::string joint_count_error(size_t got, const Model& model, const std::string& where);
 
 /// Parses an inertia given as "Ixx,Iyy,Izz" or "Ixx,Iyy,Izz,Ixy,Ixz,Iyz".
 Matrix3 parse_inertia(const std::string& text, const std::string& flag);

@@ -40,7 +40,7 @@ Drawing robot_drawing(const Model& model, Data& data, int frame, const CaptureSa
   forward_kinematics(model, data, s.base, s.theta);
   Drawing d;
   double half = 0.05;
-  for (int i = 1; i <= model.n(); ++i)
+  for (int i = 1; i < model.nb(); ++i)
     if (model.body(i).parent == 0) half = std::max(half, model.body(i).tree.p.cwiseAbs().maxCoeff());
   const Matrix3& R0 = data.R[0];
   const Vector3& p0 = data.p[0];
@@ -53,7 +53,7 @@ Drawing robot_drawing(const Model& model, Data& data, int frame, const CaptureSa
     for (int a : {-1, 1})
       for (int b : {-1, 1}) d.lines.push_back({corner(a, b, -1), corner(a, b, 1)});
   }
-  for (int i = 1; i <= model.n(); ++i) {
+  for (int i = 1; i < model.nb(); ++i) {
     const int parent = model.body(i).parent;
     if (parent > 0) d.lines.push_back({data.p[static_cast<size_t>(parent)], data.p[static_cast<size_t>(i)]});
     d.dots.push_back(data.p[static_cast<size_t>(i)]);
@@ -195,10 +195,10 @@ std::vector<plot::Figure> capture(const Model& model, int frame, const Target& t
   for (const auto& run : runs)
     for (const auto& s : run.result->series) {
       forward_kinematics(model, data, s.base, s.theta);
-      for (int i = 0; i <= model.n() && planar; ++i) planar = std::abs(data.p[static_cast<size_t>(i)].z() - z0) < 1e-6;
+      for (int i = 0; i < model.nb() && planar; ++i) planar = std::abs(data.p[static_cast<size_t>(i)].z() - z0) < 1e-6;
     }
   double reach = 0;
-  for (int i = 1; i <= model.n(); ++i) reach += model.body(i).tree.p.norm();
+  for (int i = 1; i < model.nb(); ++i) reach += model.body(i).tree.p.norm();
   const double arrow = std::max(0.2, 0.12 * reach);
 
   std::vector<plot::Figure> out;

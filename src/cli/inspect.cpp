@@ -15,6 +15,24 @@ struct InspectOptions {
   bool json = false;
 };
 
+/// What the loader did to the file (issue 11): merged links, mimic and locked joints, repairs.
+void print_load_report(const UrdfReport& rep) {
+  auto line = [](const char* label, const std::vector<std::string>& items) {
+    if (items.empty()) return;
+    std::cout << label;
+    for (size_t i = 0; i < items.size(); ++i) std::cout << items[i] << (i + 1 < items.size() ? ", " : "\n");
+  };
+  line("merged into base ", rep.merged_links);
+  std::vector<std::string> m, l, r;
+  for (const auto& x : rep.mimics)
+    m.push_back(detail::str(x.joint, " = ", x.multiplier, " * ", x.leader, " + ", x.offset));
+  for (const auto& x : rep.locked) l.push_back(detail::str(x.first, " = ", x.second));
+  for (const auto& x : rep.repairs) r.push_back(detail::str(x.link, ": ", x.what));
+  line("mimic joints     ", m);
+  line("locked joints    ", l);
+  line("inertia repairs  ", r);
+}
+
 int run_inspect(const InspectOptions& o) {
   const Robot r = load_robot(o.robot);
   const Target target = o.target.build();
@@ -42,6 +60,8 @@ int run_inspect(const InspectOptions& o) {
     j["total_mass"] = r.model.total_mass();
     j["effective_mass"] = m_e;
     j["integrated_effective_mass"] = M_ie;
+    j["model_repairs"] = repairs_json(r.report);
+    j["model_load"] = report_json(r.report);
     j["version"] = FFSR_VERSION;
     std::cout << j.dump(2) << "\n";
     return 0;
@@ -56,6 +76,7 @@ int run_inspect(const InspectOptions& o) {
   const auto names = r.model.joint_names();
   for (size_t i = 0; i < names.size(); ++i)
     std::cout << names[i] << "=" << r.theta(static_cast<Eigen::Index>(i)) * 180.0 / M_PI << (i + 1 < names.size() ? ", " : " deg\n");
+  print_load_report(r.report);
   std::cout << "direction u      [" << u.transpose().format(Eigen::IOFormat(6, 0, ", ")) << "]\n";
   std::cout << "effective mass   m_e  = " << m_e << " kg   (Eq. 4)\n";
   std::cout << "integrated mass  M_ie = " << M_ie << " kg   (Eq. 14)\n";

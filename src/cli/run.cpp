@@ -115,7 +115,8 @@ struct FromCommandLine {
 
 /// Top-level keys of the result that --expect does not compare: inputs, not results (the resolved
 /// scenario holds paths that differ between machines; the version changes with every release).
-const std::vector<std::string> kNotCompared = {"version", "scenario"};
+// model_repairs and model_load describe the model as loaded (inputs too), not results
+const std::vector<std::string> kNotCompared = {"version", "scenario", "model_repairs", "model_load"};
 
 }  // namespace
 
@@ -134,19 +135,20 @@ Scenario prepare_scenario(RunOptions o, const CLI::App& app, bool urdf_on_comman
     const size_t slash = o.config.find_last_of('/');
     return slash == std::string::npos ? path : o.config.substr(0, slash + 1) + path;
   };
+  UrdfReport report;
   auto model_ptr = std::make_unique<Model>([&] {
     if (builtin && !urdf_on_command_line && o.urdf == "paper_3dof.urdf")
-      return model_from_urdf_string(kPaper3dofUrdf, "built-in paper_3dof.urdf", o.end_effector);
+      return model_from_urdf_string(kPaper3dofUrdf, "built-in paper_3dof.urdf", o.load.build(o.end_effector), &report);
     o.urdf = next_to_config(o.urdf, urdf_on_command_line);
-    return model_from_urdf_file(o.urdf, o.end_effector);
+    return model_from_urdf_file(o.urdf, o.load.build(o.end_effector), &report);
   }());
+  warn_repairs(report);
   const Model& model = *model_ptr;
 
   CaptureProblem pb;
   pb.model = &model;
   pb.frame = model.end_effector();
-  if (static_cast<int>(o.joints_deg.size()) != model.n())
-    throw InputError(str("--joints-deg: got ", o.joints_deg.size(), " angles, the robot has ", model.n(), " joints"));
+  if (static_cast<int>(o.joints_deg.size()) != model.n()) throw InputError(joint_count_error(o.joints_deg.size(), model, ""));
   pb.theta = Eigen::Map<const Eigen::VectorXd>(o.joints_deg.data(), model.n()) * (M_PI / 180.0);
   for (double x : o.joints_deg) finite(x, "joints-deg");
   pb.base.position = vec3(o.base_position, "base-position");
@@ -212,7 +214,7 @@ Scenario prepare_scenario(RunOptions o, const CLI::App& app, bool urdf_on_comman
   if (opt.gain != 0.0 && task.rows() >= model.n())
     throw InputError(str("--gain: the ", o.task, " task has ", task.rows(), " rows and the robot ", model.n(),
                          " joints: no null space to optimize in (set gain = 0 or constrain fewer axes)"));
-  Scenario sc{std::move(o), where, builtin, std::move(model_ptr), pb, task, baseline_task, opt};
+  Scenario sc{std::move(o), where, builtin, std::move(model_ptr), pb, task, baseline_task, opt, std::move(report)};
   sc.problem.model = sc.model.get();
   return sc;
 }
@@ -411,6 +413,9 @@ int run_scenario(RunOptions options, const CLI::App& app, FromCommandLine cli) {
                    {"feedback", o.feedback},
                    {"tolerance", o.tolerance},
                    {"objective", o.objective}};
+  j["scenario"].update(o.load.to_json());
+  j["model_repairs"] = repairs_json(sc.report);
+  j["model_load"] = report_json(sc.report);  // merged links, mimic and locked joints, repairs
   j["capture_point"] = to_json(Eigen::VectorXd(base_run.capture_point));
   j["baseline"] = result_json(base_run, baseline_task, 0.0);
   j["optimized"] = result_json(opt_run, task, opt.gain);
@@ -514,6 +519,7 @@ void add_scenario_options(CLI::App& app, RunOptions& o) {
   };
   app.add_option("--urdf", o.urdf, "Robot URDF (relative to the scenario file)");
   app.add_option("--end-effector", o.end_effector, "End-effector frame (default: the single leaf link)");
+  o.load.add_to(app);  // bus, mount, locked joints, inertia repairs, end-effector offset (issue 11)
   vec("--joints-deg", o.joints_deg, "Initial joint angles, deg");
   vec("--base-position", o.base_position, "Initial base position, m");
   vec("--base-rpy-deg", o.base_rpy_deg, "Initial base attitude (roll, pitch, yaw), deg");

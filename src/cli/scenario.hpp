@@ -4,6 +4,7 @@
 #pragma once
 
 #include "common.hpp"
+#include "model_options.hpp"
 
 #include "ffsr/optimize/capture.hpp"
 
@@ -40,6 +41,7 @@ struct RunOptions {
   std::string expect;  ///< a stored result to compare with (regression run)
   double rtol = 1e-6, atol = 1e-9;
   bool quiet = false;
+  ModelLoadOptions load;  ///< bus, locks, repairs, end-effector offset (model_options.hpp)
 };
 
 /// Registers the scenario keys (everything but --config, --json, --csv, --quiet) on `app`.
@@ -55,6 +57,7 @@ struct Scenario {
   CaptureProblem problem;  ///< problem.model points to *model
   CaptureTask task, baseline_task;
   CaptureOptions capture;
+  UrdfReport report;  ///< what the loader did to the file (merged links, mimic and locked joints, repairs)
 };
 
 /// Checks the keys (a scenario file must name kRequired; `app` tells which were given) and builds

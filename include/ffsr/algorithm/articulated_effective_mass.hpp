@@ -35,7 +35,9 @@ inline double inverse_effective_mass_articulated(const Model& model, Data& data,
   if (!pe.allFinite())
     throw NumericalError(detail::str("effective_mass: the position of frame '", model.frame(frame).name,
                                      "' overflows double precision"));
-  const int nb = model.n() + 1;
+  const int nb = model.nb();
+  if (nb - 1 != model.n())  // a mimic joint couples bodies through one coordinate: not a tree recursion
+    throw InputError("inverse_effective_mass_articulated: the model has mimic joints; use inverse_effective_mass");
   const int ee = model.frame(frame).body;
   const Vector3& p0 = data.p[0];
   Vector6 f;
@@ -93,7 +95,7 @@ inline constexpr int kArticulatedMinJoints = 8;
 inline double integrated_effective_mass_fast(const Model& model, Data& data, const BasePose& base,
                                              const Eigen::Ref<const Eigen::VectorXd>& theta, int frame,
                                              const Vector3& u, double target_inverse_mass) {
-  if (model.n() < kArticulatedMinJoints) {
+  if (model.n() < kArticulatedMinJoints || model.nb() - 1 != model.n()) {  // small, or mimic joints: dense
     crba(model, data, base, theta);
     return 1.0 / (inverse_effective_mass(model, data, frame, u) + target_inverse_mass);
   }

@@ -9,12 +9,13 @@ namespace ffsr {
 /// algorithm (RBDA 6.2), with all spatial quantities in inertial axes about the base frame origin,
 /// so that the base motion subspace is the identity and composite inertias add without transforms.
 /// Reads base, theta. Writes the kinematics (forward_kinematics), data.Ic and data.H, the full
-/// symmetric (6+n)x(6+n) matrix in the coordinates of model.hpp. Returns data.H. Throws NumericalError
+/// symmetric (6+n)x(6+n) matrix in the coordinates of model.hpp (a coordinate that drives several
+/// joints through mimics sums their entries: H = T^T H_full T). Returns data.H. Throws NumericalError
 /// when H overflows (not finite).
 inline const Eigen::MatrixXd& crba(const Model& model, Data& data, const BasePose& base,
                                    const Eigen::Ref<const Eigen::VectorXd>& theta) {
   forward_kinematics(model, data, base, theta);
-  const int nb = model.n() + 1;
+  const int nb = model.nb();
   const Vector3& p0 = data.p[0];
   for (int i = 0; i < nb; ++i) {
     const auto ui = static_cast<size_t>(i);
@@ -25,20 +26,23 @@ inline const Eigen::MatrixXd& crba(const Model& model, Data& data, const BasePos
   for (int i = nb - 1; i > 0; --i) data.Ic[static_cast<size_t>(model.body(i).parent)] += data.Ic[static_cast<size_t>(i)];
 
   Eigen::MatrixXd& H = data.H;
+  H.setZero();
   H.topLeftCorner<6, 6>() = data.Ic[0].matrix();
   for (int i = 1; i < nb; ++i) {
     const Vector6 S = data.S.col(i - 1);
     const Vector6 F = data.Ic[static_cast<size_t>(i)] * S;
-    const int ci = 5 + i;
-    H(ci, ci) = S.dot(F);
+    const int ci = 6 + model.body(i).coord;
+    H(ci, ci) += S.dot(F);
     for (int j = model.body(i).parent; j > 0; j = model.body(j).parent) {
-      const int cj = 5 + j;
-      H(cj, ci) = H(ci, cj) = data.S.col(j - 1).dot(F);
+      const int cj = 6 + model.body(j).coord;
+      const double hij = data.S.col(j - 1).dot(F);
+      H(cj, ci) += hij;  // both (i, j) and (j, i): twice on the diagonal when i and j share a coordinate
+      H(ci, cj) += hij;
     }
-    H.block<6, 1>(0, ci) = F;
-    H.block<1, 6>(ci, 0) = F.transpose();
+    H.block<6, 1>(0, ci) += F;
+    H.block<1, 6>(ci, 0) += F.transpose();
   }
-  // Entries between joints on different branches are never written: they keep the zero Data set.
+  // Entries between joints on different branches stay zero.
   // Finite but huge lengths, masses or prismatic positions (a joint origin of 1e186 m in a URDF,
   // found by fuzz_urdf) overflow to inf/NaN here: an error, never a NaN answer downstream.
   for (Eigen::Index k = 0; k < H.size(); ++k)

@@ -18,7 +18,7 @@ inline void linear_jacobian_transpose_times(const Model& model, Data& data, int 
   data.w.segment<3>(3) = (pe - data.p[0]).cross(u);
   for (int i = model.frame(frame).body; i > 0; i = model.body(i).parent) {
     const auto S = data.S.col(i - 1);
-    data.w(5 + i) = model.body(i).joint.type == JointType::Revolute
+    data.w(6 + model.body(i).coord) += model.body(i).joint.type == JointType::Revolute
                         ? S.tail<3>().dot((pe - data.p[static_cast<size_t>(i)]).cross(u))
                         : S.head<3>().dot(u);
   }
@@ -94,12 +94,12 @@ inline double integrated_effective_mass_gradient(const Model& model, Data& data,
   const double inv_me = inverse_effective_mass(model, data, frame, u);
   detail::cholesky_backward(data.L, data.y);  // y = H^-1 w
   const double M = 1.0 / (inv_me + target_inverse_mass);
-  const int nb = model.n() + 1;
+  const int nb = model.nb();
   const Vector3& p0 = data.p[0];
   // velocities and momenta of the bodies for the generalized velocity y
   data.V[0] = data.y.head<6>();
   for (int i = 1; i < nb; ++i)
-    data.V[static_cast<size_t>(i)] = data.V[static_cast<size_t>(model.body(i).parent)] + data.S.col(i - 1) * data.y(5 + i);
+    data.V[static_cast<size_t>(i)] = data.V[static_cast<size_t>(model.body(i).parent)] + data.S.col(i - 1) * data.y(6 + model.body(i).coord);
   for (int i = 0; i < nb; ++i) {
     const auto ui = static_cast<size_t>(i);
     const Inertia& in = model.body(i).inertia;
@@ -110,7 +110,8 @@ inline double integrated_effective_mass_gradient(const Model& model, Data& data,
   const int ee_body = model.frame(frame).body;
   const Vector3 pe = frame_pose(model, data, frame).p;
   const Vector6& Vee = data.V[static_cast<size_t>(ee_body)];
-  for (int i = 1; i < nb; ++i) {
+  grad.setZero();
+  for (int i = 1; i < nb; ++i) {  // body i adds its part to the gradient entry of its coordinate
     const auto ui = static_cast<size_t>(i);
     const Vector6 S = data.S.col(i - 1);
     const double yHy = 2.0 * cross_motion(data.V[ui], S).dot(data.F[ui]);
@@ -120,7 +121,7 @@ inline double integrated_effective_mass_gradient(const Model& model, Data& data,
       const Vector3 dp = S.head<3>() + S.tail<3>().cross(pe - p0);
       udv = u.dot(X.head<3>() + X.tail<3>().cross(pe - p0) + Vee.tail<3>().cross(dp));
     }
-    grad(i - 1) = -M * M * (2.0 * udv - yHy);
+    grad(model.body(i).coord) += -M * M * (2.0 * udv - yHy);
   }
   return M;
 }

@@ -23,11 +23,12 @@ inline const Eigen::MatrixXd& frame_jacobian(const Model& model, Data& data, int
   for (int i = model.frame(frame).body; i > 0; i = model.body(i).parent) {
     const auto S = data.S.col(i - 1);
     const Vector3 z = S.tail<3>();
+    const int c = 6 + model.body(i).coord;  // mimics: several joints add into one column
     if (model.body(i).joint.type == JointType::Revolute) {
-      J.block<3, 1>(0, 5 + i) = z.cross(pe - data.p[static_cast<size_t>(i)]);
-      J.block<3, 1>(3, 5 + i) = z;
+      J.block<3, 1>(0, c) += z.cross(pe - data.p[static_cast<size_t>(i)]);
+      J.block<3, 1>(3, c) += z;
     } else {
-      J.block<3, 1>(0, 5 + i) = S.head<3>();
+      J.block<3, 1>(0, c) += S.head<3>();
     }
   }
   return J;

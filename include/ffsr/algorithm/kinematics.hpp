@@ -21,7 +21,8 @@ inline void check_configuration(const Model& model, const BasePose& base, const 
 
 /// Forward kinematics (RBDA 4.1, in the inertial frame).
 /// Reads base, theta. Writes data.base, data.R, data.p (every body frame in o) and data.S (the joint
-/// motion subspaces in inertial axes about the base frame origin). The base quaternion is normalized.
+/// motion subspaces in inertial axes about the base frame origin, per unit rate of each body's
+/// coordinate: mimic joints carry their multiplier). The base quaternion is normalized.
 inline void forward_kinematics(const Model& model, Data& data, const BasePose& base,
                                const Eigen::Ref<const Eigen::VectorXd>& theta) {
   detail::check_configuration(model, base, theta, "forward_kinematics");
@@ -29,7 +30,7 @@ inline void forward_kinematics(const Model& model, Data& data, const BasePose& b
   data.base.orientation = base.orientation.normalized();
   data.R[0] = data.base.orientation.toRotationMatrix();
   data.p[0] = base.position;
-  const int nb = model.n() + 1;
+  const int nb = model.nb();
   for (int i = 1; i < nb; ++i) {
     const Body& b = model.body(i);
     const auto ui = static_cast<size_t>(i);
@@ -37,15 +38,15 @@ inline void forward_kinematics(const Model& model, Data& data, const BasePose& b
     const Matrix3 Rj = data.R[pi] * b.tree.R;
     const Vector3 pj = data.p[pi] + data.R[pi] * b.tree.p;
     const Vector3 z = Rj * b.joint.axis;
-    const double q = theta(i - 1);
+    const double q = b.joint_position(theta), k = b.multiplier;
     if (b.joint.type == JointType::Revolute) {
       data.R[ui] = Rj * rotation_about(b.joint.axis, q);
       data.p[ui] = pj;
-      data.S.col(i - 1) << (pj - data.p[0]).cross(z), z;
+      data.S.col(i - 1) << k * (pj - data.p[0]).cross(z), k * z;
     } else {
       data.R[ui] = Rj;
       data.p[ui] = pj + z * q;
-      data.S.col(i - 1) << z, Vector3::Zero();
+      data.S.col(i - 1) << k * z, Vector3::Zero();
     }
   }
 }

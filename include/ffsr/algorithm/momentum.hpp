@@ -12,11 +12,11 @@ template <class Visit>
 void for_each_body_velocity(const Model& model, const Data& data, const Eigen::Ref<const Eigen::VectorXd>& v,
                             Visit&& visit) {
   detail::require_size(v.size(), model.nv(), "body velocities", "v");
-  const int nb = model.n() + 1;
+  const int nb = model.nb();
   // w_i and the velocity of the body point at the base origin, u_i (a spatial velocity about p0)
   std::vector<Vector6> Vs(static_cast<size_t>(nb));  // small, off the hot path
   Vs[0] = v.head<6>();
-  for (int i = 1; i < nb; ++i) Vs[static_cast<size_t>(i)] = Vs[static_cast<size_t>(model.body(i).parent)] + data.S.col(i - 1) * v(5 + i);
+  for (int i = 1; i < nb; ++i) Vs[static_cast<size_t>(i)] = Vs[static_cast<size_t>(model.body(i).parent)] + data.S.col(i - 1) * v(6 + model.body(i).coord);
   for (int i = 0; i < nb; ++i) {
     const auto ui = static_cast<size_t>(i);
     const Vector3 c = data.p[ui] + data.R[ui] * model.body(i).inertia.com;

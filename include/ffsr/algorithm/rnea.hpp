@@ -27,7 +27,7 @@ inline const Eigen::VectorXd& rnea(const Model& model, Data& data, const BasePos
   // fictitious upward acceleration of the base.
   data.V[0] << R0.transpose() * v0, R0.transpose() * w0;
   data.A[0] << R0.transpose() * (a.head<3>() - w0.cross(v0) - model.gravity), R0.transpose() * a.segment<3>(3);
-  const int nb = model.n() + 1;
+  const int nb = model.nb();
   auto body_force = [&](int i) {
     const auto ui = static_cast<size_t>(i);
     const Inertia& in = model.body(i).inertia;
@@ -39,15 +39,16 @@ inline const Eigen::VectorXd& rnea(const Model& model, Data& data, const BasePos
     const Body& b = model.body(i);
     const auto ui = static_cast<size_t>(i);
     const auto pi = static_cast<size_t>(b.parent);
-    const double q = theta(i - 1), qd = v(5 + i), qdd = a(5 + i);
+    // joint position; rate and acceleration of its coordinate (S carries the mimic multiplier)
+    const double q = b.joint_position(theta), qd = v(6 + b.coord), qdd = a(6 + b.coord);
     Pose X = b.tree;  // pose of body i in its parent
     Vector6 S;
     if (b.joint.type == JointType::Revolute) {
       X.R = b.tree.R * rotation_about(b.joint.axis, q);
-      S << Vector3::Zero(), b.joint.axis;
+      S << Vector3::Zero(), b.multiplier * b.joint.axis;
     } else {
       X.p = b.tree.p + b.tree.R * b.joint.axis * q;
-      S << b.joint.axis, Vector3::Zero();
+      S << b.multiplier * b.joint.axis, Vector3::Zero();
     }
     data.Xup[ui] = X;
     // motion transform parent -> child: w_c = R^T w_p, v_c = R^T (v_p + w_p x p)
@@ -60,13 +61,15 @@ inline const Eigen::VectorXd& rnea(const Model& model, Data& data, const BasePos
     data.A[ui] = to_child(data.A[pi]) + S * qdd + cross_motion(data.V[ui], S * qd);
     body_force(i);
   }
+  data.tau.setZero();
   for (int i = nb - 1; i > 0; --i) {
     const auto ui = static_cast<size_t>(i);
     const Body& b = model.body(i);
     const Pose& X = data.Xup[ui];
     const Vector6& f = data.F[ui];
-    data.tau(5 + i) = b.joint.type == JointType::Revolute ? b.joint.axis.dot(f.tail<3>())
-                                                          : b.joint.axis.dot(f.head<3>());
+    // a coordinate that drives several joints (mimics) gets the sum: tau = T^T tau_full
+    data.tau(6 + b.coord) += b.multiplier * (b.joint.type == JointType::Revolute ? b.joint.axis.dot(f.tail<3>())
+                                                                                  : b.joint.axis.dot(f.head<3>()));
     // force transform child -> parent: f_p = R f_c, n_p = R n_c + p x (R f_c)
     const Vector3 fp = X.R * f.head<3>();
     data.F[static_cast<size_t>(b.parent)].head<3>() += fp;

@@ -1,10 +1,14 @@
 // ffsr/io/urdf.hpp -- URDF -> Model, through urdfdom. Link with ffsr::urdf.
 //
-// The root link is the free-floating base. Revolute, continuous and prismatic joints move; fixed
-// joints merge their child's inertia into the parent body and keep the child as a named frame.
-// Joint order: depth-first from the root, siblings in the order of their <joint> elements in the
-// file. The loader validates rather than repairs; every error is a ModelError naming the file and
-// the element.
+// The root link is the free-floating base, or (UrdfOptions::bus) the URDF is mounted on a
+// spacecraft bus that becomes the base, its root link and every link fixed to it merged into the bus.
+// Revolute, continuous and prismatic joints move; fixed joints merge their child's inertia into the
+// parent body and keep the child as a named frame; mimic joints follow their leader (model.hpp);
+// locked joints (UrdfOptions::locks) are fixed at a value. Joint order: depth-first from the root,
+// siblings in the order of their <joint> elements in the file. The loader validates rather than
+// repairs unless asked (UrdfOptions::inertia_repair, min_mass, min_inertia), and reports every repair
+// in UrdfReport; every error is a ModelError (or an InputError for a bad option) naming the file and
+// the element, or the option.
 #pragma once
 
 #include "ffsr/model/model.hpp"
@@ -17,10 +21,63 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <set>
 #include <sstream>
 
 namespace ffsr {
+
+/// A spacecraft bus to mount the URDF on (the keys bus-mass, bus-inertia, bus-com, mount-xyz,
+/// mount-rpy-deg of the command). The bus frame is the free-floating base frame.
+struct Bus {
+  std::string name = "bus";
+  double mass = 0.0;                  ///< kg, > 0
+  Matrix3 inertia = Matrix3::Zero();  ///< about the bus centre of mass, bus frame
+  Vector3 com = Vector3::Zero();      ///< bus centre of mass in the bus frame
+  Pose mount;                         ///< pose of the URDF's root link in the bus frame
+};
+
+enum class InertiaRepair { None, Balance };
+
+/// How a URDF is turned into a Model.
+struct UrdfOptions {
+  std::string end_effector;                        ///< link name; empty: the single leaf link
+  std::optional<Vector3> end_effector_offset;      ///< contact point in the end-effector frame
+  std::optional<Bus> bus;                          ///< mount the robot on a bus
+  std::vector<std::pair<std::string, double>> locks;  ///< joint name, value (rad or m)
+  /// Balance: raise the two smaller principal moments of a link just enough (by half the deficit
+  /// each) that the largest equals their sum (the triangle inequality; cf. MuJoCo's balanceinertia).
+  InertiaRepair inertia_repair = InertiaRepair::None;
+  double min_mass = 0.0;     ///< links with an <inertial> lighter than this get this mass (boundmass)
+  double min_inertia = 0.0;  ///< principal moments below this are raised to it (boundinertia)
+};
+
+/// One change the loader made to a link's inertial values. `before` and `after` are the mass (one
+/// number) or the principal moments (three, ascending).
+struct ModelRepair {
+  std::string link, what;
+  std::vector<double> before, after;
+};
+
+/// What the loader did to the file, for `inspect` and the JSON output.
+struct UrdfReport {
+  std::vector<std::string> merged_links;  ///< links merged into the base (bus) body
+  struct Mimic {
+    std::string joint, leader;
+    double multiplier, offset;
+  };
+  std::vector<Mimic> mimics;                            ///< resolved to independent leaders
+  std::vector<std::pair<std::string, double>> locked;  ///< every joint fixed at a value (with followers)
+  std::vector<ModelRepair> repairs;
+};
+
+inline const char* inertia_repair_name(InertiaRepair r) { return r == InertiaRepair::Balance ? "balance" : "none"; }
+/// "none" or "balance"; throws InputError naming the option otherwise.
+inline InertiaRepair parse_inertia_repair(const std::string& s) {
+  if (s == "none") return InertiaRepair::None;
+  if (s == "balance") return InertiaRepair::Balance;
+  throw InputError(detail::str("inertia-repair: unknown mode '", s, "'; expected 'none' or 'balance'"));
+}
 namespace detail {
 
 /// Throws ModelError unless `xml` is well-formed UTF-8 without NUL bytes. TinyXML (under urdfdom)
@@ -82,6 +139,42 @@ inline Inertia urdf_inertia(const urdf::Link& link) {
   in.com = origin.p;
   in.I = origin.R * I * origin.R.transpose();
   return in;
+}
+
+/// Applies the repairs of `o` to the inertia of `link` and records each one. Principal moments are
+/// changed in the principal axes, which stay. Reads o.min_mass, o.min_inertia, o.inertia_repair.
+inline Inertia repaired_inertia(const Inertia& in, const std::string& link, const UrdfOptions& o,
+                                std::vector<ModelRepair>& repairs) {
+  Inertia out = in;
+  if (!in.I.allFinite() || !std::isfinite(in.mass)) return out;  // validation reports it
+  if (o.min_mass > 0 && out.mass >= 0 && out.mass < o.min_mass) {  // a negative mass stays an error
+    repairs.push_back({link, "mass raised to min-mass", {out.mass}, {o.min_mass}});
+    out.mass = o.min_mass;
+  }
+  const Matrix3 Isym = 0.5 * (in.I + in.I.transpose());
+  Eigen::SelfAdjointEigenSolver<Matrix3> es(Isym);
+  Vector3 e = es.eigenvalues();  // ascending
+  const Vector3 before = e;
+  if (o.min_inertia > 0 && e.minCoeff() < o.min_inertia) {
+    for (int k = 0; k < 3; ++k) e(k) = std::max(e(k), o.min_inertia);
+    repairs.push_back({link, "principal moments raised to min-inertia", {before(0), before(1), before(2)}, {e(0), e(1), e(2)}});
+  }
+  const double tol = 1e-9 * std::max(1.0, e.cwiseAbs().maxCoeff());  // validate_inertia's tolerance
+  if (o.inertia_repair == InertiaRepair::Balance && e(2) > e(0) + e(1) + tol) {
+    const Vector3 b = e;
+    const double deficit = e(2) - e(0) - e(1);
+    e(0) += 0.5 * deficit;
+    e(1) += 0.5 * deficit;
+    repairs.push_back({link, "principal moments balanced (triangle inequality)", {b(0), b(1), b(2)}, {e(0), e(1), e(2)}});
+  }
+  if (e != before) out.I = es.eigenvectors() * e.asDiagonal() * es.eigenvectors().transpose();
+  return out;
+}
+
+/// The pose of a joint's child frame in its parent link frame with the joint at q (a locked joint).
+inline Pose joint_pose_at(const Pose& origin, bool revolute, const Vector3& axis, double q) {
+  const Vector3 a = axis.normalized();
+  return origin * (revolute ? Pose{Vector3::Zero(), rotation_about(a, q)} : Pose{a * q, Matrix3::Identity()});
 }
 
 /// Order of the <joint> elements in the document (urdfdom keeps joints in a map by name).
@@ -157,10 +250,11 @@ inline void reject_joint_loops(const std::string& xml, const std::string& source
 
 }  // namespace detail
 
-/// Builds a Model from URDF text. `source` names the file in error messages. `end_effector` names
-/// the end-effector frame (a link name); empty means the single leaf link.
-inline Model model_from_urdf_string(const std::string& xml, const std::string& source = "<string>",
-                                    const std::string& end_effector = "") {
+/// Builds a Model from URDF text with the options `opt` (bus, mimic, locks, repairs, end-effector).
+/// `source` names the file in error messages. Fills `report` (when given) with what was done to the
+/// file: links merged into the bus, mimic and locked joints, inertia repairs. Never prints.
+inline Model model_from_urdf_string(const std::string& xml, const std::string& source, const UrdfOptions& opt,
+                                    UrdfReport* report = nullptr) {
   using detail::str;
   detail::require_utf8(xml, source);
   urdf::ModelInterfaceSharedPtr urdf;
@@ -211,11 +305,80 @@ inline Model model_from_urdf_string(const std::string& xml, const std::string& s
   };
 
   try {
-    ModelBuilder builder(root->name, detail::urdf_inertia(*root));
-    builder.set_source(source);
-    if (root->inertial && root->inertial->mass <= 0)
-      throw ModelError(str("base link '", root->name, "': mass must be positive, got ", root->inertial->mass));
-    if (!root->inertial) throw ModelError(str("base link '", root->name, "': has no <inertial> (the base needs a mass)"));
+    UrdfReport rep;
+    // --- locked joints: each names a moving joint, once, with a value inside its limits -------------
+    std::map<std::string, double> locked;
+    for (const auto& [name, value] : opt.locks) {
+      const auto it = urdf->joints_.find(name);
+      if (it == urdf->joints_.end()) {
+        std::string list;
+        for (const auto& jp : urdf->joints_)
+          if (jp.second->type != urdf::Joint::FIXED) list += (list.empty() ? "" : ", ") + jp.first;
+        throw InputError(str("lock-joints: unknown joint '", name, "'; the moving joints are: ", list));
+      }
+      const urdf::Joint& j = *it->second;
+      if (j.type == urdf::Joint::FIXED) throw InputError(str("lock-joints: joint '", name, "' is a fixed joint already"));
+      if (j.type != urdf::Joint::REVOLUTE && j.type != urdf::Joint::PRISMATIC && j.type != urdf::Joint::CONTINUOUS)
+        throw InputError(str("lock-joints: joint '", name, "' is not revolute, continuous or prismatic"));
+      if (!std::isfinite(value)) throw InputError(str("lock-joints: joint '", name, "': the value must be finite"));
+      if (j.type != urdf::Joint::CONTINUOUS && j.limits && !(j.limits->lower == 0.0 && j.limits->upper == 0.0) &&
+          (value < j.limits->lower || value > j.limits->upper))
+        throw InputError(str("lock-joints: '", name, "=", value, "' is outside the joint's limits [", j.limits->lower, ", ",
+                             j.limits->upper, "]"));
+      if (!locked.emplace(name, value).second) throw InputError(str("lock-joints: joint '", name, "' is locked twice"));
+    }
+    // The value a joint is locked at: its own, or through its mimic leaders (q_f = m q_l + o).
+    auto lock_value = [&](const urdf::Joint& j) -> std::optional<double> {
+      const urdf::Joint* cur = &j;
+      double mult = 1.0, off = 0.0;
+      for (size_t depth = 0; depth <= urdf->joints_.size(); ++depth) {
+        const auto it = locked.find(cur->name);
+        if (it != locked.end()) return mult * it->second + off;
+        if (!cur->mimic) return std::nullopt;
+        const auto lt = urdf->joints_.find(cur->mimic->joint_name);
+        if (lt == urdf->joints_.end()) return std::nullopt;  // unknown leader: ModelBuilder::build reports it
+        off += mult * cur->mimic->offset;
+        mult *= cur->mimic->multiplier;
+        cur = lt->second.get();
+      }
+      return std::nullopt;  // a mimic loop: ModelBuilder::build reports it
+    };
+    // --- inertias, repaired when asked, validated with a hint at the options --------------------------
+    auto link_inertia = [&](const urdf::Link& l) {
+      Inertia in = detail::urdf_inertia(l);
+      if (l.inertial) in = detail::repaired_inertia(in, l.name, opt, rep.repairs);
+      try {
+        validate_inertia(in, "link '" + l.name + "'", false);
+      } catch (const ModelError& e) {
+        throw ModelError(str(e.what(), " (to load the file as it is: inertia-repair = \"balance\", min-mass, min-inertia)"));
+      }
+      return in;
+    };
+    // --- the base: the bus with the root mounted on it, or the root link itself -----------------------
+    std::optional<ModelBuilder> builder;
+    const Inertia root_inertia = link_inertia(*root);
+    if (opt.bus) {
+      const Bus& bus = *opt.bus;
+      if (!std::isfinite(bus.mass) || bus.mass <= 0)
+        throw InputError(str("bus-mass: must be positive and finite, got ", bus.mass));
+      if (!bus.com.allFinite()) throw InputError("bus-com: values must be finite");
+      if (!bus.mount.p.allFinite() || !bus.mount.R.allFinite())
+        throw InputError("mount-xyz/mount-rpy-deg: values must be finite");
+      try {
+        validate_inertia({bus.mass, bus.com, bus.inertia}, "the bus", true);
+      } catch (const ModelError& e) {
+        throw InputError(str("bus-inertia: ", e.what()));
+      }
+      builder.emplace(bus.name, Inertia{bus.mass, bus.com, bus.inertia});
+      builder->add_fixed("mount", bus.name, bus.mount, root->name, root_inertia);
+    } else {
+      const char* hint = "; to mount the arm on a spacecraft bus give bus-mass, bus-inertia, bus-com, mount-xyz, mount-rpy-deg";
+      if (!root->inertial) throw ModelError(str("base link '", root->name, "': has no <inertial> (the base needs a mass", hint, ")"));
+      if (root->inertial->mass <= 0)
+        throw ModelError(str("base link '", root->name, "': mass must be positive, got ", root->inertial->mass, hint));
+      builder.emplace(root->name, root_inertia);
+    }
+    builder->set_source(source);
     std::set<std::string> visited{root->name};
     std::vector<urdf::LinkConstSharedPtr> stack{root};
     while (!stack.empty()) {
@@ -228,32 +391,45 @@ inline Model model_from_urdf_string(const std::string& xml, const std::string& s
       const urdf::JointConstSharedPtr j = link->parent_joint;
       if (!j) throw ModelError(str("link '", link->name, "' has no parent joint"));
       if (!visited.insert(link->name).second) throw ModelError(str("link '", link->name, "' is reached twice (closed loop)"));
-      if (j->mimic) throw ModelError(str("joint '", j->name, "': mimic joints are not supported"));
       const Pose origin = detail::urdf_pose(j->parent_to_joint_origin_transform);
-      const Inertia inertia = detail::urdf_inertia(*link);
+      const Inertia inertia = link_inertia(*link);
       const Vector3 axis(j->axis.x, j->axis.y, j->axis.z);
+      const bool moving = j->type == urdf::Joint::REVOLUTE || j->type == urdf::Joint::PRISMATIC ||
+                          j->type == urdf::Joint::CONTINUOUS;
+      if (moving) {
+        if (const std::optional<double> q = lock_value(*j)) {  // locked: a fixed joint at q
+          if (!axis.allFinite() || axis.norm() < 1e-12)
+            throw ModelError(str("joint '", j->name, "': axis must be a finite non-zero vector"));
+          builder->add_fixed(j->name, j->parent_link_name,
+                             detail::joint_pose_at(origin, j->type != urdf::Joint::PRISMATIC, axis, *q), link->name,
+                             inertia);
+          rep.locked.emplace_back(j->name, *q);
+          continue;
+        }
+      }
       switch (j->type) {
         case urdf::Joint::FIXED:
-          builder.add_fixed(j->name, j->parent_link_name, origin, link->name, inertia);
+          builder->add_fixed(j->name, j->parent_link_name, origin, link->name, inertia);
           break;
         case urdf::Joint::REVOLUTE:
         case urdf::Joint::PRISMATIC: {
           if (!j->limits) throw ModelError(str("joint '", j->name, "': a revolute or prismatic joint needs <limit>"));
           const double lo = j->limits->lower, hi = j->limits->upper;
           const bool unlimited = lo == 0.0 && hi == 0.0;  // URDF's default when lower/upper are omitted
-          builder.add_joint(j->name, j->type == urdf::Joint::REVOLUTE ? JointType::Revolute : JointType::Prismatic,
-                            j->parent_link_name, origin, axis, link->name, inertia,
-                            unlimited ? -std::numeric_limits<double>::infinity() : lo,
-                            unlimited ? std::numeric_limits<double>::infinity() : hi);
+          builder->add_joint(j->name, j->type == urdf::Joint::REVOLUTE ? JointType::Revolute : JointType::Prismatic,
+                             j->parent_link_name, origin, axis, link->name, inertia,
+                             unlimited ? -std::numeric_limits<double>::infinity() : lo,
+                             unlimited ? std::numeric_limits<double>::infinity() : hi);
           break;
         }
         case urdf::Joint::CONTINUOUS:
-          builder.add_joint(j->name, JointType::Revolute, j->parent_link_name, origin, axis, link->name, inertia);
+          builder->add_joint(j->name, JointType::Revolute, j->parent_link_name, origin, axis, link->name, inertia);
           break;
         default:
           throw ModelError(str("joint '", j->name, "': unsupported joint type (only revolute, continuous, prismatic "
                                "and fixed are supported)"));
       }
+      if (moving && j->mimic) builder->set_mimic(j->name, j->mimic->joint_name, j->mimic->multiplier, j->mimic->offset);
     }
     if (visited.size() != urdf->links_.size()) {
       std::string orphans;
@@ -261,8 +437,21 @@ inline Model model_from_urdf_string(const std::string& xml, const std::string& s
         if (!visited.count(l.first)) orphans += (orphans.empty() ? "" : ", ") + l.first;
       throw ModelError(str("links not connected to the root '", root->name, "': ", orphans));
     }
-    if (!end_effector.empty()) builder.set_end_effector(end_effector);
-    return builder.build();
+    if (!opt.end_effector.empty()) builder->set_end_effector(opt.end_effector);
+    if (opt.end_effector_offset) {
+      if (!opt.end_effector_offset->allFinite()) throw InputError("end-effector-offset: expected 3 finite numbers");
+      builder->set_end_effector_offset(*opt.end_effector_offset);
+    }
+    Model model = builder->build();
+    if (report) {
+      for (const auto& f : model.frames())
+        if (f.body == 0 && f.name != model.body(0).name && f.name != model.frame(model.end_effector()).name)
+          rep.merged_links.push_back(f.name);
+      for (const auto& b : model.bodies())
+        if (!b.leader.empty()) rep.mimics.push_back({b.joint.name, b.leader, b.multiplier, b.offset});
+      *report = std::move(rep);
+    }
+    return model;
   } catch (const ModelError& e) {
     throw ModelError(str(source, ": ", e.what()));
   } catch (const InputError& e) {
@@ -270,8 +459,17 @@ inline Model model_from_urdf_string(const std::string& xml, const std::string& s
   }
 }
 
-/// Builds a Model from a URDF file (see model_from_urdf_string).
-inline Model model_from_urdf_file(const std::string& path, const std::string& end_effector = "") {
+/// Builds a Model from URDF text. `source` names the file in error messages. `end_effector` names
+/// the end-effector frame (a link name); empty means the single leaf link.
+inline Model model_from_urdf_string(const std::string& xml, const std::string& source = "<string>",
+                                    const std::string& end_effector = "") {
+  UrdfOptions opt;
+  opt.end_effector = end_effector;
+  return model_from_urdf_string(xml, source, opt);
+}
+
+/// Builds a Model from a URDF file with options (see model_from_urdf_string).
+inline Model model_from_urdf_file(const std::string& path, const UrdfOptions& opt, UrdfReport* report = nullptr) {
   // Only regular files of a sane size: /dev/zero or a FIFO would be read forever.
   std::error_code ec;
   const auto status = std::filesystem::status(path, ec);
@@ -285,7 +483,14 @@ inline Model model_from_urdf_file(const std::string& path, const std::string& en
   std::ostringstream ss;
   ss << in.rdbuf();
   if (in.bad()) throw ModelError(detail::str(path, ": cannot read the URDF file"));
-  return model_from_urdf_string(ss.str(), path, end_effector);
+  return model_from_urdf_string(ss.str(), path, opt, report);
+}
+
+/// Builds a Model from a URDF file (see model_from_urdf_string).
+inline Model model_from_urdf_file(const std::string& path, const std::string& end_effector = "") {
+  UrdfOptions opt;
+  opt.end_effector = end_effector;
+  return model_from_urdf_file(path, opt);
 }
 
 }  // namespace ffsr

@@ -13,28 +13,28 @@ namespace ffsr {
 
 struct Data {
   explicit Data(const Model& model)
-      : R(static_cast<size_t>(model.n() + 1)),
-        p(static_cast<size_t>(model.n() + 1)),
-        S(6, model.n()),
-        Ic(static_cast<size_t>(model.n() + 1)),
+      : R(static_cast<size_t>(model.nb())),
+        p(static_cast<size_t>(model.nb())),
+        S(6, model.nb() - 1),
+        Ic(static_cast<size_t>(model.nb())),
         H(model.nv(), model.nv()),
         L(model.nv(), model.nv()),
         J(6, model.nv()),
         Jf(6, model.n()),
         w(model.nv()),
         y(model.nv()),
-        V(static_cast<size_t>(model.n() + 1)),
-        A(static_cast<size_t>(model.n() + 1)),
-        F(static_cast<size_t>(model.n() + 1)),
-        Xup(static_cast<size_t>(model.n() + 1)),
+        V(static_cast<size_t>(model.nb())),
+        A(static_cast<size_t>(model.nb())),
+        F(static_cast<size_t>(model.nb())),
+        Xup(static_cast<size_t>(model.nb())),
         tau(model.nv()),
         HbInv_Hbm(6, model.n()),
-        IA(static_cast<size_t>(model.n() + 1)),
-        pA(static_cast<size_t>(model.n() + 1)),
-        U(static_cast<size_t>(model.n() + 1)),
+        IA(static_cast<size_t>(model.nb())),
+        pA(static_cast<size_t>(model.nb())),
+        U(static_cast<size_t>(model.nb())),
         D(model.n()),
         u(model.n()),
-        path(static_cast<size_t>(model.n() + 1)) {
+        path(static_cast<size_t>(model.nb())) {
     S.setZero();
     H.setZero();
     L.setZero();

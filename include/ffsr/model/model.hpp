@@ -3,9 +3,15 @@
 // Coordinates (the one place they are fixed; see also README "Conventions"):
 //  - Configuration: the base pose (position of the base link frame origin and its attitude,
 //    both in the inertial frame o) and the joint positions theta (radians or metres), one per
-//    moving joint, in model order: for a URDF, depth-first from the base with siblings in the order
-//    of their <joint> elements in the file; for a ModelBuilder, the order the joints were added
-//    (every parent before its children).
+//    independent moving joint (a coordinate), in model order: for a URDF, depth-first from the base
+//    with siblings in the order of their <joint> elements in the file; for a ModelBuilder, the order
+//    the joints were added (every parent before its children).
+//  - Mimic joints: a follower joint moves as q_f = multiplier * theta_c + offset with theta_c the
+//    coordinate of its (resolved) leader. It is a body of the tree but no coordinate: n() counts
+//    coordinates, nb() bodies. Every algorithm maps body i to its coordinate body(i).coord and
+//    takes the motion subspace of body i per unit rate of that coordinate (S_i * multiplier), so a
+//    coordinate that drives several joints gets the sum of their contributions (H = T^T H_full T for
+//    the constant map q_full = T theta + c).
 //  - Generalized velocity (6+n): [v0, w0, theta_dot] with v0 the linear velocity of the base
 //    link frame origin and w0 the angular velocity of the base, both in the inertial frame.
 //  - Generalized acceleration: the time derivative of that vector.
@@ -64,6 +70,14 @@ struct Body {
   Joint joint;          ///< the joint from the parent (unused for the base)
   Pose tree;            ///< joint frame in the parent body frame at zero joint position
   Inertia inertia;      ///< in this body's frame, fixed-joint children merged in
+  int coord = -1;           ///< the coordinate (index into theta) that drives the joint (-1 for the base)
+  double multiplier = 1.0;  ///< joint position = multiplier * theta(coord) + offset (1, 0 unless a mimic)
+  double offset = 0.0;
+  std::string leader;       ///< the joint this one mimics, resolved to an independent joint ("" if none)
+  /// The joint position of this body for the coordinates theta.
+  double joint_position(const Eigen::Ref<const Eigen::VectorXd>& theta) const {
+    return multiplier * theta(coord) + offset;
+  }
 };
 
 /// A named frame rigidly attached to a body (every link, including those merged by fixed joints).
@@ -101,8 +115,14 @@ class ModelBuilder;
 /// A free-floating multibody tree. Constant after it is built (see ModelBuilder).
 class Model {
  public:
-  /// Number of moving joints n (the joint-space dimension).
-  int n() const { return static_cast<int>(bodies_.size()) - 1; }
+  /// Number of coordinates n (independent moving joints; the joint-space dimension).
+  int n() const { return static_cast<int>(coord_body_.size()); }
+  /// Number of bodies, the base included (n() + 1 unless there are mimic joints).
+  int nb() const { return static_cast<int>(bodies_.size()); }
+  /// The body whose joint is coordinate k (the leader of its mimics).
+  int coordinate_body(int k) const { return coord_body_[static_cast<size_t>(k)]; }
+  /// The joint of coordinate k (name, type, limits).
+  const Joint& joint(int k) const { return body(coordinate_body(k)).joint; }
   /// Dimension of the generalized velocity, 6 + n.
   int nv() const { return n() + 6; }
   const std::vector<Body>& bodies() const { return bodies_; }
@@ -119,9 +139,10 @@ class Model {
   }
   /// The default end-effector frame (the single leaf, or the one set by the builder).
   int end_effector() const { return end_effector_; }
+  /// The names of the coordinates' joints, in coordinate order.
   std::vector<std::string> joint_names() const {
     std::vector<std::string> names;
-    for (size_t i = 1; i < bodies_.size(); ++i) names.push_back(bodies_[i].joint.name);
+    for (int b : coord_body_) names.push_back(body(b).joint.name);
     return names;
   }
   double total_mass() const {
@@ -138,6 +159,7 @@ class Model {
   friend class ModelBuilder;
   std::vector<Body> bodies_;
   std::vector<Frame> frames_;
+  std::vector<int> coord_body_;
   int end_effector_ = -1;
 };
 
@@ -207,12 +229,33 @@ class ModelBuilder {
     return *this;
   }
 
+  /// Puts the contact point at `xyz` in the end-effector frame (where the fingers close rather than
+  /// at a link origin): build() adds the frame "<end-effector>_contact" there, on the same body, and
+  /// makes it the end-effector, so every quantity of the end-effector (J_f, m_e, M_ie) uses it.
+  ModelBuilder& set_end_effector_offset(const Vector3& xyz) {
+    if (!xyz.allFinite()) throw InputError("end-effector-offset: expected 3 finite numbers");
+    ee_offset_ = xyz;
+    has_ee_offset_ = true;
+    return *this;
+  }
+
+  /// Makes the moving joint `follower` a mimic of `leader`: q_follower = multiplier * q_leader + offset
+  /// (URDF <mimic>). The follower is then no coordinate of its own. Leaders may themselves be mimics
+  /// (chains resolve in build()); the joints may be added before or after this call.
+  ModelBuilder& set_mimic(const std::string& follower, const std::string& leader, double multiplier, double offset) {
+    if (!std::isfinite(multiplier) || !std::isfinite(offset))
+      throw ModelError(detail::str("mimic joint '", follower, "': multiplier and offset must be finite"));
+    mimic_.push_back({follower, leader, multiplier, offset});
+    return *this;
+  }
+
   /// Validates the tree and returns the model. Throws ModelError (moving link without mass,
   /// no joint) or InputError (unknown or ambiguous end-effector).
   Model build() const {
     using detail::str;
     Model m = model_;
-    if (m.n() < 1) throw ModelError("the robot has no moving joint");
+    if (m.nb() < 2) throw ModelError("the robot has no moving joint");
+    resolve_mimics(m);
     validate_inertia(m.bodies_[0].inertia, "base link '" + m.bodies_[0].name + "'", true);
     for (int i = 1; i <= m.n(); ++i)
       validate_inertia(m.body(i).inertia, "link '" + m.body(i).name + "' (moving)", true);
@@ -227,6 +270,14 @@ class ModelBuilder {
                              " leaf links (", list, "); name one"));
       }
       m.end_effector_ = m.frame_index(leaves.front());
+    }
+    if (has_ee_offset_) {
+      const Frame ee = m.frames_[static_cast<size_t>(m.end_effector_)];
+      const std::string name = ee.name + "_contact";
+      for (const auto& f : m.frames_)
+        if (f.name == name) throw ModelError(str("end-effector-offset: a frame '", name, "' already exists"));
+      m.frames_.push_back({name, ee.body, ee.pose * Pose{ee_offset_, Matrix3::Identity()}});
+      m.end_effector_ = static_cast<int>(m.frames_.size()) - 1;
     }
     return m;
   }
@@ -285,6 +336,65 @@ class ModelBuilder {
       if (model_.frames_[i].name == name) return static_cast<int>(i);
     return -1;
   }
+  /// Resolves the mimic chains to independent joints and numbers the coordinates: every joint that
+  /// mimics no other is a coordinate, in body order; a follower takes its resolved leader's
+  /// coordinate with the composed multiplier and offset. O(bodies * chain length).
+  void resolve_mimics(Model& m) const {
+    using detail::str;
+    auto body_of = [&m](const std::string& joint) {
+      for (int i = 1; i < m.nb(); ++i)
+        if (m.bodies_[static_cast<size_t>(i)].joint.name == joint) return i;
+      return -1;
+    };
+    auto spec_of = [this](const std::string& joint) -> const MimicSpec* {
+      for (const auto& s : mimic_)
+        if (s.follower == joint) return &s;
+      return nullptr;
+    };
+    for (const auto& s : mimic_)
+      if (body_of(s.follower) < 0) throw ModelError(str("mimic joint '", s.follower, "': not a moving joint of the model"));
+    for (int i = 1; i < m.nb(); ++i) {
+      Body& b = m.bodies_[static_cast<size_t>(i)];
+      std::vector<std::string> chain{b.joint.name};
+      double mult = 1.0, off = 0.0;
+      for (const MimicSpec* s = spec_of(b.joint.name); s; s = spec_of(chain.back())) {
+        if (body_of(s->leader) < 0)
+          throw ModelError(str("mimic joint '", s->follower, "': its leader '", s->leader,
+                               "' is not a moving joint of the model"));
+        off += mult * s->offset;  // q_f = mult * (m q_l + o) + off
+        mult *= s->multiplier;
+        for (const auto& c : chain)
+          if (c == s->leader) {
+            std::string loop;
+            for (const auto& x : chain) loop += "'" + x + "' -> ";
+            throw ModelError(str("mimic joints form a loop: ", loop, "'", s->leader, "'"));
+          }
+        chain.push_back(s->leader);
+      }
+      b.multiplier = mult;
+      b.offset = off;
+      b.leader = chain.size() > 1 ? chain.back() : std::string();
+    }
+    m.coord_body_.clear();
+    for (int i = 1; i < m.nb(); ++i) {
+      Body& b = m.bodies_[static_cast<size_t>(i)];
+      if (b.leader.empty()) {
+        b.coord = m.n();
+        m.coord_body_.push_back(i);
+      }
+    }
+    for (int i = 1; i < m.nb(); ++i) {
+      Body& b = m.bodies_[static_cast<size_t>(i)];
+      if (!b.leader.empty()) b.coord = m.bodies_[static_cast<size_t>(body_of(b.leader))].coord;
+    }
+  }
+  struct MimicSpec {
+    std::string follower, leader;
+    double multiplier, offset;
+  };
+  std::vector<MimicSpec> mimic_;
+  Vector3 ee_offset_ = Vector3::Zero();
+  bool has_ee_offset_ = false;
   Model model_;
   std::vector<int> frame_parent_{-1};  ///< for each frame, the frame it hangs on (-1 for the base)
   std::string ee_name_;

@@ -289,7 +289,7 @@ struct GradientPolicy {
     }
     // joint limits: repulsive gradient inside 10 % of the range
     for (int k = 0; k < n; ++k) {
-      const Joint& j = model.body(k + 1).joint;
+      const Joint& j = model.joint(k);
       if (!(std::isfinite(j.lower) && std::isfinite(j.upper))) continue;
       const double margin = 0.1 * (j.upper - j.lower), q = theta(k);
       const double scale = grad.cwiseAbs().maxCoeff() + 1.0;
@@ -319,7 +319,7 @@ struct ServoPolicy {
                   const Eigen::VectorXd& theta, const Eigen::MatrixXd& Nproj, Eigen::VectorXd& qd_null) {
     err = theta_goal - theta;
     for (int k = 0; k < model.n(); ++k) {
-      const Joint& j = model.body(k + 1).joint;
+      const Joint& j = model.joint(k);
       if (!std::isfinite(j.lower) && !std::isfinite(j.upper)) err(k) = std::remainder(err(k), 2 * M_PI);
     }
     const double k_s = gain > 0 ? gain : 10.0 / s.line.duration;
@@ -498,7 +498,7 @@ CaptureResult integrate_capture(const CaptureProblem& pb, const CaptureTask& tas
     if (!theta.allFinite() || !base.position.allFinite())
       throw NumericalError(str(where, ": the state became non-finite at t = ", t + h, " s"));
     for (int j = 0; j < n; ++j) {
-      const Joint& jt = model.body(j + 1).joint;
+      const Joint& jt = model.joint(j);
       if (theta(j) < jt.lower - 1e-9 || theta(j) > jt.upper + 1e-9)
         throw NumericalError(str(where, ": joint '", jt.name, "' left its limits [", jt.lower, ", ", jt.upper,
                                  "] rad at t = ", t + h, " s (", theta(j), " rad)"));

@@ -113,7 +113,7 @@ inline double unit_uniform(std::mt19937_64& rng) { return static_cast<double>(rn
 
 inline bool within_limits(const Model& model, const Eigen::VectorXd& theta) {
   for (int k = 0; k < model.n(); ++k) {
-    const Joint& j = model.body(k + 1).joint;
+    const Joint& j = model.joint(k);
     if (theta(k) < j.lower - 1e-12 || theta(k) > j.upper + 1e-12) return false;
   }
   return true;
@@ -156,7 +156,7 @@ inline bool project_to_manifold(const Model& model, Data& data, const CapturePro
 inline double configuration_distance(const Model& model, const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
   double d = 0;
   for (int k = 0; k < model.n(); ++k) {
-    const Joint& j = model.body(k + 1).joint;
+    const Joint& j = model.joint(k);
     double x = a(k) - b(k);
     if (!std::isfinite(j.lower) && !std::isfinite(j.upper)) x = std::remainder(x, 2 * M_PI);
     d = std::max(d, std::abs(x));
@@ -265,7 +265,7 @@ inline ManifoldSearchResult detail::search_manifold(const CaptureProblem& pb, co
   for (int i = 0; i < random_starts; ++i) {
     Eigen::VectorXd q(n);
     for (int k = 0; k < n; ++k) {
-      const Joint& j = model.body(k + 1).joint;
+      const Joint& j = model.joint(k);
       const double lo = std::isfinite(j.lower) ? j.lower : -M_PI, hi = std::isfinite(j.upper) ? j.upper : M_PI;
       q(k) = lo + (hi - lo) * detail::unit_uniform(rng);
     }
@@ -281,8 +281,8 @@ inline ManifoldSearchResult detail::search_manifold(const CaptureProblem& pb, co
                                  std::vector<double>(static_cast<size_t>(m), so.constraint_tolerance * 0.1));
   std::vector<double> lb(static_cast<size_t>(n)), ub(static_cast<size_t>(n));
   for (int k = 0; k < n; ++k) {
-    lb[static_cast<size_t>(k)] = model.body(k + 1).joint.lower;
-    ub[static_cast<size_t>(k)] = model.body(k + 1).joint.upper;
+    lb[static_cast<size_t>(k)] = model.joint(k).lower;
+    ub[static_cast<size_t>(k)] = model.joint(k).upper;
   }
   local.set_lower_bounds(lb);
   local.set_upper_bounds(ub);
