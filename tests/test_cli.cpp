@@ -322,15 +322,17 @@ void check_series_csv(const std::string& path, size_t n_joints) {
     CHECK(c.column(col) >= 0);
   }
   CHECK(c.header.size() == 2 + n_joints + 7 + 3 + 2);
-  size_t baseline = 0, optimized = 0;
+  size_t baseline = 0, optimized = 0, global = 0;
   for (const auto& row : c.rows) {
     REQUIRE(row.size() == c.header.size());
     if (row[0] == "baseline") ++baseline;
     if (row[0] == "optimized") ++optimized;
+    if (row[0] == "global") ++global;
   }
   CHECK(baseline > 10);
   CHECK(optimized > 10);
-  CHECK(baseline + optimized == c.rows.size());
+  CHECK(global > 10);  // the global run (on by default) has its series too
+  CHECK(baseline + optimized + global == c.rows.size());
 }
 
 }  // namespace
