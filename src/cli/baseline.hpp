@@ -31,7 +31,8 @@ struct Tolerance {
 /// difference, "path: stored X, now Y" (path like optimized.capture_configuration_deg[1]; numbers
 /// in their shortest round-trip form). A key present on one side only, an array of another length,
 /// a changed string or boolean and a change of type are differences too. Top-level keys listed in
-/// `skip` (inputs such as the resolved scenario and the version, not results) are not compared.
+/// `skip` (inputs such as the resolved scenario and the version, not results) are not compared, nor
+/// are keys named "seconds" at any depth (wall-clock times).
 std::vector<std::string> compare_results(const nlohmann::json& stored, const nlohmann::json& now, Tolerance tol,
                                          const std::vector<std::string>& skip);
 
@@ -40,6 +41,9 @@ namespace detail_baseline {
 
 using ffsr::detail::str;
 using nlohmann::json;
+
+/// Keys of this name (at any depth) hold wall-clock times, e.g. global.search.seconds: never compared.
+inline constexpr const char* kTimingKey = "seconds";
 
 inline std::string show(const json& v) {
   if (v.is_array()) return str("an array of ", v.size());
@@ -58,11 +62,12 @@ inline void compare(const json& a, const json& b, const std::string& path, Toler
   if (a.is_object() && b.is_object()) {
     const std::string prefix = path.empty() ? "" : path + ".";
     for (const auto& [key, value] : a.items()) {
+      if (key == kTimingKey) continue;  // a wall-clock time is not a result
       if (!b.contains(key)) out.push_back(str(prefix, key, ": stored ", show(value), ", now missing"));
       else compare(value, b.at(key), prefix + key, tol, out);
     }
     for (const auto& [key, value] : b.items())
-      if (!a.contains(key)) out.push_back(str(prefix, key, ": stored missing, now ", show(value)));
+      if (key != kTimingKey && !a.contains(key)) out.push_back(str(prefix, key, ": stored missing, now ", show(value)));
     return;
   }
   if (a.is_array() && b.is_array()) {

@@ -280,7 +280,10 @@ std::vector<plot::Figure> capture(const Model& model, int frame, const Target& t
   plot::Figure joints;
   joints.name = "joints";
   joints.title = "Capture process: joint angles";
-  joints.cols = static_cast<int>(std::max<size_t>(1, runs.size()));
+  // side by side for one or two runs; stacked for more (three columns leave the last panel, which
+  // carries the legend outside, too narrow a viewport: PLplot aborts)
+  joints.cols = runs.size() <= 2 ? static_cast<int>(std::max<size_t>(1, runs.size())) : 1;
+  joints.rows = runs.size() <= 2 ? 1 : static_cast<int>(runs.size());
   std::vector<Panel> joint_panels;
   double jmin = 1e300, jmax = -1e300;
   for (size_t r = 0; r < runs.size(); ++r) {
