@@ -433,7 +433,7 @@ TEST_CASE("expect: a result compared with itself passes, a moved value gives exi
     json moved = base;
     moved["baseline"]["capture_configuration_deg"][1] =
         base.at("baseline").at("capture_configuration_deg")[1].get<double>() + 0.5;
-    moved["global"] = {{"rows", 3}};                     // stored only
+    moved["no_such_run"] = {{"rows", 3}};                // stored only
     moved.erase("force_reduction_percent");              // now only
     moved["optimized"]["task"] = "pose";                 // a string
     moved["optimized"]["capture_point"] = {1.0, 2.0};    // another length
@@ -443,7 +443,7 @@ TEST_CASE("expect: a result compared with itself passes, a moved value gives exi
     CHECK(lines.size() == 5);
     const std::string all = r.err;
     CHECK(contains(all, "baseline.capture_configuration_deg[1]: stored "));
-    CHECK(contains(all, "global: stored an object of 1 keys, now missing"));
+    CHECK(contains(all, "no_such_run: stored an object of 1 keys, now missing"));
     CHECK(contains(all, "force_reduction_percent: stored missing, now "));
     CHECK(contains(all, "optimized.task: stored \"pose\", now \"position\""));
     CHECK(contains(all, "optimized.capture_point: stored 2 entries, now 3"));
