@@ -33,6 +33,11 @@ class NumericalError : public Error {
  public:
   using Error::Error;
 };
+/// A planned motion left a joint's URDF limits (a NumericalError: callers that catch those see it).
+class JointLimitError : public NumericalError {
+ public:
+  using NumericalError::NumericalError;
+};
 class IntegrationError : public Error {
  public:
   using Error::Error;

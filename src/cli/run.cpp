@@ -285,6 +285,7 @@ void add_global_json(nlohmann::json& j, const GlobalRun& g, const CaptureResult&
   x["optimality_gap_percent"] = r.optimality_gap_percent;
   x["shooting_iterations"] = r.shooting_iterations;
   x["goals_tried"] = r.goals_tried;
+  x["goals_out_of_limits"] = r.goals_out_of_limits;
   x["reached_manifold_optimum"] = r.reached_manifold_optimum;
   x["search"] = {{"method", r.search.method},
                  {"starts", r.search.starts},
@@ -315,7 +316,9 @@ void print_global_notes(std::ostream& out, const GlobalRun& g, const CaptureResu
   out << std::fixed << std::setprecision(3) << "global (" << o.objective << ", seed " << o.seed
       << "): reached " << r.objective / unit << u << ", manifold optimum at the reached base pose "
       << r.manifold_optimum / unit << u << " (gap " << r.optimality_gap_percent << " %), " << r.shooting_iterations
-      << " reaching run(s), " << r.goals_tried << " goal(s) tried; search: " << r.search.method << ", " << r.search.starts << " starts, "
+      << " reaching run(s), " << r.goals_tried << " goal(s) tried"
+      << (r.goals_out_of_limits > 0 ? " (" + std::to_string(r.goals_out_of_limits) + " behind a joint limit)" : "")
+      << "; search: " << r.search.method << ", " << r.search.starts << " starts, "
       << r.evaluations << " evaluations" << (mb ? ", " + std::to_string(r.objective_evaluations) + " CVODE runs" : "")
       << ", " << r.search_seconds << " s\n";
   if (!r.reached_manifold_optimum)

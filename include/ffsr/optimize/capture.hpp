@@ -500,7 +500,7 @@ CaptureResult integrate_capture(const CaptureProblem& pb, const CaptureTask& tas
     for (int j = 0; j < n; ++j) {
       const Joint& jt = model.joint(j);
       if (theta(j) < jt.lower - 1e-9 || theta(j) > jt.upper + 1e-9)
-        throw NumericalError(str(where, ": joint '", jt.name, "' left its limits [", jt.lower, ", ", jt.upper,
+        throw JointLimitError(str(where, ": joint '", jt.name, "' left its limits [", jt.lower, ", ", jt.upper,
                                  "] rad at t = ", t + h, " s (", theta(j), " rad)"));
     }
     ++res.steps;

@@ -368,6 +368,7 @@ struct GlobalCaptureResult {
   bool reached_manifold_optimum = true;
   int shooting_iterations = 0;       ///< reaching runs over every goal tried
   int goals_tried = 0;
+  int goals_out_of_limits = 0;       ///< goals given up because the way to them crosses a joint limit
   long evaluations = 0;              ///< over every search
   long objective_evaluations = 0;    ///< multibody simulations over every search
   double search_seconds = 0;         ///< over every search
@@ -383,6 +384,7 @@ struct GlobalCaptureResult {
 /// as measured. opt.gain is not used; opt.max_joint_rate limits the joint rates (0: not limited).
 /// Throws InputError for bad arguments (as plan_capture, plus a rate limit below what the task alone
 /// needs), NumericalError when a run fails the checks of integrate_capture or no goal is reached.
+/// A reaching run that would leave a joint's limits gives its goal up (goals_out_of_limits).
 inline GlobalCaptureResult plan_capture_global(const CaptureProblem& pb, const CaptureTask& task,
                                                const CaptureOptions& opt, const GlobalCaptureOptions& g) {
   using detail::str;
@@ -443,8 +445,14 @@ inline GlobalCaptureResult plan_capture_global(const CaptureProblem& pb, const C
       servo.theta_goal = goal;
       CaptureOptions run_opt = quiet;
       run_opt.record_series = opt.record_series;
-      CaptureResult run = integrate_capture(pb, task, run_opt, setup, servo, where);
       ++res.shooting_iterations;
+      CaptureResult run;
+      try {
+        run = integrate_capture(pb, task, run_opt, setup, servo, where);
+      } catch (const JointLimitError&) {
+        ++res.goals_out_of_limits;
+        break;  // the way to this goal crosses a joint limit: next goal
+      }
       const ManifoldPoint reached = evaluate_capture(pb, setup, run.base, run.theta, g.search.objective, g.search.multibody);
       if (g.search.objective == GlobalObjective::MultibodyForce) ++res.objective_evaluations;
       // the goal re-optimized locally at the reached base pose
@@ -488,13 +496,15 @@ inline GlobalCaptureResult plan_capture_global(const CaptureProblem& pb, const C
     // the counters of every goal tried, the run of the best reached one
     fallback->shooting_iterations = res.shooting_iterations;
     fallback->goals_tried = res.goals_tried;
+    fallback->goals_out_of_limits = res.goals_out_of_limits;
     fallback->evaluations = res.evaluations;
     fallback->objective_evaluations = res.objective_evaluations;
     fallback->search_seconds = res.search_seconds;
     return *fallback;
   }
   throw NumericalError(str(where, ": no capture configuration chosen by the search was reached (", res.goals_tried,
-                           " goals, ", res.shooting_iterations, " reaching runs)"));
+                           " goals, ", res.goals_out_of_limits, " of them behind a joint limit, ",
+                           res.shooting_iterations, " reaching runs)"));
 }
 
 }  // namespace ffsr
