@@ -8,7 +8,7 @@ cli="${1:-$root/build/src/cli/ffsr-optimize}"
 out="$root/docs/figures"
 tmp="$(mktemp -d)"
 trap 'rm -rf "$tmp"' EXIT
-mkdir -p "$out" "$tmp/3dof" "$tmp/7dof" "$tmp/contact" "$tmp/xi"
+mkdir -p "$out" "$tmp/3dof" "$tmp/7dof" "$tmp/contact" "$tmp/xi" "$tmp/map"
 
 # Figures 10 and 11: the 3-DOF robot, plain and optimized (Table 4)
 "$cli" --config "$root/robots/paper_3dof.toml" --plot "$tmp/3dof" --quiet > /dev/null
@@ -23,11 +23,18 @@ mkdir -p "$out" "$tmp/3dof" "$tmp/7dof" "$tmp/contact" "$tmp/xi"
 
 cp "$tmp/3dof/capture_plain.png" "$out/3dof_capture_plain.png"
 cp "$tmp/3dof/capture_optimized.png" "$out/3dof_capture_optimized.png"
+cp "$tmp/3dof/capture_global.png" "$out/3dof_capture_global.png"
 cp "$tmp/3dof/histories.png" "$out/3dof_histories.png"
 cp "$tmp/7dof/capture_plain.png" "$out/7dof_capture_plain.png"
 cp "$tmp/7dof/capture_optimized.png" "$out/7dof_capture_optimized.png"
+cp "$tmp/7dof/capture_global.png" "$out/7dof_capture_global.png"
 cp "$tmp/7dof/histories.png" "$out/7dof_histories.png"
 cp "$tmp/contact/contact.png" "$out/contact_gonthier.png"
 cp "$tmp/xi/xi_stiffness.png" "$tmp/xi/xi_approach_speed.png" "$tmp/xi/xi_restitution.png" "$out/"
-# Figures 8 and 9 come from `map --plot` once that subcommand exists.
+# Figures 8 and 9: M_ie of the 3-DOF robot over the paper's ranges (2 deg grid, 1.3 million points),
+# the slices through theta = 0 and the grid in 3-D
+"$cli" map --urdf "$root/robots/paper_3dof.urdf" --joints-deg 0,0,0 --vary 1,2,3 \
+  --range-deg=-90,90,-120,120,-120,120 --step-deg 2 --csv "$tmp/map/map.csv" --plot "$tmp/map" --quiet > /dev/null
+cp "$tmp/map/map_slices.png" "$out/3dof_map_slices.png"
+cp "$tmp/map/map_cloud.png" "$out/3dof_map_cloud.png"
 ls -l "$out"

@@ -251,6 +251,63 @@ TEST_CASE("contact --plot (Figure 3) and xi (Figures 4-6)", "[plot][cli]") {
       for (double x : xs) CHECK(x == Approx(xs.front()).margin(1e-9));
 }
 
+TEST_CASE("map --plot: one, two and three varied joints; the CSV beside the pictures", "[plot][cli][map]") {
+  TempDir dir;
+  const std::string urdf = ffsr::test::kRobots + "paper_3dof.urdf";
+  const std::vector<std::string> base{kCli, "map", "--urdf", urdf, "--joints-deg", "0,0,0", "--quiet"};
+  auto map = [&](std::vector<std::string> extra) {
+    std::vector<std::string> a = base;
+    a.insert(a.end(), extra.begin(), extra.end());
+    return run_command(a);
+  };
+  // three joints: the slices through theta = 0 (Figure 9) and the 3-D view (Figure 8)
+  auto r = map({"--vary", "1,2,3", "--step-deg", "10", "--csv", dir / "m3.csv", "--plot", dir.str()});
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  check_png(dir / "map_slices.png", 1400, 420, 16);
+  check_png(dir / "map_cloud.png", 1000, 700, 16);
+  CHECK(r.out.find("wrote " + (dir / "map_slices.png")) != std::string::npos);
+  // two joints: the heat map (Figure 9), as SVG
+  r = map({"--vary", "2,3", "--step-deg", "5", "--csv", dir / "m2.csv", "--plot", dir.str(), "--plot-format", "svg"});
+  REQUIRE(r.exit_code == 0);
+  check_svg(dir / "map.svg");
+  // one joint: M_ie against the angle
+  TempDir one;
+  r = map({"--vary", "3", "--step-deg", "1", "--csv", one / "m1.csv", "--plot", one.str()});
+  REQUIRE(r.exit_code == 0);
+  check_png(one / "map.png", 1000, 700);
+  CHECK(fs::exists(one / "m1.csv"));
+}
+
+TEST_CASE("map --plot bad inputs: one error line naming the flag, no CSV and no picture", "[plot][cli][map][errors]") {
+  const std::string urdf3 = ffsr::test::kRobots + "paper_3dof.urdf";
+  const std::string urdf7 = ffsr::test::kRobots + "paper_7dof.urdf";
+  struct Case {
+    std::vector<std::string> extra;
+    std::string urdf, joints, message;
+  };
+  const std::vector<Case> cases = {
+      {{"--vary", "1,2,3", "--shard", "1/3", "--plot", "."}, urdf3, "0,0,0", "--plot: a shard holds part of the grid"},
+      {{"--vary", "1,2,3,4", "--step-deg", "90", "--plot", "."}, urdf7, "0,0,0,0,0,0,0", "--plot: pictures are drawn for 1 to 3"},
+      {{"--vary", "1,2,3", "--step-deg", "10", "--slice-deg", "0,0", "--plot", "."}, urdf3, "0,0,0", "--slice-deg"},
+      {{"--vary", "1,2", "--slice-deg", "0,0", "--plot", "."}, urdf3, "0,0,0", "--slice-deg: slices are drawn for three"},
+      {{"--vary", "1,2", "--plot", "no_such_folder"}, urdf3, "0,0,0", "--plot: folder 'no_such_folder' does not exist"},
+      {{"--vary", "1,2", "--plot", ".", "--plot-format", "gif"}, urdf3, "0,0,0", "--plot-format: unknown format 'gif'"},
+      {{"--vary", "1,2,3", "--step-deg", "0.5", "--plot", "."}, urdf3, "0,0,0", "--plot: the grid has 373248000 points"},
+  };
+  for (const auto& c : cases) {
+    TempDir dir;
+    std::vector<std::string> a{kCli, "map", "--urdf", c.urdf, "--joints-deg", c.joints, "--csv", "m.csv", "--quiet"};
+    a.insert(a.end(), c.extra.begin(), c.extra.end());
+    const auto r = run_command(a, dir.str());
+    INFO(c.message << "\n" << r.err);
+    CHECK(r.exit_code == 2);
+    CHECK(r.err.rfind("ffsr-optimize: error: " + c.message, 0) == 0);
+    CHECK(std::count(r.err.begin(), r.err.end(), '\n') == 1);
+    CHECK(dir.entries().empty());
+  }
+}
+
 TEST_CASE("plot bad inputs: a missing folder or an unknown format give one error line and no output", "[plot][cli]") {
   TempDir dir;
   const std::string missing = dir / "no_such_folder";

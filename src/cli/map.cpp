@@ -16,7 +16,14 @@
 // are claimed in order, formatted with std::to_chars (the shortest text that reads back as the same
 // double) and appended to the output in order, so the output never has to fit in memory. The file
 // is written to a temporary next to the destination and renamed at the end: all or nothing.
+//
+// Pictures (--plot DIR): one varied joint gives M_ie against the angle; two a heat map with contour
+// lines and a colour bar (Figure 9); three the orthogonal slices through --slice-deg (Figure 9's
+// theta_i = 0 slices) and the grid as coloured points in 3-D (Figure 8). The values are kept in memory
+// for that (8 bytes a point), so a plotted grid is limited to kMaxPlotPoints; a shard holds part of
+// the grid only and is not plotted.
 #include "common.hpp"
+#include "figures.hpp"
 #include "subcommands.hpp"
 
 #include <atomic>
@@ -48,6 +55,7 @@ struct MapOptions {
   std::string step_deg = "2";
   std::string csv;
   std::string shard = "0/1";
+  std::string plot, plot_format = "png", slice_deg;
   unsigned threads = 0;
   std::uint64_t max_points = 1000000000ULL;
   bool quiet = false;
@@ -202,6 +210,8 @@ struct Worker {
   Eigen::VectorXd theta;
   std::vector<char> text;
   std::vector<double> angles;
+  double* values = nullptr;        // M_ie by point index - first_point, when the grid is plotted
+  std::uint64_t first_point = 0;
   // the largest and smallest M_ie seen, and where (smallest point index on ties)
   double max_M = -1, min_M = std::numeric_limits<double>::infinity();
   std::uint64_t argmax = 0, argmin = 0;
@@ -226,6 +236,7 @@ struct Worker {
       }
       const double M = integrated_effective_mass_fast(model, data, base, theta, frame, u, target_inverse_mass);  // Eq. 14
       const double F = max_force_closed_form(law, M);                                                  // Eq. 24
+      if (values) values[idx - first_point] = M;
       if (M > max_M) max_M = M, argmax = idx;
       if (M < min_M) min_M = M, argmin = idx;
       for (size_t a = 0; a < k; ++a) p = put(p, end, angles[a], ',');
@@ -247,6 +258,49 @@ std::string point_deg(const Grid& g, std::uint64_t idx) {
   for (size_t i = 0; i < a.size(); ++i) os << (i ? ", " : "") << a[i];
   os << "]";
   return os.str();
+}
+
+constexpr std::uint64_t kMaxPlotPoints = 50000000;
+
+/// The figures of a plotted grid (see the top of this file).
+std::vector<plot::Figure> map_figures(const Grid& grid, const std::vector<std::string>& names,
+                                      std::vector<double> values, const std::vector<double>& slice_deg) {
+  figures::Grid g;
+  for (const Axis& a : grid.axes) {
+    g.axis_labels.push_back(str("θ", a.joint + 1, " (deg)"));
+    std::vector<double> axis(a.count);
+    for (std::uint64_t i = 0; i < a.count; ++i) axis[i] = a.angle_deg(i);
+    g.axes.push_back(std::move(axis));
+  }
+  g.values = std::move(values);
+  std::string joints;
+  for (const Axis& a : grid.axes) joints += (joints.empty() ? "" : ", ") + names[static_cast<size_t>(a.joint)];
+  if (grid.axes.size() == 1) {
+    plot::Figure fig;
+    fig.name = "map";
+    plot::Panel p;
+    const size_t imax = static_cast<size_t>(std::max_element(g.values.begin(), g.values.end()) - g.values.begin());
+    p.title = str("M_ie over ", joints, ": maximum ", g.values[imax], " kg at ", g.axes[0][imax], " deg");
+    p.xlabel = g.axis_labels[0];
+    p.ylabel = g.value_label;
+    plot::Curve c;
+    c.label = "M_ie";
+    c.x = g.axes[0];
+    c.y = g.values;
+    plot::Curve m;
+    m.label = "maximum";
+    m.symbol = "▲";
+    m.color = 1;
+    m.line_style = 0;
+    m.x = {g.axes[0][imax]};
+    m.y = {g.values[imax]};
+    p.curves = {c, m};
+    fig.panels.emplace_back(std::move(p));
+    return {fig};
+  }
+  if (grid.axes.size() == 2) return {figures::map_heat(g, "map", "")};
+  return {figures::map_slices(g, slice_deg, "map_slices", ""),
+          figures::map_cloud(g, "map_cloud", "M_ie over " + joints + " (Figure 8)")};
 }
 
 int run_map(const MapOptions& o) {
@@ -274,6 +328,28 @@ int run_map(const MapOptions& o) {
   const std::uint64_t first = shard.begin(grid.size, shard.k), last = shard.begin(grid.size, shard.k + 1);
   const std::uint64_t count = last - first;
 
+  // the pictures' arguments, checked before the grid is evaluated
+  const bool plotting = !o.plot.empty();
+  const plot::Format plot_format = plot::parse_format(o.plot_format, "--plot-format");
+  std::vector<double> slice_deg(grid.axes.size(), 0.0);
+  if (!o.slice_deg.empty()) {
+    slice_deg = parse_list(o.slice_deg, "--slice-deg", {grid.axes.size()});
+    if (grid.axes.size() != 3) throw InputError("--slice-deg: slices are drawn for three varied joints only");
+  }
+  if (plotting) {
+    plot::require_available("--plot");
+    plot::check_folder(o.plot, "--plot");
+    if (grid.axes.size() > 3)
+      throw InputError(str("--plot: pictures are drawn for 1 to 3 varied joints, got ", grid.axes.size(),
+                           " (the CSV holds every point)"));
+    if (shard.n > 1)
+      throw InputError("--plot: a shard holds part of the grid only; run the whole grid (--shard 0/1) to plot it");
+    if (grid.size > kMaxPlotPoints)
+      throw InputError(str("--plot: the grid has ", grid.size, " points; pictures are drawn for at most ",
+                           kMaxPlotPoints, " (use a coarser --step-deg)"));
+  }
+  std::vector<double> values(plotting ? count : 0);
+
   CsvOutput out(o.csv);
   if (shard.k == 0) {
     std::string header;
@@ -292,6 +368,10 @@ int run_map(const MapOptions& o) {
   std::vector<std::unique_ptr<Worker>> workers;
   for (unsigned t = 0; t < threads; ++t)
     workers.push_back(std::make_unique<Worker>(r.model, grid, law, r, u, target_inverse_mass, kBlock));
+  for (auto& w : workers) {
+    w->values = plotting ? values.data() : nullptr;
+    w->first_point = first;
+  }
 
   std::atomic<std::uint64_t> next_block{0}, done{0};
   std::mutex m;
@@ -337,6 +417,9 @@ int run_map(const MapOptions& o) {
   }
   for (auto& t : pool) t.join();
   if (error) std::rethrow_exception(error);
+  // the pictures before the CSV is committed: a failed drawing leaves no CSV behind
+  std::vector<std::string> drawn;
+  if (plotting) drawn = plot::render(map_figures(grid, r.model.joint_names(), std::move(values), slice_deg), o.plot, plot_format);
   out.commit();
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
@@ -355,6 +438,7 @@ int run_map(const MapOptions& o) {
        << " kg at " << point_deg(grid, lo->argmin) << " deg\n";
   }
   if (o.csv != "-") os << "wrote " << o.csv << "\n";
+  for (const std::string& f : drawn) os << "wrote " << f << "\n";
   return 0;
 }
 
@@ -381,6 +465,12 @@ void register_map(CLI::App& app, Action& action) {
       ->capture_default_str();
   sub->add_option("--threads", o->threads, "Worker threads; 0: all cores")->check(CLI::Range(0U, 1024U))->capture_default_str();
   sub->add_option("--max-points", o->max_points, "Refuse grids with more points than this")->capture_default_str();
+  sub->add_option("--plot", o->plot,
+                  "Draw the map into this (existing) folder: M_ie against one joint, a heat map for two (Figure 9), "
+                  "slices and a 3-D view for three (Figures 8, 9)");
+  sub->add_option("--plot-format", o->plot_format, "Figure format: png, svg or pdf")->capture_default_str();
+  sub->add_option("--slice-deg", o->slice_deg,
+                  "Three varied joints: the point the slices go through, one angle per varied joint, deg (default 0,0,0)");
   sub->add_flag("--quiet", o->quiet, "No progress line");
   sub->callback([o, &action] { action = [o] { return run_map(*o); }; });
 }

@@ -182,6 +182,19 @@ class Renderer {
       xmin = std::log10(xmin);
       xmax = std::log10(xmax);
     }
+    // an inside legend goes to the corner where its box hides the fewest curve points; when every
+    // corner would hide some, the y range grows upwards until the box fits above the curves
+    int corner = 0;
+    if (has_legend && !p.legend_outside) {
+      const long entries = std::count_if(p.curves.begin(), p.curves.end(), [](const Curve& c) { return !c.label.empty(); });
+      const double box_w = 0.34, box_h = std::min(0.6, 0.03 + 0.085 * static_cast<double>(entries));
+      long hidden = 0;
+      corner = emptiest_corner(p.curves, tx, xmin, xmax, ymin, ymax, box_w, box_h, hidden);
+      if (hidden > 0 && p.limits.size() != 4 && !p.equal_aspect) {
+        ymax = ymin + (ymax - ymin) / (1.0 - box_h - 0.02);
+        corner = emptiest_corner(p.curves, tx, xmin, xmax, ymin, ymax, box_w, box_h, hidden);
+      }
+    }
     if (p.equal_aspect) {
       const double w = (vx1 - vx0) * fig_.width, h = (vy1 - vy0) * fig_.height;
       const double s = std::max((xmax - xmin) / w, (ymax - ymin) / h);
@@ -219,27 +232,28 @@ class Renderer {
     pls_.mtex("b", 3.0, 0.5, 0.5, p.xlabel.c_str());
     pls_.mtex("l", 4.5, 0.5, 0.5, p.ylabel.c_str());
     pls_.mtex("t", 1.0, 0.5, 0.5, p.title.c_str());
-    if (has_legend) legend(p.curves, p.legend_outside, emptiest_corner(p.curves, tx, xmin, xmax, ymin, ymax));
+    if (has_legend) legend(p.curves, p.legend_outside, corner);
   }
 
-  /// The corner of the axes (0 top right, 1 top left, 2 bottom right, 3 bottom left) whose
-  /// quarter holds the fewest curve points (densely sampled curves; segments count by their ends),
-  /// so that an inside legend hides as little as possible.
+  /// The corner of the axes (0 top right, 1 top left, 2 bottom right, 3 bottom left) whose legend
+  /// box (box_w x box_h, fractions of the axes) covers the fewest curve points, and that count.
   template <class Tx>
   static int emptiest_corner(const std::vector<Curve>& curves, Tx tx, double xmin, double xmax, double ymin,
-                             double ymax) {
+                             double ymax, double box_w, double box_h, long& hidden) {
     long count[4] = {0, 0, 0, 0};
     for (const auto& c : curves)
       for (size_t i = 0; i < std::min(c.x.size(), c.y.size()); ++i) {
         const double u = (tx(c.x[i]) - xmin) / (xmax - xmin), v = (c.y[i] - ymin) / (ymax - ymin);
-        // sample along segments too, so sparse polylines count where they pass
-        const bool right = u > 0.55, left = u < 0.45, top = v > 0.55, bottom = v < 0.45;
+        const bool right = u > 1.0 - box_w - 0.02, left = u < box_w + 0.02;
+        const bool top = v > 1.0 - box_h - 0.02, bottom = v < box_h + 0.02;
         if (top && right) ++count[0];
         if (top && left) ++count[1];
         if (bottom && right) ++count[2];
         if (bottom && left) ++count[3];
       }
-    return static_cast<int>(std::min_element(count, count + 4) - count);
+    const int best = static_cast<int>(std::min_element(count, count + 4) - count);
+    hidden = count[best];
+    return best;
   }
 
   void legend(const std::vector<Curve>& curves, bool outside, int corner = 0) {
