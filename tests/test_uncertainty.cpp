@@ -8,6 +8,7 @@
 #include "ffsr/ffsr.hpp"
 #include "ffsr/io/urdf.hpp"
 #include "ffsr/uncertainty/multibody.hpp"
+#include "ffsr/uncertainty/robust_objective.hpp"
 #include "ffsr/uncertainty/sampling.hpp"
 
 #include <cmath>
@@ -251,4 +252,81 @@ TEST_CASE("validate: bad spreads name the key", "[uncertainty]") {
   s = {};
   s[Quantity::Spin] = law(Spread::Law::LogNormal, 0.1);
   CHECK_THAT(msg(s), Catch::Contains("uncertainty.spin"));
+}
+
+// ------------------------------------------------------------------------------------------------
+// the robust objective of the global search: CVaR_95 of the exact F_max and its gradient
+// ------------------------------------------------------------------------------------------------
+
+TEST_CASE("the exact force peak scales as M^(alpha/(alpha+1)) for the eight laws (the robust objective's premise)",
+          "[uncertainty][robust]") {
+  for (std::string_view name : contact_law_names())
+    for (const ContactParams& cp : {ContactParams{1e9, 1.5, 0.9}, ContactParams{3e7, 1.0, 0.3},
+                                    ContactParams{5e10, 2.2, 0.6}})
+      for (double v : {0.01, 0.2, 1.0}) {
+        const AnyContactLaw law = make_contact_law(name, cp, v);
+        const double f1 = max_force_exact(law, 1.0), p = cp.alpha / (cp.alpha + 1.0);
+        for (double M : {1e-3, 0.37, 12.5, 4e3}) {
+          INFO(name << " K " << cp.K << " alpha " << cp.alpha << " c_r " << cp.c_r << " v " << v << " M " << M);
+          CHECK(max_force_exact(law, M) == Approx(f1 * std::pow(M, p)).epsilon(1e-10));
+        }
+      }
+}
+
+TEST_CASE("robust objective: CVaR_95 and p95 against the per-sample forces, its gradient against differences",
+          "[uncertainty][robust]") {
+  const Model m = model_from_urdf_file(kRobots + "paper_7dof.urdf");
+  Data data(m);
+  const int frame = m.end_effector();
+  BasePose base;
+  base.orientation = Quaternion(Eigen::AngleAxisd(0.2, Vector3(0, 1, 1).normalized()));
+  Eigen::VectorXd theta(7);
+  theta << 0.3, 0.9, -0.4, 0.7, 0.2, 1.1, -0.5;
+  UncertaintySpec spec;
+  spec[Quantity::TargetMass] = law(Spread::Law::Normal, 0.1, true);
+  spec[Quantity::TargetInertia] = law(Spread::Law::Normal, 0.2);
+  spec[Quantity::ContactOffset] = law(Spread::Law::Normal, 0.02);
+  spec[Quantity::Normal] = law(Spread::Law::Cone, 5.0 * M_PI / 180.0);
+  spec[Quantity::Stiffness] = law(Spread::Law::LogNormal, std::log(10.0) / 2.0);
+  spec[Quantity::Exponent] = law(Spread::Law::Uniform, 0.1, true);
+  spec[Quantity::Restitution] = law(Spread::Law::Uniform, 0.0);
+  spec[Quantity::Restitution].has_range = true;
+  spec[Quantity::Restitution].min = 0.6;
+  spec[Quantity::Restitution].max = 0.95;
+  spec.seed = 11;
+  const UncertainNominal nom = paper_nominal();
+  std::vector<UncertainSample> set;
+  for (std::uint64_t i = 0; i < 237; ++i) set.push_back(draw_sample(spec, nom, i));
+  RobustForceObjective obj(set, "gonthier");
+  REQUIRE(obj.tail_count() == 12u);  // ceil(237 / 20)
+
+  // the value: the mean of the 12 largest exact peaks, each solved directly
+  const Matrix3 G = robot_inverse_mass_matrix(m, data, base, theta, frame);
+  std::vector<double> f;
+  for (const auto& s : set) f.push_back(sample_force(G, s, "gonthier", ForceModel::Exact).f_max);
+  std::sort(f.begin(), f.end());
+  double cvar = 0;
+  for (size_t k = f.size() - 12; k < f.size(); ++k) cvar += f[k];
+  cvar /= 12;
+  const auto v = obj.value(G);
+  CHECK(v.cvar95 == Approx(cvar).epsilon(1e-10));
+  CHECK(v.p95 == Approx(f[225]).epsilon(1e-10));  // nearest rank ceil(0.95 * 237) = 226, index 225
+  CHECK(v.p95 == Approx(robust_force_p95(m, data, base, theta, frame, set, "gonthier")).epsilon(1e-10));
+  CHECK(v.cvar95 >= v.p95);
+
+  // the gradient against central differences of the value
+  Eigen::VectorXd g(7);
+  const double c0 = obj.value_and_gradient(m, data, base, theta, frame, g);
+  CHECK(c0 == Approx(cvar).epsilon(1e-10));
+  for (int k = 0; k < 7; ++k) {
+    const double h = 1e-6;
+    Eigen::VectorXd tp = theta, tm = theta;
+    tp(k) += h;
+    tm(k) -= h;
+    const double fp = obj.value(robot_inverse_mass_matrix(m, data, base, tp, frame)).cvar95;
+    const double fm = obj.value(robot_inverse_mass_matrix(m, data, base, tm, frame)).cvar95;
+    INFO("joint " << k);
+    CHECK(g(k) == Approx((fp - fm) / (2 * h)).epsilon(1e-5).margin(1e-6 * std::abs(c0)));
+  }
+  CHECK_THROWS_AS(RobustForceObjective({}, "gonthier"), InputError);
 }

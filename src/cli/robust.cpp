@@ -1,7 +1,8 @@
 // ffsr-optimize robust --config SCENARIO.toml [flags]: Monte Carlo of the maximum contact force over
 // what is not known about the target (the scenario's [uncertainty] table), for the capture
-// configurations of the main job (plain and optimized, planned as the main job plans them) or one
-// given with --capture-joints-deg. Samples are common to all configurations and depend on
+// configurations of the main job (plain, optimized and, unless global = false, the global run --
+// with objective = "robust-force" both the nominal global run and the robust one -- planned as the
+// main job plans them) or one given with --capture-joints-deg. Samples are common to all configurations and depend on
 // (seed, index) only, so --shard K/N runs can be merged exactly (--merge): a shard's JSON keeps every
 // sample's F_max, the merge concatenates them by index and recomputes the summary.
 //
@@ -399,12 +400,26 @@ int run_robust(RobustOptions& o, CLI::App& app) {  // by reference: the file's k
     configs.push_back(std::move(c));
   } else {
     const auto [plain, optimized] = plan_plain_and_optimized(sc, o.quiet);
-    for (const auto* r : {&plain, &optimized}) {
+    auto add = [&](const char* name, const CaptureResult& r) {
       Configuration c;
-      c.name = r == &plain ? "plain" : "optimized";
-      c.theta = r->theta;
-      c.base = r->base;
+      c.name = name;
+      c.theta = r.theta;
+      c.base = r.base;
       configs.push_back(std::move(c));
+    };
+    add("plain", plain);
+    add("optimized", optimized);
+    if (so.global) {
+      // the global run with the scenario's objective; for robust-force, the nominal global run (mass)
+      // beside the robust one, on the same samples: the price and the gain of robustness side by side
+      const GlobalObjective objective = global_objective(so.objective);
+      if (objective == GlobalObjective::RobustForce) {
+        add("global", run_global(sc, optimized, GlobalObjective::Mass, nullptr, true).result.run);
+        const auto set = scenario_robust_objective(sc, read_uncertainty_table(o.config, where));
+        add("robust", run_global(sc, optimized, objective, set).result.run);
+      } else {
+        add("global", run_global(sc, optimized, objective).result.run);
+      }
     }
   }
 
@@ -533,6 +548,37 @@ int run_robust(RobustOptions& o, CLI::App& app) {  // by reference: the file's k
 }
 
 }  // namespace
+
+UncertaintySpec read_uncertainty_table(const std::string& config, const std::string& where) {
+  toml::table root;
+  try {
+    root = toml::parse_file(config);
+  } catch (const toml::parse_error& e) {
+    throw InputError(str(where, ":", e.source().begin.line, ": ", e.description()));
+  }
+  UncertaintySpec spec;
+  try {
+    parse_uncertainty(root, spec, false, false, where);
+  } catch (const InputError& e) {
+    if (!root.get("uncertainty"))
+      throw InputError(str("--objective: robust-force needs an [uncertainty] table in ", where));
+    throw;
+  }
+  return spec;
+}
+
+std::shared_ptr<RobustForceObjective> scenario_robust_objective(const Scenario& sc, const UncertaintySpec& spec) {
+  UncertainNominal nominal;
+  nominal.target = propagate_target(sc.problem.target, sc.capture.duration);
+  nominal.contact = sc.problem.contact;
+  nominal.approach_speed = sc.problem.approach_speed;
+  UncertaintySpec s = spec;
+  s.seed = robust_objective_seed(spec);
+  std::vector<UncertainSample> samples(s.samples);
+  const int threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  parallel_for(0, s.samples, threads, [&](std::uint64_t i) { samples[i] = draw_sample(s, nominal, i); });
+  return std::make_shared<RobustForceObjective>(std::move(samples), sc.problem.law);
+}
 
 void register_robust(CLI::App& app, Action& action) {
   auto o = std::make_shared<RobustOptions>();

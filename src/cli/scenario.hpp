@@ -7,6 +7,8 @@
 #include "model_options.hpp"
 
 #include "ffsr/optimize/capture.hpp"
+#include "ffsr/optimize/global.hpp"
+#include "ffsr/uncertainty/robust_objective.hpp"
 
 #include <unistd.h>
 
@@ -67,6 +69,31 @@ Scenario prepare_scenario(RunOptions o, const CLI::App& app, bool urdf_on_comman
 /// The main job's two planning runs: plain (rho = 0, the baseline task) and optimized. A
 /// NumericalError names the run. Progress on a terminal unless `quiet`.
 std::pair<CaptureResult, CaptureResult> plan_plain_and_optimized(const Scenario& sc, bool quiet);
+
+/// The global run (issue 9) and what the outputs need beside it.
+struct GlobalRun {
+  GlobalCaptureResult result;
+  double paper_objective = 0;  ///< the objective at the paper's-method run's capture configuration
+};
+/// The objective named as the scenario key `objective` spells it (mass for an unknown name: the
+/// scenario was validated before).
+GlobalObjective global_objective(const std::string& name);
+/// Plans the global run: the optimized run's task, no gain, the joint-rate limit, the paper's-method
+/// capture configuration as an extra start (so the global row is never worse than it). `robust`:
+/// the sample set of the robust-force objective (null otherwise). The reaching runs stop within
+/// 1 % of the manifold optimum, 0.01 % for robust-force or with `tight_reaching`. Errors name the run.
+GlobalRun run_global(const Scenario& sc, const CaptureResult& paper_run, GlobalObjective objective,
+                     std::shared_ptr<RobustForceObjective> robust = nullptr, bool tight_reaching = false);
+
+/// The [uncertainty] table of a scenario file (read with toml++; robust.cpp). InputError naming the
+/// file and key.
+UncertaintySpec read_uncertainty_table(const std::string& config, const std::string& where);
+/// The seed of the robust-force objective's sample set: the table's seed + 1, so that the search's
+/// samples are independent of the ones `robust` evaluates with the same table (an out-of-sample check).
+inline std::uint64_t robust_objective_seed(const UncertaintySpec& spec) { return spec.seed + 1; }
+/// The robust-force objective of a scenario: spec.samples samples (seed robust_objective_seed)
+/// around the nominal target at T, the scenario's contact and law.
+std::shared_ptr<RobustForceObjective> scenario_robust_objective(const Scenario& sc, const UncertaintySpec& spec);
 
 /// CLI11's TOML reader for the main job: drops the [uncertainty] table (read by `robust` with a
 /// full TOML parser: CLI11 2.1 does not parse its inline tables), keeps every other key.

@@ -20,6 +20,9 @@
 //    multibody-force objective, which has no gradient, the distinct local optima of M_ie are ranked
 //    by the CVODE multibody peak (simulate/multibody.hpp), evaluated directly at each of them.
 //    exact-force is a monotone function of M_ie (Eq. 16 scaling), so its optimum is M_ie's.
+//    robust-force (issue 12): SLSQP minimizes CVaR_95 of the exact F_max over a fixed set of
+//    uncertain samples (uncertainty/robust_objective.hpp) with its analytic gradient, under the same
+//    constraints; the optima are compared by that value.
 // 3. Reaching (plan_capture_global). The same line reference and time law as the paper's method,
 //    the task first, and the null space servoing to the chosen configuration (ServoPolicy in
 //    capture.hpp), with the joint-rate limit. The base pose at T depends on the path, so it shoots:
@@ -31,16 +34,18 @@
 
 #include "ffsr/optimize/capture.hpp"
 #include "ffsr/simulate/multibody.hpp"
+#include "ffsr/uncertainty/robust_objective.hpp"
 
 #include <nlopt.hpp>
 
 #include <chrono>
 #include <cstdint>
+#include <memory>
 #include <random>
 
 namespace ffsr {
 
-enum class GlobalObjective { Mass, ExactForce, MultibodyForce };
+enum class GlobalObjective { Mass, ExactForce, MultibodyForce, RobustForce };
 
 /// The objective's name as the command spells it.
 inline const char* objective_name(GlobalObjective o) {
@@ -48,6 +53,7 @@ inline const char* objective_name(GlobalObjective o) {
     case GlobalObjective::Mass: return "mass";
     case GlobalObjective::ExactForce: return "exact-force";
     case GlobalObjective::MultibodyForce: return "multibody-force";
+    case GlobalObjective::RobustForce: return "robust-force";
   }
   return "?";
 }
@@ -60,18 +66,21 @@ struct ManifoldSearchOptions {
   int max_local_evaluations = 300;        ///< SLSQP budget per start
   MultibodyContactOptions multibody;      ///< for the multibody-force objective
   int max_ranked = 8;                     ///< multibody-force: local optima ranked (the best by M_ie)
+  /// robust-force: CVaR_95 of the exact F_max over this fixed sample set (robust_objective.hpp),
+  /// minimized by SLSQP with its gradient. Shared by copies of the options; not thread-safe.
+  std::shared_ptr<RobustForceObjective> robust;
 };
 
 /// A configuration on the capture manifold with its M_ie and objective value.
 struct ManifoldPoint {
   Eigen::VectorXd theta;
   double M_ie = 0;
-  double objective = 0;  ///< kg (mass) or N (exact-force, multibody-force)
+  double objective = 0;  ///< kg (mass) or N (exact-force, multibody-force, robust-force: CVaR_95)
 };
 
 struct ManifoldSearchResult {
   ManifoldPoint best;
-  std::vector<ManifoldPoint> local_optima;  ///< distinct, sorted by M_ie (multibody-force: objective 0 = not ranked)
+  std::vector<ManifoldPoint> local_optima;  ///< distinct, sorted by M_ie (robust-force: by CVaR_95; multibody-force: objective 0 = not ranked)
   std::string method;
   int starts = 0;             ///< starts drawn (plus extra starts given)
   int projected_starts = 0;   ///< starts that the projection put on the manifold
@@ -171,6 +180,7 @@ struct SlsqpContext {
   const CaptureTask* task;
   const CaptureSetup* setup;
   const BasePose* base;
+  RobustForceObjective* robust = nullptr;  ///< robust-force: the objective (else M_ie)
   long evaluations = 0;
   Eigen::VectorXd theta, g, r;
   Eigen::MatrixXd J;
@@ -181,6 +191,11 @@ inline double slsqp_objective(unsigned n, const double* x, double* grad, void* p
   ++c.evaluations;
   c.theta = Eigen::Map<const Eigen::VectorXd>(x, n);
   c.g.resize(n);
+  if (c.robust) {
+    const double f = c.robust->value_and_gradient(*c.model, *c.data, *c.base, c.theta, c.pb->frame, c.g);
+    if (grad) Eigen::Map<Eigen::VectorXd>(grad, n) = c.g;
+    return f;
+  }
   const double M = integrated_effective_mass_gradient(*c.model, *c.data, *c.base, c.theta, c.pb->frame,
                                                       c.setup->u_cap, c.setup->target_inv_mass, c.g);
   if (grad) Eigen::Map<Eigen::VectorXd>(grad, n) = c.g;
@@ -200,11 +215,12 @@ inline void slsqp_constraints(unsigned m, double* result, unsigned n, const doub
 }  // namespace detail
 
 /// Value of the objective at a capture configuration (base at T). Mass: M_ie (kg); exact-force:
-/// the single-body peak (Eq. 16) at M_ie; multibody-force: the CVODE multibody peak. Runs crba
-/// (and CVODE for the multibody objective).
+/// the single-body peak (Eq. 16) at M_ie; multibody-force: the CVODE multibody peak; robust-force:
+/// CVaR_95 of `robust` (required then). Runs crba (and CVODE for the multibody objective).
 inline ManifoldPoint evaluate_capture(const CaptureProblem& pb, const CaptureSetup& s, const BasePose& base,
                                       const Eigen::VectorXd& theta, GlobalObjective objective,
-                                      const MultibodyContactOptions& mo = {}) {
+                                      const MultibodyContactOptions& mo = {},
+                                      RobustForceObjective* robust = nullptr) {
   const Model& model = *pb.model;
   Data data(model);
   crba(model, data, base, theta);
@@ -215,6 +231,10 @@ inline ManifoldPoint evaluate_capture(const CaptureProblem& pb, const CaptureSet
     case GlobalObjective::MultibodyForce:
       p.objective = simulate_contact(model, base, theta, pb.frame, s.capture_target, pb.approach_speed, pb.contact,
                                      pb.law, mo).f_max;
+      break;
+    case GlobalObjective::RobustForce:
+      if (!robust) throw InputError("evaluate_capture: the robust-force objective needs its sample set");
+      p.objective = robust->value(robot_inverse_mass_matrix(model, data, base, theta, pb.frame)).cvar95;
       break;
   }
   return p;
@@ -257,9 +277,12 @@ inline ManifoldSearchResult detail::search_manifold(const CaptureProblem& pb, co
   const int n = model.n();
   Data data(model);
   ManifoldSearchResult res;
+  const bool robust = so.objective == GlobalObjective::RobustForce;
+  if (robust && !so.robust) throw InputError("search_capture_manifold: the robust-force objective needs its sample set");
   res.method = so.objective == GlobalObjective::MultibodyForce
                    ? "multistart NLopt SLSQP on M_ie, local optima ranked by the CVODE multibody peak"
-                   : "multistart NLopt SLSQP";
+               : robust ? "multistart NLopt SLSQP on CVaR_95 of the exact F_max over the sample set"
+                        : "multistart NLopt SLSQP";
   std::mt19937_64 rng(so.seed);
   std::vector<Eigen::VectorXd> starts = extra_starts;
   for (int i = 0; i < random_starts; ++i) {
@@ -273,7 +296,7 @@ inline ManifoldSearchResult detail::search_manifold(const CaptureProblem& pb, co
   }
   res.starts = static_cast<int>(starts.size());
 
-  detail::SlsqpContext ctx{&model, &data, &pb, &task, &s, &base, 0, {}, {}, {}, {}};
+  detail::SlsqpContext ctx{&model, &data, &pb, &task, &s, &base, robust ? so.robust.get() : nullptr, 0, {}, {}, {}, {}};
   const int m = task.rows();
   nlopt::opt local(nlopt::LD_SLSQP, static_cast<unsigned>(n));
   local.set_min_objective(detail::slsqp_objective, &ctx);
@@ -311,20 +334,23 @@ inline ManifoldSearchResult detail::search_manifold(const CaptureProblem& pb, co
     crba(model, data, base, th);
     const double M = 1.0 / (inverse_effective_mass(model, data, pb.frame, s.u_cap) + s.target_inv_mass);
     if (!std::isfinite(M)) continue;
+    // the value the local optima are compared by: M_ie, or CVaR_95 for robust-force
+    const double v = robust ? so.robust->value(robot_inverse_mass_matrix(model, data, base, th, pb.frame)).cvar95 : M;
     bool duplicate = false;
     for (ManifoldPoint& p : found)
       if (detail::configuration_distance(model, p.theta, th) < 1e-3) {
         duplicate = true;
-        if (M < p.M_ie) p = {th, M, M};
+        if (v < p.objective) p = {th, M, v};
       }
-    if (!duplicate) found.push_back({th, M, M});
+    if (!duplicate) found.push_back({th, M, v});
   }
   res.evaluations = ctx.evaluations;
   if (found.empty())
     throw InputError(str("search_capture_manifold: no configuration puts the end-effector on the capture point [",
                          s.x_cap.transpose(), "] from the base pose at T (", res.starts,
                          " starts); the capture point is out of reach"));
-  std::sort(found.begin(), found.end(), [](const ManifoldPoint& a, const ManifoldPoint& b) { return a.M_ie < b.M_ie; });
+  std::sort(found.begin(), found.end(),
+            [](const ManifoldPoint& a, const ManifoldPoint& b) { return a.objective < b.objective; });
   res.local_optima = found;
   if (so.objective == GlobalObjective::MultibodyForce) {
     // no gradient: evaluate the CVODE peak directly at the best local optima of M_ie
@@ -340,6 +366,8 @@ inline ManifoldSearchResult detail::search_manifold(const CaptureProblem& pb, co
       }
     }
     for (size_t i = k; i < res.local_optima.size(); ++i) res.local_optima[i].objective = 0;  // not evaluated
+  } else if (robust) {
+    res.best = found.front();  // sorted by CVaR_95, evaluated above
   } else {
     res.best = evaluate_capture(pb, s, base, found.front().theta, so.objective);
     for (ManifoldPoint& p : res.local_optima)
@@ -453,7 +481,8 @@ inline GlobalCaptureResult plan_capture_global(const CaptureProblem& pb, const C
         ++res.goals_out_of_limits;
         break;  // the way to this goal crosses a joint limit: next goal
       }
-      const ManifoldPoint reached = evaluate_capture(pb, setup, run.base, run.theta, g.search.objective, g.search.multibody);
+      const ManifoldPoint reached =
+          evaluate_capture(pb, setup, run.base, run.theta, g.search.objective, g.search.multibody, g.search.robust.get());
       if (g.search.objective == GlobalObjective::MultibodyForce) ++res.objective_evaluations;
       // the goal re-optimized locally at the reached base pose
       ManifoldSearchResult local;

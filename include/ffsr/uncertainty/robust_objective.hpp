@@ -1,0 +1,158 @@
+// ffsr/uncertainty/robust_objective.hpp -- a tail measure of the maximum contact force over a fixed
+// set of uncertain samples, with its gradient in the joint angles: the objective "robust-force" of
+// the global capture search (optimize/global.hpp). Eigen only.
+//
+// The measure. For a capture configuration (base pose and joint angles at T) and samples i = 1..N
+// (uncertainty/sampling.hpp), F_i is the exact single-body peak (Eq. 16) of sample i. The objective
+// is the conditional value at risk at 95 % (CVaR_95): the mean of the k = ceil(N / 20) largest F_i.
+// CVaR bounds the 95th percentile from above, is continuous in the configuration (the percentile
+// jumps from one sample to another) and its gradient is the mean of the tail samples' gradients,
+// which SLSQP can use. The 95th percentile (nearest rank) is reported beside it.
+//
+// The force of a sample as a function of the configuration. With G = J_v H^-1 J_v^T the robot's
+// 3x3 inverse mass matrix at the end-effector (sampling.hpp),
+//   M_i = 1 / (u_i^T G u_i + b_i),   b_i the target's inverse mass along u_i (sample constant),
+// and the exact peak of Eq. 16 scales as F_i = c_i M_i^(a_i / (a_i + 1)) (a_i the contact exponent):
+// in Eq. 16 with delta = L x, t = L / v s (v = delta_dot^-) the mass enters only through
+// L^(a + 1) = M v^2 / K (the damping factor depends on c_r and v only, Table 1), and F = K L^a.
+// So c_i = F_i(1 kg) is computed once per sample by the exact peak, and a configuration costs one G
+// and N evaluations of c_i M_i^p_i -- no peak solve per evaluation (test_uncertainty checks the
+// scaling against the exact peak for the eight laws).
+//
+// The gradient. d(u^T G u)/dtheta = sum_ab u_a u_b dG_ab/dtheta, and the six entries dG_ab/dtheta
+// come from six analytic gradients of the effective mass (effective_mass.hpp) along e_a and
+// (e_a + e_b)/sqrt(2), by polarization: G_ab = q((e_a + e_b)/sqrt 2) - (G_aa + G_bb)/2 with
+// q(w) = w^T G w. Then dF_i = p_i F_i / M_i dM_i and dM_i = -M_i^2 d(u_i^T G u_i).
+#pragma once
+
+#include "ffsr/uncertainty/sampling.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <string>
+#include <vector>
+
+namespace ffsr {
+
+/// CVaR_95 of the exact F_max over a fixed sample set (see the top of this file). Holds scratch
+/// buffers: one object per thread.
+class RobustForceObjective {
+ public:
+  /// `law` names the damping law (Table 1). InputError for an empty sample set or a bad law.
+  RobustForceObjective(std::vector<UncertainSample> samples, std::string law)
+      : samples_(std::move(samples)), law_(std::move(law)) {
+    if (samples_.empty()) throw InputError("RobustForceObjective: no samples");
+    c_.resize(samples_.size());
+    p_.resize(samples_.size());
+    for (std::size_t i = 0; i < samples_.size(); ++i) {
+      const UncertainSample& s = samples_[i];
+      c_[i] = max_force_exact(make_contact_law(law_, s.contact, s.approach_velocity), 1.0);
+      p_[i] = s.contact.alpha / (s.contact.alpha + 1.0);
+    }
+    tail_ = (samples_.size() + 19) / 20;
+    F_.resize(samples_.size());
+    M_.resize(samples_.size());
+    order_.resize(samples_.size());
+  }
+
+  const std::vector<UncertainSample>& samples() const { return samples_; }
+  const std::string& law() const { return law_; }
+  /// k = ceil(N / 20): the samples averaged by CVaR_95.
+  std::size_t tail_count() const { return tail_; }
+
+  struct Value {
+    double cvar95 = 0;  ///< mean of the tail_count() largest F_max, N
+    double p95 = 0;     ///< 95th percentile (nearest rank), N
+  };
+
+  /// The measure for a configuration with robot inverse mass matrix G (robot_inverse_mass_matrix).
+  Value value(const Matrix3& G) {
+    forces(G);
+    select_tail();
+    Value v;
+    for (std::size_t j = 0; j < tail_; ++j) v.cvar95 += F_[order_[j]];
+    v.cvar95 /= static_cast<double>(tail_);
+    // nearest rank 95: the ceil(0.95 N)-th smallest is the (N - ceil(0.95 N) + 1)-th largest
+    const std::size_t n = samples_.size(), from_top = n - (95 * n + 99) / 100;  // 0-based among the largest
+    std::nth_element(order_.begin(), order_.begin() + static_cast<std::ptrdiff_t>(from_top), order_.end(),
+                     [&](std::size_t a, std::size_t b) { return F_[a] > F_[b]; });
+    v.p95 = F_[order_[from_top]];
+    return v;
+  }
+
+  /// CVaR_95 at (base, theta) and its gradient in theta (size n). Runs crba; writes data.
+  double value_and_gradient(const Model& model, Data& data, const BasePose& base,
+                            const Eigen::Ref<const Eigen::VectorXd>& theta, int frame,
+                            Eigen::Ref<Eigen::VectorXd> grad) {
+    const int n = model.n();
+    detail::require_size(grad.size(), n, "RobustForceObjective", "grad");
+    for (auto& d : dG_) d.resize(n);
+    g_.resize(n);
+    // the diagonal: q(e_a) and its gradient
+    Matrix3 G;
+    double q[3];
+    for (int a = 0; a < 3; ++a) {
+      const double M = integrated_effective_mass_gradient(model, data, base, theta, frame, Vector3::Unit(a), 0.0, g_);
+      q[a] = 1.0 / M;
+      G(a, a) = q[a];
+      dG_[static_cast<std::size_t>(a)] = -g_ * (q[a] * q[a]);  // d(1/M) = -dM / M^2
+    }
+    // the off-diagonal entries by polarization along (e_a + e_b)/sqrt(2)
+    static constexpr int kPairs[3][2] = {{0, 1}, {0, 2}, {1, 2}};
+    for (int k = 0; k < 3; ++k) {
+      const int a = kPairs[k][0], b = kPairs[k][1];
+      const Vector3 w = (Vector3::Unit(a) + Vector3::Unit(b)) / std::sqrt(2.0);
+      const double M = integrated_effective_mass_gradient(model, data, base, theta, frame, w, 0.0, g_);
+      const double qw = 1.0 / M;
+      G(a, b) = G(b, a) = qw - 0.5 * (q[a] + q[b]);
+      auto& d = dG_[static_cast<std::size_t>(3 + k)];
+      d = -g_ * (qw * qw) - 0.5 * (dG_[static_cast<std::size_t>(a)] + dG_[static_cast<std::size_t>(b)]);
+    }
+    forces(G);
+    select_tail();
+    double cvar = 0;
+    grad.setZero();
+    for (std::size_t j = 0; j < tail_; ++j) {
+      const std::size_t i = order_[j];
+      const Vector3& u = samples_[i].normal_world;
+      cvar += F_[i];
+      // dF_i = p_i F_i / M_i dM_i = -p_i F_i M_i d(u^T G u)
+      const double s = -p_[i] * F_[i] * M_[i];
+      grad += s * (u(0) * u(0) * dG_[0] + u(1) * u(1) * dG_[1] + u(2) * u(2) * dG_[2] +
+                   2.0 * u(0) * u(1) * dG_[3] + 2.0 * u(0) * u(2) * dG_[4] + 2.0 * u(1) * u(2) * dG_[5]);
+    }
+    cvar /= static_cast<double>(tail_);
+    grad /= static_cast<double>(tail_);
+    return cvar;
+  }
+
+ private:
+  void forces(const Matrix3& G) {
+    for (std::size_t i = 0; i < samples_.size(); ++i) {
+      const Vector3& u = samples_[i].normal_world;
+      M_[i] = 1.0 / (u.dot(G * u) + samples_[i].target_inverse_mass);
+      F_[i] = c_[i] * std::pow(M_[i], p_[i]);
+      if (!std::isfinite(F_[i]) || !(M_[i] > 0))
+        throw NumericalError(detail::str("RobustForceObjective: sample ", samples_[i].index,
+                                         " has no finite force (M_ie = ", M_[i], " kg)"));
+    }
+  }
+  /// order_[0..tail_) = the indices of the tail_ largest forces (ties by index, so deterministic).
+  void select_tail() {
+    for (std::size_t i = 0; i < order_.size(); ++i) order_[i] = i;
+    auto larger = [&](std::size_t a, std::size_t b) { return F_[a] > F_[b] || (F_[a] == F_[b] && a < b); };
+    std::nth_element(order_.begin(), order_.begin() + static_cast<std::ptrdiff_t>(tail_ - 1), order_.end(), larger);
+    std::sort(order_.begin(), order_.begin() + static_cast<std::ptrdiff_t>(tail_), larger);
+  }
+
+  std::vector<UncertainSample> samples_;
+  std::string law_;
+  std::vector<double> c_, p_, F_, M_;
+  std::vector<std::size_t> order_;
+  std::size_t tail_ = 1;
+  std::array<Eigen::VectorXd, 6> dG_;
+  Eigen::VectorXd g_;
+};
+
+}  // namespace ffsr
