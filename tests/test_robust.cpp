@@ -254,3 +254,23 @@ TEST_CASE("robust-force: the main job's global run minimizes CVaR_95; robust sho
   CHECK(e.err.find("robust-force needs an [uncertainty] table") != std::string::npos);
   CHECK(std::count(e.err.begin(), e.err.end(), '\n') == 1);
 }
+
+TEST_CASE("robust --json -: the JSON alone on standard output, the table on standard error", "[robust]") {
+  TempDir dir;
+  Args a{"--config", kScenario, "--samples", "50", "--json", "-"};
+  a.insert(a.end(), kGiven.begin(), kGiven.end());
+  const CommandResult r = robust(a, dir.str());
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  const json j = json::parse(r.out);  // throws if the table were mixed in
+  CHECK(j["configurations"][0]["summary"]["n"] == 50);
+  CHECK(r.err.find("configuration") != std::string::npos);
+  // two outputs on standard output: refused before any work
+  Args b{"--config", kScenario, "--json", "-", "--csv", "-"};
+  b.insert(b.end(), kGiven.begin(), kGiven.end());
+  const CommandResult two = robust(b, dir.str());
+  CHECK(two.exit_code == 2);
+  CHECK(two.out.empty());
+  CHECK(std::count(two.err.begin(), two.err.end(), '\n') == 1);
+  CHECK(dir.entries().empty());
+}

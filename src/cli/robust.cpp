@@ -331,17 +331,24 @@ int run_merge(const RobustOptions& o) {
     throw InputError(str("--merge: the shards cover samples 0 to ", next, " of ", first["samples"].get<std::uint64_t>()));
   m["shard"] = {{"k", 0}, {"n", 1}, {"first", 0}, {"end", next}, {"merged_from", parts.size()}};
   finish_summary(m);
-  if (!o.json.empty()) write_file_atomic(o.json, m.dump(1) + "\n");
-  std::cout << "ffsr-optimize " << FFSR_VERSION << " robust: merged " << parts.size() << " shard summaries, " << next
+  Outputs outputs;  // the table goes to standard error when the JSON goes to standard output
+  outputs.add("--json", o.json);
+  outputs.set("--json", m.dump(1) + "\n");
+  outputs.write();
+  std::ostream& out = outputs.table();
+  out << "ffsr-optimize " << FFSR_VERSION << " robust: merged " << parts.size() << " shard summaries, " << next
             << " samples (seed " << m["seed"].get<std::uint64_t>() << ", " << m["force_model"].get<std::string>()
             << " F_max)\n\n";
-  print_summary(m, std::cout);
+  print_summary(m, out);
   return 0;
 }
 
 int run_robust(RobustOptions& o, CLI::App& app) {  // by reference: the file's keys land in o.scenario
   if (!o.merge.empty()) return run_merge(o);
   if (o.config.empty()) throw InputError("robust: --config SCENARIO.toml is required (or --merge FILES)");
+  Outputs outputs;  // checked first (two outputs on standard output); the table goes to standard error then
+  outputs.add("--json", o.json);
+  outputs.add("--csv", o.csv);
   // --- the scenario file: toml++ for the whole file, the keys into the scenario options ----------
   const std::string where = "scenario " + o.config;
   const bool urdf_cli = app.get_option("--urdf")->count() > 0;
@@ -515,8 +522,7 @@ int run_robust(RobustOptions& o, CLI::App& app) {  // by reference: the file's k
   }
   finish_summary(j);
 
-  std::vector<std::pair<std::string, std::string>> files;
-  if (!o.json.empty()) files.emplace_back(o.json, j.dump(1) + "\n");
+  if (!o.json.empty()) outputs.set("--json", j.dump(1) + "\n");
   if (!o.csv.empty()) {
     std::ostringstream c;
     c << std::setprecision(12)
@@ -535,15 +541,16 @@ int run_robust(RobustOptions& o, CLI::App& app) {  // by reference: the file's k
         c << "," << s.approach_speed << "," << s.contact.K << "," << s.contact.alpha << "," << s.contact.c_r << ","
           << cf.forces[i].M_ie << "," << cf.forces[i].approach_velocity << "," << cf.forces[i].f_max << "\n";
       }
-    files.emplace_back(o.csv, c.str());
+    outputs.set("--csv", c.str());
   }
-  if (!files.empty()) write_files_atomic(files);
+  outputs.write();
 
-  std::cout << "ffsr-optimize " << FFSR_VERSION << " robust: " << where << " (" << model.n() << " joints, " << pb.law
+  std::ostream& out = outputs.table();
+  out << "ffsr-optimize " << FFSR_VERSION << " robust: " << where << " (" << model.n() << " joints, " << pb.law
             << ", " << o.force_model << " F_max)\n"
             << spec.samples << " samples, seed " << spec.seed << "; this run: samples " << first << " to " << end
             << " (shard " << shard_k << "/" << shard_n << "), " << redraws << " redraws by the physical rules\n\n";
-  print_summary(j, std::cout);
+  print_summary(j, out);
   return 0;
 }
 
