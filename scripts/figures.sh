@@ -8,7 +8,7 @@ cli="${1:-$root/build/src/cli/ffsr-optimize}"
 out="$root/docs/figures"
 tmp="$(mktemp -d)"
 trap 'rm -rf "$tmp"' EXIT
-mkdir -p "$out" "$tmp/3dof" "$tmp/7dof" "$tmp/contact" "$tmp/xi" "$tmp/map"
+mkdir -p "$out" "$tmp/3dof" "$tmp/7dof" "$tmp/contact" "$tmp/xi" "$tmp/map" "$tmp/robust"
 
 # Figures 10 and 11: the 3-DOF robot, plain and optimized (Table 4)
 "$cli" --config "$root/robots/paper_3dof.toml" --plot "$tmp/3dof" --quiet > /dev/null
@@ -37,4 +37,7 @@ cp "$tmp/xi/xi_stiffness.png" "$tmp/xi/xi_approach_speed.png" "$tmp/xi/xi_restit
   --range-deg=-90,90,-120,120,-120,120 --step-deg 2 --csv "$tmp/map/map.csv" --plot "$tmp/map" --quiet > /dev/null
 cp "$tmp/map/map_slices.png" "$out/3dof_map_slices.png"
 cp "$tmp/map/map_cloud.png" "$out/3dof_map_cloud.png"
+# beyond the paper: F_max over the uncertain target of the example (1000 samples, exact model)
+"$cli" robust --config "$root/robots/paper_7dof_position_uncertain.toml" --plot "$tmp/robust" --quiet > /dev/null
+cp "$tmp/robust/robust.png" "$out/7dof_robust.png"
 ls -l "$out"

@@ -274,3 +274,37 @@ TEST_CASE("robust --json -: the JSON alone on standard output, the table on stan
   CHECK(std::count(two.err.begin(), two.err.end(), '\n') == 1);
   CHECK(dir.entries().empty());
 }
+
+TEST_CASE("robust --plot: the CDF and histogram per configuration, from a run and from merged shards", "[robust][plot]") {
+  TempDir dir;
+  Args a{"--config", kScenario, "--samples", "400", "--plot", dir.str(), "--json", dir / "r.json"};
+  a.insert(a.end(), kGiven.begin(), kGiven.end());
+  const CommandResult r = robust(a, dir.str());
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  CHECK(r.out.find("wrote " + (dir / "robust.png")) != std::string::npos);
+  std::ifstream png(dir / "robust.png", std::ios::binary);
+  std::string head(8, '\0');
+  png.read(&head[0], 8);
+  CHECK(head == "\x89PNG\r\n\x1a\n");
+  // from a merged summary, as SVG
+  TempDir svg;
+  const CommandResult m =
+      robust({"--merge", dir / "r.json", "--plot", svg.str(), "--plot-format", "svg"}, dir.str());
+  INFO(m.err);
+  REQUIRE(m.exit_code == 0);
+  std::ifstream in(svg / "robust.svg");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  CHECK(ss.str().find("<svg") != std::string::npos);
+  CHECK(ss.str().find("</svg>") != std::string::npos);
+  // a missing folder: one line, before any work, no output file
+  TempDir empty;
+  Args b{"--config", kScenario, "--plot", "no_such_folder", "--json", "r.json"};
+  b.insert(b.end(), kGiven.begin(), kGiven.end());
+  const CommandResult bad = robust(b, empty.str());
+  CHECK(bad.exit_code == 2);
+  CHECK(bad.err.find("--plot: folder 'no_such_folder' does not exist") != std::string::npos);
+  CHECK(std::count(bad.err.begin(), bad.err.end(), '\n') == 1);
+  CHECK(empty.entries().empty());
+}

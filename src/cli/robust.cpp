@@ -9,6 +9,7 @@
 // The [uncertainty] table is read with toml++ (CLI11 2.1's reader does not parse its inline tables);
 // the other keys of the file go to the same options as the flags, and a flag overrides the file.
 #include "common.hpp"
+#include "plot.hpp"
 #include "scenario.hpp"
 #include "subcommands.hpp"
 
@@ -43,7 +44,7 @@ struct RobustOptions {
   int threads = std::max(1u, std::thread::hardware_concurrency());
   std::vector<double> capture_joints_deg, capture_base_position{0, 0, 0}, capture_base_rpy_deg{0, 0, 0};
   std::vector<std::string> merge;
-  std::string json, csv;
+  std::string json, csv, plot, plot_format = "png";
   bool quiet = false;
 };
 
@@ -203,6 +204,76 @@ struct Configuration {
 
 std::string quantity_label(std::size_t q) { return std::string(kQuantityNames[q]); }
 
+/// The distribution of F_max per configuration (kN): the empirical CDF with the 95th percentile
+/// marked, and the histogram (shared bins, drawn as steps) -- from the summary JSON's f_max arrays,
+/// so a merged summary is drawn the same way as a run.
+plot::Figure robust_figure(const nlohmann::json& summary) {
+  plot::Figure fig;
+  fig.name = "robust";
+  fig.title = str("F_max over ", summary["samples"].get<std::uint64_t>(), " samples (",
+                  summary["force_model"].get<std::string>(), " model, seed ", summary["seed"].get<std::uint64_t>(), ")");
+  fig.cols = 2;
+  fig.width = 1200;
+  fig.height = 700;
+  plot::Panel cdf, hist;
+  cdf.title = "empirical CDF, 95th percentile marked";
+  cdf.xlabel = hist.xlabel = "F_max (kN)";
+  cdf.ylabel = "fraction";
+  hist.title = "histogram (40 shared bins)";
+  hist.ylabel = "fraction per bin";
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (const auto& c : summary["configurations"])
+    for (const auto& f : c["f_max"]) {
+      lo = std::min(lo, f.get<double>() / 1e3);
+      hi = std::max(hi, f.get<double>() / 1e3);
+    }
+  if (!(hi > lo)) hi = lo + 1.0;
+  constexpr int kBins = 40;
+  const double w = (hi - lo) / kBins;
+  int color = 0;
+  for (const auto& c : summary["configurations"]) {
+    std::vector<double> f = c["f_max"].get<std::vector<double>>();
+    for (double& x : f) x /= 1e3;
+    std::sort(f.begin(), f.end());
+    const double n = static_cast<double>(f.size());
+    plot::Curve line;
+    line.label = c["name"].get<std::string>();
+    line.color = color;
+    line.line_style = 1 + color % 4;
+    for (std::size_t i = 0; i < f.size(); ++i) {  // the CDF as steps
+      line.x.push_back(f[i]);
+      line.y.push_back(static_cast<double>(i) / n);
+      line.x.push_back(f[i]);
+      line.y.push_back(static_cast<double>(i + 1) / n);
+    }
+    plot::Curve p95;
+    p95.color = color;
+    p95.line_style = 0;
+    p95.symbol = "●";
+    p95.x = {c["summary"]["p95"].get<double>() / 1e3};
+    p95.y = {0.95};
+    cdf.curves.push_back(std::move(line));
+    cdf.curves.push_back(std::move(p95));
+    std::vector<double> count(kBins, 0.0);
+    for (double x : f) count[static_cast<std::size_t>(std::min(kBins - 1, static_cast<int>((x - lo) / w)))] += 1.0 / n;
+    plot::Curve steps;
+    steps.label = c["name"].get<std::string>();
+    steps.color = color;
+    steps.line_style = 1 + color % 4;
+    for (int b = 0; b < kBins; ++b) {
+      steps.x.push_back(lo + b * w);
+      steps.y.push_back(count[static_cast<std::size_t>(b)]);
+      steps.x.push_back(lo + (b + 1) * w);
+      steps.y.push_back(count[static_cast<std::size_t>(b)]);
+    }
+    hist.curves.push_back(std::move(steps));
+    ++color;
+  }
+  fig.panels.emplace_back(std::move(cdf));
+  fig.panels.emplace_back(std::move(hist));
+  return fig;
+}
+
 /// The parameters of a sample as JSON (the CSV columns, by name), SI units, spin in deg/s.
 nlohmann::json sample_json(const UncertainSample& s) {
   const Matrix3& I = s.target.inertia;
@@ -285,6 +356,11 @@ void finish_summary(nlohmann::json& j) {
 }
 
 int run_merge(const RobustOptions& o) {
+  plot::parse_format(o.plot_format, "--plot-format");
+  if (!o.plot.empty()) {
+    plot::require_available("--plot");
+    plot::check_folder(o.plot, "--plot");
+  }
   std::vector<nlohmann::json> parts;
   for (const auto& path : o.merge) {
     std::ifstream in(path);
@@ -334,12 +410,15 @@ int run_merge(const RobustOptions& o) {
   Outputs outputs;  // the table goes to standard error when the JSON goes to standard output
   outputs.add("--json", o.json);
   outputs.set("--json", m.dump(1) + "\n");
+  std::vector<std::string> drawn;
+  if (!o.plot.empty()) drawn = plot::render({robust_figure(m)}, o.plot, plot::parse_format(o.plot_format, "--plot-format"));
   outputs.write();
   std::ostream& out = outputs.table();
   out << "ffsr-optimize " << FFSR_VERSION << " robust: merged " << parts.size() << " shard summaries, " << next
             << " samples (seed " << m["seed"].get<std::uint64_t>() << ", " << m["force_model"].get<std::string>()
             << " F_max)\n\n";
   print_summary(m, out);
+  for (const std::string& f : drawn) out << "wrote " << f << "\n";
   return 0;
 }
 
@@ -349,6 +428,11 @@ int run_robust(RobustOptions& o, CLI::App& app) {  // by reference: the file's k
   Outputs outputs;  // checked first (two outputs on standard output); the table goes to standard error then
   outputs.add("--json", o.json);
   outputs.add("--csv", o.csv);
+  const plot::Format plot_format = plot::parse_format(o.plot_format, "--plot-format");
+  if (!o.plot.empty()) {
+    plot::require_available("--plot");
+    plot::check_folder(o.plot, "--plot");
+  }
   // --- the scenario file: toml++ for the whole file, the keys into the scenario options ----------
   const std::string where = "scenario " + o.config;
   const bool urdf_cli = app.get_option("--urdf")->count() > 0;
@@ -543,6 +627,8 @@ int run_robust(RobustOptions& o, CLI::App& app) {  // by reference: the file's k
       }
     outputs.set("--csv", c.str());
   }
+  std::vector<std::string> drawn;  // the picture first: a failed drawing leaves no output file
+  if (!o.plot.empty()) drawn = plot::render({robust_figure(j)}, o.plot, plot_format);
   outputs.write();
 
   std::ostream& out = outputs.table();
@@ -551,6 +637,7 @@ int run_robust(RobustOptions& o, CLI::App& app) {  // by reference: the file's k
             << spec.samples << " samples, seed " << spec.seed << "; this run: samples " << first << " to " << end
             << " (shard " << shard_k << "/" << shard_n << "), " << redraws << " redraws by the physical rules\n\n";
   print_summary(j, out);
+  for (const std::string& f : drawn) out << "wrote " << f << "\n";
   return 0;
 }
 
@@ -611,6 +698,9 @@ void register_robust(CLI::App& app, Action& action) {
   sub->add_option("--merge", o->merge, "Merge these shard summaries (JSON files of --json) exactly; no scenario needed");
   sub->add_option("--json", o->json, "Write the summary (with every sample's F_max, for merging) to this JSON file");
   sub->add_option("--csv", o->csv, "Write one row per sample and configuration to this CSV file");
+  sub->add_option("--plot", o->plot,
+                  "Draw the CDF and the histogram of F_max per configuration into this (existing) folder (robust.png)");
+  sub->add_option("--plot-format", o->plot_format, "Figure format: png, svg or pdf")->capture_default_str();
   sub->add_flag("--quiet", o->quiet, "No progress line");
   sub->callback([o, sub, &action] { action = [o, sub] { return run_robust(*o, *sub); }; });
 }
