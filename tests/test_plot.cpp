@@ -251,7 +251,7 @@ TEST_CASE("contact --plot (Figure 3) and xi (Figures 4-6)", "[plot][cli]") {
       for (double x : xs) CHECK(x == Approx(xs.front()).margin(1e-9));
 }
 
-TEST_CASE("map --plot: one, two and three varied joints; the CSV beside the pictures", "[plot][cli][map]") {
+TEST_CASE("map --plot: one, two and three varied joints -- the CSV beside the pictures", "[plot][cli][map]") {
   TempDir dir;
   const std::string urdf = ffsr::test::kRobots + "paper_3dof.urdf";
   const std::vector<std::string> base{kCli, "map", "--urdf", urdf, "--joints-deg", "0,0,0", "--quiet"};

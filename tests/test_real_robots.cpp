@@ -277,7 +277,7 @@ TEST_CASE("mimic reduction: H, C, J_bm, M_ie gradient against the full model", "
   }
 }
 
-TEST_CASE("mimic chains resolve; loops and unknown leaders are ModelErrors naming the joints", "[model][mimic]") {
+TEST_CASE("mimic chains resolve -- loops and unknown leaders are ModelErrors naming the joints", "[model][mimic]") {
   Rng rng(301);
   auto inertia = [&](double m) { return Inertia{m, rng.vec3(0.3), rng.inertia(0.05 * m)}; };
   auto pose = [&] { return Pose::from_xyz_rpy(rng.vec3(0.6), rng.vec3(M_PI)); };
@@ -457,7 +457,7 @@ const char* kOddUrdf = R"(<robot name="odd">
 </robot>)";
 }  // namespace
 
-TEST_CASE("inertia repairs: an error naming the link and the option by default; balance and bounds when asked", "[urdf][repair]") {
+TEST_CASE("inertia repairs: an error naming the link and the option by default -- balance and bounds when asked", "[urdf][repair]") {
   CHECK_THROWS_WITH(model_from_urdf_string(kOddUrdf, "odd.urdf", UrdfOptions{}),
                     Catch::Contains("odd.urdf") && Catch::Contains("'odd'") && Catch::Contains("inertia-repair"));
   UrdfOptions o;

@@ -107,7 +107,7 @@ TEST_CASE("robust: 4 shards merged equal the unsharded run to the last digit", "
   CHECK(gap.err.find("--merge") != std::string::npos);
 }
 
-TEST_CASE("robust: sample i depends on (seed, i) only; p95 of 1e3 against 2e4 samples; no NaN", "[robust]") {
+TEST_CASE("robust: sample i depends on (seed, i) only -- p95 of 1e3 against 2e4 samples -- no NaN", "[robust]") {
   TempDir dir;
   Args a{"--config", kScenario, "--samples", "20000", "--json", dir / "big.json", "--csv", dir / "big.csv"};
   a.insert(a.end(), kGiven.begin(), kGiven.end());
@@ -202,7 +202,7 @@ TEST_CASE("robust: bad inputs give one error line naming the key, exit 2, no out
   CHECK(j["configurations"][0]["tail"][0]["parameters"]["stiffness"] == 2e9);  // no spread: the flag's value
 }
 
-TEST_CASE("robust-force: the main job's global run minimizes CVaR_95; robust shows it beside the nominal global run",
+TEST_CASE("robust-force: the main job's global run minimizes CVaR_95 -- robust shows it beside the nominal global run",
           "[robust][global]") {
   TempDir dir;
   // the main job: the example scenario asks for objective = "robust-force"

@@ -201,7 +201,7 @@ TEST_CASE("multibody force of a sample: same M_ie and delta_dot^- as the closed 
   }
 }
 
-TEST_CASE("summary: nearest-rank percentiles, mean and deviation of 1..100; parallel_for = serial", "[uncertainty]") {
+TEST_CASE("summary: nearest-rank percentiles, mean and deviation of 1..100 -- parallel_for = serial", "[uncertainty]") {
   std::vector<double> v;
   for (int k = 100; k >= 1; --k) v.push_back(k);
   const ForceSummary s = summarize(v);
