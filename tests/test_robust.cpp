@@ -42,8 +42,8 @@ json read_json(const std::string& path) {
   return json::parse(in);
 }
 
-/// The example scenario with its URDF path made absolute and its [uncertainty] table replaced.
-std::string scenario_with(const std::string& uncertainty) {
+/// The example scenario with its URDF path made absolute and without its [uncertainty] table.
+std::string scenario_without_uncertainty() {
   std::ifstream in(kScenario);
   std::stringstream ss;
   ss << in.rdbuf();
@@ -51,7 +51,12 @@ std::string scenario_with(const std::string& uncertainty) {
   s = s.substr(0, s.find("\n[uncertainty]") + 1);
   const std::string key = "urdf = \"paper_7dof.urdf\"";
   s.replace(s.find(key), key.size(), "urdf = \"" + kSource + "/robots/paper_7dof.urdf\"");
-  return s + "[uncertainty]\n" + uncertainty + "\n";
+  return s;
+}
+
+/// The example scenario with its URDF path made absolute and its [uncertainty] table replaced.
+std::string scenario_with(const std::string& uncertainty) {
+  return scenario_without_uncertainty() + "[uncertainty]\n" + uncertainty + "\n";
 }
 
 std::string write(const TempDir& dir, const std::string& name, const std::string& text) {
@@ -248,14 +253,7 @@ TEST_CASE("robust-force: the main job's global run minimizes CVaR_95 -- robust s
   CHECK(rb.out.find("robust ") != std::string::npos);
 
   // robust-force needs the [uncertainty] table
-  std::ifstream in(kScenario);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  std::string text = ss.str();
-  text = text.substr(0, text.find("\n[uncertainty]") + 1);
-  const std::string key = "urdf = \"paper_7dof.urdf\"";
-  text.replace(text.find(key), key.size(), "urdf = \"" + kSource + "/robots/paper_7dof.urdf\"");
-  const std::string no_table = write(dir, "no_table.toml", text);
+  const std::string no_table = write(dir, "no_table.toml", scenario_without_uncertainty());
   const CommandResult e = run_command({kCli, "--config", no_table, "--quiet"}, dir.str());
   CHECK(e.exit_code == 2);
   CHECK(e.err.find("robust-force needs an [uncertainty] table") != std::string::npos);
