@@ -275,7 +275,7 @@ std::vector<plot::Figure> capture(const Model& model, int frame, const Target& t
   drift.ylabel = "rotation from t = 0 (deg)";
   sigma.title = "smallest singular value of the task Jacobian";
   const bool any_pose = std::any_of(runs.begin(), runs.end(), [](const CaptureRun& r) { return r.task.kind == CaptureTask::Kind::Pose; });
-  sigma.ylabel = any_pose ? "σ#dmin#u of J#dt#u (m/rad; rad/rad for rotation rows)" : "σ#dmin#u of J#dt#u (m/rad)";
+  sigma.ylabel = any_pose ? "σ#dmin#u of J#dt#u (m/rad, rad/rad)" : "σ#dmin#u of J#dt#u (m/rad)";
   for (Panel* p : {&mie, &fmax, &drift, &sigma}) p->xlabel = "time t (s)";
   plot::Figure joints;
   joints.name = "joints";
