@@ -16,7 +16,11 @@
 #include <algorithm>
 #include <array>
 #include <cstdio>
+#include <cmath>
 #include <iostream>
+#include <limits>
+#include <random>
+#include <utility>
 
 using namespace ffsr;
 using namespace ffsr_test;
@@ -614,5 +618,43 @@ TEST_CASE("inverse effective mass: the articulated-body recursion equals the den
                                                          t.normal_world(), t.inverse_mass_along_normal());
       CHECK(std::abs(fast - M) < 1e-10 * M);
     }
+  }
+}
+
+TEST_CASE("sin_cos of the kinematics: within 2 units in the last place of std::sin and std::cos", "[dynamics]") {
+  std::mt19937_64 gen(31);
+  std::uniform_real_distribution<double> small(-10.0, 10.0), large(-1e5, 1e5);
+  double worst_abs = 0, worst_rel = 0;
+  auto check = [&](double x) {
+    double s = 0, c = 0;
+    ffsr::detail::sin_cos(x, s, c);
+    const double S = std::sin(x), C = std::cos(x);
+    for (const auto& [a, b] : {std::pair<double, double>{s, S}, std::pair<double, double>{c, C}}) {
+      const double d = std::abs(a - b);
+      worst_abs = std::max(worst_abs, d);
+      if (b != 0) worst_rel = std::max(worst_rel, d / std::abs(b));
+    }
+  };
+  for (int i = 0; i < 200000; ++i) {
+    check(small(gen));
+    check(large(gen));
+  }
+  // the hard cases of the reduction: the doubles nearest to multiples of pi/2 (sin or cos near 0)
+  for (int k = -60000; k <= 60000; k += 7) {
+    const double x = k * (M_PI / 2);
+    check(x);
+    check(std::nextafter(x, 1e9));
+    check(std::nextafter(x, -1e9));
+  }
+  for (double x : {0.0, -0.0, 1e-300, M_PI / 4, 1e5, -1e5}) check(x);
+  INFO("worst absolute " << worst_abs << ", worst relative " << worst_rel);
+  CHECK(worst_abs <= 2 * std::numeric_limits<double>::epsilon());
+  CHECK(worst_rel <= 2 * std::numeric_limits<double>::epsilon());
+  // beyond the reduced range, and non-finite: the standard functions
+  for (double x : {1e5 * 1.5, 1e300, std::numeric_limits<double>::infinity(), std::numeric_limits<double>::quiet_NaN()}) {
+    double s = 0, c = 0;
+    ffsr::detail::sin_cos(x, s, c);
+    const double S = std::sin(x), C = std::cos(x);
+    CHECK(((s == S && c == C) || (std::isnan(s) && std::isnan(S) && std::isnan(c) && std::isnan(C))));
   }
 }

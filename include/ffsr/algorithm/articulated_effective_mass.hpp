@@ -5,6 +5,39 @@
 #include "ffsr/algorithm/effective_mass.hpp"
 
 namespace ffsr {
+namespace detail {
+
+/// Solves A x = b for a symmetric positive definite 6x6 A by Cholesky with fixed loop bounds (the
+/// compiler unrolls it; Eigen's LLT<Matrix6> runs its generic loops, a tenth of the recursion's time).
+/// Reads the lower triangle. False when A is not positive definite (x is then unspecified).
+inline bool solve_spd6(const Matrix6& A, const Vector6& b, Vector6& x) {
+  double L[6][6];
+  for (int j = 0; j < 6; ++j) {
+    double d = A(j, j);
+    for (int k = 0; k < j; ++k) d -= L[j][k] * L[j][k];
+    if (!(d > 0.0)) return false;
+    const double ljj = std::sqrt(d), inv = 1.0 / ljj;
+    L[j][j] = ljj;
+    for (int i = j + 1; i < 6; ++i) {
+      double s = A(i, j);
+      for (int k = 0; k < j; ++k) s -= L[i][k] * L[j][k];
+      L[i][j] = s * inv;
+    }
+  }
+  for (int i = 0; i < 6; ++i) {  // L z = b
+    double s = b(i);
+    for (int k = 0; k < i; ++k) s -= L[i][k] * x(k);
+    x(i) = s / L[i][i];
+  }
+  for (int i = 5; i >= 0; --i) {  // L^T x = z
+    double s = x(i);
+    for (int k = i + 1; k < 6; ++k) s -= L[k][i] * x(k);
+    x(i) = s / L[i][i];
+  }
+  return true;
+}
+
+}  // namespace detail
 
 /// Inverse effective mass u^T J_v H^-1 J_v^T u (the denominator of Eq. 4) of the free-floating robot
 /// at the origin of `frame`, in O(n) by the articulated-body algorithm (RBDA 7.3, with the floating
@@ -65,10 +98,8 @@ inline double inverse_effective_mass_articulated(const Model& model, Data& data,
     data.IA[up].noalias() += data.IA[ui] - U * (U.transpose() / D);
     data.pA[up].noalias() += data.pA[ui] + U * (ui_ / D);
   }
-  const Eigen::LLT<Matrix6> IA0(data.IA[0]);
-  if (IA0.info() != Eigen::Success)
+  if (!detail::solve_spd6(data.IA[0], -data.pA[0], data.A[0]))
     throw NumericalError("effective_mass: the articulated inertia of the base is not positive definite");
-  data.A[0] = -IA0.solve(data.pA[0]);
   // forward pass along the path base -> ee only (the other bodies do not change f^T a_e): collect the
   // path in data.path from the leaf, then walk it from the base
   int len = 0;
