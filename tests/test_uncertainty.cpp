@@ -38,6 +38,15 @@ Spread law(Spread::Law l, double scale, bool relative = false) {
   return s;
 }
 
+/// A uniform law on [min, max] (the example scenario's c_r).
+Spread uniform_range(double min, double max) {
+  Spread s = law(Spread::Law::Uniform, 0.0);
+  s.has_range = true;
+  s.min = min;
+  s.max = max;
+  return s;
+}
+
 }  // namespace
 
 TEST_CASE("sampler: splitmix64 test vector, mt19937_64 stream, sample i depends on (seed, i) only", "[uncertainty]") {
@@ -146,10 +155,7 @@ TEST_CASE("per-sample M_ie and F_max agree with the direct library computation",
   spec[Quantity::Normal] = law(Spread::Law::Cone, 40 * M_PI / 180);
   spec[Quantity::TargetInertia] = law(Spread::Law::Uniform, 0.2, true);
   spec[Quantity::ContactOffset] = law(Spread::Law::Uniform, 0.05);
-  spec[Quantity::Restitution] = law(Spread::Law::Uniform, 0.0);
-  spec[Quantity::Restitution].has_range = true;
-  spec[Quantity::Restitution].min = 0.6;
-  spec[Quantity::Restitution].max = 0.95;
+  spec[Quantity::Restitution] = uniform_range(0.6, 0.95);
   const UncertainNominal nom = paper_nominal();
   for (std::uint64_t i = 0; i < 20; ++i) {
     const UncertainSample s = draw_sample(spec, nom, i);
@@ -289,10 +295,7 @@ TEST_CASE("robust objective: CVaR_95 and p95 against the per-sample forces, its 
   spec[Quantity::Normal] = law(Spread::Law::Cone, 5.0 * M_PI / 180.0);
   spec[Quantity::Stiffness] = law(Spread::Law::LogNormal, std::log(10.0) / 2.0);
   spec[Quantity::Exponent] = law(Spread::Law::Uniform, 0.1, true);
-  spec[Quantity::Restitution] = law(Spread::Law::Uniform, 0.0);
-  spec[Quantity::Restitution].has_range = true;
-  spec[Quantity::Restitution].min = 0.6;
-  spec[Quantity::Restitution].max = 0.95;
+  spec[Quantity::Restitution] = uniform_range(0.6, 0.95);
   spec.seed = 11;
   const UncertainNominal nom = paper_nominal();
   std::vector<UncertainSample> set;
@@ -350,10 +353,7 @@ TEST_CASE("robust objective: with the normal known, CVaR_95 and p95 rank configu
   spec[Quantity::Spin] = law(Spread::Law::Normal, 1.0 * M_PI / 180.0);
   spec[Quantity::Stiffness] = law(Spread::Law::LogNormal, 0.587);
   spec[Quantity::Exponent] = law(Spread::Law::Uniform, 0.1, true);
-  spec[Quantity::Restitution] = law(Spread::Law::Uniform, 0.0);
-  spec[Quantity::Restitution].has_range = true;
-  spec[Quantity::Restitution].min = 0.6;
-  spec[Quantity::Restitution].max = 0.95;
+  spec[Quantity::Restitution] = uniform_range(0.6, 0.95);
   spec.seed = 5;
   const UncertainNominal nom = paper_nominal();
   const Vector3 u0 = nom.target.normal_world();

@@ -69,11 +69,7 @@ int run_contact(const ContactOptions& o) {
   o.law.set_target_motion(target);
   if (!std::isfinite(o.law.approach_speed)) throw InputError("--approach-speed: must be finite");
   const ContactParams params = o.law.params();
-  const plot::Format plot_format = plot::parse_format(o.plot_format, "--plot-format");
-  if (!o.plot.empty()) {
-    plot::require_available("--plot");
-    plot::check_folder(o.plot, "--plot");
-  }
+  const plot::Format plot_format = plot::check_request(o.plot, o.plot_format);
   std::vector<std::string> names;
   if (o.law.model == "all") {
     for (auto n : contact_law_names()) names.emplace_back(n);

@@ -60,6 +60,15 @@ void check_folder(const std::string& dir, const std::string& flag) {
     throw InputError(str(flag, ": folder '", dir, "' does not exist (create it first)"));
 }
 
+Format check_request(const std::string& dir, const std::string& format) {
+  const Format f = parse_format(format, "--plot-format");
+  if (!dir.empty()) {
+    require_available("--plot");
+    check_folder(dir, "--plot");
+  }
+  return f;
+}
+
 std::array<int, 3> palette(int i) {
   static constexpr std::array<std::array<int, 3>, kPaletteSize> okabe_ito{{{0, 114, 178},
                                                                           {213, 94, 0},

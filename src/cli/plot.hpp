@@ -30,6 +30,9 @@ Format parse_format(const std::string& text, const std::string& flag);
 const char* extension(Format f);
 /// Checks that `dir` is an existing folder; InputError naming `flag` and the folder otherwise.
 void check_folder(const std::string& dir, const std::string& flag);
+/// The checks of a subcommand's --plot DIR and --plot-format FORMAT before any work: the format
+/// always; when `dir` is not empty, that this build draws and that the folder exists. Returns the format.
+Format check_request(const std::string& dir, const std::string& format);
 
 /// The colour-blind-safe palette of Okabe and Ito (2008), in the order used for runs and laws:
 /// blue, vermillion, bluish green, reddish purple, orange, sky blue, black -- and wine (Tol's muted

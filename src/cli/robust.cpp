@@ -356,11 +356,7 @@ void finish_summary(nlohmann::json& j) {
 }
 
 int run_merge(const RobustOptions& o) {
-  plot::parse_format(o.plot_format, "--plot-format");
-  if (!o.plot.empty()) {
-    plot::require_available("--plot");
-    plot::check_folder(o.plot, "--plot");
-  }
+  const plot::Format plot_format = plot::check_request(o.plot, o.plot_format);
   std::vector<nlohmann::json> parts;
   for (const auto& path : o.merge) {
     std::ifstream in(path);
@@ -411,7 +407,7 @@ int run_merge(const RobustOptions& o) {
   outputs.add("--json", o.json);
   outputs.set("--json", m.dump(1) + "\n");
   std::vector<std::string> drawn;
-  if (!o.plot.empty()) drawn = plot::render({robust_figure(m)}, o.plot, plot::parse_format(o.plot_format, "--plot-format"));
+  if (!o.plot.empty()) drawn = plot::render({robust_figure(m)}, o.plot, plot_format);
   outputs.write();
   std::ostream& out = outputs.table();
   out << "ffsr-optimize " << FFSR_VERSION << " robust: merged " << parts.size() << " shard summaries, " << next
@@ -428,11 +424,7 @@ int run_robust(RobustOptions& o, CLI::App& app) {  // by reference: the file's k
   Outputs outputs;  // checked first (two outputs on standard output); the table goes to standard error then
   outputs.add("--json", o.json);
   outputs.add("--csv", o.csv);
-  const plot::Format plot_format = plot::parse_format(o.plot_format, "--plot-format");
-  if (!o.plot.empty()) {
-    plot::require_available("--plot");
-    plot::check_folder(o.plot, "--plot");
-  }
+  const plot::Format plot_format = plot::check_request(o.plot, o.plot_format);
   // --- the scenario file: toml++ for the whole file, the keys into the scenario options ----------
   const std::string where = "scenario " + o.config;
   const bool urdf_cli = app.get_option("--urdf")->count() > 0;

@@ -381,11 +381,7 @@ int run_scenario(RunOptions options, const CLI::App& app, FromCommandLine cli) {
   const bool builtin = sc.builtin;
   const std::string& where = sc.where;
   const bool want_series = !o.csv.empty();
-  const plot::Format plot_format = plot::parse_format(o.plot_format, "--plot-format");
-  if (!o.plot.empty()) {
-    plot::require_available("--plot");
-    plot::check_folder(o.plot, "--plot");
-  }
+  const plot::Format plot_format = plot::check_request(o.plot, o.plot_format);
   sc.capture.record_series = want_series || !o.plot.empty();
 
   // --- the two runs ------------------------------------------------------------------------------

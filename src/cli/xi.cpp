@@ -41,11 +41,7 @@ int run_xi(const XiOptions& o) {
   }
   if (!std::isfinite(o.approach_speed) || o.approach_speed <= 0)
     throw InputError(str("--approach-speed: must be positive and finite, got ", o.approach_speed));
-  const plot::Format plot_format = plot::parse_format(o.plot_format, "--plot-format");
-  if (!o.plot.empty()) {
-    plot::require_available("--plot");
-    plot::check_folder(o.plot, "--plot");
-  }
+  const plot::Format plot_format = plot::check_request(o.plot, o.plot_format);
   std::vector<std::string> laws;
   for (auto n : contact_law_names()) laws.emplace_back(n);
   auto g = [](double x) {

@@ -8,7 +8,7 @@ namespace ffsr {
 namespace detail {
 
 /// Solves A x = b for a symmetric positive definite 6x6 A by Cholesky with fixed loop bounds (the
-/// compiler unrolls it; Eigen's LLT<Matrix6> runs its generic loops, a tenth of the recursion's time).
+/// compiler unrolls it; Eigen's LLT<Matrix6> runs its generic loops: 6 % of the recursion's time at 14 joints).
 /// Reads the lower triangle. False when A is not positive definite (x is then unspecified).
 inline bool solve_spd6(const Matrix6& A, const Vector6& b, Vector6& x) {
   double L[6][6];
