@@ -166,7 +166,7 @@ class Renderer {
     const double px = 1.0 / fig_.width, py = 1.0 / fig_.height;
     vx0 = c.x0 + 82 * px;
     vx1 = c.x1 - (18 + right_extra) * px;
-    vy0 = c.y0 + 60 * py;  // the x-axis label of the bottom row clears the page edge
+    vy0 = c.y0 + 50 * py;
     vy1 = c.y1 - 30 * py;
   }
 
