@@ -74,7 +74,7 @@ int main(int argc, char** argv) {
     std::vector<UncertainSample> samples(n_exact);
     std::vector<double> f(n_exact);
     Data data(model);
-    const Matrix3 G = robot_inverse_mass_matrix(model, data, base, theta, frame);
+    const Matrix6 G = robot_inverse_inertia(model, data, base, theta, frame);
     parallel_for(0, n_exact, 2, [&](std::uint64_t i) {
       samples[i] = draw_sample(spec, nominal, i);
       f[i] = sample_force(G, samples[i], law, ForceModel::Exact).f_max;

@@ -658,3 +658,62 @@ TEST_CASE("sin_cos of the kinematics: within 2 units in the last place of std::s
     CHECK(((s == S && c == C) || (std::isnan(s) && std::isnan(S) && std::isnan(c) && std::isnan(C))));
   }
 }
+
+TEST_CASE("inverse inertia at a point: a force at p_e + rho is the effective mass of a frame there; form gradient against central differences",
+          "[dynamics]") {
+  // Lambda^-1 = J H^-1 J^T at the end-effector's body origin. Three independent checks: its linear
+  // block and the whole matrix from finite differences of forward kinematics; s^T Lambda^-1 s with
+  // s = [u; rho x u] equals the effective mass of the end-effector frame, a different point of the
+  // same body (rho = p_ee - p_body from forward kinematics); and the analytic gradient of a form
+  // s^T Lambda^-1 s (any 6-vector s) equals central differences.
+  Rng rng(47);
+  for (const auto& r : robots_under_test()) {
+    Data d(r.model);
+    const int body = r.model.frame(r.ee).body;
+    const int origin = r.model.frame_index(r.model.body(body).name);
+    REQUIRE(r.model.frame(origin).body == body);
+    for (int k = 0; k < 3; ++k) {
+      const Config q = random_config(r.model, rng);
+      INFO(r.name << " config " << k);
+      crba(r.model, d, q.base, q.theta);
+      const Matrix6 L = inverse_inertia_matrix(r.model, d, origin);
+      CHECK((L - L.transpose()).cwiseAbs().maxCoeff() == 0.0);
+      CHECK(Eigen::SelfAdjointEigenSolver<Matrix6>(L).eigenvalues().minCoeff() > -1e-12 * L.norm());
+      const MatrixXd H = fd_inertia_matrix(r, q, library_chart);
+      const MatrixXd J = fd_frame_jacobian(r, q, origin, library_chart);
+      const MatrixXd Lfd = J * H.ldlt().solve(J.transpose());
+      CHECK(rel_err(MatrixXd(L), Lfd) < 1e-6);
+
+      forward_kinematics(r.model, d, q.base, q.theta);
+      const Vector3 rho = frame_pose(r.model, d, r.ee).p - frame_pose(r.model, d, origin).p;
+      CHECK(rho.norm() > 0.05);  // a genuinely different point
+      crba(r.model, d, q.base, q.theta);
+      for (int j = 0; j < 3; ++j) {
+        const Vector3 u = rng.unit();
+        Vector6 s;
+        s << u, rho.cross(u);
+        const double at_point = s.dot(L * s);
+        CHECK(std::abs(at_point - inverse_effective_mass(r.model, d, r.ee, u)) < 1e-10 * at_point);
+      }
+
+      Vector6 s;
+      s << rng.vec3(1.0), rng.vec3(0.5);  // not a force at a point in general (s_f . s_m != 0)
+      VectorXd g(r.model.n());
+      crba(r.model, d, q.base, q.theta);
+      const double qs = inverse_inertia_form_gradient(r.model, d, origin, s, g);
+      CHECK(qs == Approx(s.dot(L * s)).epsilon(1e-12));
+      for (int c = 0; c < r.model.n(); ++c) {
+        const double h = 1e-6;
+        VectorXd tp = q.theta, tm = q.theta;
+        tp(c) += h;
+        tm(c) -= h;
+        crba(r.model, d, q.base, tp);
+        const double fp = s.dot(inverse_inertia_matrix(r.model, d, origin) * s);
+        crba(r.model, d, q.base, tm);
+        const double fm = s.dot(inverse_inertia_matrix(r.model, d, origin) * s);
+        INFO("coordinate " << c);
+        CHECK(g(c) == Approx((fp - fm) / (2 * h)).epsilon(1e-6).margin(1e-8 * qs));
+      }
+    }
+  }
+}

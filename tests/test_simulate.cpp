@@ -124,6 +124,19 @@ TEST_CASE("Multibody contact conserves momentum, and energy without damping", "[
     CHECK(r.contact_duration > r.t_at_f_max);
     CHECK(r.delta_max >= r.delta_at_f_max);
   }
+  // struck 12 cm away from the end-effector's origin: the force's moment about the origin now acts
+  // on the arm; the pair of forces stays collinear and the momentum is still conserved
+  MultibodyContactOptions o;
+  o.robot_contact_offset = Vector3(0.05, -0.08, 0.07);
+  for (double c_r : {0.7, 1.0}) {
+    const MultibodyContactResult r = simulate_contact(m, base, q, m.end_effector(), t, 0.3, {1e9, 1.5, c_r}, "hunt-crossley", o);
+    const double scale = r.momentum_start.norm() + t.mass * 0.3;
+    INFO("offset, c_r " << c_r << " dP " << (r.momentum_end - r.momentum_start).transpose());
+    CHECK((r.momentum_end - r.momentum_start).norm() < 1e-9 * scale);
+    if (c_r == 1.0) CHECK(r.energy_end == Approx(r.energy_start).epsilon(1e-7));
+    else CHECK(r.energy_end < r.energy_start);
+    CHECK(r.approach_velocity == Approx(0.3 - t.normal_world().dot(t.velocity + t.angular_velocity_world().cross(t.offset_world()))).epsilon(1e-9));
+  }
 }
 
 TEST_CASE("Multibody contact: series, errors", "[simulate]") {

@@ -148,7 +148,7 @@ TEST_CASE("per-sample M_ie and F_max agree with the direct library computation",
   base.orientation = Quaternion(Eigen::AngleAxisd(0.2, Vector3(0, 1, 1).normalized()));
   const Eigen::VectorXd theta = deg({10, 80, 95, -70, 85, 100, 5});
   const int frame = m.end_effector();
-  const Matrix3 G = robot_inverse_mass_matrix(m, data, base, theta, frame);
+  const Matrix6 G = robot_inverse_inertia(m, data, base, theta, frame);
   CHECK((G - G.transpose()).norm() <= 1e-15 * G.norm());
   UncertaintySpec spec;
   spec.seed = 5;
@@ -195,7 +195,7 @@ TEST_CASE("multibody force of a sample: same M_ie and delta_dot^- as the closed 
   spec[Quantity::Spin] = law(Spread::Law::Normal, 0.5 * M_PI / 180);
   UncertainNominal nom = paper_nominal();
   nom.target.attitude = Quaternion::Identity();  // the planar robot: normal in its plane
-  const Matrix3 G = robot_inverse_mass_matrix(m, data, base, theta, frame);
+  const Matrix6 G = robot_inverse_inertia(m, data, base, theta, frame);
   for (std::uint64_t i = 0; i < 2; ++i) {
     const UncertainSample s = draw_sample(spec, nom, i);
     const SampleForce mb = sample_force_multibody(m, base, theta, frame, s, "herbert-mcwhannell");
@@ -205,6 +205,27 @@ TEST_CASE("multibody force of a sample: same M_ie and delta_dot^- as the closed 
     // the paper's Table 3: single-body vs multibody agree to better than 1 % on this robot
     CHECK(mb.f_max == Approx(ex.f_max).epsilon(0.01));
   }
+  // the bodies touching 5-15 cm away from the end-effector's point: the multibody run, which
+  // integrates the robot struck at that point, still agrees with Lambda^-1 at p_e and s = [u; rho x u]
+  // (the rotational compliance changes F_max far more than the 1 % tolerance)
+  UncertaintySpec point;
+  point.seed = 9;
+  point[Quantity::ContactPoint] = law(Spread::Law::Uniform, 0.15);
+  int moved = 0;
+  for (std::uint64_t i = 0; i < 3; ++i) {
+    const UncertainSample s = draw_sample(point, nom, i);
+    INFO("sample " << i << " rho " << s.robot_offset.transpose());
+    CHECK((s.wrench.tail<3>() - s.robot_offset.cross(s.normal_world)).norm() < 1e-15);
+    const SampleForce mb = sample_force_multibody(m, base, theta, frame, s, "herbert-mcwhannell");
+    const SampleForce ex = sample_force(G, s, "herbert-mcwhannell", ForceModel::Exact);
+    UncertainSample at_pe = s;
+    at_pe.wrench.tail<3>().setZero();
+    const SampleForce ex0 = sample_force(G, at_pe, "herbert-mcwhannell", ForceModel::Exact);
+    CHECK(mb.M_ie == Approx(ex.M_ie).epsilon(1e-10));
+    CHECK(mb.f_max == Approx(ex.f_max).epsilon(0.01));
+    moved += std::abs(ex.f_max / ex0.f_max - 1) > 0.03;
+  }
+  CHECK(moved >= 2);
 }
 
 TEST_CASE("summary: nearest-rank percentiles, mean and deviation of 1..100 -- parallel_for = serial", "[uncertainty]") {
@@ -304,7 +325,7 @@ TEST_CASE("robust objective: CVaR_95 and p95 against the per-sample forces, its 
   REQUIRE(obj.tail_count() == 12u);  // ceil(237 / 20)
 
   // the value: the mean of the 12 largest exact peaks, each solved directly
-  const Matrix3 G = robot_inverse_mass_matrix(m, data, base, theta, frame);
+  const Matrix6 G = robot_inverse_inertia(m, data, base, theta, frame);
   std::vector<double> f;
   for (const auto& s : set) f.push_back(sample_force(G, s, "gonthier", ForceModel::Exact).f_max);
   std::sort(f.begin(), f.end());
@@ -326,21 +347,24 @@ TEST_CASE("robust objective: CVaR_95 and p95 against the per-sample forces, its 
     Eigen::VectorXd tp = theta, tm = theta;
     tp(k) += h;
     tm(k) -= h;
-    const double fp = obj.value(robot_inverse_mass_matrix(m, data, base, tp, frame)).cvar95;
-    const double fm = obj.value(robot_inverse_mass_matrix(m, data, base, tm, frame)).cvar95;
+    const double fp = obj.value(robot_inverse_inertia(m, data, base, tp, frame)).cvar95;
+    const double fm = obj.value(robot_inverse_inertia(m, data, base, tm, frame)).cvar95;
     INFO("joint " << k);
     CHECK(g(k) == Approx((fp - fm) / (2 * h)).epsilon(1e-5).margin(1e-6 * std::abs(c0)));
   }
   CHECK_THROWS_AS(RobustForceObjective({}, "gonthier"), InputError);
 }
 
-// Why a robust capture configuration can only differ from the nominal one through the normal: the
-// configuration enters every sample's exact peak F_i = c_i M_i^(alpha_i/(alpha_i+1)) only through
-// g = u_i^T G(theta) u_i (M_i = 1 / (g + t_i), t_i the target side). With the normal known, u_i = u_0
-// for all i, so every F_i falls as g rises, and so do CVaR_95, p95 and the nominal M_ie = 1/(g + t_0):
-// they rank configurations identically and share their minimizer. Checked here over pairs of random
-// configurations; with a 30 deg normal cone some pairs rank differently (the normal is what couples).
-TEST_CASE("robust objective: with the normal known, CVaR_95 and p95 rank configurations as the nominal M_ie does",
+// Why a robust capture configuration differs from the nominal one only through the normal and the
+// point where the bodies touch: the configuration enters every sample's exact peak
+// F_i = c_i M_i^(alpha_i/(alpha_i+1)) only through g = s_i^T Lambda^-1(theta) s_i, s_i = [u_i; rho_i x u_i]
+// (M_i = 1 / (g + t_i), t_i the target side). With the normal known and the contact point the
+// planned one, s_i = [u_0; 0] for all i, so every F_i falls as g rises, and so do CVaR_95, p95 and the
+// nominal M_ie = 1/(g + t_0): they rank configurations identically and share their minimizer -- the
+// target's mass, inertia, centre of mass (contact-offset), spin and the contact parameters cannot
+// make a robust optimum differ. Checked here over pairs of random configurations; with a 30 deg
+// normal cone, or the contact point uncertain by 2 cm, some pairs rank differently.
+TEST_CASE("robust objective: with the normal and the contact point known, CVaR_95 and p95 rank configurations as the nominal M_ie does",
           "[uncertainty][robust]") {
   const Model m = model_from_urdf_file(kRobots + "paper_7dof.urdf");
   Data data(m);
@@ -372,9 +396,9 @@ TEST_CASE("robust objective: with the normal known, CVaR_95 and p95 rank configu
     for (int k = 0; k < 150; ++k) {
       Eigen::VectorXd theta(7);
       for (int j = 0; j < 7; ++j) theta(j) = U(rng);
-      const Matrix3 G = robot_inverse_mass_matrix(m, data, base, theta, frame);
+      const Matrix6 G = robot_inverse_inertia(m, data, base, theta, frame);
       const auto v = obj.value(G);
-      rows.push_back({1.0 / (u0.dot(G * u0) + t0), v.cvar95, v.p95});
+      rows.push_back({1.0 / (u0.dot(G.topLeftCorner<3, 3>() * u0) + t0), v.cvar95, v.p95});
     }
     int cvar_flips = 0, p95_flips = 0, pairs = 0;
     for (size_t a = 0; a < rows.size(); ++a)
@@ -399,4 +423,12 @@ TEST_CASE("robust objective: with the normal known, CVaR_95 and p95 rank configu
   cone[Quantity::Normal] = law(Spread::Law::Cone, 30.0 * M_PI / 180.0);
   const auto uncertain = rank_flips(cone);
   CHECK(uncertain.first > 0);
+
+  // where the bodies touch uncertain by 2 cm (normal known): the end-effector's rotational compliance
+  // enters the samples (s_i = [u_0; rho_i x u_0]), which the nominal M_ie does not see
+  UncertaintySpec point = spec;
+  point[Quantity::ContactPoint] = law(Spread::Law::Uniform, 0.02);
+  const auto moved = rank_flips(point);
+  CHECK(moved.first > 0);
+  CHECK(moved.second > 0);
 }

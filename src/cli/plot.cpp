@@ -125,6 +125,7 @@ void range(const std::vector<const std::vector<double>*>& arrays, double margin,
 
 struct Cell {
   double x0, x1, y0, y1;  // normalized page coordinates of the panel's cell
+  bool bottom = false;    // in the figure's last row: its x-axis label meets the page edge
 };
 
 class Renderer {
@@ -146,7 +147,8 @@ class Renderer {
     for (size_t k = 0; k < fig_.panels.size(); ++k) {
       const int r = static_cast<int>(k) / cols, c = static_cast<int>(k) % cols;
       const double h = top / rows, w = 1.0 / cols;
-      const Cell cell{c * w, (c + 1) * w, top - (r + 1) * h, top - r * h};
+      const bool bottom = r == static_cast<int>(fig_.panels.size() - 1) / cols;
+      const Cell cell{c * w, (c + 1) * w, top - (r + 1) * h, top - r * h, bottom};
       std::visit([&](const auto& p) { draw(p, cell); }, fig_.panels[k]);
     }
   }
@@ -166,7 +168,7 @@ class Renderer {
     const double px = 1.0 / fig_.width, py = 1.0 / fig_.height;
     vx0 = c.x0 + 82 * px;
     vx1 = c.x1 - (18 + right_extra) * px;
-    vy0 = c.y0 + 50 * py;
+    vy0 = c.y0 + (c.bottom ? 62 : 50) * py;  // the page edge clips descenders of the last row's x label
     vy1 = c.y1 - 30 * py;
   }
 

@@ -286,7 +286,8 @@ nlohmann::json sample_json(const UncertainSample& s) {
           {"approach_speed", s.approach_speed},
           {"stiffness", s.contact.K},
           {"exponent", s.contact.alpha},
-          {"restitution", s.contact.c_r}};
+          {"restitution", s.contact.c_r},
+          {"robot_contact_offset", to_json(Eigen::VectorXd(s.robot_offset))}};
 }
 
 /// The three most extreme uncertain quantities of a sample, as "name score".
@@ -528,7 +529,7 @@ int run_robust(RobustOptions& o, CLI::App& app) {  // by reference: the file's k
   const UncertainSample nominal_sample = draw_sample(fixed, nominal, 0);
   for (auto& c : configs) {
     c.forces.resize(count);
-    const Matrix3 G = robot_inverse_mass_matrix(model, data, c.base, c.theta, pb.frame);
+    const Matrix6 G = robot_inverse_inertia(model, data, c.base, c.theta, pb.frame);
     if (force_model == ForceModel::Multibody) {
       c.nominal = sample_force_multibody(model, c.base, c.theta, pb.frame, nominal_sample, pb.law);
       parallel_for(0, count, o.threads, [&](std::uint64_t i) {
@@ -604,7 +605,7 @@ int run_robust(RobustOptions& o, CLI::App& app) {  // by reference: the file's k
     c << std::setprecision(12)
       << "configuration,sample,target_mass,Ixx,Iyy,Izz,Ixy,Ixz,Iyz,offset_x,offset_y,offset_z,normal_x,normal_y,"
          "normal_z,spin_x_deg,spin_y_deg,spin_z_deg,velocity_x,velocity_y,velocity_z,approach_speed,stiffness,"
-         "exponent,restitution,M_ie,delta_dot,F_max\n";
+         "exponent,restitution,robot_offset_x,robot_offset_y,robot_offset_z,M_ie,delta_dot,F_max\n";
     for (const auto& cf : configs)
       for (std::uint64_t i = 0; i < count; ++i) {
         const UncertainSample& s = samples[i];
@@ -615,7 +616,7 @@ int run_robust(RobustOptions& o, CLI::App& app) {  // by reference: the file's k
         for (const Vector3* v : {&s.target.contact_offset, &s.target.normal, &w, &s.target.velocity})
           c << "," << (*v)(0) << "," << (*v)(1) << "," << (*v)(2);
         c << "," << s.approach_speed << "," << s.contact.K << "," << s.contact.alpha << "," << s.contact.c_r << ","
-          << cf.forces[i].M_ie << "," << cf.forces[i].approach_velocity << "," << cf.forces[i].f_max << "\n";
+          << s.robot_offset(0) << "," << s.robot_offset(1) << "," << s.robot_offset(2) << "," << cf.forces[i].M_ie << "," << cf.forces[i].approach_velocity << "," << cf.forces[i].f_max << "\n";
       }
     outputs.set("--csv", c.str());
   }

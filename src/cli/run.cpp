@@ -461,7 +461,7 @@ int run_scenario(RunOptions options, const CLI::App& app, FromCommandLine cli) {
     const std::pair<const char*, const CaptureResult*> rows[] = {
         {"baseline", &base_run}, {"optimized", &opt_run}, {"global", &global->result.run}};
     for (const auto& [name, r] : rows) {
-      const auto v = robust->value(robot_inverse_mass_matrix(model, data, r->base, r->theta, pb.frame));
+      const auto v = robust->value(robot_inverse_inertia(model, data, r->base, r->theta, pb.frame));
       rj[name] = {{"cvar95", v.cvar95}, {"p95", v.p95}};
       note << (r == &base_run ? ": " : ", ") << (r == &base_run ? "plain" : name) << " " << v.cvar95 / 1e3 << " / "
            << v.p95 / 1e3 << " kN";

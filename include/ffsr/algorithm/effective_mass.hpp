@@ -7,21 +7,33 @@
 namespace ffsr {
 namespace detail {
 
-/// w = J_v^T u for the origin of `frame`: the generalized force that a unit force along u at the
-/// point produces. Reads the kinematics. Writes data.w.
-inline void linear_jacobian_transpose_times(const Model& model, Data& data, int frame, const Vector3& u) {
+/// w = J^T [f; m] for the origin of `frame` (J the 6x(6+n) point Jacobian, linear rows first): the
+/// generalized force that a force f at the point and a couple m produce. A unit force u at the point
+/// p_e + rho is the pair (u, rho x u). Reads the kinematics. Writes data.w.
+inline void jacobian_transpose_times(const Model& model, Data& data, int frame, const Vector3& f, const Vector3& m) {
   const Vector3 pe = frame_pose(model, data, frame).p;
   if (!pe.allFinite()) throw NumericalError(str("effective_mass: the position of frame '", model.frame(frame).name,
                                                 "' overflows double precision"));
   data.w.setZero();
-  data.w.head<3>() = u;
-  data.w.segment<3>(3) = (pe - data.p[0]).cross(u);
+  data.w.head<3>() = f;
+  data.w.segment<3>(3) = (pe - data.p[0]).cross(f) + m;
   for (int i = model.frame(frame).body; i > 0; i = model.body(i).parent) {
     const auto S = data.S.col(i - 1);
     data.w(6 + model.body(i).coord) += model.body(i).joint.type == JointType::Revolute
-                        ? S.tail<3>().dot((pe - data.p[static_cast<size_t>(i)]).cross(u))
-                        : S.head<3>().dot(u);
+                        ? S.tail<3>().dot((pe - data.p[static_cast<size_t>(i)]).cross(f)) + S.tail<3>().dot(m)
+                        : S.head<3>().dot(f);
   }
+}
+
+/// w = J_v^T u for the origin of `frame`: the generalized force that a unit force along u at the
+/// point produces. Reads the kinematics. Writes data.w.
+inline void linear_jacobian_transpose_times(const Model& model, Data& data, int frame, const Vector3& u) {
+  jacobian_transpose_times(model, data, frame, u, Vector3::Zero());
+}
+
+inline void check_frame(const Model& model, int frame, const char* where) {
+  if (frame < 0 || frame >= static_cast<int>(model.frames().size()))
+    throw InputError(str(where, ": frame index ", frame, " out of range"));
 }
 
 inline void check_unit_direction(const Vector3& u, const char* where) {
@@ -36,13 +48,34 @@ inline void check_unit_direction(const Vector3& u, const char* where) {
 /// Reads data.H and the kinematics. Writes data.L, data.w and data.y (= L^-1 w).
 inline double inverse_effective_mass(const Model& model, Data& data, int frame, const Vector3& u) {
   detail::check_unit_direction(u, "effective_mass");
-  if (frame < 0 || frame >= static_cast<int>(model.frames().size()))
-    throw InputError(detail::str("effective_mass: frame index ", frame, " out of range"));
+  detail::check_frame(model, frame, "effective_mass");
   detail::linear_jacobian_transpose_times(model, data, frame, u);
   detail::cholesky(data.H, data.L, "effective_mass");
   data.y = data.w;
   detail::cholesky_forward(data.L, data.y);
   return data.y.squaredNorm();
+}
+
+/// The robot's 6x6 inverse inertia at the origin of `frame`, Lambda^-1 = J H^-1 J^T (J the point
+/// Jacobian of frame_jacobian, linear rows first, for the free-floating system: the base moves under
+/// momentum conservation). For a unit force u at the point p_e + rho (rho in the inertial frame),
+/// the robot's inverse effective mass is s^T Lambda^-1 s with s = [u; rho x u]; its top-left 3x3
+/// block is G = J_v H^-1 J_v^T. Computed as Y^T Y with Y = L^-1 J^T (six forward substitutions),
+/// symmetrized.
+/// Reads data.H (crba) and the kinematics. Writes data.L, data.w and data.y.
+inline Matrix6 inverse_inertia_matrix(const Model& model, Data& data, int frame) {
+  detail::check_frame(model, frame, "inverse_inertia_matrix");
+  detail::cholesky(data.H, data.L, "inverse_inertia_matrix");
+  Eigen::Matrix<double, Eigen::Dynamic, 6> Y(data.H.rows(), 6);
+  for (int k = 0; k < 6; ++k) {
+    Vector6 e = Vector6::Unit(k);
+    detail::jacobian_transpose_times(model, data, frame, e.head<3>(), e.tail<3>());
+    data.y = data.w;
+    detail::cholesky_forward(data.L, data.y);
+    Y.col(k) = data.y;
+  }
+  const Matrix6 L = Y.transpose() * Y;
+  return 0.5 * (L + L.transpose());  // exactly symmetric (the product's rounding is not)
 }
 
 /// Effective mass m_e = 1 / (u^T (J_v H^-1 J_v^T) u) of the free-floating robot at the origin of
@@ -76,24 +109,29 @@ inline double integrated_effective_mass(const Model& model, Data& data, const Ba
 
 namespace ffsr {
 
-/// Analytic gradient of the integrated effective mass with respect to the joint angles, at a fixed
-/// base pose and for a fixed inertial contact direction u and target inverse mass along the normal
-/// (Target::inverse_mass_along_normal). With y = H^-1 w, w = J_v^T u, and 1/m_e = w^T y:
-///   d(1/m_e)/dtheta_k = 2 u . d(J_v y)/dtheta_k - y^T (dH/dtheta_k) y,
+/// Analytic gradient in the joint angles of the quadratic form q = s^T Lambda^-1 s of the robot's
+/// inverse inertia at the origin of `frame` (inverse_inertia_matrix) for a constant s = [f; m] in the
+/// inertial frame, at a fixed base pose. With w = J^T s, y = H^-1 w and q = w^T y:
+///   dq/dtheta_k = 2 s . d(J y)/dtheta_k - y^T (dH/dtheta_k) y,
 /// where y^T (dH/dtheta_k) y = 2 (V_k x S_k) . h_k (V_k the spatial velocity of body k and h_k the
-/// spatial momentum of the subtree of k, both for the velocity y), and d(J_v y)/dtheta_k follows
-/// from moving the subtree of k by the twist S_k. Then dM_ie = -M_ie^2 d(1/m_e). O(n) after the
-/// Cholesky factorization. Runs crba. Writes data.H, data.L, data.w, data.y, data.V, data.F and
-/// `grad` (size n). Returns M_ie.
-inline double integrated_effective_mass_gradient(const Model& model, Data& data, const BasePose& base,
-                                                 const Eigen::Ref<const Eigen::VectorXd>& theta, int frame,
-                                                 const Vector3& u, double target_inverse_mass,
-                                                 Eigen::Ref<Eigen::VectorXd> grad) {
-  detail::require_size(grad.size(), model.n(), "integrated_effective_mass_gradient", "grad");
-  crba(model, data, base, theta);
-  const double inv_me = inverse_effective_mass(model, data, frame, u);
+/// spatial momentum of the subtree of k, both for the velocity y), and d(J y)/dtheta_k -- the change
+/// of the end-effector's linear velocity at its origin and of its angular velocity -- follows from
+/// moving the subtree of k by the twist S_k. O(n) after the Cholesky factorization. For s = [u; 0]
+/// q is the inverse effective mass of Eq. 4; for s = [u; rho x u], that at the point p_e + rho
+/// (rho held fixed in the inertial frame). Reads data.H (crba) and the kinematics. Writes data.L,
+/// data.w, data.y, data.V, data.F and `grad` (size n). Returns q.
+inline double inverse_inertia_form_gradient(const Model& model, Data& data, int frame, const Vector6& s,
+                                            Eigen::Ref<Eigen::VectorXd> grad) {
+  detail::require_size(grad.size(), model.n(), "inverse_inertia_form_gradient", "grad");
+  detail::check_frame(model, frame, "inverse_inertia_form_gradient");
+  detail::require_finite_all(s, "inverse_inertia_form_gradient", "s");
+  const Vector3 u = s.head<3>(), mc = s.tail<3>();
+  detail::jacobian_transpose_times(model, data, frame, u, mc);
+  detail::cholesky(data.H, data.L, "inverse_inertia_form_gradient");
+  data.y = data.w;
+  detail::cholesky_forward(data.L, data.y);
+  const double q = data.y.squaredNorm();
   detail::cholesky_backward(data.L, data.y);  // y = H^-1 w
-  const double M = 1.0 / (inv_me + target_inverse_mass);
   const int nb = model.nb();
   const Vector3& p0 = data.p[0];
   // velocities and momenta of the bodies for the generalized velocity y
@@ -115,14 +153,34 @@ inline double integrated_effective_mass_gradient(const Model& model, Data& data,
     const auto ui = static_cast<size_t>(i);
     const Vector6 S = data.S.col(i - 1);
     const double yHy = 2.0 * cross_motion(data.V[ui], S).dot(data.F[ui]);
-    double udv = 0.0;
+    double sdv = 0.0;
     if (supports(model, i, ee_body)) {
-      const Vector6 X = cross_motion(S, Vee - data.V[ui]);
+      const Vector6 X = cross_motion(S, Vee - data.V[ui]);  // d(V_ee)/dtheta_k, referred to p0
       const Vector3 dp = S.head<3>() + S.tail<3>().cross(pe - p0);
-      udv = u.dot(X.head<3>() + X.tail<3>().cross(pe - p0) + Vee.tail<3>().cross(dp));
+      sdv = u.dot(X.head<3>() + X.tail<3>().cross(pe - p0) + Vee.tail<3>().cross(dp)) + mc.dot(X.tail<3>());
     }
-    grad(model.body(i).coord) += -M * M * (2.0 * udv - yHy);
+    grad(model.body(i).coord) += 2.0 * sdv - yHy;
   }
+  return q;
+}
+
+/// Analytic gradient of the integrated effective mass with respect to the joint angles, at a fixed
+/// base pose and for a fixed inertial contact direction u and target inverse mass along the normal
+/// (Target::inverse_mass_along_normal): with 1/m_e = q(u) of inverse_inertia_form_gradient for
+/// s = [u; 0], dM_ie = -M_ie^2 d(1/m_e). Runs crba. Writes data.H, data.L, data.w, data.y, data.V,
+/// data.F and `grad` (size n). Returns M_ie.
+inline double integrated_effective_mass_gradient(const Model& model, Data& data, const BasePose& base,
+                                                 const Eigen::Ref<const Eigen::VectorXd>& theta, int frame,
+                                                 const Vector3& u, double target_inverse_mass,
+                                                 Eigen::Ref<Eigen::VectorXd> grad) {
+  detail::require_size(grad.size(), model.n(), "integrated_effective_mass_gradient", "grad");
+  detail::check_unit_direction(u, "effective_mass");
+  crba(model, data, base, theta);
+  Vector6 s;
+  s << u, Vector3::Zero();
+  const double inv_me = inverse_inertia_form_gradient(model, data, frame, s, grad);
+  const double M = 1.0 / (inv_me + target_inverse_mass);
+  grad *= -M * M;
   return M;
 }
 

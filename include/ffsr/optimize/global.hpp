@@ -234,7 +234,7 @@ inline ManifoldPoint evaluate_capture(const CaptureProblem& pb, const CaptureSet
       break;
     case GlobalObjective::RobustForce:
       if (!robust) throw InputError("evaluate_capture: the robust-force objective needs its sample set");
-      p.objective = robust->value(robot_inverse_mass_matrix(model, data, base, theta, pb.frame)).cvar95;
+      p.objective = robust->value(robot_inverse_inertia(model, data, base, theta, pb.frame)).cvar95;
       break;
   }
   return p;
@@ -335,7 +335,7 @@ inline ManifoldSearchResult detail::search_manifold(const CaptureProblem& pb, co
     const double M = 1.0 / (inverse_effective_mass(model, data, pb.frame, s.u_cap) + s.target_inv_mass);
     if (!std::isfinite(M)) continue;
     // the value the local optima are compared by: M_ie, or CVaR_95 for robust-force
-    const double v = robust ? so.robust->value(robot_inverse_mass_matrix(model, data, base, th, pb.frame)).cvar95 : M;
+    const double v = robust ? so.robust->value(robot_inverse_inertia(model, data, base, th, pb.frame)).cvar95 : M;
     bool duplicate = false;
     for (ManifoldPoint& p : found)
       if (detail::configuration_distance(model, p.theta, th) < 1e-3) {

@@ -4,15 +4,17 @@
 // The free-floating robot (joints passive: zero torque; gravity model.gravity, zero by default) and
 // the target (a free rigid body) touch at one point. The target's surface near the contact is the
 // plane through its material contact point (r_tp) with normal u_n, both fixed in the target; the
-// end-effector is a point. The deformation is the end-effector's penetration of that plane,
-// delta = u . (p_e - p_tp) with u = R_t u_n, and the law of contact/contact_law.hpp gives the force
-// F(delta, delta_dot) >= 0. It acts along u: +F u on the target and -F u on the robot, both at the
-// end-effector point, so the pair is collinear and the total linear and angular momentum of robot
-// plus target are conserved exactly (a test checks it).
+// end-effector is a point: the origin of the end-effector frame, or a point fixed in the end-effector
+// at rho from it (MultibodyContactOptions::robot_contact_offset: a contact elsewhere on the gripper).
+// The deformation is that point's penetration of the plane, delta = u . (p_c - p_tp) with
+// u = R_t u_n, and the law of contact/contact_law.hpp gives the force F(delta, delta_dot) >= 0. It
+// acts along u: +F u on the target and -F u on the robot, both at the robot's contact point p_c, so
+// the pair is collinear and the total linear and angular momentum of robot plus target are conserved
+// exactly (a test checks it).
 //
-// Start: first touch (delta = 0). The robot moves with zero total momentum and the end-effector
-// velocity equal to `approach_speed` along u (joint rates from the pseudo-inverse of the linear rows
-// of J_f; the base follows from momentum conservation); the target moves with its own velocity and
+// Start: first touch (delta = 0). The robot moves with zero total momentum and the velocity of its
+// contact point equal to `approach_speed` along u (joint rates from the pseudo-inverse of the linear
+// rows of J_f at that point; the base follows from momentum conservation); the target moves with its own velocity and
 // spin. delta_dot^- = u . (v_e - v_tp) of that state (Eq. 10-12) sets the damping (Eq. 22).
 // Integration: SUNDIALS CVODE (BDF, Newton, dense), tight tolerances, on displacements from the
 // initial state so that the ~0.1 mm deformation is resolved; separation (delta back to zero) and the
@@ -38,6 +40,9 @@ struct MultibodyContactOptions {
   long max_num_steps = 200000;      ///< CVODE step budget
   double max_duration = 0;          ///< give up after this contact time (s); 0: 100 x the Hertz estimate
   bool record_series = false;       ///< keep (t, F, delta) at every internal step
+  /// rho: the robot's contact point is the end-effector frame's origin plus rho (inertial frame at
+  /// the first touch; the point is fixed in the end-effector body). Zero: the origin itself.
+  Vector3 robot_contact_offset = Vector3::Zero();
 };
 
 struct ContactSample {
@@ -90,17 +95,22 @@ struct ContactSystem {
   Target target;          ///< at the first touch
   Matrix3 Rt0;
   Vector3 ct0, r0;        ///< target centre of mass and contact offset (in o) at the first touch
+  Vector3 rho_ee;         ///< the robot's contact point from the end-effector origin, end-effector frame
   int n;
   // scratch
   Eigen::VectorXd theta, v, tau, a, ydot_scratch, y_scratch;
 
-  ContactSystem(const Model& m, const BasePose& b, const Eigen::VectorXd& th, int f, const Target& t)
+  /// `rho` is the robot's contact point from the end-effector origin, inertial frame at (b, th).
+  ContactSystem(const Model& m, const BasePose& b, const Eigen::VectorXd& th, int f, const Target& t,
+                const Vector3& rho = Vector3::Zero())
       : model(m), data(m), base0(b), theta0(th), frame(f), target(t), n(m.n()),
         theta(m.n()), v(m.nv()), tau(m.nv()), a(m.nv()) {
     base0.orientation.normalize();
     Rt0 = target.rotation();
     ct0 = target.position;
     r0 = Rt0 * target.contact_offset;
+    forward_kinematics(model, data, base0, theta0);
+    rho_ee = frame_pose(model, data, frame).R.transpose() * rho;
   }
   Eigen::Index size() const { return 24 + 2 * n; }
   // offsets
@@ -110,7 +120,7 @@ struct ContactSystem {
   struct Kin {
     BasePose base;
     Matrix3 Rt;
-    Vector3 ct, u, pe, ve, ptp, vtp, wt, vt;
+    Vector3 ct, u, pe, ve, ptp, vtp, wt, vt, rho;  ///< pe, ve: the robot's contact point; rho = pe - origin
     double delta, delta_dot;
   };
   /// Kinematics of the contact at state y (writes data kinematics and data.J).
@@ -122,8 +132,10 @@ struct ContactSystem {
     v = y.segment(iv(), 6 + n);
     forward_kinematics(model, data, k.base, theta);
     frame_jacobian(model, data, frame);
-    k.pe = frame_pose(model, data, frame).p;
-    k.ve = data.J.topRows<3>() * v;
+    const Pose pf = frame_pose(model, data, frame);
+    k.rho = pf.R * rho_ee;
+    k.pe = pf.p + k.rho;
+    k.ve = data.J.topRows<3>() * v + (data.J.bottomRows<3>() * v).cross(k.rho);
     const Eigen::Index t0 = it();
     k.Rt = rotation_from_vector(y.segment<3>(t0 + 3)) * Rt0;
     k.ct = ct0 + y.segment<3>(t0);
@@ -147,8 +159,9 @@ struct ContactSystem {
   void rhs(const Law& law, const Eigen::Ref<const Eigen::VectorXd>& y, Eigen::Ref<Eigen::VectorXd> ydot) {
     const Kin k = kinematics(y);
     const double F = law.force(k.delta, k.delta_dot);
-    // robot: H a = J^T (-F u) - C
+    // robot: H a = J^T [-F u; rho x (-F u)] - C
     tau.noalias() = data.J.topRows<3>().transpose() * (-F * k.u);
+    tau.noalias() += data.J.bottomRows<3>().transpose() * k.rho.cross(-F * k.u);
     forward_dynamics(model, data, k.base, theta, v, tau, a);
     ydot.segment<3>(0) = v.head<3>();
     ydot.segment<3>(3) = rotation_vector_rate(y.segment<3>(3), v.segment<3>(3));
@@ -187,14 +200,17 @@ struct ContactSystem {
 
 }  // namespace detail
 
-/// Initial joint rates of the approach: the end-effector moves at `approach_speed` along u with
-/// zero total momentum, theta_dot = pinv(J_f,v) (approach_speed u) (complete orthogonal
-/// decomposition, so a rank-deficient J_f such as the planar robot's works). Runs crba.
+/// Initial joint rates of the approach: the end-effector's point at `rho` from its origin (inertial
+/// frame) moves at `approach_speed` along u with zero total momentum,
+/// theta_dot = pinv(J_f,v - [rho]x J_f,w) (approach_speed u) (complete orthogonal decomposition, so
+/// a rank-deficient J_f such as the planar robot's works). Runs crba.
 inline Eigen::VectorXd approach_joint_rates(const Model& model, Data& data, const BasePose& base,
                                             const Eigen::Ref<const Eigen::VectorXd>& theta, int frame,
-                                            const Vector3& u, double approach_speed) {
+                                            const Vector3& u, double approach_speed,
+                                            const Vector3& rho = Vector3::Zero()) {
   generalized_jacobian(model, data, base, theta, frame);
-  const Eigen::MatrixXd Jv = data.Jf.topRows<3>();
+  Eigen::MatrixXd Jv = data.Jf.topRows<3>();
+  if (!rho.isZero()) Jv -= skew(rho) * data.Jf.bottomRows<3>();
   Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod(Jv);
   cod.setThreshold(1e-10);
   return cod.solve(Vector3(approach_speed * u));
@@ -214,16 +230,26 @@ inline MultibodyContactResult simulate_contact(const Model& model, const BasePos
   validate(params, "simulate_contact");
   detail::require_finite(approach_speed, "simulate_contact", "approach speed");
   Data data(model);
+  const Vector3& rho = options.robot_contact_offset;
+  detail::require_finite_all(rho, "simulate_contact", "robot contact offset");
   // place the target at the first touch
   crba(model, data, base, theta);
-  const Vector3 pe = frame_pose(model, data, frame).p;
+  const Vector3 pe = frame_pose(model, data, frame).p + rho;
   const Vector3 u = target.normal_world();
   target.position = pe - target.offset_world();
-  const double M_ie = 1.0 / (inverse_effective_mass(model, data, frame, u) + target.inverse_mass_along_normal());
-  const Eigen::VectorXd qd = approach_joint_rates(model, data, base, theta, frame, u, approach_speed);
+  double inv_me;
+  if (rho.isZero()) {
+    inv_me = inverse_effective_mass(model, data, frame, u);
+  } else {
+    Vector6 s;
+    s << u, rho.cross(u);
+    inv_me = s.dot(inverse_inertia_matrix(model, data, frame) * s);
+  }
+  const double M_ie = 1.0 / (inv_me + target.inverse_mass_along_normal());
+  const Eigen::VectorXd qd = approach_joint_rates(model, data, base, theta, frame, u, approach_speed, rho);
   const Vector6 xb = base_velocity_from_momentum(model, data, qd);
 
-  detail::ContactSystem sys(model, base, Eigen::VectorXd(theta), frame, target);
+  detail::ContactSystem sys(model, base, Eigen::VectorXd(theta), frame, target, rho);
   const Eigen::Index N = sys.size();
   Eigen::VectorXd y0 = Eigen::VectorXd::Zero(N);
   y0.segment<6>(sys.iv()) = xb;

@@ -9,20 +9,22 @@
 // jumps from one sample to another) and its gradient is the mean of the tail samples' gradients,
 // which SLSQP can use. The 95th percentile (nearest rank) is reported beside it.
 //
-// The force of a sample as a function of the configuration. With G = J_v H^-1 J_v^T the robot's
-// 3x3 inverse mass matrix at the end-effector (sampling.hpp),
-//   M_i = 1 / (u_i^T G u_i + b_i),   b_i the target's inverse mass along u_i (sample constant),
+// The force of a sample as a function of the configuration. With Lambda^-1 = J H^-1 J^T the robot's
+// 6x6 inverse inertia at the end-effector and s_i = [u_i; rho_i x u_i] the sample's unit force at
+// its contact point (sampling.hpp),
+//   M_i = 1 / (s_i^T Lambda^-1 s_i + b_i),   b_i the target's inverse mass along u_i (sample constant),
 // and the exact peak of Eq. 16 scales as F_i = c_i M_i^(a_i / (a_i + 1)) (a_i the contact exponent):
 // in Eq. 16 with delta = L x, t = L / v s (v = delta_dot^-) the mass enters only through
 // L^(a + 1) = M v^2 / K (the damping factor depends on c_r and v only, Table 1), and F = K L^a.
-// So c_i = F_i(1 kg) is computed once per sample by the exact peak, and a configuration costs one G
-// and N evaluations of c_i M_i^p_i -- no peak solve per evaluation (test_uncertainty checks the
-// scaling against the exact peak for the eight laws).
+// So c_i = F_i(1 kg) is computed once per sample by the exact peak, and a configuration costs one
+// Lambda^-1 and N evaluations of c_i M_i^p_i -- no peak solve per evaluation (test_uncertainty
+// checks the scaling against the exact peak for the eight laws).
 //
-// The gradient. d(u^T G u)/dtheta = sum_ab u_a u_b dG_ab/dtheta, and the six entries dG_ab/dtheta
-// come from six analytic gradients of the effective mass (effective_mass.hpp) along e_a and
-// (e_a + e_b)/sqrt(2), by polarization: G_ab = q((e_a + e_b)/sqrt 2) - (G_aa + G_bb)/2 with
-// q(w) = w^T G w. Then dF_i = p_i F_i / M_i dM_i and dM_i = -M_i^2 d(u_i^T G u_i).
+// The gradient. dF_i = p_i F_i / M_i dM_i and dM_i = -M_i^2 d(s_i^T Lambda^-1 s_i), so the gradient
+// of CVaR_95 is d tr(Lambda^-1 W) with W = sum over the tail of w_i s_i s_i^T, w_i = -p_i F_i M_i / k.
+// W is a symmetric 6x6 matrix: with its eigen-decomposition W = sum_j l_j e_j e_j^T the gradient is
+// sum_j l_j d(e_j^T Lambda^-1 e_j), six analytic form gradients (effective_mass.hpp,
+// inverse_inertia_form_gradient) whatever the number of samples.
 #pragma once
 
 #include "ffsr/uncertainty/sampling.hpp"
@@ -66,9 +68,9 @@ class RobustForceObjective {
     double p95 = 0;     ///< 95th percentile (nearest rank), N
   };
 
-  /// The measure for a configuration with robot inverse mass matrix G (robot_inverse_mass_matrix).
-  Value value(const Matrix3& G) {
-    forces(G);
+  /// The measure for a configuration with robot inverse inertia Lambda^-1 (robot_inverse_inertia).
+  Value value(const Matrix6& Linv) {
+    forces(Linv);
     select_tail();
     Value v;
     for (std::size_t j = 0; j < tail_; ++j) v.cvar95 += F_[order_[j]];
@@ -87,51 +89,37 @@ class RobustForceObjective {
                             Eigen::Ref<Eigen::VectorXd> grad) {
     const int n = model.n();
     detail::require_size(grad.size(), n, "RobustForceObjective", "grad");
-    for (auto& d : dG_) d.resize(n);
     g_.resize(n);
-    // the diagonal: q(e_a) and its gradient
-    Matrix3 G;
-    double q[3];
-    for (int a = 0; a < 3; ++a) {
-      const double M = integrated_effective_mass_gradient(model, data, base, theta, frame, Vector3::Unit(a), 0.0, g_);
-      q[a] = 1.0 / M;
-      G(a, a) = q[a];
-      dG_[static_cast<std::size_t>(a)] = -g_ * (q[a] * q[a]);  // d(1/M) = -dM / M^2
-    }
-    // the off-diagonal entries by polarization along (e_a + e_b)/sqrt(2)
-    static constexpr int kPairs[3][2] = {{0, 1}, {0, 2}, {1, 2}};
-    for (int k = 0; k < 3; ++k) {
-      const int a = kPairs[k][0], b = kPairs[k][1];
-      const Vector3 w = (Vector3::Unit(a) + Vector3::Unit(b)) / std::sqrt(2.0);
-      const double M = integrated_effective_mass_gradient(model, data, base, theta, frame, w, 0.0, g_);
-      const double qw = 1.0 / M;
-      G(a, b) = G(b, a) = qw - 0.5 * (q[a] + q[b]);
-      auto& d = dG_[static_cast<std::size_t>(3 + k)];
-      d = -g_ * (qw * qw) - 0.5 * (dG_[static_cast<std::size_t>(a)] + dG_[static_cast<std::size_t>(b)]);
-    }
-    forces(G);
+    crba(model, data, base, theta);
+    forces(inverse_inertia_matrix(model, data, frame));
     select_tail();
     double cvar = 0;
-    grad.setZero();
+    Matrix6 W = Matrix6::Zero();
     for (std::size_t j = 0; j < tail_; ++j) {
       const std::size_t i = order_[j];
-      const Vector3& u = samples_[i].normal_world;
       cvar += F_[i];
-      // dF_i = p_i F_i / M_i dM_i = -p_i F_i M_i d(u^T G u)
-      const double s = -p_[i] * F_[i] * M_[i];
-      grad += s * (u(0) * u(0) * dG_[0] + u(1) * u(1) * dG_[1] + u(2) * u(2) * dG_[2] +
-                   2.0 * u(0) * u(1) * dG_[3] + 2.0 * u(0) * u(2) * dG_[4] + 2.0 * u(1) * u(2) * dG_[5]);
+      const Vector6& s = samples_[i].wrench;
+      W.noalias() += (-p_[i] * F_[i] * M_[i]) * (s * s.transpose());
     }
     cvar /= static_cast<double>(tail_);
-    grad /= static_cast<double>(tail_);
+    W /= static_cast<double>(tail_);
+    const Eigen::SelfAdjointEigenSolver<Matrix6> es(W);
+    const double scale = es.eigenvalues().cwiseAbs().maxCoeff();
+    grad.setZero();
+    for (int k = 0; k < 6; ++k) {
+      const double l = es.eigenvalues()(k);
+      if (!(std::abs(l) > 1e-15 * scale)) continue;  // rank-deficient W (no contact-point: rank <= 3)
+      inverse_inertia_form_gradient(model, data, frame, es.eigenvectors().col(k), g_);
+      grad += l * g_;
+    }
     return cvar;
   }
 
  private:
-  void forces(const Matrix3& G) {
+  void forces(const Matrix6& Linv) {
     for (std::size_t i = 0; i < samples_.size(); ++i) {
-      const Vector3& u = samples_[i].normal_world;
-      M_[i] = 1.0 / (u.dot(G * u) + samples_[i].target_inverse_mass);
+      const Vector6& s = samples_[i].wrench;
+      M_[i] = 1.0 / (s.dot(Linv * s) + samples_[i].target_inverse_mass);
       F_[i] = c_[i] * std::pow(M_[i], p_[i]);
       if (!std::isfinite(F_[i]) || !(M_[i] > 0))
         throw NumericalError(detail::str("RobustForceObjective: sample ", samples_[i].index,
@@ -151,7 +139,6 @@ class RobustForceObjective {
   std::vector<double> c_, p_, F_, M_;
   std::vector<std::size_t> order_;
   std::size_t tail_ = 1;
-  std::array<Eigen::VectorXd, 6> dG_;
   Eigen::VectorXd g_;
 };
 

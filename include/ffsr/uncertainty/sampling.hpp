@@ -4,16 +4,33 @@
 // What is uncertain. The capture configuration (joint angles and base pose at the capture time T)
 // is planned for the nominal target; what is not known is the target as it is met at T and the
 // contact. A sample is the target at the capture -- its mass, inertia, contact offset r_tp, normal
-// u_n, spin omega_t (target frame), linear velocity v_t -- and the contact: approach speed,
-// stiffness K, restitution c_r, exponent alpha. The target's attitude at T is the nominal one
-// (propagated from t = 0 by the planner), so u = R_t u_n and r = R_t r_tp change through u_n and
-// r_tp only. Per sample (Eq. 10-14, 20-25):
-//   M_ie = 1 / (u^T G u + 1/m_t + (r_tp x u_n)^T I_t^-1 (r_tp x u_n)),  G = J_v H^-1 J_v^T (robot),
-//   delta_dot^- = v_a - u . (v_t + omega x r)   (the end-effector moves at v_a along u, Eq. 10-12),
+// u_n, spin omega_t (target frame), linear velocity v_t -- and the contact: where the bodies touch,
+// approach speed, stiffness K, restitution c_r, exponent alpha. The target's attitude at T is the
+// nominal one (propagated from t = 0 by the planner), so u = R_t u_n and r = R_t r_tp change
+// through u_n and r_tp only.
+//
+// Two quantities move the contact point, and they differ in what they move:
+//   contact-offset  e: the lever arm r_tp + e from the target's centre of mass to the contact point
+//                   (the centre of mass is not where it was estimated); the point where the bodies
+//                   touch is the planned one, the end-effector's point p_e.
+//   contact-point   d: the point where the bodies touch is displaced by d (target frame) from the
+//                   planned one -- the grasp feature is not where it was seen, so it meets another
+//                   point of the end-effector's contact surface. Both bodies see it: the lever arm is
+//                   r_tp + d and the robot is struck at p_e + rho, rho = R_t d. The robot's inverse
+//                   effective mass there is s^T Lambda^-1 s with s = [u; rho x u] and Lambda^-1 =
+//                   J H^-1 J^T its 6x6 inverse inertia at p_e: the end-effector's rotational
+//                   compliance enters, which depends on the configuration (the nominal M_ie does not
+//                   see it).
+// Per sample (Eq. 10-14, 20-25):
+//   M_ie = 1 / (s^T Lambda^-1 s + 1/m_t + (r_tp x u_n)^T I_t^-1 (r_tp x u_n)),  s = [u; rho x u]
+//          (rho = 0 without contact-point: s^T Lambda^-1 s = u^T G u, G = J_v H^-1 J_v^T),
+//   delta_dot^- = v_a - u . (v_t + omega x r)   (the robot's contact point moves at v_a along u,
+//                                                Eq. 10-12),
 //   F_max = closed form (Eq. 24) or the exact peak of Eq. 16, or a multibody CVODE run
 //   (uncertainty/multibody.hpp).
-// G is a property of the configuration, computed once (robot_inverse_mass_matrix); a sample then
-// costs a 3x3 solve and the peak of Eq. 16 -- 1e5 samples take well under a second.
+// Lambda^-1 is a property of the configuration, computed once (robot_inverse_inertia); a sample
+// then costs a 6-vector quadratic form and the peak of Eq. 16 -- 1e5 samples take well under a
+// second.
 //
 // The laws (Spread), with x0 the nominal value:
 //   normal      x = x0 + s z          s = std, or relative-std |x0|   z ~ N(0, 1)
@@ -22,7 +39,7 @@
 //   cone        the normal u_n: uniform on the spherical cap of half-angle a <= 90 deg about the
 //               nominal normal (cos of the angle uniform in [cos a, 1], azimuth uniform)
 // Any scalar law may carry bounds `min`/`max` (a bounded law: values outside are redrawn, i.e. the
-// law is truncated). Vectors (contact offset, spin, velocity) take normal or uniform laws per
+// law is truncated). Vectors (contact offset, contact point, spin, velocity) take normal or uniform laws per
 // component, added to the nominal vector, with absolute spreads. The inertia takes a relative
 // spread of its principal moments (each scaled by 1 + e, e normal or uniform) and, optionally, a
 // rotation of its principal axes by an angle uniform in [0, axes] about a uniformly random axis.
@@ -81,13 +98,14 @@ enum class Quantity {
   ApproachSpeed,
   Stiffness,
   Restitution,
-  Exponent
+  Exponent,
+  ContactPoint
 };
-inline constexpr std::size_t kNumQuantities = 10;
+inline constexpr std::size_t kNumQuantities = 11;
 /// Scenario keys of the quantities ([uncertainty] table), in the order of Quantity.
 inline constexpr std::array<std::string_view, kNumQuantities> kQuantityNames{
     "target-mass", "target-inertia", "contact-offset", "normal", "spin", "target-velocity",
-    "approach-speed", "stiffness", "restitution", "exponent"};
+    "approach-speed", "stiffness", "restitution", "exponent", "contact-point"};
 
 /// The law of one uncertain quantity (see the top of this file). Units are the quantity's own, SI,
 /// except `spin` (rad/s here; the CLI takes deg/s) and the angles (rad).
@@ -134,6 +152,8 @@ struct UncertainSample {
   ContactParams contact;
   double approach_speed = 0;
   Vector3 normal_world = Vector3::UnitX();  ///< u = R_t u_n
+  Vector3 robot_offset = Vector3::Zero();   ///< rho: the robot's contact point is p_e + rho (inertial frame)
+  Vector6 wrench = (Vector6() << 1, 0, 0, 0, 0, 0).finished();  ///< s = [u; rho x u]: a unit force along u at p_e + rho
   double approach_velocity = 0;             ///< delta_dot^- (Eq. 10-12)
   double target_inverse_mass = 0;           ///< 1/m_t + (r x u)^T I^-1 (r x u), target frame
   int redraws = 0;                          ///< redrawn quantities and samples (physical rules)
@@ -208,16 +228,22 @@ inline UncertainSample draw_sample(const UncertaintySpec& spec, const UncertainN
 inline Matrix3 robot_inverse_mass_matrix(const Model& model, Data& data, const BasePose& base,
                                          const Eigen::Ref<const Eigen::VectorXd>& theta, int frame);
 
+/// The robot's 6x6 inverse inertia Lambda^-1 = J H^-1 J^T at the origin of `frame`
+/// (effective_mass.hpp, inverse_inertia_matrix): a sample's robot-side inverse effective mass is
+/// s^T Lambda^-1 s with s = UncertainSample::wrench (its top-left block is G). Runs crba. Writes data.
+inline Matrix6 robot_inverse_inertia(const Model& model, Data& data, const BasePose& base,
+                                     const Eigen::Ref<const Eigen::VectorXd>& theta, int frame);
+
 /// How F_max is computed per sample: Eq. 24 (closed), the exact peak of Eq. 16 (exact), or the
 /// multibody CVODE reference (uncertainty/multibody.hpp; not available from this header).
 enum class ForceModel { Closed, Exact, Multibody };
 
-/// M_ie, delta_dot^- and F_max of one sample for a configuration with inverse mass matrix G
-/// (closed or exact force model). `law` names the damping law (Table 1).
+/// M_ie, delta_dot^- and F_max of one sample for a configuration with inverse inertia Lambda^-1
+/// (robot_inverse_inertia; closed or exact force model). `law` names the damping law (Table 1).
 struct SampleForce {
   double M_ie = 0, approach_velocity = 0, f_max = 0;
 };
-inline SampleForce sample_force(const Matrix3& G, const UncertainSample& s, std::string_view law, ForceModel model);
+inline SampleForce sample_force(const Matrix6& Linv, const UncertainSample& s, std::string_view law, ForceModel model);
 
 /// Summary of F_max over a sample set: mean, standard deviation (n - 1), the 50th, 95th and 99th
 /// percentiles and the maximum. Percentiles are order statistics (nearest rank): p-th = the

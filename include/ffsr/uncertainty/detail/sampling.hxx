@@ -15,7 +15,8 @@ inline bool is_scalar_quantity(Quantity q) {
          q == Quantity::Restitution || q == Quantity::Exponent;
 }
 inline bool is_vector_quantity(Quantity q) {
-  return q == Quantity::ContactOffset || q == Quantity::Spin || q == Quantity::TargetVelocity;
+  return q == Quantity::ContactOffset || q == Quantity::ContactPoint || q == Quantity::Spin ||
+         q == Quantity::TargetVelocity;
 }
 /// A number as a person wrote it (6 significant digits), for messages about what they wrote.
 inline std::string short_number(double x) {
@@ -189,7 +190,12 @@ inline UncertainSample draw_sample(const UncertaintySpec& spec, const UncertainN
                                         sc(Q::Restitution));
     s.contact.alpha = detail::draw_scalar(spec[Q::Exponent], Q::Exponent, nominal.contact.alpha, rng, s.redraws,
                                           sc(Q::Exponent));
+    // drawn last, so that the streams of the other quantities do not depend on whether it is set
+    const Vector3 d = detail::draw_offset(spec[Q::ContactPoint], rng, sc(Q::ContactPoint));
+    s.target.contact_offset += d;
+    s.robot_offset = R * d;
     s.normal_world = R * s.target.normal;
+    s.wrench << s.normal_world, s.robot_offset.cross(s.normal_world);
     const Vector3 r = R * s.target.contact_offset;
     s.approach_velocity = s.approach_speed - s.normal_world.dot(s.target.velocity + (R * s.target.angular_velocity).cross(r));
     if (s.approach_velocity > 0) {
@@ -213,10 +219,15 @@ inline Matrix3 robot_inverse_mass_matrix(const Model& model, Data& data, const B
   return Y.transpose() * Y;
 }
 
-inline SampleForce sample_force(const Matrix3& G, const UncertainSample& s, std::string_view law, ForceModel model) {
-  const Vector3& u = s.normal_world;
+inline Matrix6 robot_inverse_inertia(const Model& model, Data& data, const BasePose& base,
+                                     const Eigen::Ref<const Eigen::VectorXd>& theta, int frame) {
+  crba(model, data, base, theta);
+  return inverse_inertia_matrix(model, data, frame);
+}
+
+inline SampleForce sample_force(const Matrix6& Linv, const UncertainSample& s, std::string_view law, ForceModel model) {
   SampleForce f;
-  f.M_ie = 1.0 / (u.dot(G * u) + s.target_inverse_mass);
+  f.M_ie = 1.0 / (s.wrench.dot(Linv * s.wrench) + s.target_inverse_mass);
   f.approach_velocity = s.approach_velocity;
   const AnyContactLaw l = make_contact_law(law, s.contact, s.approach_velocity);
   if (model == ForceModel::Closed) f.f_max = max_force_closed_form(l, f.M_ie);
@@ -302,9 +313,9 @@ inline double robust_force_p95(const Model& model, Data& data, const BasePose& b
                                const Eigen::Ref<const Eigen::VectorXd>& theta, int frame,
                                const std::vector<UncertainSample>& samples, std::string_view law) {
   if (samples.empty()) throw InputError("robust_force_p95: no samples");
-  const Matrix3 G = robot_inverse_mass_matrix(model, data, base, theta, frame);
+  const Matrix6 Linv = robot_inverse_inertia(model, data, base, theta, frame);
   std::vector<double> f(samples.size());
-  for (std::size_t i = 0; i < samples.size(); ++i) f[i] = sample_force(G, samples[i], law, ForceModel::Exact).f_max;
+  for (std::size_t i = 0; i < samples.size(); ++i) f[i] = sample_force(Linv, samples[i], law, ForceModel::Exact).f_max;
   std::sort(f.begin(), f.end());
   return nearest_rank(f, 95);
 }
