@@ -54,6 +54,8 @@ int main(int argc, char** argv) {
     spec[Quantity::TargetInertia] = uniform_rel(0.2);
     spec[Quantity::ContactOffset].law = Spread::Law::Uniform;
     spec[Quantity::ContactOffset].scale = 0.02;
+    spec[Quantity::ContactPoint].law = Spread::Law::Uniform;  // the example scenario's table
+    spec[Quantity::ContactPoint].scale = 0.02;
     spec[Quantity::Normal].law = Spread::Law::Cone;
     spec[Quantity::Normal].scale = 5 * M_PI / 180;
     spec[Quantity::Spin].law = Spread::Law::Normal;
