@@ -136,6 +136,17 @@ TEST_CASE("robust: sample i depends on (seed, i) only -- p95 of 1e3 against 2e4 
   // (ln F spread ~0.25: sqrt(0.95 * 0.05 / 1000) / density); 5 % is more than three of them.
   const double p95_small = js["configurations"][0]["summary"]["p95"], p95_big = jb["configurations"][0]["summary"]["p95"];
   CHECK(std::abs(p95_small / p95_big - 1) < 0.05);
+  // the 1e3 run's distribution-free 95 % interval of the law's p95 holds the 2e4 estimate, and the
+  // 2e4 interval is narrower; both intervals are order statistics of the stored values
+  const json cs = js["configurations"][0]["summary"]["p95_ci95"], cb = jb["configurations"][0]["summary"]["p95_ci95"];
+  CHECK(cs["lo"].get<double>() <= p95_big);
+  CHECK(p95_big < cs["hi"].get<double>());
+  CHECK(cb["hi"].get<double>() - cb["lo"].get<double>() < cs["hi"].get<double>() - cs["lo"].get<double>());
+  std::vector<double> sorted = fs;
+  std::sort(sorted.begin(), sorted.end());
+  CHECK(cs["lo"].get<double>() == sorted[cs["lower_rank"].get<std::size_t>() - 1]);
+  CHECK(cs["hi"].get<double>() == sorted[cs["upper_rank"].get<std::size_t>() - 1]);
+  CHECK(small.out.find("95 % confidence interval of the 95th percentile") != std::string::npos);
   // the CSV: a header and one row per sample, 31 columns, no NaN
   std::ifstream csv(dir / "big.csv");
   std::string line;

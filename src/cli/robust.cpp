@@ -304,7 +304,11 @@ nlohmann::json extremes(const UncertainSample& s, const UncertaintySpec& spec) {
 }
 
 nlohmann::json summary_json(const ForceSummary& s) {
-  return {{"n", s.n}, {"mean", s.mean}, {"std", s.std}, {"p50", s.p50}, {"p95", s.p95}, {"p99", s.p99}, {"max", s.max}};
+  const auto& ci = s.p95_ci;
+  auto bound = [](std::size_t rank, double v) { return rank ? nlohmann::json(v) : nlohmann::json(); };
+  return {{"n", s.n}, {"mean", s.mean}, {"std", s.std}, {"p50", s.p50}, {"p95", s.p95}, {"p99", s.p99}, {"max", s.max},
+          {"p95_ci95", {{"lo", bound(ci.lower, ci.lo)}, {"hi", bound(ci.upper, ci.hi)}, {"lower_rank", ci.lower},
+                        {"upper_rank", ci.upper}, {"coverage", ci.coverage}}}};
 }
 
 std::string extremes_text(const nlohmann::json& ex) {
@@ -329,6 +333,22 @@ void print_summary(const nlohmann::json& j, std::ostream& out) {
     for (const char* k : {"mean", "std", "p50", "p95", "p99", "max"}) out << std::setw(10) << s[k].get<double>() / 1e3;
     out << "\n";
   }
+  // how well the samples pin the 95th percentile of the law down: the distribution-free interval
+  out << "95 % confidence interval of the 95th percentile (order statistics, distribution-free), kN:";
+  const char* sep = "\n  ";
+  for (const auto& c : j["configurations"]) {
+    const auto& ci = c["summary"]["p95_ci95"];
+    auto bound = [](const nlohmann::json& b, const char* none) {
+      std::ostringstream os;
+      if (b.is_null()) os << none;
+      else os << std::fixed << std::setprecision(3) << b.get<double>() / 1e3;
+      return os.str();
+    };
+    out << sep << c["name"].get<std::string>() << " [" << bound(ci["lo"], "-") << ", " << bound(ci["hi"], "none: too few samples")
+        << "]";
+    sep = ", ";
+  }
+  out << "\n";
   for (const auto& c : j["configurations"]) {
     out << "\nlargest F_max, " << c["name"].get<std::string>() << " (score: z for normal laws, ln(x/x0)/sigma, "
         << "[-1, 1] in a uniform range, angle/half-angle in the cone):\n";

@@ -252,8 +252,28 @@ inline SampleForce sample_force(const Matrix6& Linv, const UncertainSample& s, s
 struct ForceSummary {
   std::size_t n = 0;
   double mean = 0, std = 0, p50 = 0, p95 = 0, p99 = 0, max = 0;
+  /// 95 % confidence interval of the 95th percentile of the law (not of the sample): the order
+  /// statistics of ranks p95_ci.lower and p95_ci.upper (quantile_interval); a bound whose rank is 0
+  /// does not exist at this n (then its value is 0).
+  struct Interval {
+    std::size_t lower = 0, upper = 0;  ///< 1-based ranks, 0: no bound
+    double lo = 0, hi = 0;             ///< the values at those ranks
+    double coverage = 0;               ///< P(lo <= true p95 < hi) >= 0.95 when both exist
+  } p95_ci;
 };
 inline ForceSummary summarize(const std::vector<double>& values_by_index);
+/// A distribution-free confidence interval of the q-quantile xi_q of a continuous law from n
+/// independent draws: with B ~ Binomial(n, q) the number of draws below xi_q, the order statistics
+/// X_(l) and X_(u) bracket it, P(X_(l) <= xi_q < X_(u)) = P(l <= B <= u - 1). l is the largest rank
+/// with P(B <= l - 1) <= (1 - confidence)/2 and u the smallest with P(B <= u - 1) >=
+/// (1 + confidence)/2 (binomial terms from lgamma), so the coverage is at least `confidence`; a rank
+/// outside 1..n is returned as 0 (no bound: too few samples, e.g. no upper bound of p95 at 95 % below n = 72).
+struct QuantileRanks {
+  std::size_t lower = 0, upper = 0;
+  double coverage = 0;  ///< P(l <= B <= u - 1) with the missing bounds taken as 0 and n + 1
+};
+inline QuantileRanks quantile_interval(std::size_t n, double q, double confidence = 0.95);
+
 /// The nearest-rank percentile of `sorted` (ascending): the ceil(percent n / 100)-th smallest value,
 /// in integer arithmetic (no rounding question at p n = integer). percent in [1, 100].
 inline double nearest_rank(const std::vector<double>& sorted, int percent);

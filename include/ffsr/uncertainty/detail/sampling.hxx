@@ -244,6 +244,37 @@ inline double nearest_rank(const std::vector<double>& sorted, int percent) {
   return sorted[rank - 1];
 }
 
+inline QuantileRanks quantile_interval(std::size_t n, double q, double confidence) {
+  if (n == 0) throw InputError("quantile_interval: no values");
+  if (!(q > 0 && q < 1)) throw InputError(detail::str("quantile_interval: q must be in (0, 1), got ", q));
+  if (!(confidence > 0 && confidence < 1))
+    throw InputError(detail::str("quantile_interval: confidence must be in (0, 1), got ", confidence));
+  const double nd = static_cast<double>(n), sd = std::sqrt(nd * q * (1 - q));
+  // the binomial mass outside [k0, k1] is below 1e-300: the CDF starts at 0 at k0
+  const auto k0 = static_cast<std::size_t>(std::max(0.0, std::floor(nd * q - 40 * sd - 40)));
+  const auto k1 = static_cast<std::size_t>(std::min(nd, std::ceil(nd * q + 40 * sd + 40)));
+  const double alpha = 0.5 * (1 - confidence), lnq = std::log(q), lnp = std::log1p(-q), lg = std::lgamma(nd + 1);
+  QuantileRanks r;
+  double cdf = 0, below_lower = 0;  // P(B <= k) and P(B <= l - 1)
+  bool have_upper = false;
+  for (std::size_t k = k0; k <= k1; ++k) {
+    const double kd = static_cast<double>(k);
+    cdf += std::exp(lg - std::lgamma(kd + 1) - std::lgamma(nd - kd + 1) + kd * lnq + (nd - kd) * lnp);
+    // rank k + 1 has P(B <= (k + 1) - 1) = cdf
+    if (cdf <= alpha && k + 1 <= n) {
+      r.lower = k + 1;
+      below_lower = cdf;
+    }
+    if (!have_upper && cdf >= 1 - alpha && k + 1 <= n) {
+      r.upper = k + 1;
+      r.coverage = cdf - below_lower;
+      have_upper = true;
+    }
+  }
+  if (!have_upper) r.coverage = 1.0 - below_lower;  // up to X_(n) and beyond: B <= n always
+  return r;
+}
+
 inline ForceSummary summarize(const std::vector<double>& v) {
   ForceSummary s;
   s.n = v.size();
@@ -263,6 +294,12 @@ inline ForceSummary summarize(const std::vector<double>& v) {
   s.p95 = nearest_rank(sorted, 95);
   s.p99 = nearest_rank(sorted, 99);
   s.max = sorted.back();
+  const QuantileRanks ci = quantile_interval(s.n, 0.95);
+  s.p95_ci.lower = ci.lower;
+  s.p95_ci.upper = ci.upper;
+  s.p95_ci.coverage = ci.coverage;
+  if (ci.lower) s.p95_ci.lo = sorted[ci.lower - 1];
+  if (ci.upper) s.p95_ci.hi = sorted[ci.upper - 1];
   return s;
 }
 
