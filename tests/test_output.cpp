@@ -460,6 +460,17 @@ TEST_CASE("expect: a result compared with itself passes, a moved value gives exi
     other["scenario"]["urdf"] = "/elsewhere/paper_3dof.urdf";
     CHECK(expect_with(other).exit_code == 0);
   }
+  SECTION("wall-clock times and the optimizers' work counters are not results: not compared") {
+    json other = base;
+    REQUIRE(other["optimized"].contains("damped_evaluations"));
+    other["optimized"]["damped_evaluations"] = other["optimized"]["damped_evaluations"].get<long>() + 7;
+    other["baseline"]["damped_evaluations"] = 0;
+    CHECK(expect_with(other).exit_code == 0);
+    other["optimized"]["steps"] = other["optimized"]["steps"].get<long>() + 1;  // a result: still compared
+    const auto r = expect_with(other);
+    CHECK(r.exit_code == 4);
+    CHECK(moved_lines(r.err).size() == 1);
+  }
   SECTION("--atol: the floor for values near zero") {
     json moved = base;
     // tracking_error is ~1e-11 m (round-off of the tracking): 1e-10 differs by a factor of ten

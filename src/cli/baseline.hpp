@@ -7,10 +7,12 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace ffsr::cli {
@@ -32,7 +34,7 @@ struct Tolerance {
 /// in their shortest round-trip form). A key present on one side only, an array of another length,
 /// a changed string or boolean and a change of type are differences too. Top-level keys listed in
 /// `skip` (inputs such as the resolved scenario and the version, not results) are not compared, nor
-/// are keys named "seconds" at any depth (wall-clock times).
+/// are the keys of kUncomparedKeys at any depth (wall-clock times and the optimizers' work counters).
 std::vector<std::string> compare_results(const nlohmann::json& stored, const nlohmann::json& now, Tolerance tol,
                                          const std::vector<std::string>& skip);
 
@@ -42,8 +44,14 @@ namespace detail_baseline {
 using ffsr::detail::str;
 using nlohmann::json;
 
-/// Keys of this name (at any depth) hold wall-clock times, e.g. global.search.seconds: never compared.
-inline constexpr const char* kTimingKey = "seconds";
+/// Keys of these names (at any depth) are never compared: wall-clock times (global.search.seconds)
+/// and the optimizers' work counters (SLSQP and damped-step evaluations), which move with the last
+/// bit of a gradient -- another compiler, Eigen version or libm -- while the results agree.
+inline constexpr std::array<std::string_view, 4> kUncomparedKeys{"seconds", "evaluations", "damped_evaluations",
+                                                                 "multibody_evaluations"};
+inline bool uncompared(const std::string& key) {
+  return std::find(kUncomparedKeys.begin(), kUncomparedKeys.end(), key) != kUncomparedKeys.end();
+}
 
 inline std::string show(const json& v) {
   if (v.is_array()) return str("an array of ", v.size());
@@ -62,12 +70,12 @@ inline void compare(const json& a, const json& b, const std::string& path, Toler
   if (a.is_object() && b.is_object()) {
     const std::string prefix = path.empty() ? "" : path + ".";
     for (const auto& [key, value] : a.items()) {
-      if (key == kTimingKey) continue;  // a wall-clock time is not a result
+      if (uncompared(key)) continue;  // a wall-clock time or a work counter is not a result
       if (!b.contains(key)) out.push_back(str(prefix, key, ": stored ", show(value), ", now missing"));
       else compare(value, b.at(key), prefix + key, tol, out);
     }
     for (const auto& [key, value] : b.items())
-      if (key != kTimingKey && !a.contains(key)) out.push_back(str(prefix, key, ": stored missing, now ", show(value)));
+      if (!uncompared(key) && !a.contains(key)) out.push_back(str(prefix, key, ": stored missing, now ", show(value)));
     return;
   }
   if (a.is_array() && b.is_array()) {
