@@ -659,7 +659,7 @@ TEST_CASE("sin_cos of the kinematics: within 2 units in the last place of std::s
   }
 }
 
-TEST_CASE("inverse inertia at a point: a force at p_e + rho is the effective mass of a frame there; form gradient against central differences",
+TEST_CASE("inverse inertia at a point: a force at p_e + rho is the effective mass of a frame there -- form gradient against central differences",
           "[dynamics]") {
   // Lambda^-1 = J H^-1 J^T at the end-effector's body origin. Three independent checks: its linear
   // block and the whole matrix from finite differences of forward kinematics; s^T Lambda^-1 s with

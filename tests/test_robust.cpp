@@ -283,6 +283,12 @@ TEST_CASE("robust --json -: the JSON alone on standard output, the table on stan
   REQUIRE(r.exit_code == 0);
   const json j = json::parse(r.out);  // throws if the table were mixed in
   CHECK(j["configurations"][0]["summary"]["n"] == 50);
+  // 50 samples are too few for an upper bound of the p95 interval: left out, not null
+  const json ci = j["configurations"][0]["summary"]["p95_ci95"];
+  CHECK(ci["upper_rank"] == 0);
+  CHECK_FALSE(ci.contains("hi"));
+  CHECK(ci["lo"].is_number());
+  CHECK(r.err.find("none: too few samples") != std::string::npos);
   CHECK(r.err.find("configuration") != std::string::npos);
   // two outputs on standard output: refused before any work
   Args b{"--config", kScenario, "--json", "-", "--csv", "-"};

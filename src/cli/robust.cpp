@@ -304,11 +304,13 @@ nlohmann::json extremes(const UncertainSample& s, const UncertaintySpec& spec) {
 }
 
 nlohmann::json summary_json(const ForceSummary& s) {
+  // a bound that does not exist at this sample count (rank 0) is left out: the JSON has no null
   const auto& ci = s.p95_ci;
-  auto bound = [](std::size_t rank, double v) { return rank ? nlohmann::json(v) : nlohmann::json(); };
+  nlohmann::json interval = {{"lower_rank", ci.lower}, {"upper_rank", ci.upper}, {"coverage", ci.coverage}};
+  if (ci.lower) interval["lo"] = ci.lo;
+  if (ci.upper) interval["hi"] = ci.hi;
   return {{"n", s.n}, {"mean", s.mean}, {"std", s.std}, {"p50", s.p50}, {"p95", s.p95}, {"p99", s.p99}, {"max", s.max},
-          {"p95_ci95", {{"lo", bound(ci.lower, ci.lo)}, {"hi", bound(ci.upper, ci.hi)}, {"lower_rank", ci.lower},
-                        {"upper_rank", ci.upper}, {"coverage", ci.coverage}}}};
+          {"p95_ci95", interval}};
 }
 
 std::string extremes_text(const nlohmann::json& ex) {
@@ -338,13 +340,13 @@ void print_summary(const nlohmann::json& j, std::ostream& out) {
   const char* sep = "\n  ";
   for (const auto& c : j["configurations"]) {
     const auto& ci = c["summary"]["p95_ci95"];
-    auto bound = [](const nlohmann::json& b, const char* none) {
+    auto bound = [&ci](const char* key, const char* none) {
       std::ostringstream os;
-      if (b.is_null()) os << none;
-      else os << std::fixed << std::setprecision(3) << b.get<double>() / 1e3;
+      if (!ci.contains(key)) os << none;
+      else os << std::fixed << std::setprecision(3) << ci[key].get<double>() / 1e3;
       return os.str();
     };
-    out << sep << c["name"].get<std::string>() << " [" << bound(ci["lo"], "-") << ", " << bound(ci["hi"], "none: too few samples")
+    out << sep << c["name"].get<std::string>() << " [" << bound("lo", "-") << ", " << bound("hi", "none: too few samples")
         << "]";
     sep = ", ";
   }
