@@ -109,6 +109,11 @@ inline double integrated_effective_mass(const Model& model, Data& data, const Ba
 
 namespace ffsr {
 
+namespace detail {
+inline double inverse_inertia_form_gradient_factored(const Model& model, Data& data, int frame, const Vector6& s,
+                                                     Eigen::Ref<Eigen::VectorXd> grad);
+}  // namespace detail
+
 /// Analytic gradient in the joint angles of the quadratic form q = s^T Lambda^-1 s of the robot's
 /// inverse inertia at the origin of `frame` (inverse_inertia_matrix) for a constant s = [f; m] in the
 /// inertial frame, at a fixed base pose. With w = J^T s, y = H^-1 w and q = w^T y:
@@ -125,9 +130,17 @@ inline double inverse_inertia_form_gradient(const Model& model, Data& data, int 
   detail::require_size(grad.size(), model.n(), "inverse_inertia_form_gradient", "grad");
   detail::check_frame(model, frame, "inverse_inertia_form_gradient");
   detail::require_finite_all(s, "inverse_inertia_form_gradient", "s");
+  detail::cholesky(data.H, data.L, "inverse_inertia_form_gradient");
+  return detail::inverse_inertia_form_gradient_factored(model, data, frame, s, grad);
+}
+
+namespace detail {
+/// inverse_inertia_form_gradient with data.L already the Cholesky factor of data.H (callers that
+/// evaluate several forms at one configuration factorize once). No argument checks.
+inline double inverse_inertia_form_gradient_factored(const Model& model, Data& data, int frame, const Vector6& s,
+                                                     Eigen::Ref<Eigen::VectorXd> grad) {
   const Vector3 u = s.head<3>(), mc = s.tail<3>();
   detail::jacobian_transpose_times(model, data, frame, u, mc);
-  detail::cholesky(data.H, data.L, "inverse_inertia_form_gradient");
   data.y = data.w;
   detail::cholesky_forward(data.L, data.y);
   const double q = data.y.squaredNorm();
@@ -163,6 +176,7 @@ inline double inverse_inertia_form_gradient(const Model& model, Data& data, int 
   }
   return q;
 }
+}  // namespace detail
 
 /// Analytic gradient of the integrated effective mass with respect to the joint angles, at a fixed
 /// base pose and for a fixed inertial contact direction u and target inverse mass along the normal

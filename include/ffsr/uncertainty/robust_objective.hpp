@@ -109,7 +109,8 @@ class RobustForceObjective {
     for (int k = 0; k < 6; ++k) {
       const double l = es.eigenvalues()(k);
       if (!(std::abs(l) > 1e-15 * scale)) continue;  // rank-deficient W (no contact-point: rank <= 3)
-      inverse_inertia_form_gradient(model, data, frame, es.eigenvectors().col(k), g_);
+      // data.L is the factor of H from inverse_inertia_matrix above: not factorized again
+      detail::inverse_inertia_form_gradient_factored(model, data, frame, es.eigenvectors().col(k), g_);
       grad += l * g_;
     }
     return cvar;
