@@ -11,6 +11,7 @@
 #include "ffsr/uncertainty/robust_objective.hpp"
 #include "ffsr/uncertainty/sampling.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <vector>
@@ -484,4 +485,185 @@ TEST_CASE("robust objective: with the normal and the contact point known, CVaR_9
   const auto moved = rank_flips(point);
   CHECK(moved.first > 0);
   CHECK(moved.second > 0);
+}
+
+TEST_CASE("the single-body F_max scales as K^(1/(alpha+1)), closed and exact, eight laws (the conditional estimator's premise)",
+          "[uncertainty][robust]") {
+  for (std::string_view name : contact_law_names())
+    for (const ContactParams& cp : {ContactParams{1e9, 1.5, 0.9}, ContactParams{3e7, 1.0, 0.3},
+                                    ContactParams{5e10, 2.2, 0.6}, ContactParams{2e8, 0.7, 1.0}})
+      for (double v : {0.01, 0.2, 1.0}) {
+        const double a = 1.0 / (cp.alpha + 1.0);
+        const AnyContactLaw l1 = make_contact_law(name, cp, v);
+        for (double ratio : {1e-3, 0.31, 7.0, 2e3}) {
+          const AnyContactLaw l2 = make_contact_law(name, {cp.K * ratio, cp.alpha, cp.c_r}, v);
+          INFO(name << " K " << cp.K << " alpha " << cp.alpha << " c_r " << cp.c_r << " v " << v << " ratio " << ratio);
+          CHECK(max_force_exact(l2, 3.7) == Approx(max_force_exact(l1, 3.7) * std::pow(ratio, a)).epsilon(1e-10));
+          CHECK(max_force_closed_form(l2, 3.7) ==
+                Approx(max_force_closed_form(l1, 3.7) * std::pow(ratio, a)).epsilon(1e-10));
+        }
+      }
+}
+
+TEST_CASE("scalar_law: the CDF of the truncated law is the sampler's (Kolmogorov-Smirnov), its density the CDF's slope",
+          "[uncertainty]") {
+  struct Case {
+    const char* what;
+    Quantity q;
+    Spread sp;
+    double x0;
+  };
+  Spread bounded_lognormal = law(Spread::Law::LogNormal, 0.587);
+  bounded_lognormal.min = 5e8;
+  bounded_lognormal.max = 4e9;
+  Spread wide_normal = law(Spread::Law::Normal, 0.6, true);  // 4.8 % of the draws below K = 0: redrawn
+  Spread capped_uniform = law(Spread::Law::Uniform, 0.5, true);
+  capped_uniform.max = 1.2e9;
+  Spread restitution_normal = law(Spread::Law::Normal, 0.1);  // about 16 % above c_r = 1: redrawn
+  const std::vector<Case> cases{
+      {"log-normal K", Quantity::Stiffness, law(Spread::Law::LogNormal, 0.587), 1e9},
+      {"log-normal K within [5e8, 4e9]", Quantity::Stiffness, bounded_lognormal, 1e9},
+      {"normal K, relative 0.6, K > 0", Quantity::Stiffness, wide_normal, 1e9},
+      {"uniform K +-50 %, capped at 1.2e9", Quantity::Stiffness, capped_uniform, 1e9},
+      {"uniform K in [2e8, 3e9]", Quantity::Stiffness, uniform_range(2e8, 3e9), 1e9},
+      {"normal c_r 0.9 +- 0.1, c_r <= 1", Quantity::Restitution, restitution_normal, 0.9},
+      {"uniform c_r in [0.6, 0.95]", Quantity::Restitution, uniform_range(0.6, 0.95), 0.9},
+  };
+  const int N = 20000;
+  for (const Case& c : cases) {
+    INFO(c.what);
+    UncertaintySpec spec;
+    spec.seed = 11;
+    spec[c.q] = c.sp;
+    REQUIRE_NOTHROW(validate(spec));
+    UncertainNominal nom = paper_nominal();
+    nom.contact.K = c.q == Quantity::Stiffness ? c.x0 : nom.contact.K;
+    nom.contact.c_r = c.q == Quantity::Restitution ? c.x0 : nom.contact.c_r;
+    std::vector<double> x(N);
+    for (int i = 0; i < N; ++i) {
+      const UncertainSample s = draw_sample(spec, nom, static_cast<std::uint64_t>(i));
+      x[static_cast<std::size_t>(i)] = c.q == Quantity::Stiffness ? s.contact.K : s.contact.c_r;
+    }
+    std::sort(x.begin(), x.end());
+    double ks = 0;
+    for (int i = 0; i < N; ++i) {
+      const double F = scalar_law(c.sp, c.q, c.x0, x[static_cast<std::size_t>(i)]).cdf;
+      ks = std::max({ks, std::abs(F - i / double(N)), std::abs(F - (i + 1) / double(N))});
+    }
+    CHECK(ks < 1.63 / std::sqrt(double(N)));  // the 1 % critical value of the KS statistic
+    // the density is the slope of the CDF (central differences) inside the support
+    for (double p : {0.1, 0.5, 0.9}) {
+      const double xm = x[static_cast<std::size_t>(p * N)], h = 1e-6 * xm;
+      const double slope =
+          (scalar_law(c.sp, c.q, c.x0, xm + h).cdf - scalar_law(c.sp, c.q, c.x0, xm - h).cdf) / (2 * h);
+      CHECK(scalar_law(c.sp, c.q, c.x0, xm).density == Approx(slope).epsilon(1e-5));
+    }
+    CHECK(scalar_law(c.sp, c.q, c.x0, 0.0).cdf == 0.0);
+    CHECK(scalar_law(c.sp, c.q, c.x0, x.front()).cdf < 1e-3);
+    CHECK(scalar_law(c.sp, c.q, c.x0, x.back()).cdf > 1 - 1e-3);
+  }
+  CHECK_THROWS_AS(scalar_law(Spread{}, Quantity::Stiffness, 1e9, 1e9), InputError);                       // fixed
+  CHECK_THROWS_AS(scalar_law(law(Spread::Law::Normal, 0.0), Quantity::Stiffness, 1e9, 1e9), InputError);  // no spread
+  CHECK_THROWS_AS(scalar_law(law(Spread::Law::Normal, 0.1), Quantity::Spin, 0.0, 0.0), InputError);       // a vector
+  Spread nowhere = law(Spread::Law::Uniform, 0.1, true);
+  nowhere.min = 2e9;  // U[0.9e9, 1.1e9] above 2e9: nothing left
+  CHECK_THROWS_AS(scalar_law(nowhere, Quantity::Stiffness, 1e9, 1e9), NumericalError);
+}
+
+namespace {
+
+/// F = c K^(1/(alpha+1)) for every sample: the law of F is the law of K mapped, so its quantiles are
+/// known exactly.
+std::vector<double> forces_of_stiffness(const std::vector<double>& K, double c, double alpha) {
+  std::vector<double> f(K.size());
+  for (std::size_t i = 0; i < K.size(); ++i) f[i] = c * std::pow(K[i], 1.0 / (alpha + 1.0));
+  return f;
+}
+
+}  // namespace
+
+TEST_CASE("stiffness-conditional percentiles: exact when F_max depends on K alone, whatever the sample", "[uncertainty][robust]") {
+  const double z95 = 1.6448536269514722, z99 = 2.3263478740408408, alpha = 1.5, c = 3.0e-2;
+  for (std::size_t n : {1u, 7u, 1000u}) {
+    INFO("n = " << n);
+    std::mt19937_64 rng(5 + n);
+    std::normal_distribution<double> z;
+    std::vector<double> K(n), A(n, alpha);
+    for (double& k : K) k = 1e9 * std::exp(0.587 * z(rng));
+    const Spread ln = law(Spread::Law::LogNormal, 0.587);
+    const ForceSummary s = summarize_stiffness_conditional(forces_of_stiffness(K, c, alpha), K, A, ln, 1e9);
+    CHECK(s.estimator == ForceSummary::Estimator::StiffnessConditional);
+    const double a = 1.0 / (alpha + 1.0);
+    CHECK(s.p50 == Approx(c * std::pow(1e9, a)).epsilon(1e-12));
+    CHECK(s.p95 == Approx(c * std::pow(1e9 * std::exp(0.587 * z95), a)).epsilon(1e-12));
+    CHECK(s.p99 == Approx(c * std::pow(1e9 * std::exp(0.587 * z99), a)).epsilon(1e-12));
+    if (n >= 2) {  // every sample gives the same conditional law: no variance left
+      CHECK(s.p95_ci.has_lo);
+      CHECK(s.p95_ci.log_standard_error < 1e-12);
+    }
+    // a uniform law on [2e8, 3e9] capped at 2.5e9: the p-quantile of K is 2e8 + p (2.5e9 - 2e8)
+    Spread u = uniform_range(2e8, 3e9);
+    u.max = 2.5e9;
+    std::uniform_real_distribution<double> U(2e8, 2.5e9);
+    for (double& k : K) k = U(rng);
+    const ForceSummary su = summarize_stiffness_conditional(forces_of_stiffness(K, c, 0.8), K,
+                                                            std::vector<double>(n, 0.8), u, 1e9);
+    CHECK(su.p95 == Approx(c * std::pow(2e8 + 0.95 * 2.3e9, 1.0 / 1.8)).epsilon(1e-12));
+    CHECK(su.p50 == Approx(c * std::pow(2e8 + 0.50 * 2.3e9, 1.0 / 1.8)).epsilon(1e-12));
+  }
+}
+
+TEST_CASE("stiffness-conditional percentiles: unbiased, less scatter than order statistics, the delta-method interval covers 95 %",
+          "[uncertainty][robust]") {
+  // ln F = ln c + ln K / (alpha + 1) with ln c ~ N(0, 0.1^2) and ln K ~ N(ln 1e9, 0.587^2): ln F is
+  // normal, so the law's 95th percentile is known in closed form.
+  const double sc = 0.1, sk = 0.587, alpha = 1.5, a = 1.0 / (alpha + 1.0), z95 = 1.6448536269514722;
+  const double mu = a * std::log(1e9), sd = std::sqrt(sc * sc + a * a * sk * sk);
+  const double truth = std::exp(mu + sd * z95);
+  const Spread ln = law(Spread::Law::LogNormal, sk);
+  const int sets = 400, n = 1000;
+  std::mt19937_64 rng(2026);
+  std::normal_distribution<double> z;
+  double sum_c = 0, sum2_c = 0, sum_o = 0, sum2_o = 0;
+  int covered = 0;
+  std::vector<double> K(n), f(n), A(n, alpha);
+  for (int k = 0; k < sets; ++k) {
+    for (int i = 0; i < n; ++i) {
+      K[i] = 1e9 * std::exp(sk * z(rng));
+      f[i] = std::exp(sc * z(rng)) * std::pow(K[i], a);
+    }
+    const ForceSummary s = summarize_stiffness_conditional(f, K, A, ln, 1e9);
+    const double ec = std::log(s.p95 / truth), eo = std::log(s.order.p95 / truth);
+    sum_c += ec;
+    sum2_c += ec * ec;
+    sum_o += eo;
+    sum2_o += eo * eo;
+    REQUIRE(s.p95_ci.has_lo);
+    REQUIRE(s.p95_ci.has_hi);
+    covered += s.p95_ci.lo <= truth && truth < s.p95_ci.hi;
+    // the order statistics are those of summarize
+    CHECK(s.order.p95 == summarize(f).p95);
+  }
+  const double mean_c = sum_c / sets, rms_c = std::sqrt(sum2_c / sets), rms_o = std::sqrt(sum2_o / sets);
+  INFO("conditional: bias " << mean_c << ", rms " << rms_c << "; order statistics: bias " << sum_o / sets << ", rms "
+                            << rms_o << "; coverage " << covered << "/" << sets);
+  CHECK(std::abs(mean_c) < 4 * rms_c / std::sqrt(double(sets)));  // unbiased to the sampling error
+  CHECK(rms_c < 0.4 * rms_o);  // here the stiffness carries 86 % of the variance of ln F
+  CHECK(covered >= 0.92 * sets);  // nominal 95 %: 380 of 400, binomial sd 4.4
+  CHECK(covered <= 0.98 * sets);
+}
+
+TEST_CASE("stiffness-conditional percentiles: bad inputs", "[uncertainty][robust]") {
+  const Spread ln = law(Spread::Law::LogNormal, 0.5);
+  const std::vector<double> one{1.0}, two{1.0, 2.0};
+  CHECK_THROWS_AS(summarize_stiffness_conditional(two, one, two, ln, 1e9), InputError);
+  CHECK_THROWS_AS(summarize_stiffness_conditional(one, one, one, Spread{}, 1e9), InputError);
+  CHECK_THROWS_AS(summarize_stiffness_conditional(one, one, one, ln, -1.0), InputError);
+  CHECK_THROWS_AS(summarize_stiffness_conditional({0.0}, one, one, ln, 1e9), InputError);
+  CHECK_THROWS_AS(summarize_stiffness_conditional(one, {-1.0}, one, ln, 1e9), InputError);
+  CHECK_THROWS_AS(summarize_stiffness_conditional({std::nan("")}, one, one, ln, 1e9), NumericalError);
+  CHECK_FALSE(stiffness_conditional_applies(ForceModel::Multibody, ln));
+  CHECK_FALSE(stiffness_conditional_applies(ForceModel::Exact, Spread{}));
+  CHECK_FALSE(stiffness_conditional_applies(ForceModel::Exact, law(Spread::Law::LogNormal, 0.0)));
+  CHECK(stiffness_conditional_applies(ForceModel::Closed, ln));
 }

@@ -298,8 +298,185 @@ inline ForceSummary summarize(const std::vector<double>& v) {
   s.p95_ci.lower = ci.lower;
   s.p95_ci.upper = ci.upper;
   s.p95_ci.coverage = ci.coverage;
+  s.p95_ci.has_lo = ci.lower != 0;
+  s.p95_ci.has_hi = ci.upper != 0;
   if (ci.lower) s.p95_ci.lo = sorted[ci.lower - 1];
   if (ci.upper) s.p95_ci.hi = sorted[ci.upper - 1];
+  s.order = {s.p50, s.p95, s.p99, s.p95_ci};
+  return s;
+}
+
+namespace detail {
+
+/// Standard normal CDF, accurate in the lower tail (erfc).
+inline double normal_cdf(double z) { return 0.5 * std::erfc(-z * 0.7071067811865476); }
+inline double normal_pdf(double z) { return 0.3989422804014327 * std::exp(-0.5 * z * z); }
+
+/// The untruncated law of a scalar Spread about x0: CDF and density at x (scale > 0 checked by the caller).
+inline LawPoint base_law(const Spread& sp, double x0, double x) {
+  const double s = sp.relative ? sp.scale * std::abs(x0) : sp.scale;
+  if (sp.law == Spread::Law::Normal) {
+    const double z = (x - x0) / s;
+    return {normal_cdf(z), std::isfinite(z) ? normal_pdf(z) / s : 0.0};
+  }
+  if (sp.law == Spread::Law::Uniform) {
+    const double lo = sp.has_range ? sp.min : x0 - s, hi = sp.has_range ? sp.max : x0 + s;
+    if (x < lo) return {0.0, 0.0};
+    if (x >= hi) return {1.0, 0.0};
+    return {(x - lo) / (hi - lo), 1.0 / (hi - lo)};
+  }
+  // log-normal, median x0
+  if (!(x > 0)) return {0.0, 0.0};
+  const double z = std::log(x / x0) / sp.scale;
+  return {normal_cdf(z), std::isfinite(z) ? normal_pdf(z) / (sp.scale * x) : 0.0};
+}
+
+/// Whether a scalar law has a density (a positive spread).
+inline bool has_density(const Spread& sp, double x0) {
+  if (sp.law == Spread::Law::Normal) return (sp.relative ? sp.scale * std::abs(x0) : sp.scale) > 0;
+  if (sp.law == Spread::Law::Uniform) {
+    if (sp.has_range) return sp.max > sp.min;
+    return (sp.relative ? sp.scale * std::abs(x0) : sp.scale) > 0;
+  }
+  if (sp.law == Spread::Law::LogNormal) return sp.scale > 0 && x0 > 0;
+  return false;
+}
+
+}  // namespace detail
+
+namespace detail {
+
+/// A scalar law truncated to its support after the redraws (the bounds min/max and the physical
+/// rule of physical_scalar: every scalar quantity > 0, c_r <= 1), built once, evaluated often.
+struct TruncatedLaw {
+  const Spread& sp;
+  double x0, L, U, cdf_L, Z;
+  TruncatedLaw(const Spread& law, Quantity q, double nominal) : sp(law), x0(nominal) {
+    if (!is_scalar_quantity(q)) throw InputError(str("scalar_law: ", quantity_key(q), " is not a scalar quantity"));
+    if (!std::isfinite(x0) || !has_density(sp, x0))
+      throw InputError(str("scalar_law: ", quantity_key(q), " has no law with a spread (fixed or zero spread)"));
+    L = std::max(sp.min, 0.0);
+    U = q == Quantity::Restitution ? std::min(sp.max, 1.0) : sp.max;
+    cdf_L = base_law(sp, x0, L).cdf;
+    Z = base_law(sp, x0, U).cdf - cdf_L;
+    if (!(Z > 0)) throw NumericalError(str("scalar_law: ", quantity_key(q), " puts no probability within its bounds"));
+  }
+  LawPoint operator()(double x) const {
+    if (x <= L) return {0.0, 0.0};
+    if (x >= U) return {1.0, 0.0};
+    const LawPoint b = base_law(sp, x0, x);
+    return {std::clamp((b.cdf - cdf_L) / Z, 0.0, 1.0), b.density / Z};
+  }
+};
+
+}  // namespace detail
+
+inline LawPoint scalar_law(const Spread& sp, Quantity q, double x0, double x) {
+  if (std::isnan(x)) throw InputError("scalar_law: x is NaN");
+  return detail::TruncatedLaw(sp, q, x0)(x);
+}
+
+inline bool stiffness_conditional_applies(ForceModel model, const Spread& stiffness) {
+  return model != ForceModel::Multibody && stiffness.law != Spread::Law::Fixed && stiffness.law != Spread::Law::Cone &&
+         detail::has_density(stiffness, 1.0);
+}
+
+namespace detail {
+
+/// The stiffness-conditional CDF of F_max at ln q = t and its derivative in t: sample i contributes
+/// P_K(K <= exp(a_i t + b_i)), a_i = alpha_i + 1, b_i = ln K_i - a_i ln F_i.
+struct ConditionalCdf {
+  const std::vector<double>& a;
+  const std::vector<double>& b;
+  const TruncatedLaw& law;
+  /// C(t), dC/dt; with `h` set, also each sample's P_K (for the variance).
+  std::pair<double, double> operator()(double t, std::vector<double>* h = nullptr) const {
+    double c = 0, d = 0;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      const double k = std::exp(a[i] * t + b[i]);
+      const LawPoint p = law(k);
+      c += p.cdf;
+      d += p.density * k * a[i];  // dP/dt = pdf(k) dk/dt, dk/dt = a k
+      if (h) (*h)[i] = p.cdf;
+    }
+    const double n = static_cast<double>(a.size());
+    return {c / n, d / n};
+  }
+};
+
+/// Solves C(t) = p for t (C non-decreasing, 0 at -inf and 1 at +inf), from t0: expands a bracket,
+/// then Newton steps kept inside it (bisection when a step leaves it or the slope vanishes).
+inline double conditional_quantile(const ConditionalCdf& C, double p, double t0) {
+  double lo = t0 - 0.25, hi = t0 + 0.25, step = 0.25;
+  for (int k = 0; C(lo).first >= p; ++k, step *= 2) {
+    if (k > 200) throw NumericalError("summarize_stiffness_conditional: no lower bracket of the quantile");
+    hi = std::min(hi, lo);
+    lo -= step;
+  }
+  step = 0.25;
+  for (int k = 0; C(hi).first < p; ++k, step *= 2) {
+    if (k > 200) throw NumericalError("summarize_stiffness_conditional: no upper bracket of the quantile");
+    lo = std::max(lo, hi);
+    hi += step;
+  }
+  double t = std::clamp(t0, lo, hi);
+  for (int it = 0; it < 200; ++it) {
+    const auto [c, d] = C(t);
+    if (c < p) lo = t;
+    else hi = t;
+    double next = d > 0 ? t - (c - p) / d : 0.5 * (lo + hi);
+    if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
+    if (std::abs(next - t) <= 1e-14 * (1.0 + std::abs(t)) || hi - lo <= 1e-14 * (1.0 + std::abs(t))) return next;
+    t = next;
+  }
+  return t;  // 200 safeguarded steps: the bracket has shrunk far below any printed digit
+}
+
+}  // namespace detail
+
+inline ForceSummary summarize_stiffness_conditional(const std::vector<double>& f, const std::vector<double>& K,
+                                                    const std::vector<double>& alpha, const Spread& stiffness,
+                                                    double K0) {
+  const std::size_t n = f.size();
+  if (K.size() != n || alpha.size() != n)
+    throw InputError(detail::str("summarize_stiffness_conditional: ", n, " forces, ", K.size(), " stiffnesses and ",
+                                 alpha.size(), " exponents"));
+  if (!stiffness_conditional_applies(ForceModel::Exact, stiffness) || !(K0 > 0) || !std::isfinite(K0))
+    throw InputError("summarize_stiffness_conditional: the stiffness has no law with a spread about a positive K0");
+  ForceSummary s = summarize(f);  // mean, std, max and the order statistics; checks f finite
+  std::vector<double> a(n), b(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!(f[i] > 0) || !(K[i] > 0) || !std::isfinite(K[i]) || !(alpha[i] > 0) || !std::isfinite(alpha[i]))
+      throw InputError(detail::str("summarize_stiffness_conditional: sample ", i, " has F_max ", f[i], ", K ", K[i],
+                                   ", alpha ", alpha[i], " (all must be positive and finite)"));
+    a[i] = alpha[i] + 1.0;
+    b[i] = std::log(K[i]) - a[i] * std::log(f[i]);
+  }
+  const detail::TruncatedLaw law(stiffness, Quantity::Stiffness, K0);
+  const detail::ConditionalCdf C{a, b, law};
+  s.estimator = ForceSummary::Estimator::StiffnessConditional;
+  s.p50 = std::exp(detail::conditional_quantile(C, 0.50, std::log(s.order.p50)));
+  const double t95 = detail::conditional_quantile(C, 0.95, std::log(s.order.p95));
+  s.p95 = std::exp(t95);
+  s.p99 = std::exp(detail::conditional_quantile(C, 0.99, std::log(s.order.p99)));
+  // delta method: Var(t^) ~ Var(P_K,i(t)) / (n C'(t)^2)
+  s.p95_ci = {};
+  s.p95_ci.coverage = 0.95;
+  if (n >= 2) {
+    std::vector<double> h(n);
+    const auto [c, d] = C(t95, &h);
+    double var = 0;
+    for (double x : h) var += (x - c) * (x - c);
+    var /= static_cast<double>(n - 1);
+    if (d > 0) {
+      const double se = std::sqrt(var / static_cast<double>(n)) / d;
+      constexpr double z975 = 1.959963984540054;
+      s.p95_ci.log_standard_error = se;
+      s.p95_ci.lo = std::exp(t95 - z975 * se);
+      s.p95_ci.hi = std::exp(t95 + z975 * se);
+      s.p95_ci.has_lo = s.p95_ci.has_hi = true;
+    }
+  }
   return s;
 }
 
