@@ -303,14 +303,46 @@ nlohmann::json extremes(const UncertainSample& s, const UncertaintySpec& spec) {
   return out;
 }
 
+nlohmann::json interval_json(const ForceSummary::Interval& ci, bool delta) {
+  // a bound that does not exist (too few samples) is left out: the JSON has no null
+  nlohmann::json out;
+  if (delta) out = {{"method", "delta"}, {"log_standard_error", ci.log_standard_error}, {"coverage", ci.coverage}};
+  else
+    out = {{"method", "order-statistics"}, {"lower_rank", ci.lower}, {"upper_rank", ci.upper}, {"coverage", ci.coverage}};
+  if (ci.has_lo) out["lo"] = ci.lo;
+  if (ci.has_hi) out["hi"] = ci.hi;
+  return out;
+}
+
 nlohmann::json summary_json(const ForceSummary& s) {
-  // a bound that does not exist at this sample count (rank 0) is left out: the JSON has no null
-  const auto& ci = s.p95_ci;
-  nlohmann::json interval = {{"lower_rank", ci.lower}, {"upper_rank", ci.upper}, {"coverage", ci.coverage}};
-  if (ci.lower) interval["lo"] = ci.lo;
-  if (ci.upper) interval["hi"] = ci.hi;
-  return {{"n", s.n}, {"mean", s.mean}, {"std", s.std}, {"p50", s.p50}, {"p95", s.p95}, {"p99", s.p99}, {"max", s.max},
-          {"p95_ci95", interval}};
+  const bool conditional = s.estimator == ForceSummary::Estimator::StiffnessConditional;
+  return {{"n", s.n},
+          {"mean", s.mean},
+          {"std", s.std},
+          {"p50", s.p50},
+          {"p95", s.p95},
+          {"p99", s.p99},
+          {"max", s.max},
+          {"estimator", conditional ? "stiffness-conditional" : "order-statistics"},
+          {"p95_ci95", interval_json(s.p95_ci, conditional)},
+          {"order_statistics",
+           {{"p50", s.order.p50}, {"p95", s.order.p95}, {"p99", s.order.p99}, {"p95_ci95", interval_json(s.order.p95_ci, false)}}}};
+}
+
+/// The law of the stiffness from the summary's "uncertainty" entry (written by run_robust).
+Spread stiffness_spread(const nlohmann::json& u) {
+  Spread sp;
+  const std::string law = u.at("law").get<std::string>();
+  if (law == "normal") sp.law = Spread::Law::Normal;
+  else if (law == "uniform") sp.law = Spread::Law::Uniform;
+  else if (law == "log-normal") sp.law = Spread::Law::LogNormal;
+  else throw InputError(str("the summary's stiffness law '", law, "' has no density"));
+  sp.scale = u.at("scale").get<double>();
+  sp.relative = u.at("relative").get<bool>();
+  sp.has_range = u.at("range").get<bool>();
+  if (!u.at("min").is_null()) sp.min = u.at("min").get<double>();
+  if (!u.at("max").is_null()) sp.max = u.at("max").get<double>();
+  return sp;
 }
 
 std::string extremes_text(const nlohmann::json& ex) {
@@ -335,8 +367,22 @@ void print_summary(const nlohmann::json& j, std::ostream& out) {
     for (const char* k : {"mean", "std", "p50", "p95", "p99", "max"}) out << std::setw(10) << s[k].get<double>() / 1e3;
     out << "\n";
   }
-  // how well the samples pin the 95th percentile of the law down: the distribution-free interval
-  out << "95 % confidence interval of the 95th percentile (order statistics, distribution-free), kN:";
+  const bool conditional = j.value("estimator", "order-statistics") == "stiffness-conditional";
+  if (conditional) {
+    // the percentiles above are the stiffness-conditional ones; the order statistics beside them
+    out << "percentiles conditional on the stiffness (the single-body F_max scales as K^(1/(alpha+1)); README)."
+        << "\norder statistics of the same samples, p95 (kN):";
+    const char* sep = " ";
+    for (const auto& c : j["configurations"]) {
+      out << sep << c["name"].get<std::string>() << " " << std::fixed << std::setprecision(3)
+          << c["summary"]["order_statistics"]["p95"].get<double>() / 1e3;
+      sep = ", ";
+    }
+    out << "\n";
+  }
+  // how well the samples pin the 95th percentile of the law down
+  out << "95 % confidence interval of the 95th percentile ("
+      << (conditional ? "conditional on the stiffness, delta method" : "order statistics, distribution-free") << "), kN:";
   const char* sep = "\n  ";
   for (const auto& c : j["configurations"]) {
     const auto& ci = c["summary"]["p95_ci95"];
@@ -363,10 +409,25 @@ void print_summary(const nlohmann::json& j, std::ostream& out) {
 }
 
 /// Summary JSON of the configurations from the per-sample F_max (by index) and the tail entries.
+/// With the stiffness-conditional estimator (single-body force models, K uncertain) the run's
+/// per-sample K and alpha and the law of K are in the JSON too, so a merge recomputes the same digits.
 void finish_summary(nlohmann::json& j) {
+  const bool conditional = j.value("estimator", "order-statistics") == "stiffness-conditional";
+  std::vector<double> K, alpha;
+  Spread law;
+  double K0 = 0;
+  if (conditional) {
+    if (!j.contains("stiffness") || !j.contains("exponent") || !j.contains("stiffness_nominal") ||
+        !j["uncertainty"].contains("stiffness"))
+      throw InputError("the summary's stiffness-conditional estimator lacks its stiffness, exponent or law");
+    K = j["stiffness"].get<std::vector<double>>();
+    alpha = j["exponent"].get<std::vector<double>>();
+    K0 = j["stiffness_nominal"].get<double>();
+    law = stiffness_spread(j["uncertainty"]["stiffness"]);
+  }
   for (auto& c : j["configurations"]) {
     const std::vector<double> f = c["f_max"].get<std::vector<double>>();
-    c["summary"] = summary_json(summarize(f));
+    c["summary"] = summary_json(conditional ? summarize_stiffness_conditional(f, K, alpha, law, K0) : summarize(f));
     auto tail = c["tail"];
     std::vector<nlohmann::json> t(tail.begin(), tail.end());
     std::stable_sort(t.begin(), t.end(), [](const nlohmann::json& a, const nlohmann::json& b) {
@@ -398,9 +459,10 @@ int run_merge(const RobustOptions& o) {
     return a["shard"]["first"].get<std::uint64_t>() < b["shard"]["first"].get<std::uint64_t>();
   });
   const nlohmann::json& first = parts.front();
-  for (const char* key : {"seed", "samples", "uncertainty", "force_model", "law", "scenario"})
+  for (const char* key : {"seed", "samples", "uncertainty", "force_model", "law", "scenario", "estimator",
+                          "stiffness_nominal"})
     for (const auto& p : parts)
-      if (p[key] != first[key])
+      if (p.contains(key) != first.contains(key) || (p.contains(key) && p[key] != first[key]))
         throw InputError(str("--merge: the summaries differ in '", key, "': they are not shards of one run"));
   nlohmann::json m = first;
   std::uint64_t next = 0;
@@ -413,6 +475,9 @@ int run_merge(const RobustOptions& o) {
     if (p["configurations"].size() != first["configurations"].size())
       throw InputError("--merge: the summaries have different configurations");
     if (i == 0) continue;
+    for (const char* key : {"stiffness", "exponent"})  // per sample, by index (stiffness-conditional)
+      if (p.contains(key) && m.contains(key))
+        for (const auto& x : p[key]) m[key].push_back(x);
     for (std::size_t c = 0; c < p["configurations"].size(); ++c) {
       const auto& pc = p["configurations"][c];
       auto& mc = m["configurations"][c];
@@ -589,6 +654,20 @@ int run_robust(RobustOptions& o, CLI::App& app) {  // by reference: the file's k
                               {"max", std::isfinite(sp.max) ? nlohmann::json(sp.max) : nlohmann::json()}, {"axes", sp.axes}};
     }
     j["uncertainty"] = u;
+  }
+  // the percentiles: conditional on the stiffness where F_max scales exactly with it (sampling.hpp)
+  if (stiffness_conditional_applies(force_model, spec[Quantity::Stiffness])) {
+    j["estimator"] = "stiffness-conditional";
+    j["stiffness_nominal"] = nominal.contact.K;
+    std::vector<double> K(count), alpha(count);
+    for (std::uint64_t i = 0; i < count; ++i) {
+      K[i] = samples[i].contact.K;
+      alpha[i] = samples[i].contact.alpha;
+    }
+    j["stiffness"] = K;
+    j["exponent"] = alpha;
+  } else {
+    j["estimator"] = "order-statistics";
   }
   j["configurations"] = nlohmann::json::array();
   std::uint64_t redraws = 0;
