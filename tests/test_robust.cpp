@@ -115,6 +115,26 @@ TEST_CASE("robust: 4 shards merged equal the unsharded run to the last digit", "
   const CommandResult gap = robust({"--merge", dir / "shard0.json", dir / "shard2.json"}, dir.str());
   CHECK(gap.exit_code == 2);
   CHECK(gap.err.find("--merge") != std::string::npos);
+  // a shard of another estimator (multibody: order statistics) is refused by name
+  json other = read_json(dir / "shard1.json");
+  other["estimator"] = "order-statistics";
+  other.erase("stiffness");
+  other.erase("exponent");
+  other.erase("stiffness_nominal");
+  std::ofstream(dir / "other1.json") << other.dump();
+  const CommandResult mixed =
+      robust({"--merge", dir / "shard0.json", dir / "other1.json", dir / "shard2.json", dir / "shard3.json"}, dir.str());
+  CHECK(mixed.exit_code == 2);
+  CHECK(mixed.err.find("differ in 'estimator'") != std::string::npos);
+  // a shard whose per-sample stiffness list lost a value
+  json cut = read_json(dir / "shard1.json");
+  cut["stiffness"].erase(cut["stiffness"].size() - 1);
+  std::ofstream(dir / "cut1.json") << cut.dump();
+  const CommandResult lost =
+      robust({"--merge", dir / "shard0.json", dir / "cut1.json", dir / "shard2.json", dir / "shard3.json"}, dir.str());
+  CHECK(lost.exit_code == 2);
+  CHECK(lost.err.find("'stiffness' lists do not hold one value per sample") != std::string::npos);
+  CHECK(std::count(lost.err.begin(), lost.err.end(), '\n') == 1);
 }
 
 TEST_CASE("robust: sample i depends on (seed, i) only -- p95 of 1e3 against 2e4 samples -- no NaN", "[robust]") {

@@ -489,6 +489,9 @@ int run_merge(const RobustOptions& o) {
   }
   if (next != first["samples"].get<std::uint64_t>())
     throw InputError(str("--merge: the shards cover samples 0 to ", next, " of ", first["samples"].get<std::uint64_t>()));
+  for (const char* key : {"stiffness", "exponent"})
+    if (m.contains(key) && (!m[key].is_array() || m[key].size() != next))
+      throw InputError(str("--merge: the summaries' '", key, "' lists do not hold one value per sample"));
   m["shard"] = {{"k", 0}, {"n", 1}, {"first", 0}, {"end", next}, {"merged_from", parts.size()}};
   finish_summary(m);
   Outputs outputs;  // the table goes to standard error when the JSON goes to standard output
