@@ -1,5 +1,5 @@
 // fuzz_scenario: arbitrary bytes as a scenario file of the main job of ffsr-optimize, run in-process
-// through the command's own code (src/cli: common.cpp, inspect.cpp, contact.cpp, run.cpp; the CLI11
+// through the command's own code (src/cli: common.cpp, inspect.cpp, contact.cpp, robust.cpp, run.cpp; the CLI11
 // app is set up as in main.cpp, and the same exceptions are caught). Checks: scenario_check.hpp.
 #include "scenario_check.hpp"
 #include "common.hpp"
@@ -45,6 +45,7 @@ int run_main(std::vector<std::string> args, std::ostringstream& out) {
   Action action;
   register_inspect(app, action);
   register_contact(app, action);
+  register_robust(app, action);
   register_run(app, action, argc, argv.data());
   app.require_subcommand(0, 1);
   try {

@@ -2,8 +2,8 @@
 // command's code in-process, fuzz_scenario.cpp) and tests/test_fuzz_regressions.cpp (which runs the
 // built ffsr-optimize on each reproducer).
 //
-// A scenario text is run as `ffsr-optimize --config DIR/scenario.toml` plus scenario_arguments(): a
-// short bounded run (command-line flags override the file) whose outputs go to DIR. The URDFs the
+// A scenario text is run as `ffsr-optimize [robust] --config DIR/scenario.toml` plus the rest of
+// scenario_arguments() (robust when the text has an [uncertainty] table): a short bounded run (command-line flags override the file) whose outputs go to DIR. The URDFs the
 // seed scenarios name (paper_3dof.urdf, paper_7dof.urdf) are copied into DIR. Asserted afterwards:
 //  - the exit code is 0, 4 (written; differs from an --expect baseline), 2 (bad input) or 3 (numerical
 //    failure): 1 means an exception that is not an
@@ -34,17 +34,25 @@ inline void prepare_scenario_dir(const std::string& dir) {
                   fs::copy_options::overwrite_existing);
 }
 
-/// The arguments after the program name: the scenario in `dir`, a bounded run, outputs in `dir`.
-inline std::vector<std::string> scenario_arguments(const std::string& dir) {
-  return {"--config", dir + "/scenario.toml", "--quiet", "--global", "false", "--duration", "2", "--step", "0.1",
-          "--json", dir + "/out.json", "--csv", dir + "/out.csv"};
-}
-
 inline std::string read_text(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   std::ostringstream ss;
   ss << in.rdbuf();
   return ss.str();
+}
+
+/// The arguments after the program name: the scenario DIR/scenario.toml, a bounded run, outputs in
+/// `dir`. A scenario with an [uncertainty] table runs `robust` on 20 samples (its table reader, the
+/// sampler's laws and redraws, the summaries), any other the main job.
+inline std::vector<std::string> scenario_arguments(const std::string& dir) {
+  std::vector<std::string> args;
+  if (read_text(dir + "/scenario.toml").find("[uncertainty]") != std::string::npos)
+    args = {"robust", "--samples", "20", "--threads", "1"};
+  for (const char* a : {"--quiet", "--global", "false", "--duration", "2", "--step", "0.1"}) args.push_back(a);
+  for (const std::string& a : std::vector<std::string>{"--config", dir + "/scenario.toml", "--json", dir + "/out.json",
+                                                      "--csv", dir + "/out.csv"})
+    args.push_back(a);
+  return args;
 }
 
 /// True when `text` has a token nan or inf (any case, with a sign or not) that is not part of a word.

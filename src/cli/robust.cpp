@@ -340,8 +340,8 @@ Spread stiffness_spread(const nlohmann::json& u) {
   sp.scale = u.at("scale").get<double>();
   sp.relative = u.at("relative").get<bool>();
   sp.has_range = u.at("range").get<bool>();
-  if (!u.at("min").is_null()) sp.min = u.at("min").get<double>();
-  if (!u.at("max").is_null()) sp.max = u.at("max").get<double>();
+  if (u.contains("min")) sp.min = u.at("min").get<double>();
+  if (u.contains("max")) sp.max = u.at("max").get<double>();
   return sp;
 }
 
@@ -370,7 +370,8 @@ void print_summary(const nlohmann::json& j, std::ostream& out) {
   const bool conditional = j.value("estimator", "order-statistics") == "stiffness-conditional";
   if (conditional) {
     // the percentiles above are the stiffness-conditional ones; the order statistics beside them
-    out << "percentiles conditional on the stiffness (the single-body F_max scales as K^(1/(alpha+1)); README)."
+    out << "p50, p95, p99: the law's percentiles conditional on the stiffness (the single-body F_max scales as"
+        << " K^(1/(alpha+1)); README); mean, std, max: the samples'."
         << "\norder statistics of the same samples, p95 (kN):";
     const char* sep = " ";
     for (const auto& c : j["configurations"]) {
@@ -652,9 +653,12 @@ int run_robust(RobustOptions& o, CLI::App& app) {  // by reference: the file's k
       const Spread& sp = spec.spread[q];
       if (sp.law == Spread::Law::Fixed) continue;
       static const char* laws[] = {"fixed", "normal", "uniform", "log-normal", "cone"};
-      u[quantity_label(q)] = {{"law", laws[static_cast<int>(sp.law)]}, {"scale", sp.scale}, {"relative", sp.relative},
-                              {"range", sp.has_range}, {"min", std::isfinite(sp.min) ? nlohmann::json(sp.min) : nlohmann::json()},
-                              {"max", std::isfinite(sp.max) ? nlohmann::json(sp.max) : nlohmann::json()}, {"axes", sp.axes}};
+      // an absent bound is left out (the JSON has no null)
+      nlohmann::json e = {{"law", laws[static_cast<int>(sp.law)]}, {"scale", sp.scale}, {"relative", sp.relative},
+                          {"range", sp.has_range}, {"axes", sp.axes}};
+      if (std::isfinite(sp.min)) e["min"] = sp.min;
+      if (std::isfinite(sp.max)) e["max"] = sp.max;
+      u[quantity_label(q)] = e;
     }
     j["uncertainty"] = u;
   }
