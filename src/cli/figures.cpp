@@ -227,8 +227,13 @@ std::vector<plot::Figure> capture(const Model& model, int frame, const Target& t
       p.ylabel = "y (m)";
       for (size_t i = 0; i < arms.size(); ++i) {
         const bool last = i + 1 == arms.size();
+        const size_t first_curve = p.curves.size();
         add(p, arms[i], 0, 1, color, alpha(i), 2.0,
-            i == 0 ? "arm at t = 0" : last ? str("arm at T = ", fixed(duration, 0), " s") : "", "●", 0.7);
+            i == 0 ? "arm at t = 0" : last ? str("arm at T = ", fixed(duration, 0), " s") : "", i == 0 ? "○" : "●",
+            i == 0 ? 0.9 : 0.7);
+        if (i == 0)  // dashed, open joints: told from the arm at T, which has the same colour
+          for (size_t c = first_curve; c < p.curves.size(); ++c)
+            if (p.curves[c].line_style == 1) p.curves[c].line_style = 3;
       }
       add(p, path, 0, 1, kBlack, 1.0, 1.0, "end-effector path", "", 1.0);
       p.curves.back().line_style = 2;

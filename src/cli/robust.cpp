@@ -216,7 +216,9 @@ plot::Figure robust_figure(const nlohmann::json& summary) {
   fig.width = 1200;
   fig.height = 700;
   plot::Panel cdf, hist;
-  cdf.title = "empirical CDF, 95th percentile marked";
+  cdf.title = summary.value("estimator", "order-statistics") == "stiffness-conditional"
+                  ? "empirical CDF; dot: p95 of the law (conditional on K)"
+                  : "empirical CDF, 95th percentile marked";
   cdf.xlabel = hist.xlabel = "F_max (kN)";
   cdf.ylabel = "fraction";
   hist.title = "histogram (40 shared bins)";
