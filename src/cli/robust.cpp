@@ -19,6 +19,7 @@
 #include <toml++/toml.h>
 
 #include <algorithm>
+#include <iterator>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
@@ -331,14 +332,17 @@ nlohmann::json summary_json(const ForceSummary& s) {
            {{"p50", s.order.p50}, {"p95", s.order.p95}, {"p99", s.order.p99}, {"p95_ci95", interval_json(s.order.p95_ci, false)}}}};
 }
 
+/// The summary JSON's names of Spread::Law, in the enum's order (written by run_robust, read back by
+/// stiffness_spread).
+constexpr const char* kLawNames[] = {"fixed", "normal", "uniform", "log-normal", "cone"};
+
 /// The law of the stiffness from the summary's "uncertainty" entry (written by run_robust).
 Spread stiffness_spread(const nlohmann::json& u) {
   Spread sp;
   const std::string law = u.at("law").get<std::string>();
-  if (law == "normal") sp.law = Spread::Law::Normal;
-  else if (law == "uniform") sp.law = Spread::Law::Uniform;
-  else if (law == "log-normal") sp.law = Spread::Law::LogNormal;
-  else throw InputError(str("the summary's stiffness law '", law, "' has no density"));
+  const auto* it = std::find(std::begin(kLawNames), std::end(kLawNames), law);
+  if (it == std::end(kLawNames)) throw InputError(str("the summary's stiffness law '", law, "' is unknown"));
+  sp.law = static_cast<Spread::Law>(it - std::begin(kLawNames));
   sp.scale = u.at("scale").get<double>();
   sp.relative = u.at("relative").get<bool>();
   sp.has_range = u.at("range").get<bool>();
@@ -654,9 +658,8 @@ int run_robust(RobustOptions& o, CLI::App& app) {  // by reference: the file's k
     for (std::size_t q = 0; q < kNumQuantities; ++q) {
       const Spread& sp = spec.spread[q];
       if (sp.law == Spread::Law::Fixed) continue;
-      static const char* laws[] = {"fixed", "normal", "uniform", "log-normal", "cone"};
       // an absent bound is left out (the JSON has no null)
-      nlohmann::json e = {{"law", laws[static_cast<int>(sp.law)]}, {"scale", sp.scale}, {"relative", sp.relative},
+      nlohmann::json e = {{"law", kLawNames[static_cast<int>(sp.law)]}, {"scale", sp.scale}, {"relative", sp.relative},
                           {"range", sp.has_range}, {"axes", sp.axes}};
       if (std::isfinite(sp.min)) e["min"] = sp.min;
       if (std::isfinite(sp.max)) e["max"] = sp.max;

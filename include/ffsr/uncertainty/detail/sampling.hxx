@@ -36,12 +36,15 @@ inline bool physical_scalar(Quantity q, double x) {
   return x > 0.0;  // mass, approach speed, stiffness, exponent
 }
 
+/// The spread of a normal or uniform law in the quantity's units: scale, or scale |x0| when relative.
+inline double absolute_scale(const Spread& sp, double x0) { return sp.relative ? sp.scale * std::abs(x0) : sp.scale; }
+
 inline double draw_scalar(const Spread& sp, Quantity q, double x0, SampleStream& rng, int& redraws, double& score) {
   if (sp.law == Spread::Law::Fixed) {
     score = 0;
     return x0;
   }
-  const double s = sp.relative ? sp.scale * std::abs(x0) : sp.scale;
+  const double s = absolute_scale(sp, x0);
   for (int k = 0; k < kMaxRedraws; ++k) {
     double x = x0, sc = 0;
     if (sp.law == Spread::Law::Normal) {
@@ -314,7 +317,7 @@ inline double normal_pdf(double z) { return 0.3989422804014327 * std::exp(-0.5 *
 
 /// The untruncated law of a scalar Spread about x0: CDF and density at x (scale > 0 checked by the caller).
 inline LawPoint base_law(const Spread& sp, double x0, double x) {
-  const double s = sp.relative ? sp.scale * std::abs(x0) : sp.scale;
+  const double s = absolute_scale(sp, x0);
   if (sp.law == Spread::Law::Normal) {
     const double z = (x - x0) / s;
     return {normal_cdf(z), std::isfinite(z) ? normal_pdf(z) / s : 0.0};
@@ -333,18 +336,11 @@ inline LawPoint base_law(const Spread& sp, double x0, double x) {
 
 /// Whether a scalar law has a density (a positive spread).
 inline bool has_density(const Spread& sp, double x0) {
-  if (sp.law == Spread::Law::Normal) return (sp.relative ? sp.scale * std::abs(x0) : sp.scale) > 0;
-  if (sp.law == Spread::Law::Uniform) {
-    if (sp.has_range) return sp.max > sp.min;
-    return (sp.relative ? sp.scale * std::abs(x0) : sp.scale) > 0;
-  }
+  if (sp.law == Spread::Law::Normal) return absolute_scale(sp, x0) > 0;
+  if (sp.law == Spread::Law::Uniform) return sp.has_range ? sp.max > sp.min : absolute_scale(sp, x0) > 0;
   if (sp.law == Spread::Law::LogNormal) return sp.scale > 0 && x0 > 0;
   return false;
 }
-
-}  // namespace detail
-
-namespace detail {
 
 /// A scalar law truncated to its support after the redraws (the bounds min/max and the physical
 /// rule of physical_scalar: every scalar quantity > 0, c_r <= 1), built once, evaluated often.
@@ -441,8 +437,9 @@ inline ForceSummary summarize_stiffness_conditional(const std::vector<double>& f
   if (K.size() != n || alpha.size() != n)
     throw InputError(detail::str("summarize_stiffness_conditional: ", n, " forces, ", K.size(), " stiffnesses and ",
                                  alpha.size(), " exponents"));
-  if (!stiffness_conditional_applies(ForceModel::Exact, stiffness) || !(K0 > 0) || !std::isfinite(K0))
-    throw InputError("summarize_stiffness_conditional: the stiffness has no law with a spread about a positive K0");
+  if (!(K0 > 0) || !std::isfinite(K0))
+    throw InputError(detail::str("summarize_stiffness_conditional: the nominal stiffness must be positive, got ", K0));
+  const detail::TruncatedLaw law(stiffness, Quantity::Stiffness, K0);  // InputError for a law without spread
   ForceSummary s = summarize(f);  // mean, std, max and the order statistics; checks f finite
   std::vector<double> a(n), b(n);
   for (std::size_t i = 0; i < n; ++i) {
@@ -452,7 +449,6 @@ inline ForceSummary summarize_stiffness_conditional(const std::vector<double>& f
     a[i] = alpha[i] + 1.0;
     b[i] = std::log(K[i]) - a[i] * std::log(f[i]);
   }
-  const detail::TruncatedLaw law(stiffness, Quantity::Stiffness, K0);
   const detail::ConditionalCdf C{a, b, law};
   s.estimator = ForceSummary::Estimator::StiffnessConditional;
   s.p50 = std::exp(detail::conditional_quantile(C, 0.50, std::log(s.order.p50)));
