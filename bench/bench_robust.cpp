@@ -59,7 +59,7 @@ int main(int argc, char** argv) {
     spec[Quantity::ContactOffset].law = Spread::Law::Uniform;
     spec[Quantity::ContactOffset].scale = 0.02;
     spec[Quantity::ContactPoint].law = Spread::Law::Uniform;  // the example scenario's table
-    spec[Quantity::ContactPoint].scale = 0.02;
+    spec[Quantity::ContactPoint].scale = 0.05;
     spec[Quantity::Normal].law = Spread::Law::Cone;
     spec[Quantity::Normal].scale = 5 * M_PI / 180;
     spec[Quantity::Spin].law = Spread::Law::Normal;

@@ -333,7 +333,8 @@ TEST_CASE("robust-force: the main job's global run minimizes CVaR_95 -- robust s
   CHECK(j["global"]["integrated_effective_mass"].get<double>() > 0);
 
   // robust: plain, optimized, the nominal global run (mass) and the robust one, on common samples
-  const CommandResult rb = robust({"--config", kScenario, "--json", dir / "robust.json", "--quiet"}, dir.str());
+  const CommandResult rb =
+      robust({"--config", kScenario, "--samples", "10000", "--json", dir / "robust.json", "--quiet"}, dir.str());
   INFO(rb.err);
   REQUIRE(rb.exit_code == 0);
   const json k = read_json(dir / "robust.json");
@@ -344,6 +345,18 @@ TEST_CASE("robust-force: the main job's global run minimizes CVaR_95 -- robust s
   const auto& rc = k["configurations"][3];
   CHECK(rc["nominal"]["M_ie"].get<double>() ==
         Approx(j["global"]["integrated_effective_mass"].get<double>()).epsilon(1e-12));
+  // issue 12: on the example (the contact point known to +-5 cm) the robust configuration's 95th
+  // percentile is below the nominal global configuration's on the evaluation samples (seed 2022, not
+  // the search's 2023), the whole paired 95 % interval of the ratio below 1, and it pays for it with
+  // a higher nominal M_ie: the price of robustness
+  const auto& gc = k["configurations"][2];
+  const json& cmp = k["robust_vs_global"];
+  INFO("p95 global " << gc["summary"]["p95"] << ", robust " << rc["summary"]["p95"] << "; ratio " << cmp);
+  CHECK(rc["summary"]["p95"].get<double>() < gc["summary"]["p95"].get<double>());
+  CHECK(cmp["p95_ratio"].get<double>() == Approx(rc["summary"]["p95"].get<double>() / gc["summary"]["p95"].get<double>()));
+  CHECK(cmp["p95_ratio_ci95"]["hi"].get<double>() < 1.0);
+  CHECK(rc["nominal"]["M_ie"].get<double>() > gc["nominal"]["M_ie"].get<double>());
+  CHECK(rb.out.find("robust against global on the same samples: p95 -") != std::string::npos);
   CHECK(rb.out.find("robust ") != std::string::npos);
 
   // robust-force needs the [uncertainty] table

@@ -653,6 +653,60 @@ TEST_CASE("stiffness-conditional percentiles: unbiased, less scatter than order 
   CHECK(covered <= 0.98 * sets);
 }
 
+TEST_CASE("paired p95 ratio of two configurations: exact for a scaled force, covers 95 % on a known law, narrower than unpaired",
+          "[uncertainty][robust]") {
+  const double sc = 0.1, sk = 0.587, alpha = 1.5, a = 1.0 / (alpha + 1.0), z95 = 1.6448536269514722;
+  const Spread ln = law(Spread::Law::LogNormal, sk);
+  // b = lambda a on every sample: the ratio is lambda and nothing varies between the two estimates
+  {
+    std::mt19937_64 rng(7);
+    std::normal_distribution<double> z;
+    std::vector<double> K(500), fa(500), fb(500), A(500, alpha);
+    for (std::size_t i = 0; i < K.size(); ++i) {
+      K[i] = 1e9 * std::exp(sk * z(rng));
+      fa[i] = std::exp(sc * z(rng)) * std::pow(K[i], a);
+      fb[i] = 0.97 * fa[i];
+    }
+    const PercentileRatio r = compare_p95_stiffness_conditional(fa, fb, K, A, ln, 1e9);
+    CHECK(r.ratio == Approx(0.97).epsilon(1e-12));
+    REQUIRE(r.has_interval);
+    CHECK(r.log_standard_error < 1e-9);
+  }
+  // ln F_a = ln c + ln K / (alpha + 1), ln F_b = ln F_a + 0.02 + 0.05 z': both normal, so the true
+  // ratio of the 95th percentiles is known in closed form
+  const double sb = 0.05, shift = 0.02;
+  const double sa_tot = std::sqrt(sc * sc + a * a * sk * sk), sb_tot = std::sqrt(sc * sc + sb * sb + a * a * sk * sk);
+  const double truth = std::exp(shift + z95 * (sb_tot - sa_tot));
+  const int sets = 400, n = 1000;
+  std::mt19937_64 rng(2027);
+  std::normal_distribution<double> z;
+  std::vector<double> K(n), fa(n), fb(n), A(n, alpha);
+  int covered = 0;
+  double paired = 0, unpaired = 0;
+  for (int k = 0; k < sets; ++k) {
+    for (int i = 0; i < n; ++i) {
+      K[i] = 1e9 * std::exp(sk * z(rng));
+      fa[i] = std::exp(sc * z(rng)) * std::pow(K[i], a);
+      fb[i] = fa[i] * std::exp(shift + sb * z(rng));
+    }
+    const PercentileRatio r = compare_p95_stiffness_conditional(fa, fb, K, A, ln, 1e9);
+    REQUIRE(r.has_interval);
+    covered += r.lo <= truth && truth < r.hi;
+    const ForceSummary a1 = summarize_stiffness_conditional(fa, K, A, ln, 1e9);
+    const ForceSummary b1 = summarize_stiffness_conditional(fb, K, A, ln, 1e9);
+    CHECK(r.ratio == Approx(b1.p95 / a1.p95).epsilon(1e-14));
+    paired += r.log_standard_error;
+    unpaired += std::hypot(a1.p95_ci.log_standard_error, b1.p95_ci.log_standard_error);
+  }
+  INFO("coverage " << covered << "/" << sets << "; mean standard error of ln ratio: paired " << paired / sets
+                   << ", unpaired " << unpaired / sets);
+  CHECK(covered >= 0.92 * sets);  // nominal 95 %: 380 of 400, binomial sd 4.4
+  CHECK(covered <= 0.98 * sets);
+  CHECK(paired < 0.6 * unpaired);  // what the samples share cancels
+  // the two configurations must share the samples
+  CHECK_THROWS_AS(compare_p95_stiffness_conditional(fa, std::vector<double>(3, 1.0), K, A, ln, 1e9), InputError);
+}
+
 TEST_CASE("stiffness-conditional percentiles: bad inputs", "[uncertainty][robust]") {
   const Spread ln = law(Spread::Law::LogNormal, 0.5);
   const std::vector<double> one{1.0}, two{1.0, 2.0};

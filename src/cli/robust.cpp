@@ -404,6 +404,19 @@ void print_summary(const nlohmann::json& j, std::ostream& out) {
     sep = ", ";
   }
   out << "\n";
+  if (j.contains("robust_vs_global")) {
+    const auto& r = j["robust_vs_global"];
+    auto pct = [](double ratio) {
+      std::ostringstream os;
+      os << std::showpos << std::fixed << std::setprecision(2) << 100.0 * (ratio - 1.0) << " %";
+      return os.str();
+    };
+    out << "robust against global on the same samples: p95 " << pct(r["p95_ratio"].get<double>());
+    if (r.contains("p95_ratio_ci95"))
+      out << ", 95 % interval [" << pct(r["p95_ratio_ci95"]["lo"].get<double>()) << ", "
+          << pct(r["p95_ratio_ci95"]["hi"].get<double>()) << "] (paired)";
+    out << "\n";
+  }
   for (const auto& c : j["configurations"]) {
     out << "\nlargest F_max, " << c["name"].get<std::string>() << " (score: z for normal laws, ln(x/x0)/sigma, "
         << "[-1, 1] in a uniform range, angle/half-angle in the cone):\n";
@@ -443,6 +456,29 @@ void finish_summary(nlohmann::json& j) {
     });
     if (t.size() > kTail) t.resize(kTail);
     c["tail"] = t;
+  }
+  // the robust configuration against the nominal global one, on the same samples: the ratio of the
+  // 95th percentiles, with a paired interval when the estimator has one
+  const nlohmann::json* global = nullptr;
+  const nlohmann::json* robust = nullptr;
+  for (const auto& c : j["configurations"]) {
+    if (c["name"] == "global") global = &c;
+    if (c["name"] == "robust") robust = &c;
+  }
+  j.erase("robust_vs_global");
+  if (global && robust) {
+    nlohmann::json r;
+    if (conditional) {
+      const PercentileRatio q =
+          compare_p95_stiffness_conditional((*global)["f_max"].get<std::vector<double>>(),
+                                            (*robust)["f_max"].get<std::vector<double>>(), K, alpha, law, K0);
+      r["p95_ratio"] = q.ratio;
+      if (q.has_interval)
+        r["p95_ratio_ci95"] = {{"lo", q.lo}, {"hi", q.hi}, {"method", "paired delta method"}};
+    } else {
+      r["p95_ratio"] = (*robust)["summary"]["p95"].get<double>() / (*global)["summary"]["p95"].get<double>();
+    }
+    j["robust_vs_global"] = r;
   }
 }
 

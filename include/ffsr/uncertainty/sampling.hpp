@@ -306,13 +306,35 @@ inline bool stiffness_conditional_applies(ForceModel model, const Spread& stiffn
 /// CDF, with less variance than the fraction of samples below q (it averages over K instead of
 /// drawing it). The p-quantile solves C(q) = p (safeguarded Newton in ln q, from the order statistic);
 /// it converges to the same law's quantile. On the 7-DOF example the 95th percentile from 1000
-/// samples scatters by 0.13-0.29 % instead of 1.6-1.8 % (bench/bench_robust.cpp).
+/// samples scatters by 0.3-0.4 % instead of 1.6-1.8 % (bench/bench_robust.cpp).
 /// `stiffness` is the law of K about its nominal K0 (scalar_law); f, K, alpha are per sample, by
 /// index. InputError for mismatched sizes, a degenerate law, or a non-positive or non-finite value.
 inline ForceSummary summarize_stiffness_conditional(const std::vector<double>& f_by_index,
                                                     const std::vector<double>& K_by_index,
                                                     const std::vector<double>& alpha_by_index,
                                                     const Spread& stiffness, double K0);
+
+/// Two configurations on the same samples (common random numbers): the ratio of their
+/// stiffness-conditional 95th percentiles, p95(b) / p95(a), with a paired 95 % interval.
+/// Delta method on the pair: each estimate t = ln p95 solves C(t) = 0.95 and moves by
+/// -(C^(t) - 0.95) / C'(t), so t_b - t_a has the per-sample influence
+///     psi_i = (P_a,i(t_a) - C_a) / C_a' - (P_b,i(t_b) - C_b) / C_b'
+/// (P_i the sample's conditional CDF, summarize_stiffness_conditional), and Var(t_b - t_a) ~ Var(psi) / n.
+/// The samples are shared, so what moves both estimates alike cancels: the paired interval is much
+/// narrower than the two single intervals together when the configurations see the samples alike.
+/// Arguments as summarize_stiffness_conditional, with f_a and f_b by index on the same samples;
+/// InputError for mismatched sizes and the inputs it refuses. No interval for n < 2.
+struct PercentileRatio {
+  double ratio = 1;               ///< p95(b) / p95(a)
+  double lo = 0, hi = 0;          ///< its 95 % interval (paired delta method)
+  bool has_interval = false;
+  double log_standard_error = 0;  ///< of ln ratio
+};
+inline PercentileRatio compare_p95_stiffness_conditional(const std::vector<double>& f_a_by_index,
+                                                         const std::vector<double>& f_b_by_index,
+                                                         const std::vector<double>& K_by_index,
+                                                         const std::vector<double>& alpha_by_index,
+                                                         const Spread& stiffness, double K0);
 
 /// A distribution-free confidence interval of the q-quantile xi_q of a continuous law from n
 /// independent draws: with B ~ Binomial(n, q) the number of draws below xi_q, the order statistics

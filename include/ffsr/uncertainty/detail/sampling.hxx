@@ -400,6 +400,21 @@ struct ConditionalCdf {
   }
 };
 
+/// The coefficients of sample i's conditional CDF P_K(K <= exp(a_i t + b_i)) at t = ln q:
+/// a_i = alpha_i + 1, b_i = ln K_i - a_i ln F_i. InputError for a non-positive or non-finite value.
+inline void conditional_coefficients(const std::vector<double>& f, const std::vector<double>& K,
+                                     const std::vector<double>& alpha, std::vector<double>& a, std::vector<double>& b) {
+  a.resize(f.size());
+  b.resize(f.size());
+  for (std::size_t i = 0; i < f.size(); ++i) {
+    if (!(f[i] > 0) || !(K[i] > 0) || !std::isfinite(K[i]) || !(alpha[i] > 0) || !std::isfinite(alpha[i]))
+      throw InputError(detail::str("summarize_stiffness_conditional: sample ", i, " has F_max ", f[i], ", K ", K[i],
+                                   ", alpha ", alpha[i], " (all must be positive and finite)"));
+    a[i] = alpha[i] + 1.0;
+    b[i] = std::log(K[i]) - a[i] * std::log(f[i]);
+  }
+}
+
 /// Solves C(t) = p for t (C non-decreasing, 0 at -inf and 1 at +inf), from t0: expands a bracket,
 /// then Newton steps kept inside it (bisection when a step leaves it or the slope vanishes).
 inline double conditional_quantile(const ConditionalCdf& C, double p, double t0) {
@@ -441,14 +456,8 @@ inline ForceSummary summarize_stiffness_conditional(const std::vector<double>& f
     throw InputError(detail::str("summarize_stiffness_conditional: the nominal stiffness must be positive, got ", K0));
   const detail::TruncatedLaw law(stiffness, Quantity::Stiffness, K0);  // InputError for a law without spread
   ForceSummary s = summarize(f);  // mean, std, max and the order statistics; checks f finite
-  std::vector<double> a(n), b(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    if (!(f[i] > 0) || !(K[i] > 0) || !std::isfinite(K[i]) || !(alpha[i] > 0) || !std::isfinite(alpha[i]))
-      throw InputError(detail::str("summarize_stiffness_conditional: sample ", i, " has F_max ", f[i], ", K ", K[i],
-                                   ", alpha ", alpha[i], " (all must be positive and finite)"));
-    a[i] = alpha[i] + 1.0;
-    b[i] = std::log(K[i]) - a[i] * std::log(f[i]);
-  }
+  std::vector<double> a, b;
+  detail::conditional_coefficients(f, K, alpha, a, b);
   const detail::ConditionalCdf C{a, b, law};
   s.estimator = ForceSummary::Estimator::StiffnessConditional;
   s.p50 = std::exp(detail::conditional_quantile(C, 0.50, std::log(s.order.p50)));
@@ -474,6 +483,43 @@ inline ForceSummary summarize_stiffness_conditional(const std::vector<double>& f
     }
   }
   return s;
+}
+
+inline PercentileRatio compare_p95_stiffness_conditional(const std::vector<double>& f_a, const std::vector<double>& f_b,
+                                                         const std::vector<double>& K, const std::vector<double>& alpha,
+                                                         const Spread& stiffness, double K0) {
+  const std::size_t n = f_a.size();
+  if (f_b.size() != n)
+    throw InputError(detail::str("compare_p95_stiffness_conditional: ", n, " and ", f_b.size(),
+                                 " forces: the two configurations must share the samples"));
+  // each estimate as the single summary computes it (and with its checks of the inputs)
+  const double ta = std::log(summarize_stiffness_conditional(f_a, K, alpha, stiffness, K0).p95);
+  const double tb = std::log(summarize_stiffness_conditional(f_b, K, alpha, stiffness, K0).p95);
+  PercentileRatio r;
+  r.ratio = std::exp(tb - ta);
+  if (n < 2) return r;
+  const detail::TruncatedLaw law(stiffness, Quantity::Stiffness, K0);
+  std::vector<double> a, b, ha(n), hb(n);
+  detail::conditional_coefficients(f_a, K, alpha, a, b);
+  const auto [ca, da] = detail::ConditionalCdf{a, b, law}(ta, &ha);
+  detail::conditional_coefficients(f_b, K, alpha, a, b);
+  const auto [cb, db] = detail::ConditionalCdf{a, b, law}(tb, &hb);
+  if (!(da > 0) || !(db > 0)) return r;
+  double mean = 0;
+  for (std::size_t i = 0; i < n; ++i) mean += (ha[i] - ca) / da - (hb[i] - cb) / db;
+  mean /= static_cast<double>(n);
+  double var = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double psi = (ha[i] - ca) / da - (hb[i] - cb) / db - mean;
+    var += psi * psi;
+  }
+  var /= static_cast<double>(n - 1);
+  constexpr double z975 = 1.959963984540054;
+  r.log_standard_error = std::sqrt(var / static_cast<double>(n));
+  r.lo = r.ratio * std::exp(-z975 * r.log_standard_error);
+  r.hi = r.ratio * std::exp(z975 * r.log_standard_error);
+  r.has_interval = true;
+  return r;
 }
 
 inline void parallel_for(std::uint64_t begin, std::uint64_t end, int threads, const std::function<void(std::uint64_t)>& f,
