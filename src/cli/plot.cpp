@@ -305,10 +305,12 @@ class Renderer {
     pls_.schr(0, kScale);
   }
 
-  void box3(const std::string& xl, const std::string& yl, const std::string& zl) {
+  /// tick: the major tick interval per axis (0: PLplot's choice, by the data range alone)
+  void box3(const std::string& xl, const std::string& yl, const std::string& zl, double xtick = 0, double ytick = 0,
+            double ztick = 0) {
     pls_.col0(kText);
     pls_.width(1.0);
-    pls_.box3("bnstu", xl.c_str(), 0, 0, "bnstu", yl.c_str(), 0, 0, "bcdmnstuv", zl.c_str(), 0, 0);
+    pls_.box3("bnstu", xl.c_str(), xtick, 0, "bnstu", yl.c_str(), ytick, 0, "bcdmnstuv", zl.c_str(), ztick, 0);
   }
 
   void draw(const Panel3& p, const Cell& cell) {
@@ -329,7 +331,16 @@ class Renderer {
     pls_.wind(-1.0, 1.0, -0.9, 1.5);
     pls_.w3d(side(x1 - x0), side(y1 - y0), side(z1 - z0), x0, x1, y0, y1, z0, z1, p.altitude,
              p.azimuth);
-    box3(p.xlabel, p.ylabel, p.zlabel);
+    // PLplot picks the ticks by the data range alone; an axis drawn short gets a coarser interval (a
+    // 1-2-5 step of at least half its range: two or three labels), or its labels run into each other
+    auto tick = [&](double r) {
+      if (side(r) >= 1.0) return 0.0;
+      const double e = std::pow(10.0, std::floor(std::log10(0.5 * r)));
+      for (double m : {1.0, 2.0, 5.0, 10.0})
+        if (m * e >= 0.5 * r) return m * e;
+      return 10.0 * e;
+    };
+    box3(p.xlabel, p.ylabel, p.zlabel, tick(x1 - x0), tick(y1 - y0), tick(z1 - z0));
     for (const auto& c : p.curves) {
       const auto n = static_cast<PLINT>(std::min({c.x.size(), c.y.size(), c.z.size()}));
       if (n == 0) continue;
