@@ -336,9 +336,9 @@ class Renderer {
     auto tick = [&](double r) {
       if (side(r) >= 1.0) return 0.0;
       const double e = std::pow(10.0, std::floor(std::log10(0.5 * r)));
-      for (double m : {1.0, 2.0, 5.0, 10.0})
+      for (double m : {1.0, 2.0, 5.0})
         if (m * e >= 0.5 * r) return m * e;
-      return 10.0 * e;
+      return 10.0 * e;  // e <= r/2 < 10 e
     };
     box3(p.xlabel, p.ylabel, p.zlabel, tick(x1 - x0), tick(y1 - y0), tick(z1 - z0));
     for (const auto& c : p.curves) {

@@ -19,10 +19,10 @@
 #include <toml++/toml.h>
 
 #include <algorithm>
-#include <iterator>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <iterator>
 #include <map>
 #include <memory>
 #include <set>

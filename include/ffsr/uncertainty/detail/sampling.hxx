@@ -313,6 +313,8 @@ namespace detail {
 
 /// Standard normal CDF, accurate in the lower tail (erfc).
 inline double normal_cdf(double z) { return 0.5 * std::erfc(-z * 0.7071067811865476); }
+/// The standard normal's 97.5 % quantile: the half-width of a 95 % interval in standard errors.
+inline constexpr double kZ975 = 1.959963984540054;
 inline double normal_pdf(double z) { return 0.3989422804014327 * std::exp(-0.5 * z * z); }
 
 /// The untruncated law of a scalar Spread about x0: CDF and density at x (scale > 0 checked by the caller).
@@ -400,21 +402,6 @@ struct ConditionalCdf {
   }
 };
 
-/// The coefficients of sample i's conditional CDF P_K(K <= exp(a_i t + b_i)) at t = ln q:
-/// a_i = alpha_i + 1, b_i = ln K_i - a_i ln F_i. InputError for a non-positive or non-finite value.
-inline void conditional_coefficients(const std::vector<double>& f, const std::vector<double>& K,
-                                     const std::vector<double>& alpha, std::vector<double>& a, std::vector<double>& b) {
-  a.resize(f.size());
-  b.resize(f.size());
-  for (std::size_t i = 0; i < f.size(); ++i) {
-    if (!(f[i] > 0) || !(K[i] > 0) || !std::isfinite(K[i]) || !(alpha[i] > 0) || !std::isfinite(alpha[i]))
-      throw InputError(detail::str("summarize_stiffness_conditional: sample ", i, " has F_max ", f[i], ", K ", K[i],
-                                   ", alpha ", alpha[i], " (all must be positive and finite)"));
-    a[i] = alpha[i] + 1.0;
-    b[i] = std::log(K[i]) - a[i] * std::log(f[i]);
-  }
-}
-
 /// Solves C(t) = p for t (C non-decreasing, 0 at -inf and 1 at +inf), from t0: expands a bracket,
 /// then Newton steps kept inside it (bisection when a step leaves it or the slope vanishes).
 inline double conditional_quantile(const ConditionalCdf& C, double p, double t0) {
@@ -445,44 +432,69 @@ inline double conditional_quantile(const ConditionalCdf& C, double p, double t0)
 
 }  // namespace detail
 
-inline ForceSummary summarize_stiffness_conditional(const std::vector<double>& f, const std::vector<double>& K,
-                                                    const std::vector<double>& alpha, const Spread& stiffness,
-                                                    double K0) {
+namespace detail {
+
+/// Each sample's conditional CDF P_K,i at the estimate t = ln p95, their mean C and the slope C'
+/// there: what the delta method needs (n >= 2).
+struct ConditionalAtP95 {
+  std::vector<double> h;
+  double c = 0, d = 0;
+};
+
+/// summarize_stiffness_conditional, and the state of its estimate at p95 when `at` is given.
+inline ForceSummary conditional_summary(const std::vector<double>& f, const std::vector<double>& K,
+                                        const std::vector<double>& alpha, const Spread& stiffness, double K0,
+                                        ConditionalAtP95* at) {
   const std::size_t n = f.size();
   if (K.size() != n || alpha.size() != n)
     throw InputError(detail::str("summarize_stiffness_conditional: ", n, " forces, ", K.size(), " stiffnesses and ",
                                  alpha.size(), " exponents"));
   if (!(K0 > 0) || !std::isfinite(K0))
     throw InputError(detail::str("summarize_stiffness_conditional: the nominal stiffness must be positive, got ", K0));
-  const detail::TruncatedLaw law(stiffness, Quantity::Stiffness, K0);  // InputError for a law without spread
+  const TruncatedLaw law(stiffness, Quantity::Stiffness, K0);  // InputError for a law without spread
   ForceSummary s = summarize(f);  // mean, std, max and the order statistics; checks f finite
-  std::vector<double> a, b;
-  detail::conditional_coefficients(f, K, alpha, a, b);
-  const detail::ConditionalCdf C{a, b, law};
+  std::vector<double> a(n), b(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!(f[i] > 0) || !(K[i] > 0) || !std::isfinite(K[i]) || !(alpha[i] > 0) || !std::isfinite(alpha[i]))
+      throw InputError(detail::str("summarize_stiffness_conditional: sample ", i, " has F_max ", f[i], ", K ", K[i],
+                                   ", alpha ", alpha[i], " (all must be positive and finite)"));
+    a[i] = alpha[i] + 1.0;
+    b[i] = std::log(K[i]) - a[i] * std::log(f[i]);
+  }
+  const ConditionalCdf C{a, b, law};
   s.estimator = ForceSummary::Estimator::StiffnessConditional;
-  s.p50 = std::exp(detail::conditional_quantile(C, 0.50, std::log(s.order.p50)));
-  const double t95 = detail::conditional_quantile(C, 0.95, std::log(s.order.p95));
+  s.p50 = std::exp(conditional_quantile(C, 0.50, std::log(s.order.p50)));
+  const double t95 = conditional_quantile(C, 0.95, std::log(s.order.p95));
   s.p95 = std::exp(t95);
-  s.p99 = std::exp(detail::conditional_quantile(C, 0.99, std::log(s.order.p99)));
+  s.p99 = std::exp(conditional_quantile(C, 0.99, std::log(s.order.p99)));
   // delta method: Var(t^) ~ Var(P_K,i(t)) / (n C'(t)^2)
   s.p95_ci = {};
   s.p95_ci.coverage = 0.95;
   if (n >= 2) {
-    std::vector<double> h(n);
-    const auto [c, d] = C(t95, &h);
+    ConditionalAtP95 local;
+    ConditionalAtP95& st = at ? *at : local;
+    st.h.resize(n);
+    std::tie(st.c, st.d) = C(t95, &st.h);
     double var = 0;
-    for (double x : h) var += (x - c) * (x - c);
+    for (double x : st.h) var += (x - st.c) * (x - st.c);
     var /= static_cast<double>(n - 1);
-    if (d > 0) {
-      const double se = std::sqrt(var / static_cast<double>(n)) / d;
-      constexpr double z975 = 1.959963984540054;
+    if (st.d > 0) {
+      const double se = std::sqrt(var / static_cast<double>(n)) / st.d;
       s.p95_ci.log_standard_error = se;
-      s.p95_ci.lo = std::exp(t95 - z975 * se);
-      s.p95_ci.hi = std::exp(t95 + z975 * se);
+      s.p95_ci.lo = std::exp(t95 - kZ975 * se);
+      s.p95_ci.hi = std::exp(t95 + kZ975 * se);
       s.p95_ci.has_lo = s.p95_ci.has_hi = true;
     }
   }
   return s;
+}
+
+}  // namespace detail
+
+inline ForceSummary summarize_stiffness_conditional(const std::vector<double>& f, const std::vector<double>& K,
+                                                    const std::vector<double>& alpha, const Spread& stiffness,
+                                                    double K0) {
+  return detail::conditional_summary(f, K, alpha, stiffness, K0, nullptr);
 }
 
 inline PercentileRatio compare_p95_stiffness_conditional(const std::vector<double>& f_a, const std::vector<double>& f_b,
@@ -492,32 +504,22 @@ inline PercentileRatio compare_p95_stiffness_conditional(const std::vector<doubl
   if (f_b.size() != n)
     throw InputError(detail::str("compare_p95_stiffness_conditional: ", n, " and ", f_b.size(),
                                  " forces: the two configurations must share the samples"));
-  // each estimate as the single summary computes it (and with its checks of the inputs)
-  const double ta = std::log(summarize_stiffness_conditional(f_a, K, alpha, stiffness, K0).p95);
-  const double tb = std::log(summarize_stiffness_conditional(f_b, K, alpha, stiffness, K0).p95);
+  detail::ConditionalAtP95 A, B;
+  const double pa = detail::conditional_summary(f_a, K, alpha, stiffness, K0, &A).p95;
+  const double pb = detail::conditional_summary(f_b, K, alpha, stiffness, K0, &B).p95;
   PercentileRatio r;
-  r.ratio = std::exp(tb - ta);
-  if (n < 2) return r;
-  const detail::TruncatedLaw law(stiffness, Quantity::Stiffness, K0);
-  std::vector<double> a, b, ha(n), hb(n);
-  detail::conditional_coefficients(f_a, K, alpha, a, b);
-  const auto [ca, da] = detail::ConditionalCdf{a, b, law}(ta, &ha);
-  detail::conditional_coefficients(f_b, K, alpha, a, b);
-  const auto [cb, db] = detail::ConditionalCdf{a, b, law}(tb, &hb);
-  if (!(da > 0) || !(db > 0)) return r;
-  double mean = 0;
-  for (std::size_t i = 0; i < n; ++i) mean += (ha[i] - ca) / da - (hb[i] - cb) / db;
-  mean /= static_cast<double>(n);
+  r.ratio = pb / pa;
+  if (n < 2 || !(A.d > 0) || !(B.d > 0)) return r;
+  // psi_i has mean zero: C is the mean of the h_i
   double var = 0;
   for (std::size_t i = 0; i < n; ++i) {
-    const double psi = (ha[i] - ca) / da - (hb[i] - cb) / db - mean;
+    const double psi = (A.h[i] - A.c) / A.d - (B.h[i] - B.c) / B.d;
     var += psi * psi;
   }
   var /= static_cast<double>(n - 1);
-  constexpr double z975 = 1.959963984540054;
   r.log_standard_error = std::sqrt(var / static_cast<double>(n));
-  r.lo = r.ratio * std::exp(-z975 * r.log_standard_error);
-  r.hi = r.ratio * std::exp(z975 * r.log_standard_error);
+  r.lo = r.ratio * std::exp(-detail::kZ975 * r.log_standard_error);
+  r.hi = r.ratio * std::exp(detail::kZ975 * r.log_standard_error);
   r.has_interval = true;
   return r;
 }
