@@ -112,10 +112,18 @@ void* counted_new_aligned(std::size_t n, std::align_val_t al) {
 void* operator new(std::size_t n) { return counted_new(n); }
 void* operator new[](std::size_t n) { return counted_new(n); }
 void* operator new(std::size_t n, const std::nothrow_t&) noexcept {
-  try { return counted_new(n); } catch (...) { return nullptr; }
+  try {
+    return counted_new(n);
+  } catch (...) {
+    return nullptr;
+  }
 }
 void* operator new[](std::size_t n, const std::nothrow_t&) noexcept {
-  try { return counted_new(n); } catch (...) { return nullptr; }
+  try {
+    return counted_new(n);
+  } catch (...) {
+    return nullptr;
+  }
 }
 void* operator new(std::size_t n, std::align_val_t a) { return counted_new_aligned(n, a); }
 void* operator new[](std::size_t n, std::align_val_t a) { return counted_new_aligned(n, a); }
@@ -162,7 +170,9 @@ struct Timing {
 };
 
 using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
 
 /// Times fn(i) (returns a double that feeds the sink): calibrates the calls per batch so that a
 /// batch lasts about s.batch_seconds, then reports the median and minimum batch mean, and the heap
@@ -178,7 +188,8 @@ Timing measure(const Settings& s, Fn&& fn) {
     for (long i = 0; i < n; ++i) acc += fn(i);
     const double dt = seconds_since(t0);
     if (dt >= 0.2 * s.batch_seconds || n >= (1L << 26)) {
-      n = std::max(1L, static_cast<long>(std::llround(static_cast<double>(n) * s.batch_seconds / std::max(dt, 1e-9))));
+      n = std::max(
+          1L, static_cast<long>(std::llround(static_cast<double>(n) * s.batch_seconds / std::max(dt, 1e-9))));
       break;
     }
     n *= 4;
@@ -239,7 +250,8 @@ std::string with_unit(double seconds) {
 
 void print_header(const char* title) {
   std::printf("\n%s\n", title);
-  std::printf("%-11s %-50s %11s %11s %12s  %s\n", "robot", "quantity", "median", "min", "allocs/call", "target");
+  std::printf("%-11s %-50s %11s %11s %12s  %s\n", "robot", "quantity", "median", "min", "allocs/call",
+              "target");
 }
 
 void print_row(const std::string& robot, const std::string& what, const Timing& t, const std::string& target,
@@ -274,8 +286,9 @@ struct Robot {
 };
 
 Robot paper_3dof(const std::string& dir) {
-  Robot r{"3-DOF", ffsr::model_from_urdf_file(dir + "/paper_3dof.urdf", "ee"), -1, degrees({0, 90, -90}), {},
-          degrees({0, 150, -100})};
+  Robot r{"3-DOF", ffsr::model_from_urdf_file(dir + "/paper_3dof.urdf", "ee"),
+          -1,      degrees({0, 90, -90}),
+          {},      degrees({0, 150, -100})};
   r.ee = r.model.frame_index("ee");
   r.target.contact_offset = ffsr::Vector3(-0.25, 0.15, 0.0);
   r.target.angular_velocity = ffsr::Vector3(0, 0, 2) * kDeg;
@@ -284,8 +297,9 @@ Robot paper_3dof(const std::string& dir) {
 }
 
 Robot paper_7dof(const std::string& dir) {
-  Robot r{"7-DOF", ffsr::model_from_urdf_file(dir + "/paper_7dof.urdf", "ee"), -1,
-          degrees({0, 29, 54, 10, -10, 120, 32}), {}, degrees({0, 90, 90, -90, 90, 90, 0})};
+  Robot r{"7-DOF", ffsr::model_from_urdf_file(dir + "/paper_7dof.urdf", "ee"),
+          -1,      degrees({0, 29, 54, 10, -10, 120, 32}),
+          {},      degrees({0, 90, 90, -90, 90, 90, 0})};
   r.ee = r.model.frame_index("ee");
   r.target.contact_offset = ffsr::Vector3(-0.25, 0.15, 0.1);
   r.target.angular_velocity = ffsr::Vector3(1, -0.5, 2) * kDeg;
@@ -305,7 +319,8 @@ struct AllocCheck {
   void require_zero(const std::string& robot, const std::string& what, const Timing& t) {
     if (t.allocs > 0) {
       char line[160];
-      std::snprintf(line, sizeof line, "%s %s: %.4g heap allocations per call", robot.c_str(), what.c_str(), t.allocs);
+      std::snprintf(line, sizeof line, "%s %s: %.4g heap allocations per call", robot.c_str(), what.c_str(),
+                    t.allocs);
       failures.emplace_back(line);
     }
   }
@@ -351,7 +366,8 @@ void bench_hot_paths(const Settings& s, const Robot& r, AllocCheck& check) {
   print_row(r.name, "forward_kinematics", fk, "");
   check.require_zero(r.name, "forward_kinematics", fk);
 
-  const Timing h = measure(s, [&](long i) { return crba(model, data, bases[pick(i)], thetas[pick(i)])(6, 6); });
+  const Timing h =
+      measure(s, [&](long i) { return crba(model, data, bases[pick(i)], thetas[pick(i)])(6, 6); });
   print_row(r.name, "crba (H)", h, "0 allocs");
   check.require_zero(r.name, "crba", h);
 
@@ -363,8 +379,9 @@ void bench_hot_paths(const Settings& s, const Robot& r, AllocCheck& check) {
   print_row(r.name, "J_f: frame_jacobian + generalized_jacobian", jf, "0 allocs");
   check.require_zero(r.name, "J_f", jf);
 
-  const Timing hjf = measure(
-      s, [&](long i) { return generalized_jacobian(model, data, bases[pick(i)], thetas[pick(i)], r.ee)(0, 0); });
+  const Timing hjf = measure(s, [&](long i) {
+    return generalized_jacobian(model, data, bases[pick(i)], thetas[pick(i)], r.ee)(0, 0);
+  });
   print_row(r.name, "crba + J_f (one configuration)", hjf, "0 allocs");
   check.require_zero(r.name, "crba + J_f", hjf);
 
@@ -430,7 +447,8 @@ void bench_map(const Settings& s, const Robot& r, AllocCheck& check) {
   });
   char target[96];
   std::snprintf(target, sizeof target, "%.3g points/s (>= 292k/s a thread), 0 allocs", 1.0 / t.median);
-  print_row(r.name, "map point: M_ie + F_max + CSV row (to_chars)", t, target, r.model.n() == 3 ? 1.0 / 292e3 : 0);
+  print_row(r.name, "map point: M_ie + F_max + CSV row (to_chars)", t, target,
+            r.model.n() == 3 ? 1.0 / 292e3 : 0);
   check.require_zero(r.name, "map point", t);
 }
 
@@ -444,7 +462,8 @@ ffsr::Model bench_chain(int n) {
     const double s = std::sin(1.7 * i), c = std::cos(2.3 * i);
     b.add_joint("j" + std::to_string(i), JointType::Revolute, parent,
                 Pose::from_xyz_rpy(Vector3(0.3 + 0.1 * s, 0.1 * c, 0.05), Vector3(0.3 * c, 0.2 * s, 0.7 * i)),
-                Vector3(s, c, 1.5), child, Inertia{3 + 2 * s, Vector3(0.15, 0.01 * c, 0), Vector3(0.1, 0.4, 0.4).asDiagonal()});
+                Vector3(s, c, 1.5), child,
+                Inertia{3 + 2 * s, Vector3(0.15, 0.01 * c, 0), Vector3(0.1, 0.4, 0.4).asDiagonal()});
     parent = child;
   }
   b.add_fixed("tip_mount", parent, Pose{Vector3(0.2, 0, 0)}, "tip", Inertia{});
@@ -462,7 +481,8 @@ void bench_crossover(const Settings& s, AllocCheck& check) {
     const int ee = model.end_effector();
     constexpr int K = 16;
     std::vector<Eigen::VectorXd> thetas;
-    for (int k = 0; k < K; ++k) thetas.push_back(Eigen::VectorXd::LinSpaced(n, -1.0 + 0.1 * k, 2.0 - 0.05 * k));
+    for (int k = 0; k < K; ++k)
+      thetas.push_back(Eigen::VectorXd::LinSpaced(n, -1.0 + 0.1 * k, 2.0 - 0.05 * k));
     const Vector3 u = Vector3(1, 2, -0.5).normalized();
     const BasePose base;
     const std::string name = "chain " + std::to_string(n);
@@ -490,7 +510,8 @@ void bench_multibody_contact(const Settings& s, const Robot& r) {
   using namespace ffsr;
   MultibodyContactResult last;
   const Timing t = measure_runs(s.contact_runs, [&] {
-    last = simulate_contact(r.model, BasePose{}, r.theta_contact, r.ee, r.target, kApproachSpeed, kContact, kLaw);
+    last = simulate_contact(r.model, BasePose{}, r.theta_contact, r.ee, r.target, kApproachSpeed, kContact,
+                            kLaw);
     return last.f_max;
   });
   print_row(r.name, "simulate_contact (multibody CVODE run)", t, "< 50 ms", 50e-3);
@@ -537,22 +558,29 @@ double bench_capture_case(const Settings& s, const Robot& r, double duration, co
     return last.M_ie;
   });
   print_row(r.name, c.label, t, "");
-  std::printf("%-11s   M_ie = %.4f kg, %ld RK4 steps (h = %.2f s, 4 evaluations each), %.1f allocations per step\n",
-              "", last.M_ie, last.steps, opt.step, t.allocs / static_cast<double>(last.steps));
+  std::printf(
+      "%-11s   M_ie = %.4f kg, %ld RK4 steps (h = %.2f s, 4 evaluations each), %.1f allocations per step\n",
+      "", last.M_ie, last.steps, opt.step, t.allocs / static_cast<double>(last.steps));
   return t.median;
 }
 
 void bench_scenarios(const Settings& s, const Robot& r3, const Robot& r7) {
   const auto xy = position_task(true, true, false), xyz = position_task(true, true, true);
-  const double plain3 = bench_capture_case(s, r3, 180.0, {"plan_capture plain (xy position, rho = 0)", xy, 0.0});
-  const double opt3 = bench_capture_case(s, r3, 180.0, {"plan_capture optimized (xy, rho = -0.01)", xy, -0.01});
+  const double plain3 =
+      bench_capture_case(s, r3, 180.0, {"plan_capture plain (xy position, rho = 0)", xy, 0.0});
+  const double opt3 =
+      bench_capture_case(s, r3, 180.0, {"plan_capture optimized (xy, rho = -0.01)", xy, -0.01});
   print_row(r3.name, "scenario: plain + optimized", {plain3 + opt3, plain3 + opt3, -1, 1}, "< 0.5 s", 0.5);
-  const double plain7 = bench_capture_case(s, r7, 157.0, {"plan_capture plain (pose, rho = 0)", pose_task(), 0.0});
+  const double plain7 =
+      bench_capture_case(s, r7, 157.0, {"plan_capture plain (pose, rho = 0)", pose_task(), 0.0});
   const double pose7 =
       bench_capture_case(s, r7, 157.0, {"plan_capture optimized (pose, rho = -0.2)", pose_task(), -0.2});
-  const double pos7 = bench_capture_case(s, r7, 157.0, {"plan_capture optimized (xyz, rho = -0.01)", xyz, -0.01});
-  print_row(r7.name, "scenario pose: plain + optimized (pose)", {plain7 + pose7, plain7 + pose7, -1, 1}, "< 2 s", 2.0);
-  print_row(r7.name, "scenario position: plain + optimized (xyz)", {plain7 + pos7, plain7 + pos7, -1, 1}, "< 2 s", 2.0);
+  const double pos7 =
+      bench_capture_case(s, r7, 157.0, {"plan_capture optimized (xyz, rho = -0.01)", xyz, -0.01});
+  print_row(r7.name, "scenario pose: plain + optimized (pose)", {plain7 + pose7, plain7 + pose7, -1, 1},
+            "< 2 s", 2.0);
+  print_row(r7.name, "scenario position: plain + optimized (xyz)", {plain7 + pos7, plain7 + pos7, -1, 1},
+            "< 2 s", 2.0);
 }
 
 #ifdef FFSR_HAVE_GLOBAL
@@ -580,9 +608,11 @@ void bench_global(const Settings& s, const Robot& r3, const Robot& r7) {
       return last.run.M_ie;
     });
     print_row(r.name, "plan_capture_global (search + reaching plan)", t, target, limit);
-    std::printf("%-11s   M_ie = %.4f kg, gap %.3f %%, %d shooting iteration(s), %ld SLSQP evaluations, search %.3f s\n",
-                "", last.run.M_ie, last.optimality_gap_percent, last.shooting_iterations, last.evaluations,
-                last.search_seconds);
+    std::printf(
+        "%-11s   M_ie = %.4f kg, gap %.3f %%, %d shooting iteration(s), %ld SLSQP evaluations, search %.3f "
+        "s\n",
+        "", last.run.M_ie, last.optimality_gap_percent, last.shooting_iterations, last.evaluations,
+        last.search_seconds);
     return pb;
   };
   run(r3, 180.0, position_task(true, true, false), "< 1 s", 1.0);
@@ -623,12 +653,13 @@ int main(int argc, char** argv) {
     if (a == "--quick") {
       s.quick = true;
     } else if (a == "-h" || a == "--help") {
-      std::printf("usage: ffsr-bench [--quick] [DIR]\n"
-                  "  DIR     directory with paper_3dof.urdf and paper_7dof.urdf, or a source tree with robots/\n"
-                  "          (default %s/robots)\n"
-                  "  --quick few repetitions, one run of each scenario, no bench_contact (smoke test);\n"
-                  "          still fails (exit 1) when a hot path allocates per call\n",
-                  FFSR_SOURCE_DIR);
+      std::printf(
+          "usage: ffsr-bench [--quick] [DIR]\n"
+          "  DIR     directory with paper_3dof.urdf and paper_7dof.urdf, or a source tree with robots/\n"
+          "          (default %s/robots)\n"
+          "  --quick few repetitions, one run of each scenario, no bench_contact (smoke test);\n"
+          "          still fails (exit 1) when a hot path allocates per call\n",
+          FFSR_SOURCE_DIR);
       return 0;
     } else if (!a.empty() && a[0] == '-') {
       std::fprintf(stderr, "ffsr-bench: error: unknown option '%s' (try --help)\n", a.c_str());
@@ -647,14 +678,16 @@ int main(int argc, char** argv) {
     const std::string dir = robots_dir(dir_arg);
     const Robot r3 = paper_3dof(dir);
     const Robot r7 = paper_7dof(dir);
-    std::printf("ffsr-bench%s: %s; median and min over %d batches of the mean time per call (~%.1f ms a batch)\n",
-                s.quick ? " --quick" : "", dir.c_str(), s.batches, s.batch_seconds * 1e3);
+    std::printf(
+        "ffsr-bench%s: %s; median and min over %d batches of the mean time per call (~%.1f ms a batch)\n",
+        s.quick ? " --quick" : "", dir.c_str(), s.batches, s.batch_seconds * 1e3);
     std::printf("heap allocations per call after set-up counted by %s\n",
                 FFSR_BENCH_MALLOC_HOOK ? "interposed malloc/calloc/realloc and operator new"
                                        : "replaced operator new (malloc not interposed on this platform)");
     AllocCheck check;
-    print_header("hot paths (paper configurations: 3-DOF [0, 90, -90] deg, 7-DOF [0, 29, 54, 10, -10, 120, 32] deg, "
-                 "16 nearby poses cycled)");
+    print_header(
+        "hot paths (paper configurations: 3-DOF [0, 90, -90] deg, 7-DOF [0, 29, 54, 10, -10, 120, 32] deg, "
+        "16 nearby poses cycled)");
     bench_hot_paths(s, r3, check);
     bench_hot_paths(s, r7, check);
     print_header("map (ffsr-optimize map, one thread; 3-DOF grid at 2 deg)");
@@ -671,11 +704,13 @@ int main(int argc, char** argv) {
       bench_contact(std::cout);
     std::cout.flush();
 
-    print_header("multibody contact: whole runs (K = 1e9, alpha = 1.5, c_r = 0.9, herbert-mcwhannell, 0.2 m/s)");
+    print_header(
+        "multibody contact: whole runs (K = 1e9, alpha = 1.5, c_r = 0.9, herbert-mcwhannell, 0.2 m/s)");
     bench_multibody_contact(s, r3);
     bench_multibody_contact(s, r7);
 
-    print_header("capture scenarios: whole plan_capture runs (RK4, step 0.1 s; 3-DOF T = 180 s, 7-DOF T = 157 s)");
+    print_header(
+        "capture scenarios: whole plan_capture runs (RK4, step 0.1 s; 3-DOF T = 180 s, 7-DOF T = 157 s)");
     bench_scenarios(s, r3, r7);
 #ifdef FFSR_HAVE_GLOBAL
     print_header("global capture optimization (optimize/global.hpp; 3 deg/s joint-rate limit)");

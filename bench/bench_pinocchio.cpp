@@ -65,10 +65,11 @@ std::string chain_urdf(int n, unsigned seed) {
   for (int i = 1; i <= n; ++i) {
     os << "<link name=\"l" << i << "\">";
     inertial(1 + 9 * 0.5 * (U(gen) + 1));
-    os << "</link><joint name=\"j" << i << "\" type=\"continuous\"><parent link=\"" << (i == 1 ? std::string("base") : "l" + std::to_string(i - 1))
-       << "\"/><child link=\"l" << i << "\"/><origin xyz=\"" << 0.4 * U(gen) << " " << 0.4 * U(gen) << " "
-       << 0.4 * U(gen) << "\" rpy=\"" << U(gen) << " " << U(gen) << " " << U(gen) << "\"/><axis xyz=\"" << U(gen)
-       << " " << U(gen) << " " << U(gen) + 1.5 << "\"/></joint>";
+    os << "</link><joint name=\"j" << i << "\" type=\"continuous\"><parent link=\""
+       << (i == 1 ? std::string("base") : "l" + std::to_string(i - 1)) << "\"/><child link=\"l" << i
+       << "\"/><origin xyz=\"" << 0.4 * U(gen) << " " << 0.4 * U(gen) << " " << 0.4 * U(gen) << "\" rpy=\""
+       << U(gen) << " " << U(gen) << " " << U(gen) << "\"/><axis xyz=\"" << U(gen) << " " << U(gen) << " "
+       << U(gen) + 1.5 << "\"/></joint>";
   }
   os << "<link name=\"ee\"/><joint name=\"ee_mount\" type=\"fixed\"><parent link=\"l" << n
      << "\"/><child link=\"ee\"/><origin xyz=\"0.3 0 0\" rpy=\"0 0 0\"/></joint></robot>";
@@ -124,7 +125,8 @@ void compare(const std::string& name, const std::string& urdf) {
   constexpr int kPoses = 1000, kPasses = 21;
   const Poses P = random_poses(n, kPoses, 1234u + static_cast<unsigned>(n));
   std::vector<double> pin_values;
-  const double tp = ffsr_bench::pinocchio_inverse_effective_mass(fm, fee, P.base, P.theta, P.u, kPasses, pin_values);
+  const double tp =
+      ffsr_bench::pinocchio_inverse_effective_mass(fm, fee, P.base, P.theta, P.u, kPasses, pin_values);
 
   auto dense = [&](int k) {
     const auto uk = static_cast<size_t>(k);
@@ -148,8 +150,8 @@ void compare(const std::string& name, const std::string& urdf) {
   const double td = time_per_eval(kPoses, kPasses, dense);
   const double ta = time_per_eval(kPoses, kPasses, articulated);
   const double tf = time_per_eval(kPoses, kPasses, fast);
-  std::printf("%-10s %3d %11.3f %11.3f %11.3f %11.3f %9.2fx %9.2fx %9.2fx %10.1e\n", name.c_str(), n, tp * 1e6,
-              td * 1e6, ta * 1e6, tf * 1e6, td / tp, ta / tp, tf / tp, worst);
+  std::printf("%-10s %3d %11.3f %11.3f %11.3f %11.3f %9.2fx %9.2fx %9.2fx %10.1e\n", name.c_str(), n,
+              tp * 1e6, td * 1e6, ta * 1e6, tf * 1e6, td / tp, ta / tp, tf / tp, worst);
 }
 
 }  // namespace
@@ -157,9 +159,10 @@ void compare(const std::string& name, const std::string& urdf) {
 int main(int argc, char** argv) {
   const std::string dir = argc > 1 ? argv[1] : std::string(FFSR_SOURCE_DIR) + "/robots";
   try {
-    std::printf("u^T J_v H^-1 J_v^T u per evaluation, median of 21 passes over the same 1000 random poses (us)\n");
-    std::printf("%-10s %3s %11s %11s %11s %11s %10s %10s %10s %10s\n", "robot", "n", "pinocchio", "ffsr dense",
-                "ffsr ABA", "ffsr fast", "dense/pin", "ABA/pin", "fast/pin", "max rel");
+    std::printf(
+        "u^T J_v H^-1 J_v^T u per evaluation, median of 21 passes over the same 1000 random poses (us)\n");
+    std::printf("%-10s %3s %11s %11s %11s %11s %10s %10s %10s %10s\n", "robot", "n", "pinocchio",
+                "ffsr dense", "ffsr ABA", "ffsr fast", "dense/pin", "ABA/pin", "fast/pin", "max rel");
     compare("3-DOF", read_text(dir + "/paper_3dof.urdf"));
     compare("7-DOF", read_text(dir + "/paper_7dof.urdf"));
     for (int n : {14, 28, 56}) compare("chain " + std::to_string(n), chain_urdf(n, static_cast<unsigned>(n)));

@@ -20,8 +20,10 @@ inline double thread_seconds() {
 /// body, the frame `frame` as an operational frame) and evaluates u^T J_v M^-1 J_v^T u at every pose
 /// (crba, computeJointJacobians, getFrameJacobian LOCAL_WORLD_ALIGNED, LLT solve). Writes the values
 /// to `values`; returns the median over `passes` passes of the mean thread CPU time per evaluation, seconds.
-double pinocchio_inverse_effective_mass(const ffsr::Model& model, int frame, const std::vector<ffsr::BasePose>& base,
+double pinocchio_inverse_effective_mass(const ffsr::Model& model, int frame,
+                                        const std::vector<ffsr::BasePose>& base,
                                         const std::vector<Eigen::VectorXd>& theta,
-                                        const std::vector<Eigen::Vector3d>& u, int passes, std::vector<double>& values);
+                                        const std::vector<Eigen::Vector3d>& u, int passes,
+                                        std::vector<double>& values);
 
 }  // namespace ffsr_bench

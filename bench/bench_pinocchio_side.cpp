@@ -12,9 +12,11 @@
 
 namespace ffsr_bench {
 
-double pinocchio_inverse_effective_mass(const ffsr::Model& fm, int frame, const std::vector<ffsr::BasePose>& base,
+double pinocchio_inverse_effective_mass(const ffsr::Model& fm, int frame,
+                                        const std::vector<ffsr::BasePose>& base,
                                         const std::vector<Eigen::VectorXd>& theta,
-                                        const std::vector<Eigen::Vector3d>& u, int passes, std::vector<double>& values) {
+                                        const std::vector<Eigen::Vector3d>& u, int passes,
+                                        std::vector<double>& values) {
   using pinocchio::SE3;
   pinocchio::Model pm;
   const int nb = fm.n() + 1;
@@ -28,13 +30,15 @@ double pinocchio_inverse_effective_mass(const ffsr::Model& fm, int frame, const 
     const auto parent = jid[static_cast<size_t>(b.parent)];
     jid[static_cast<size_t>(i)] =
         b.joint.type == ffsr::JointType::Revolute
-            ? pm.addJoint(parent, pinocchio::JointModelRevoluteUnaligned(b.joint.axis), placement, b.joint.name)
-            : pm.addJoint(parent, pinocchio::JointModelPrismaticUnaligned(b.joint.axis), placement, b.joint.name);
+            ? pm.addJoint(parent, pinocchio::JointModelRevoluteUnaligned(b.joint.axis), placement,
+                          b.joint.name)
+            : pm.addJoint(parent, pinocchio::JointModelPrismaticUnaligned(b.joint.axis), placement,
+                          b.joint.name);
     pm.appendBodyToJoint(jid[static_cast<size_t>(i)], inertia(b.inertia), SE3::Identity());
   }
   const ffsr::Frame& f = fm.frame(frame);
-  const auto fid = pm.addFrame(
-      pinocchio::Frame("ee_bench", jid[static_cast<size_t>(f.body)], SE3(f.pose.R, f.pose.p), pinocchio::OP_FRAME));
+  const auto fid = pm.addFrame(pinocchio::Frame("ee_bench", jid[static_cast<size_t>(f.body)],
+                                                SE3(f.pose.R, f.pose.p), pinocchio::OP_FRAME));
   if (pm.nv != 6 + fm.n()) throw std::runtime_error("pinocchio model: wrong size");
   pinocchio::Data pd(pm);
   const int count = static_cast<int>(base.size());

@@ -28,8 +28,10 @@ int main(int argc, char** argv) {
   std::string dir = std::string(FFSR_SOURCE_DIR) + "/robots";
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
-    if (a == "--quick") quick = true;
-    else dir = a;
+    if (a == "--quick")
+      quick = true;
+    else
+      dir = a;
   }
   try {
     const Model model = model_from_urdf_file(dir + "/paper_7dof.urdf", "ee");
@@ -73,7 +75,9 @@ int main(int argc, char** argv) {
     validate(spec);
     const std::string law = "herbert-mcwhannell";
     using clock = std::chrono::steady_clock;
-    auto seconds = [](clock::time_point a) { return std::chrono::duration<double>(clock::now() - a).count(); };
+    auto seconds = [](clock::time_point a) {
+      return std::chrono::duration<double>(clock::now() - a).count();
+    };
 
     const std::uint64_t n_exact = quick ? 10000 : 100000, n_mb = quick ? 20 : 1000;
     auto t = clock::now();
@@ -93,9 +97,10 @@ int main(int argc, char** argv) {
     const Spread& k_law = spec[Quantity::Stiffness];
     const ForceSummary s = summarize_stiffness_conditional(f, K, alpha, k_law, nominal.contact.K);
     const double t_exact = seconds(t);
-    std::printf("exact F_max:     %7llu samples in %7.3f s on 2 threads (target < 2 s for 1e5)   p95 %.1f N"
-                " (order statistic %.1f N)\n",
-                static_cast<unsigned long long>(n_exact), t_exact, s.p95, s.order.p95);
+    std::printf(
+        "exact F_max:     %7llu samples in %7.3f s on 2 threads (target < 2 s for 1e5)   p95 %.1f N"
+        " (order statistic %.1f N)\n",
+        static_cast<unsigned long long>(n_exact), t_exact, s.p95, s.order.p95);
     // Convergence: disjoint blocks of 1000 of these samples, each block's p95 against the whole set's,
     // for the two estimators (issue 12: 1e3 against 1e5 within 1 %)
     {
@@ -107,7 +112,8 @@ int main(int argc, char** argv) {
           return std::vector<double>(v.begin() + static_cast<std::ptrdiff_t>(b * block),
                                      v.begin() + static_cast<std::ptrdiff_t>((b + 1) * block));
         };
-        const ForceSummary sb = summarize_stiffness_conditional(cut(f), cut(K), cut(alpha), k_law, nominal.contact.K);
+        const ForceSummary sb =
+            summarize_stiffness_conditional(cut(f), cut(K), cut(alpha), k_law, nominal.contact.K);
         const double ec = sb.p95 / s.p95 - 1, eo = sb.order.p95 / s.order.p95 - 1;
         sc += ec;
         sc2 += ec * ec;
@@ -118,10 +124,12 @@ int main(int argc, char** argv) {
       }
       const double nb = static_cast<double>(blocks);
       auto sd = [nb](double a, double a2) { return std::sqrt(std::max(0.0, a2 / nb - (a / nb) * (a / nb))); };
-      std::printf("p95 of %zu blocks of 1000 against all %llu samples: stiffness-conditional sd %.2f %%, %d within 1 %%;"
-                  " order statistics sd %.2f %%, %d within 1 %%\n",
-                  blocks, static_cast<unsigned long long>(n_exact), 100 * sd(sc, sc2), within_c, 100 * sd(so, so2),
-                  within_o);
+      std::printf(
+          "p95 of %zu blocks of 1000 against all %llu samples: stiffness-conditional sd %.2f %%, %d within 1 "
+          "%%;"
+          " order statistics sd %.2f %%, %d within 1 %%\n",
+          blocks, static_cast<unsigned long long>(n_exact), 100 * sd(sc, sc2), within_c, 100 * sd(so, so2),
+          within_o);
     }
     t = clock::now();
     std::vector<double> fm(n_mb);
@@ -131,8 +139,10 @@ int main(int argc, char** argv) {
     const double t_mb = seconds(t);
     double worst = 0;
     for (std::uint64_t i = 0; i < n_mb; ++i) worst = std::max(worst, std::abs(fm[i] / f[i] - 1));
-    std::printf("multibody F_max: %7llu samples in %7.3f s on 2 threads (target < 30 s for 1e3)  largest |mb/exact - 1| %.3g\n",
-                static_cast<unsigned long long>(n_mb), t_mb, worst);
+    std::printf(
+        "multibody F_max: %7llu samples in %7.3f s on 2 threads (target < 30 s for 1e3)  largest |mb/exact - "
+        "1| %.3g\n",
+        static_cast<unsigned long long>(n_mb), t_mb, worst);
     return 0;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "ffsr-bench-robust: %s\n", e.what());

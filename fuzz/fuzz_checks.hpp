@@ -39,7 +39,8 @@ void require_finite(const Eigen::DenseBase<Derived>& m, const std::string& what)
   for (Eigen::Index i = 0; i < m.rows(); ++i)
     for (Eigen::Index j = 0; j < m.cols(); ++j)
       if (!std::isfinite(m(i, j)))
-        fail(what + "(" + std::to_string(i) + "," + std::to_string(j) + ") is not finite: " + std::to_string(m(i, j)));
+        fail(what + "(" + std::to_string(i) + "," + std::to_string(j) +
+             ") is not finite: " + std::to_string(m(i, j)));
 }
 
 /// Runs f; an ffsr::Error is an accepted answer (returns false), any other exception is a Finding.

@@ -29,7 +29,8 @@ inline Eigen::VectorXd read_theta(Input& in, const ffsr::Model& model) {
   static const double paper3[] = {0.0, 150.0 * M_PI / 180, -100.0 * M_PI / 180};
   static const double paper7[] = {0, M_PI / 2, M_PI / 2, -M_PI / 2, M_PI / 2, M_PI / 2, 0};
   Eigen::VectorXd theta(model.n());
-  for (int i = 0; i < model.n(); ++i) theta(i) = in.real(model.n() == 3 ? paper3[i] : model.n() == 7 ? paper7[i] : 0.0);
+  for (int i = 0; i < model.n(); ++i)
+    theta(i) = in.real(model.n() == 3 ? paper3[i] : model.n() == 7 ? paper7[i] : 0.0);
   return theta;
 }
 
@@ -116,8 +117,8 @@ inline void check_effective_mass(Input& in, const ffsr::Model& model) {
   });
   returns_or_ffsr_error("integrated_effective_mass_gradient", [&] {
     Eigen::VectorXd grad(model.n());
-    const double M_ie = ffsr::integrated_effective_mass_gradient(model, data, base, theta, f, target.normal_world(),
-                                                                 target.inverse_mass_along_normal(), grad);
+    const double M_ie = ffsr::integrated_effective_mass_gradient(
+        model, data, base, theta, f, target.normal_world(), target.inverse_mass_along_normal(), grad);
     require_finite(M_ie, "M_ie (gradient)");
     require_finite(grad, "grad M_ie");
   });
@@ -135,9 +136,12 @@ inline void check_contact_law(Input& in) {
   require_finite(ffsr::lambda(law), "lambda");
   returns_or_ffsr_error("zeta", [&] { require_finite(ffsr::zeta(law), "zeta"); });
   returns_or_ffsr_error("relative_error", [&] { require_finite(ffsr::relative_error(law), "xi"); });
-  returns_or_ffsr_error("max_deformation", [&] { require_finite(ffsr::max_deformation(law, M), "delta_max"); });
-  returns_or_ffsr_error("max_force_estimate", [&] { require_finite(ffsr::max_force_estimate(law, M), "F'_max"); });
-  returns_or_ffsr_error("max_force_closed_form", [&] { require_finite(ffsr::max_force_closed_form(law, M), "F_max"); });
+  returns_or_ffsr_error("max_deformation",
+                        [&] { require_finite(ffsr::max_deformation(law, M), "delta_max"); });
+  returns_or_ffsr_error("max_force_estimate",
+                        [&] { require_finite(ffsr::max_force_estimate(law, M), "F'_max"); });
+  returns_or_ffsr_error("max_force_closed_form",
+                        [&] { require_finite(ffsr::max_force_closed_form(law, M), "F_max"); });
   returns_or_ffsr_error("exact_peak", [&] {
     const ffsr::ForcePeak pk = ffsr::exact_peak(law, M);
     require_finite(pk.force, "exact F_max");
@@ -148,17 +152,21 @@ inline void check_contact_law(Input& in) {
   if (std::isfinite(delta) && std::isfinite(delta_dot)) {  // force() propagates NaN by contract
     returns_or_ffsr_error("force", [&] {
       const double F = ffsr::force(law, delta, delta_dot);
-      if (std::isnan(F)) fail("force(" + std::to_string(delta) + ", " + std::to_string(delta_dot) + ") is NaN");
+      if (std::isnan(F))
+        fail("force(" + std::to_string(delta) + ", " + std::to_string(delta_dot) + ") is NaN");
       if (F < 0) fail("force is negative");
     });
   }
   returns_or_ffsr_error("deformation", [&] {
     std::visit([&](const auto& l) { require_finite(l.deformation(M, delta_dot), "delta(delta_dot)"); }, law);
   });
-  returns_or_ffsr_error("model_accuracy", [&] { require_finite(ffsr::model_accuracy(in.real(1840), in.real(1851)), "accuracy"); });
+  returns_or_ffsr_error("model_accuracy", [&] {
+    require_finite(ffsr::model_accuracy(in.real(1840), in.real(1851)), "accuracy");
+  });
   returns_or_ffsr_error("approach_velocity", [&] {
     const ffsr::Vector3 u(in.real(1), in.real(0), in.real(0)), ve(in.real(0.2), in.real(0), in.real(0)),
-        vt(in.real(0), in.real(0), in.real(0)), wt(in.real(0), in.real(0), in.real(0.03)), r(in.real(-0.25), in.real(0.15), in.real(0));
+        vt(in.real(0), in.real(0), in.real(0)), wt(in.real(0), in.real(0), in.real(0.03)),
+        r(in.real(-0.25), in.real(0.15), in.real(0));
     require_finite(ffsr::approach_velocity(u, ve, vt, wt, r), "approach velocity");
   });
 }
@@ -181,9 +189,9 @@ inline void check_simulate_contact(Input& in, const ffsr::Model& model) {
   returns_or_ffsr_error("simulate_contact", [&] {
     const ffsr::MultibodyContactResult r =
         ffsr::simulate_contact(model, base, theta, model.end_effector(), target, speed, p, law, opt);
-    for (double x : {r.approach_velocity, r.integrated_effective_mass, r.f_max, r.t_at_f_max, r.delta_at_f_max,
-                     r.delta_max, r.contact_duration, r.separation_velocity, r.restitution, r.energy_start,
-                     r.energy_end})
+    for (double x : {r.approach_velocity, r.integrated_effective_mass, r.f_max, r.t_at_f_max,
+                     r.delta_at_f_max, r.delta_max, r.contact_duration, r.separation_velocity, r.restitution,
+                     r.energy_start, r.energy_end})
       require_finite(x, "simulate_contact result");
     require_finite(r.momentum_start, "momentum_start");
     require_finite(r.momentum_end, "momentum_end");
@@ -212,7 +220,8 @@ inline void check_plan_capture(Input& in, const ffsr::Model& model) {
   const uint8_t tb = in.byte(model.n() == 3 ? 0x03 : 0x10);  // 3-DOF: position xy; 7-DOF: pose
   task.kind = (tb & 0x10) ? ffsr::CaptureTask::Kind::Pose : ffsr::CaptureTask::Kind::Position;
   task.axes = {(tb & 1) != 0, (tb & 2) != 0, (tb & 4) != 0};
-  if (tb & 0x20) task.final_orientation = ffsr::rotation_from_rpy(ffsr::Vector3(in.real(0), in.real(0), in.real(0)));
+  if (tb & 0x20)
+    task.final_orientation = ffsr::rotation_from_rpy(ffsr::Vector3(in.real(0), in.real(0), in.real(0)));
   ffsr::CaptureOptions opt;
   opt.duration = in.real(2);
   if (std::isfinite(opt.duration) && opt.duration > 2) opt.duration = 2;  // bounded work per input
@@ -221,7 +230,8 @@ inline void check_plan_capture(Input& in, const ffsr::Model& model) {
   opt.gain = in.real(0);
   opt.feedback = in.real(1);
   opt.tolerance = in.real(1e-3);
-  opt.objective = (tb & 0x40) ? ffsr::CaptureObjective::ExactMaxForce : ffsr::CaptureObjective::IntegratedEffectiveMass;
+  opt.objective =
+      (tb & 0x40) ? ffsr::CaptureObjective::ExactMaxForce : ffsr::CaptureObjective::IntegratedEffectiveMass;
   opt.record_series = true;
   returns_or_ffsr_error("plan_capture", [&] {
     const ffsr::CaptureResult r = ffsr::plan_capture(pb, task, opt);
@@ -230,9 +240,10 @@ inline void check_plan_capture(Input& in, const ffsr::Model& model) {
     require_finite(r.base.orientation.coeffs(), "base attitude(T)");
     require_finite(r.end_effector, "end-effector(T)");
     require_finite(r.capture_point, "capture point");
-    for (double x : {r.tracking_error, r.orientation_error, r.base_position_drift, r.base_attitude_drift, r.M_ie,
-                     r.approach_velocity, r.f_max_closed_form, r.f_max_exact, r.max_momentum, r.max_body_momentum,
-                     r.max_quaternion_error, r.max_com_drift, r.max_tracking_error, r.min_singular_value})
+    for (double x :
+         {r.tracking_error, r.orientation_error, r.base_position_drift, r.base_attitude_drift, r.M_ie,
+          r.approach_velocity, r.f_max_closed_form, r.f_max_exact, r.max_momentum, r.max_body_momentum,
+          r.max_quaternion_error, r.max_com_drift, r.max_tracking_error, r.min_singular_value})
       require_finite(x, "plan_capture result");
     for (const auto& s : r.series) {
       require_finite(s.theta, "series theta");
@@ -249,10 +260,18 @@ inline void check_numeric_input(const uint8_t* data, size_t size) {
   const uint8_t sel = in.byte(0);
   const ffsr::Model& model = paper_robot((sel & 4) != 0);
   switch (sel & 3) {
-    case 0: check_effective_mass(in, model); break;
-    case 1: check_contact_law(in); break;
-    case 2: check_simulate_contact(in, model); break;
-    default: check_plan_capture(in, model); break;
+    case 0:
+      check_effective_mass(in, model);
+      break;
+    case 1:
+      check_contact_law(in);
+      break;
+    case 2:
+      check_simulate_contact(in, model);
+      break;
+    default:
+      check_plan_capture(in, model);
+      break;
   }
 }
 

@@ -48,9 +48,10 @@ inline std::vector<std::string> scenario_arguments(const std::string& dir) {
   std::vector<std::string> args;
   if (read_text(dir + "/scenario.toml").find("[uncertainty]") != std::string::npos)
     args = {"robust", "--samples", "20", "--threads", "1"};
-  for (const char* a : {"--quiet", "--global", "false", "--duration", "2", "--step", "0.1"}) args.push_back(a);
-  for (const std::string& a : std::vector<std::string>{"--config", dir + "/scenario.toml", "--json", dir + "/out.json",
-                                                      "--csv", dir + "/out.csv"})
+  for (const char* a : {"--quiet", "--global", "false", "--duration", "2", "--step", "0.1"})
+    args.push_back(a);
+  for (const std::string& a : std::vector<std::string>{"--config", dir + "/scenario.toml", "--json",
+                                                       dir + "/out.json", "--csv", dir + "/out.csv"})
     args.push_back(a);
   return args;
 }
@@ -63,7 +64,8 @@ inline bool has_non_finite_token(const std::string& text) {
 
 inline void check_json_finite(const nlohmann::json& j, const std::string& path) {
   if (j.is_null()) fail("JSON output: null (a NaN or inf) at " + path);
-  if (j.is_number_float() && !std::isfinite(j.get<double>())) fail("JSON output: non-finite number at " + path);
+  if (j.is_number_float() && !std::isfinite(j.get<double>()))
+    fail("JSON output: non-finite number at " + path);
   if (j.is_object())
     for (auto it = j.begin(); it != j.end(); ++it) check_json_finite(it.value(), path + "/" + it.key());
   if (j.is_array())

@@ -75,7 +75,8 @@ inline void check_urdf_input(const uint8_t* data, size_t size) {
     for (int j = 0; j < model.n(); ++j) {
       const ffsr::Joint& jt = model.joint(j);
       double q = 3.2 * next();
-      if (std::isfinite(jt.lower) && std::isfinite(jt.upper)) q = jt.lower + 0.5 * (next() + 1.0) * (jt.upper - jt.lower);
+      if (std::isfinite(jt.lower) && std::isfinite(jt.upper))
+        q = jt.lower + 0.5 * (next() + 1.0) * (jt.upper - jt.lower);
       theta(j) = q;
     }
     ffsr::BasePose base;

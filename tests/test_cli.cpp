@@ -128,8 +128,8 @@ std::vector<double> numbers(const json& a) {
 
 TEST_CASE("inspect --json on the 3-DOF robot at [0, 90, -90] deg (Table 3, row 5)", "[cli][paper]") {
   const auto j = parse_json(cli({"inspect", "--urdf", kUrdf3, "--joints-deg", "0,90,-90", "--json"}));
-  for (const char* key : {"H", "J_f", "end_effector_position", "effective_mass", "integrated_effective_mass",
-                          "joint_names"})
+  for (const char* key :
+       {"H", "J_f", "end_effector_position", "effective_mass", "integrated_effective_mass", "joint_names"})
     CHECK(j.contains(key));
 
   // H: (6 + 3) x (6 + 3), symmetric
@@ -169,7 +169,8 @@ TEST_CASE("inspect --json on the 3-DOF robot at [0, 90, -90] deg (Table 3, row 5
 
 TEST_CASE("inspect: negative angles work as --joints-deg=... and as --joints-deg ...", "[cli]") {
   const auto eq = parse_json(cli({"inspect", "--urdf", kUrdf3, "--joints-deg=-2.29,91.75,-79.77", "--json"}));
-  const auto sp = parse_json(cli({"inspect", "--urdf", kUrdf3, "--joints-deg", "-2.29,91.75,-79.77", "--json"}));
+  const auto sp =
+      parse_json(cli({"inspect", "--urdf", kUrdf3, "--joints-deg", "-2.29,91.75,-79.77", "--json"}));
   const auto deg_eq = numbers(eq.at("joints_deg"));
   const auto deg_sp = numbers(sp.at("joints_deg"));
   REQUIRE(deg_eq.size() == 3);
@@ -184,7 +185,8 @@ TEST_CASE("inspect: negative angles work as --joints-deg=... and as --joints-deg
 }
 
 TEST_CASE("inspect: the 7-DOF robot's end-effector at [0, 90, 90, -90, 90, 90, 0] deg", "[cli][paper]") {
-  const auto j = parse_json(cli({"inspect", "--urdf", kUrdf7, "--joints-deg", "0,90,90,-90,90,90,0", "--json"}));
+  const auto j =
+      parse_json(cli({"inspect", "--urdf", kUrdf7, "--joints-deg", "0,90,90,-90,90,90,0", "--json"}));
   const auto p = numbers(j.at("end_effector_position"));
   REQUIRE(p.size() == 3);
   CHECK(p[0] == Approx(1.8).margin(0.05));
@@ -211,8 +213,8 @@ TEST_CASE("inspect without --json prints a readable summary", "[cli]") {
 
 TEST_CASE("contact --json at [0, 90, -90] deg reproduces Table 3, row 5", "[cli][paper]") {
   const auto j = parse_json(cli({"contact", "--urdf", kUrdf3, "--joints-deg", "0,90,-90", "--json"}));
-  for (const char* key : {"integrated_effective_mass", "approach_velocity", "f_max_closed_form", "f_max_exact",
-                          "f_max_multibody", "model_accuracy"})
+  for (const char* key : {"integrated_effective_mass", "approach_velocity", "f_max_closed_form",
+                          "f_max_exact", "f_max_multibody", "model_accuracy"})
     CHECK(j.contains(key));
   CHECK(j.at("integrated_effective_mass").get<double>() == Approx(5.817).epsilon(1e-3));
   // 0.2 m/s along the normal plus the target's 2 deg/s spin at r_tp = (-0.25, 0.15, 0)
@@ -242,13 +244,14 @@ TEST_CASE("contact --model all --json lists the eight laws", "[cli]") {
     CHECK(law.at("f_max_closed_form").get<double>() > 0);
     CHECK(law.at("f_max_multibody").get<double>() > 0);
   }
-  CHECK(names == std::vector<std::string>{"hunt-crossley", "herbert-mcwhannell", "lankarani-nikravesh", "lee-wang",
-                                          "flores", "gonthier", "zhiying-qishao", "hu-guo"});
+  CHECK(names == std::vector<std::string>{"hunt-crossley", "herbert-mcwhannell", "lankarani-nikravesh",
+                                          "lee-wang", "flores", "gonthier", "zhiying-qishao", "hu-guo"});
 }
 
 TEST_CASE("contact --series writes F(t) and delta(t)", "[cli]") {
   TempDir tmp;
-  const auto r = cli({"contact", "--urdf", kUrdf3, "--joints-deg", "0,90,-90", "--series", "series.csv"}, tmp.str());
+  const auto r =
+      cli({"contact", "--urdf", kUrdf3, "--joints-deg", "0,90,-90", "--series", "series.csv"}, tmp.str());
   INFO(r.err);
   REQUIRE(r.exit_code == 0);
   CHECK(tmp.entries() == std::vector<std::string>{"series.csv"});  // no temporary file left
@@ -262,7 +265,8 @@ TEST_CASE("contact --series writes F(t) and delta(t)", "[cli]") {
   double f_max = 0, t_prev = -1;
   for (const auto& row : c.rows) {
     REQUIRE(row.size() == c.header.size());
-    const double t = std::stod(row[static_cast<size_t>(t_col)]), f = std::stod(row[static_cast<size_t>(f_col)]);
+    const double t = std::stod(row[static_cast<size_t>(t_col)]),
+                 f = std::stod(row[static_cast<size_t>(f_col)]);
     CHECK(f >= 0.0);
     CHECK(t >= t_prev);
     t_prev = t;
@@ -281,8 +285,8 @@ void check_result_keys(const json& j) {
   for (const char* run : {"baseline", "optimized"}) {
     INFO(run);
     REQUIRE(j.contains(run));
-    for (const char* key : {"capture_configuration_deg", "integrated_effective_mass", "f_max_closed_form",
-                            "tracking_error"})
+    for (const char* key :
+         {"capture_configuration_deg", "integrated_effective_mass", "f_max_closed_form", "tracking_error"})
       CHECK(j.at(run).contains(key));
   }
   CHECK(j.contains("mass_reduction_percent"));
@@ -309,9 +313,12 @@ void check_table4(const json& j) {
   CHECK(M_base <= 6.0);
   CHECK(M_opt <= 1.4);
   CHECK(j.at("force_reduction_percent").get<double>() >= 50.0);
-  CHECK(j.at("mass_reduction_percent").get<double>() == Approx(100.0 * (M_base - M_opt) / M_base).epsilon(1e-9));
-  const double F_base = base.at("f_max_closed_form").get<double>(), F_opt = opt.at("f_max_closed_form").get<double>();
-  CHECK(j.at("force_reduction_percent").get<double>() == Approx(100.0 * (F_base - F_opt) / F_base).epsilon(1e-9));
+  CHECK(j.at("mass_reduction_percent").get<double>() ==
+        Approx(100.0 * (M_base - M_opt) / M_base).epsilon(1e-9));
+  const double F_base = base.at("f_max_closed_form").get<double>(),
+               F_opt = opt.at("f_max_closed_form").get<double>();
+  CHECK(j.at("force_reduction_percent").get<double>() ==
+        Approx(100.0 * (F_base - F_opt) / F_base).epsilon(1e-9));
 }
 
 void check_series_csv(const std::string& path, size_t n_joints) {
@@ -354,7 +361,8 @@ TEST_CASE("the built-in default scenario (no arguments) reproduces Table 4", "[c
 
 TEST_CASE("run: --config robots/paper_3dof.toml from another directory finds its URDF", "[cli][paper]") {
   TempDir tmp;
-  const auto r = cli({"--config", kScenario3, "--json", "out.json", "--csv", "out.csv", "--quiet"}, tmp.str());
+  const auto r =
+      cli({"--config", kScenario3, "--json", "out.json", "--csv", "out.csv", "--quiet"}, tmp.str());
   INFO(r.err);
   REQUIRE(r.exit_code == 0);
   const json j = read_json_file(tmp / "out.json");
@@ -418,8 +426,9 @@ struct BadCase {
   std::vector<std::string> dirs = {};  ///< directories to create in the working directory first
 };
 
-const std::string kLaws = "hunt-crossley, herbert-mcwhannell, lankarani-nikravesh, lee-wang, flores, gonthier, "
-                          "zhiying-qishao, hu-guo";
+const std::string kLaws =
+    "hunt-crossley, herbert-mcwhannell, lankarani-nikravesh, lee-wang, flores, gonthier, "
+    "zhiying-qishao, hu-guo";
 
 Args inspect3(Args extra) {
   Args a{"inspect", "--urdf", kUrdf3};
@@ -445,17 +454,21 @@ Args run_default(Args extra) {  // the built-in scenario, asking for both output
   return a;
 }
 Args scenario(const std::string& file) {
-  return {"--config", kBadScenarios + "/" + file, "--quiet", "--global", "false", "--json", "out.json", "--csv", "out.csv"};
+  return {
+      "--config", kBadScenarios + "/" + file, "--quiet", "--global", "false", "--json", "out.json", "--csv",
+      "out.csv"};
 }
 
 std::vector<BadCase> bad_cases() {
   return {
       // --- inspect: robot -----------------------------------------------------------------------
-      {"missing URDF file", {"inspect", "--urdf", "{TMP}/no_such_robot.urdf", "--joints-deg", "0,90,-90"},
+      {"missing URDF file",
+       {"inspect", "--urdf", "{TMP}/no_such_robot.urdf", "--joints-deg", "0,90,-90"},
        {"no_such_robot.urdf", "cannot open"}},
       {"missing --urdf", {"inspect", "--joints-deg", "0,90,-90"}, {"--urdf"}},
       {"wrong joint count", inspect3({"--joints-deg", "0,90"}), {"--joints-deg", "3 joints"}},
-      {"wrong joint count, 7-DOF", {"inspect", "--urdf", kUrdf7, "--joints-deg", "0,90,-90"},
+      {"wrong joint count, 7-DOF",
+       {"inspect", "--urdf", kUrdf7, "--joints-deg", "0,90,-90"},
        {"--joints-deg", "7 joints"}},
       {"non-numeric angle", inspect3({"--joints-deg", "0,abc,-90"}), {"--joints-deg", "'abc'"}},
       {"NaN angle", inspect3({"--joints-deg", "0,nan,-90"}), {"--joints-deg", "'nan'", "finite"}},
@@ -466,26 +479,35 @@ std::vector<BadCase> bad_cases() {
       {"unknown flag", inspect3q({"--bogus"}), {"--bogus"}},
       {"base position of 2 values", inspect3q({"--base-position", "1,2"}), {"--base-position", "got 2"}},
       {"base rpy of 2 values", inspect3q({"--base-rpy-deg", "1,2"}), {"--base-rpy-deg"}},
-      {"unknown end-effector", inspect3q({"--end-effector", "nope"}),
+      {"unknown end-effector",
+       inspect3q({"--end-effector", "nope"}),
        {"'nope'", "base, link1, link2, link3, ee"}},
       // --- inspect: target ----------------------------------------------------------------------
-      {"target inertia of 4 values", inspect3q({"--target-inertia", "100,100,100,0"}),
+      {"target inertia of 4 values",
+       inspect3q({"--target-inertia", "100,100,100,0"}),
        {"--target-inertia", "3 or 6", "got 4"}},
-      {"contact offset of 2 values", inspect3q({"--contact-offset", "-0.25,0.15"}), {"--contact-offset", "got 2"}},
+      {"contact offset of 2 values",
+       inspect3q({"--contact-offset", "-0.25,0.15"}),
+       {"--contact-offset", "got 2"}},
       {"normal of 4 values", inspect3q({"--normal", "1,0,0,0"}), {"--normal", "got 4"}},
       {"zero normal", inspect3q({"--normal", "0,0,0"}), {"--normal", "non-zero"}},
       {"negative target mass", inspect3q({"--target-mass", "-200"}), {"--target-mass", "-200"}},
       {"zero target mass", inspect3q({"--target-mass", "0"}), {"--target-mass", "positive"}},
       {"NaN target mass", inspect3q({"--target-mass", "nan"}), {"--target-mass"}},
-      {"non-PD target inertia", inspect3q({"--target-inertia", "100,100,100,200,0,0"}),
+      {"non-PD target inertia",
+       inspect3q({"--target-inertia", "100,100,100,200,0,0"}),
        {"--target-inertia", "positive definite"}},
-      {"negative target moment", inspect3q({"--target-inertia", "-100,100,100"}),
+      {"negative target moment",
+       inspect3q({"--target-inertia", "-100,100,100"}),
        {"--target-inertia", "positive definite"}},
-      {"triangle inequality", inspect3q({"--target-inertia", "1,1,10"}),
+      {"triangle inequality",
+       inspect3q({"--target-inertia", "1,1,10"}),
        {"--target-inertia", "triangle inequality"}},
       {"NaN target attitude", inspect3q({"--target-rpy-deg", "nan,0,0"}), {"--target-rpy-deg", "'nan'"}},
       // --- contact --------------------------------------------------------------------------------
-      {"negative stiffness", contact3({"--stiffness", "-1e9"}), {"--stiffness", "stiffness K must be positive"}},
+      {"negative stiffness",
+       contact3({"--stiffness", "-1e9"}),
+       {"--stiffness", "stiffness K must be positive"}},
       {"non-numeric stiffness", contact3({"--stiffness", "abc"}), {"--stiffness", "abc"}},
       {"zero exponent", contact3({"--exponent", "0"}), {"--exponent", "alpha must be positive"}},
       {"c_r = 0", contact3({"--restitution", "0"}), {"--restitution", "0 < c_r <= 1", "got 0"}},
@@ -494,30 +516,41 @@ std::vector<BadCase> bad_cases() {
       {"unknown contact law", contact3({"--model", "newton", "--json"}), {"--model", "'newton'", kLaws}},
       {"receding bodies", contact3({"--approach-speed", "-0.2"}), {"do not approach"}},
       {"zero approach speed, no spin",
-       contact3({"--approach-speed", "0", "--target-angular-velocity-deg", "0,0,0"}), {"do not approach"}},
+       contact3({"--approach-speed", "0", "--target-angular-velocity-deg", "0,0,0"}),
+       {"do not approach"}},
       {"infinite approach speed", contact3({"--approach-speed", "inf"}), {"--approach-speed", "finite"}},
-      {"target spin of 2 values", contact3({"--target-angular-velocity-deg", "0,2"}),
+      {"target spin of 2 values",
+       contact3({"--target-angular-velocity-deg", "0,2"}),
        {"--target-angular-velocity-deg"}},
-      {"--series into a missing directory", contact3({"--series", "missing_dir/series.csv"}),
+      {"--series into a missing directory",
+       contact3({"--series", "missing_dir/series.csv"}),
        {"missing_dir/series.csv", "cannot write"}},
-      {"--series onto a directory", contact3({"--series", "a_dir", "--json"}), {"a_dir", "cannot write"}, 2,
+      {"--series onto a directory",
+       contact3({"--series", "a_dir", "--json"}),
+       {"a_dir", "cannot write"},
+       2,
        {"a_dir"}},
       // --- main job, flags over the built-in scenario ---------------------------------------------
       {"run: wrong joint count", run_default({"--joints-deg", "1,2"}), {"--joints-deg", "got 2"}},
       {"run: non-numeric angle", run_default({"--joints-deg", "1,abc,3"}), {"--joints-deg", "abc"}},
       {"run: unknown contact law", run_default({"--model", "newton"}), {"--model", "'newton'", kLaws}},
       {"run: c_r = 0", run_default({"--restitution", "0"}), {"--restitution", "c_r"}},
-      {"run: target inertia of 4 values", run_default({"--target-inertia", "100,100,100,0"}),
+      {"run: target inertia of 4 values",
+       run_default({"--target-inertia", "100,100,100,0"}),
        {"--target-inertia", "got 4"}},
       {"run: negative target mass", run_default({"--target-mass", "-5"}), {"--target-mass", "-5"}},
       {"run: zero normal", run_default({"--normal", "0,0,0"}), {"--normal", "non-zero"}},
-      {"run: base position of 2 values", run_default({"--base-position", "1,2"}), {"--base-position", "got 2"}},
+      {"run: base position of 2 values",
+       run_default({"--base-position", "1,2"}),
+       {"--base-position", "got 2"}},
       {"run: zero approach speed", run_default({"--approach-speed", "0"}), {"--approach-speed", "positive"}},
       {"run: zero tolerance", run_default({"--tolerance", "0"}), {"--tolerance", "positive"}},
       {"run: NaN gain", run_default({"--gain", "nan"}), {"--gain", "finite"}},
       {"run: pose task on 3 joints with gain", run_default({"--task", "pose"}), {"--gain", "no null space"}},
       {"run: unknown task", run_default({"--task", "orbit"}), {"--task", "'orbit'"}},
-      {"run: unknown baseline task", run_default({"--baseline-task", "orbit"}), {"--baseline-task", "'orbit'"}},
+      {"run: unknown baseline task",
+       run_default({"--baseline-task", "orbit"}),
+       {"--baseline-task", "'orbit'"}},
       {"run: bad task axes", run_default({"--task-axes", "xw"}), {"--task-axes", "'xw'"}},
       {"run: negative duration", run_default({"--duration", "-1"}), {"--duration", "positive"}},
       {"run: zero step", run_default({"--step", "0"}), {"--step", "got 0"}},
@@ -526,23 +559,36 @@ std::vector<BadCase> bad_cases() {
       {"run: unknown end-effector", run_default({"--end-effector", "nope"}), {"'nope'", "link3, ee"}},
       {"run: missing URDF", run_default({"--urdf", "{TMP}/no_such_robot.urdf"}), {"no_such_robot.urdf"}},
       {"run: stray positional argument", run_default({"orbit"}), {"orbit"}},
-      {"run: non-existent --config", run_default({"--config", "{TMP}/no_such_scenario.toml"}),
+      {"run: non-existent --config",
+       run_default({"--config", "{TMP}/no_such_scenario.toml"}),
        {"--config", "no_such_scenario.toml"}},
-      {"run: --json into a missing directory", {"--quiet", "--json", "missing_dir/out.json"},
+      {"run: --json into a missing directory",
+       {"--quiet", "--json", "missing_dir/out.json"},
        {"missing_dir/out.json", "cannot write"}},
       {"run: --csv into a missing directory, --json fine",
-       {"--quiet", "--json", "out.json", "--csv", "missing_dir/out.csv"}, {"missing_dir/out.csv", "cannot write"}},
-      {"run: --csv onto a directory, --json fine", {"--quiet", "--json", "out.json", "--csv", "a_dir"},
-       {"a_dir", "cannot write"}, 2, {"a_dir"}},
-      {"run: capture point out of reach", run_default({"--target-position", "20,1.45,0"}),
-       {"out of reach"}, 3},
+       {"--quiet", "--json", "out.json", "--csv", "missing_dir/out.csv"},
+       {"missing_dir/out.csv", "cannot write"}},
+      {"run: --csv onto a directory, --json fine",
+       {"--quiet", "--json", "out.json", "--csv", "a_dir"},
+       {"a_dir", "cannot write"},
+       2,
+       {"a_dir"}},
+      {"run: capture point out of reach",
+       run_default({"--target-position", "20,1.45,0"}),
+       {"out of reach"},
+       3},
       // --- scenario files -------------------------------------------------------------------------
-      {"scenario: missing key", scenario("missing_duration.toml"), {"missing key 'duration'", "missing_duration.toml"}},
+      {"scenario: missing key",
+       scenario("missing_duration.toml"),
+       {"missing key 'duration'", "missing_duration.toml"}},
       {"scenario: unknown key", scenario("unknown_key.toml"), {"colour"}},
-      {"scenario: unreadable URDF", scenario("unreadable_urdf.toml"),
+      {"scenario: unreadable URDF",
+       scenario("unreadable_urdf.toml"),
        {"bad_scenarios/no_such_robot.urdf", "cannot open"}},
       {"scenario: capture point out of reach", scenario("out_of_reach.toml"), {"out of reach"}, 3},
-      {"scenario: non-redundant task with gain", scenario("pose_with_gain.toml"), {"--gain", "no null space"}},
+      {"scenario: non-redundant task with gain",
+       scenario("pose_with_gain.toml"),
+       {"--gain", "no null space"}},
       {"scenario: unknown task", scenario("unknown_task.toml"), {"--task", "'orbit'"}},
       {"scenario: bad task axes", scenario("bad_task_axes.toml"), {"--task-axes", "'xw'"}},
       {"scenario: negative duration", scenario("negative_duration.toml"), {"--duration", "-180"}},
@@ -556,7 +602,9 @@ std::vector<BadCase> bad_cases() {
       {"scenario: joint angles not numbers", scenario("joints_not_numbers.toml"), {"--joints-deg", "zero"}},
       {"scenario: wrong joint count", scenario("wrong_joint_count.toml"), {"--joints-deg", "got 2"}},
       {"scenario: receding approach", scenario("receding.toml"), {"--approach-speed", "positive"}},
-      {"scenario: target inertia of 4 values", scenario("bad_target_inertia.toml"), {"--target-inertia", "got 4"}},
+      {"scenario: target inertia of 4 values",
+       scenario("bad_target_inertia.toml"),
+       {"--target-inertia", "got 4"}},
       {"scenario: zero normal", scenario("zero_normal.toml"), {"--normal", "non-zero"}},
   };
 }
@@ -644,9 +692,7 @@ TEST_CASE("bad inputs: every malformed URDF in tests/data/bad_urdf gives exit 2 
 
 TEST_CASE("an output file from an earlier run is not replaced by a failing run", "[cli]") {
   TempDir tmp;
-  {
-    std::ofstream(tmp / "out.json") << "{\"earlier\": true}\n";
-  }
+  { std::ofstream(tmp / "out.json") << "{\"earlier\": true}\n"; }
   const auto r = cli({"--quiet", "--json", "out.json", "--target-position", "20,1.45,0"}, tmp.str());
   CHECK(r.exit_code == 3);
   CHECK(tmp.entries() == std::vector<std::string>{"out.json"});

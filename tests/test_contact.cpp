@@ -44,23 +44,31 @@ std::vector<AnyContactLaw> all_laws(const ContactParams& p, double v0) {
 // Table 1 written out independently of damping.hpp, in the order of contact_law_names().
 double table1_factor(std::size_t i, double c) {
   switch (i) {
-    case 0: return 1.5 * (1 - c);                                   // Hunt-Crossley
-    case 1: return 6 * (1 - c) / ((2 * c - 1) * (2 * c - 1) + 3);   // Herbert-McWhannell
-    case 2: return 0.75 * (1 - c * c);                              // Lankarani-Nikravesh
-    case 3: return 0.75 * (1 - c);                                  // Lee-Wang
-    case 4: return 8 * (1 - c) / (5 * c);                           // Flores et al.
-    case 5: return (1 - c * c) / c;                                 // Gonthier et al.
-    case 6: return 0.75 * (1 - c * c) * std::exp(2 * (1 - c));      // Zhiying-Qishao
-    case 7: return 1.5 * (1 - c) / c;                               // Hu-Guo
-    default: return std::nan("");
+    case 0:
+      return 1.5 * (1 - c);  // Hunt-Crossley
+    case 1:
+      return 6 * (1 - c) / ((2 * c - 1) * (2 * c - 1) + 3);  // Herbert-McWhannell
+    case 2:
+      return 0.75 * (1 - c * c);  // Lankarani-Nikravesh
+    case 3:
+      return 0.75 * (1 - c);  // Lee-Wang
+    case 4:
+      return 8 * (1 - c) / (5 * c);  // Flores et al.
+    case 5:
+      return (1 - c * c) / c;  // Gonthier et al.
+    case 6:
+      return 0.75 * (1 - c * c) * std::exp(2 * (1 - c));  // Zhiying-Qishao
+    case 7:
+      return 1.5 * (1 - c) / c;  // Hu-Guo
+    default:
+      return std::nan("");
   }
 }
 
 // F along the single-body contact as a function of s = δ̇/δ̇⁻ (Eq. 19 into Eq. 15).
 double force_at_rate(const AnyContactLaw& law, double M, double s) {
   const double v0 = approach_velocity(law);
-  return std::visit(
-      [&](const auto& l) { return l.force(l.deformation(M, s * v0), s * v0); }, law);
+  return std::visit([&](const auto& l) { return l.force(l.deformation(M, s * v0), s * v0); }, law);
 }
 
 }  // namespace
@@ -72,9 +80,9 @@ double force_at_rate(const AnyContactLaw& law, double M, double s) {
 TEST_CASE("damping factors follow Table 1 and vanish at c_r = 1", "[contact]") {
   const auto names = contact_law_names();
   REQUIRE(names.size() == 8);
-  const std::array<std::string_view, 8> expected{"hunt-crossley", "herbert-mcwhannell",
-                                                 "lankarani-nikravesh", "lee-wang", "flores",
-                                                 "gonthier", "zhiying-qishao", "hu-guo"};
+  const std::array<std::string_view, 8> expected{
+      "hunt-crossley", "herbert-mcwhannell", "lankarani-nikravesh", "lee-wang",
+      "flores",        "gonthier",           "zhiying-qishao",      "hu-guo"};
   for (std::size_t i = 0; i < 8; ++i) {
     CHECK(names[i] == expected[i]);
     for (double c : {0.1, 0.3, 0.5, 0.9, 0.99, 1.0}) {
@@ -110,34 +118,38 @@ TEST_CASE("Eq. 10-12: the approach velocities of the paper's scenarios", "[conta
   const Eigen::Vector3d u = Eigen::Vector3d::UnitX();
   const Eigen::Vector3d v_e = 0.2 * u, v_t = Eigen::Vector3d::Zero();
   // 3-DOF: ω = [0, 0, 2] deg/s, r = [-0.25, 0.15, 0]; u·(ω × r) = -0.15 ω_z by hand.
-  const double v3 = approach_velocity(u, v_e, v_t, Eigen::Vector3d(0, 0, 2 * kDeg),
-                                      Eigen::Vector3d(-0.25, 0.15, 0));
+  const double v3 =
+      approach_velocity(u, v_e, v_t, Eigen::Vector3d(0, 0, 2 * kDeg), Eigen::Vector3d(-0.25, 0.15, 0));
   CHECK(v3 == Approx(0.2 + 0.15 * 2 * kDeg).epsilon(1e-15));
   CHECK(v3 == Approx(0.2052).margin(5e-5));  // the issue's ≈ 0.2052 m/s
   // 7-DOF: ω = [1, -0.5, 2] deg/s, r = [-0.25, 0.15, 0.1]; (ω × r)_x = ω_y r_z - ω_z r_y.
-  const double v7 = approach_velocity(u, v_e, v_t, Eigen::Vector3d(1, -0.5, 2) * kDeg,
-                                      Eigen::Vector3d(-0.25, 0.15, 0.1));
+  const double v7 =
+      approach_velocity(u, v_e, v_t, Eigen::Vector3d(1, -0.5, 2) * kDeg, Eigen::Vector3d(-0.25, 0.15, 0.1));
   CHECK(v7 == Approx(0.2 - (-0.5 * 0.1 - 2 * 0.15) * kDeg).epsilon(1e-15));
   CHECK(v7 == Approx(0.2061).margin(5e-5));  // the issue's ≈ 0.2061 m/s
   // A moving target along u reduces the approach velocity one for one (Eq. 12).
   CHECK(approach_velocity(u, v_e, 0.05 * u, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()) ==
         Approx(0.15).epsilon(1e-15));
   CHECK_THROWS_AS(approach_velocity(2 * u, v_e, v_t, v_t, v_t), InputError);
-  CHECK_THROWS_AS(approach_velocity(u, Eigen::Vector3d(std::nan(""), 0, 0), v_t, v_t, v_t),
-                  InputError);
+  CHECK_THROWS_AS(approach_velocity(u, Eigen::Vector3d(std::nan(""), 0, 0), v_t, v_t, v_t), InputError);
 }
 
 TEST_CASE("Table 3 (3-DOF): closed-form F_max at the paper's M_ie within 0.3 %", "[contact][paper]") {
-  const double v0 = approach_velocity(Eigen::Vector3d::UnitX(), Eigen::Vector3d(0.2, 0, 0),
-                                      Eigen::Vector3d::Zero(), Eigen::Vector3d(0, 0, 2 * kDeg),
-                                      Eigen::Vector3d(-0.25, 0.15, 0));
+  const double v0 =
+      approach_velocity(Eigen::Vector3d::UnitX(), Eigen::Vector3d(0.2, 0, 0), Eigen::Vector3d::Zero(),
+                        Eigen::Vector3d(0, 0, 2 * kDeg), Eigen::Vector3d(-0.25, 0.15, 0));
   const auto law = make_contact_law("herbert-mcwhannell", kPaper, v0);
   // Table 3: integrated effective mass [kg] and "Proposed Method" [kN].
-  const std::array<std::pair<double, double>, 10> rows{{{1.555, 0.834}, {1.648, 0.863},
-                                                        {3.679, 1.397}, {4.299, 1.534},
-                                                        {5.817, 1.840}, {5.926, 1.860},
-                                                        {7.446, 2.133}, {9.635, 2.490},
-                                                        {13.74, 3.081}, {21.093, 3.985}}};
+  const std::array<std::pair<double, double>, 10> rows{{{1.555, 0.834},
+                                                        {1.648, 0.863},
+                                                        {3.679, 1.397},
+                                                        {4.299, 1.534},
+                                                        {5.817, 1.840},
+                                                        {5.926, 1.860},
+                                                        {7.446, 2.133},
+                                                        {9.635, 2.490},
+                                                        {13.74, 3.081},
+                                                        {21.093, 3.985}}};
   for (const auto& [M, paper_kN] : rows) {
     const double F = max_force_closed_form(law, M);
     INFO("M_ie = " << M << " kg: ours " << F / 1e3 << " kN, paper " << paper_kN << " kN");
@@ -146,16 +158,21 @@ TEST_CASE("Table 3 (3-DOF): closed-form F_max at the paper's M_ie within 0.3 %",
 }
 
 TEST_CASE("Table 6 (7-DOF): closed-form F_max at the paper's M_ie within 0.3 %", "[contact][paper]") {
-  const double v0 = approach_velocity(Eigen::Vector3d::UnitX(), Eigen::Vector3d(0.2, 0, 0),
-                                      Eigen::Vector3d::Zero(), Eigen::Vector3d(1, -0.5, 2) * kDeg,
-                                      Eigen::Vector3d(-0.25, 0.15, 0.1));
+  const double v0 =
+      approach_velocity(Eigen::Vector3d::UnitX(), Eigen::Vector3d(0.2, 0, 0), Eigen::Vector3d::Zero(),
+                        Eigen::Vector3d(1, -0.5, 2) * kDeg, Eigen::Vector3d(-0.25, 0.15, 0.1));
   const auto law = make_contact_law("herbert-mcwhannell", kPaper, v0);
   // Table 6: integrated effective mass [kg] and "Proposed Method" [kN].
-  const std::array<std::pair<double, double>, 10> rows{{{4.875, 1.664}, {7.876, 2.218},
-                                                        {2.848, 1.205}, {3.061, 1.258},
-                                                        {3.167, 1.284}, {5.003, 1.690},
-                                                        {2.513, 1.118}, {1.658, 0.871},
-                                                        {2.677, 1.161}, {1.495, 0.819}}};
+  const std::array<std::pair<double, double>, 10> rows{{{4.875, 1.664},
+                                                        {7.876, 2.218},
+                                                        {2.848, 1.205},
+                                                        {3.061, 1.258},
+                                                        {3.167, 1.284},
+                                                        {5.003, 1.690},
+                                                        {2.513, 1.118},
+                                                        {1.658, 0.871},
+                                                        {2.677, 1.161},
+                                                        {1.495, 0.819}}};
   for (const auto& [M, paper_kN] : rows) {
     const double F = max_force_closed_form(law, M);
     INFO("M_ie = " << M << " kg: ours " << F / 1e3 << " kN, paper " << paper_kN << " kN");
@@ -196,8 +213,8 @@ TEST_CASE("Eq. 20 and Eq. 25 as printed (with λ and ln) agree with the implemen
     for (const auto& law : all_laws({K, a, c}, v0)) {
       INFO(contact_law_name(law) << " c_r = " << c);
       const double lam = lambda(law), f = damping_factor(law);
-      const double d20 = std::pow(M * (a + 1) / (lam * lam) * (lam * v0 + K * std::log(K / (lam * v0 + K))),
-                                  1 / (a + 1));
+      const double d20 =
+          std::pow(M * (a + 1) / (lam * lam) * (lam * v0 + K * std::log(K / (lam * v0 + K))), 1 / (a + 1));
       const double z25 = std::pow(K, 1 / (a + 1)) *
                          std::pow((a + 1) * v0 * v0 / (f * f) * (f + std::log(1 / (f + 1))), a / (a + 1));
       // Cancellation in λ δ̇⁻ + K ln(...) costs about log10(1/f) digits: tolerance 1e-11.
@@ -264,11 +281,11 @@ TEST_CASE("G(s) = g(s)/f² of Eq. 19: series and log1p branches against long dou
 TEST_CASE("Figure 3: both points, Gonthier, M = 1 kg, K = 1e9, 0.2 m/s, c_r = 0.5", "[contact][paper]") {
   const HertzDamped<Gonthier> law({1e9, 1.5, 0.5}, 0.2);
   const double M = 1.0;
-  const ForcePeak pk = law.exact_peak(M);          // "*" : (δ'_max, F_max)
-  const double d_max = law.max_deformation(M);     // "o" : (δ_max, F'_max)
+  const ForcePeak pk = law.exact_peak(M);       // "*" : (δ'_max, F_max)
+  const double d_max = law.max_deformation(M);  // "o" : (δ_max, F'_max)
   const double F_est = law.max_force_estimate(M);
   INFO("(delta'_max, F_max) = (" << pk.deformation << " m, " << pk.force << " N), (delta_max, F'_max) = ("
-       << d_max << " m, " << F_est << " N), xi = " << law.relative_error() << " %");
+                                 << d_max << " m, " << F_est << " N), xi = " << law.relative_error() << " %");
   CHECK(pk.deformation < d_max);
   CHECK(pk.force > F_est);
   CHECK(pk.deformation_rate > 0.0);
@@ -290,14 +307,16 @@ TEST_CASE("Figures 4-5: ξ does not depend on K or on the approach velocity", "[
     // Figure 4: K from 1e7 to 1e11 at δ̇⁻ = 0.2; ξ from the two maxima (Eq. 21); < 1e-6 relative.
     for (double K : {1e7, 1e8, 1e9, 1e10, 1e11}) {
       const auto law = make_contact_law(name, {K, 1.5, 0.9}, 0.2);
-      const double xi = (max_force_exact(law, 1.0) - max_force_estimate(law, 1.0)) / max_force_exact(law, 1.0) * 100;
+      const double xi =
+          (max_force_exact(law, 1.0) - max_force_estimate(law, 1.0)) / max_force_exact(law, 1.0) * 100;
       CHECK(rel(xi, xi_ref) < 1e-6);
       CHECK(rel(relative_error(law), xi_ref) < 1e-6);
     }
     // Figure 5: δ̇⁻ from 0.01 to 1 m/s at K = 1e9; < 1e-6 relative.
     for (double v0 : {0.01, 0.05, 0.1, 0.5, 1.0}) {
       const auto law = make_contact_law(name, kPaper, v0);
-      const double xi = (max_force_exact(law, 2.5) - max_force_estimate(law, 2.5)) / max_force_exact(law, 2.5) * 100;
+      const double xi =
+          (max_force_exact(law, 2.5) - max_force_estimate(law, 2.5)) / max_force_exact(law, 2.5) * 100;
       CHECK(rel(xi, xi_ref) < 1e-6);
     }
   }
@@ -554,14 +573,16 @@ TEST_CASE("cvode: an exception in the right-hand side propagates unchanged", "[c
   cvode::Integrator b(always, Eigen::Vector2d(0, 1), 0.0);
   CHECK_THROWS_AS(b.step(1.0), MyError);
   // A throwing root function too.
-  cvode::Roots bad_root = [](double t, const Eigen::Ref<const Eigen::VectorXd>&, Eigen::Ref<Eigen::VectorXd> g) {
+  cvode::Roots bad_root = [](double t, const Eigen::Ref<const Eigen::VectorXd>&,
+                             Eigen::Ref<Eigen::VectorXd> g) {
     if (t > 0.1) throw MyError("root");
     g[0] = 1;
   };
   cvode::Integrator c(oscillator, Eigen::Vector2d(0, 1), 0.0, {}, 1, bad_root);
   CHECK_THROWS_AS(c.advance(1.0), MyError);
   // A non-finite derivative is an IntegrationError that says so.
-  cvode::Rhs nan_rhs = [](double t, const Eigen::Ref<const Eigen::VectorXd>& y, Eigen::Ref<Eigen::VectorXd> yd) {
+  cvode::Rhs nan_rhs = [](double t, const Eigen::Ref<const Eigen::VectorXd>& y,
+                          Eigen::Ref<Eigen::VectorXd> yd) {
     oscillator(t, y, yd);
     if (t > 0.2) yd[1] = std::nan("");
   };
@@ -639,7 +660,7 @@ TEST_CASE("the force peak next to first touch (tiny exponent) is found, and ξ i
         };
         for (double d : {1e-3, 1e-6})
           CHECK(lnF(pk.t) >= std::max(lnF(pk.t * (1 - d)), lnF(std::min(1.0, pk.t * (1 + d)))) -
-                               1e-14 * std::max(1.0, std::abs(lnF(pk.t))));  // rounding of ln F
+                                 1e-14 * std::max(1.0, std::abs(lnF(pk.t))));  // rounding of ln F
         if (K == 1e9 && alpha < 1e-300) {
           // δ at the peak (~t* ~ 1e-320 m) is not representable: an error, never F = 0
           CHECK_THROWS_AS(exact_peak(law, 5.8158), NumericalError);

@@ -86,7 +86,8 @@ const Chart library_chart = advance_library;
 TEST_CASE("random tree: the builder made the intended tree", "[dynamics]") {
   const TestRobot r = random_tree(7);
   CHECK(r.model.n() == 9);
-  CHECK(r.model.joint_names() == std::vector<std::string>{"ja1", "jb1", "ja2", "jc1", "jb2", "ja3", "ja4", "jc2", "jb3"});
+  CHECK(r.model.joint_names() ==
+        std::vector<std::string>{"ja1", "jb1", "ja2", "jc1", "jb2", "ja3", "ja4", "jc2", "jb3"});
   // total mass: the sum of the masses given to the builder (exact up to rounding, 1e-12 relative)
   double m = 0;
   for (const auto& l : r.links) m += l.inertia.mass;
@@ -133,7 +134,8 @@ TEST_CASE("H columns equal RNEA with unit accelerations", "[dynamics]") {
         // RNEA is computed in body coordinates without composites: an independent route.
         // 1e-12 relative to max(1, |H col|): rounding only.
         CHECK(rel_err(VectorXd(rnea(r.model, d, q.base, q.theta, zero, e)), VectorXd(H.col(i))) < 1e-12);
-        CHECK(rel_err(VectorXd(rnea(with_g, dg, q.base, q.theta, zero, e) - g_bias), VectorXd(H.col(i))) < 1e-12);
+        CHECK(rel_err(VectorXd(rnea(with_g, dg, q.base, q.theta, zero, e) - g_bias), VectorXd(H.col(i))) <
+              1e-12);
       }
       // without velocity the gravity bias is the weight: force M g on the base, moment about the
       // base origin (c - p0) x M g (closed form, statics of the whole system)
@@ -141,7 +143,8 @@ TEST_CASE("H columns equal RNEA with unit accelerations", "[dynamics]") {
       const auto s = link_states(r, dk, q);
       const Vector3 c = system_com(r, s);
       Vector6 weight;
-      weight << -r.model.total_mass() * with_g.gravity, -(c - q.base.position).cross(r.model.total_mass() * with_g.gravity);
+      weight << -r.model.total_mass() * with_g.gravity,
+          -(c - q.base.position).cross(r.model.total_mass() * with_g.gravity);
       CHECK(rel_err(Vector6(g_bias.head<6>()), weight) < 1e-12);
     }
   }
@@ -159,8 +162,8 @@ TEST_CASE("RNEA is H a + C, and bias_forces is RNEA at zero acceleration", "[dyn
       const VectorXd C0 = rnea(r.model, d, q.base, q.theta, v, VectorXd::Zero(r.model.nv()));
       const VectorXd tau = rnea(r.model, d, q.base, q.theta, v, a);
       INFO(r.name << " config " << k);
-      CHECK(rel_err(C, C0) == 0.0);                          // the same computation
-      CHECK(rel_err(tau, VectorXd(H * a + C)) < 1e-11);      // Eq. 1, rounding only
+      CHECK(rel_err(C, C0) == 0.0);                      // the same computation
+      CHECK(rel_err(tau, VectorXd(H * a + C)) < 1e-11);  // Eq. 1, rounding only
     }
   }
 }
@@ -196,7 +199,7 @@ TEST_CASE("first six rows of H v are the total momentum", "[dynamics]") {
       const Vector6 h_fd = fd_momentum(r, fd_link_velocities(r, q, v, library_chart), q.base.position);
       INFO(r.name << " config " << k);
       CHECK(rel_err(momentum(r.model, d, v), Hv) < 1e-12);  // two library routes: rounding only
-      CHECK(rel_err(Hv, h_fd) < 1e-8);                       // FD body sum, truncation O(h^2)
+      CHECK(rel_err(Hv, h_fd) < 1e-8);                      // FD body sum, truncation O(h^2)
     }
   }
 }
@@ -206,7 +209,8 @@ TEST_CASE("frame_jacobian against finite differences of forward kinematics", "[d
   for (const auto& r : robots_under_test()) {
     Data d(r.model);
     std::vector<int> frames{r.ee, 0};
-    if (r.name == "random tree") frames = {r.ee, r.model.frame_index("tool"), r.model.frame_index("c2"), r.model.frame_index("b3"), 0};
+    if (r.name == "random tree")
+      frames = {r.ee, r.model.frame_index("tool"), r.model.frame_index("c2"), r.model.frame_index("b3"), 0};
     for (int k = 0; k < 3; ++k) {
       const Config q = random_config(r.model, rng);
       forward_kinematics(r.model, d, q.base, q.theta);
@@ -240,8 +244,10 @@ TEST_CASE("J_f is the end-effector velocity under zero momentum", "[dynamics]") 
       // alone would carry on a clamped base, 1e-8 of it
       VectorXd v_clamped = VectorXd::Zero(r.model.nv());
       v_clamped.tail(r.model.n()) = theta_dot;
-      const double scale = fd_momentum(r, fd_link_velocities(r, q, v_clamped, library_chart), q.base.position).norm();
-      CHECK(fd_momentum(r, fd_link_velocities(r, q, v, library_chart), q.base.position).norm() < 1e-8 * scale);
+      const double scale =
+          fd_momentum(r, fd_link_velocities(r, q, v_clamped, library_chart), q.base.position).norm();
+      CHECK(fd_momentum(r, fd_link_velocities(r, q, v, library_chart), q.base.position).norm() <
+            1e-8 * scale);
       CHECK(momentum(r.model, d, v).norm() < 1e-12 * scale);
       // and with a given momentum the base velocity reproduces it (library momentum, rounding)
       const Vector6 h = Vector6(rng.vec(6, 50.0));
@@ -288,7 +294,8 @@ TEST_CASE("effective mass does not depend on the base-velocity coordinates", "[d
       T.block<3, 3>(0, 0) = R0;
       T.block<3, 3>(3, 3) = R0;
       CHECK(rel_err(H_body, MatrixXd(T.transpose() * H * T)) < 1e-8);
-      CHECK(rel_err(MatrixXd(H_com.topLeftCorner(3, 3)), MatrixXd(r.model.total_mass() * Matrix3::Identity())) < 1e-8);
+      CHECK(rel_err(MatrixXd(H_com.topLeftCorner(3, 3)),
+                    MatrixXd(r.model.total_mass() * Matrix3::Identity())) < 1e-8);
       CHECK(H_com.block(0, 3, 3, r.model.nv() - 3).cwiseAbs().maxCoeff() < 1e-8 * H.cwiseAbs().maxCoeff());
     }
   }
@@ -389,7 +396,8 @@ TEST_CASE("effective mass invariances", "[dynamics]") {
       // unchanged (rounding grows with the 10 m shift: 1e-12 relative)
       Config moved = q;
       moved.base.position += Vector3(10.0, -7.0, 4.0);
-      CHECK(integrated_effective_mass(r.model, d, moved.base, moved.theta, r.ee, t) == Approx(M).epsilon(1e-12));
+      CHECK(integrated_effective_mass(r.model, d, moved.base, moved.theta, r.ee, t) ==
+            Approx(M).epsilon(1e-12));
       CHECK(rel_err(MatrixXd(crba(r.model, d, moved.base, moved.theta)), H) < 1e-12);
       // turning the base and the target by the same rotation leaves M_ie unchanged
       const Quaternion Q = rng.quaternion();
@@ -397,9 +405,11 @@ TEST_CASE("effective mass invariances", "[dynamics]") {
       turned.base.orientation = Q * q.base.orientation;
       Target tt = t;
       tt.attitude = Q * t.attitude;
-      CHECK(integrated_effective_mass(r.model, d, turned.base, turned.theta, r.ee, tt) == Approx(M).epsilon(1e-10));
+      CHECK(integrated_effective_mass(r.model, d, turned.base, turned.theta, r.ee, tt) ==
+            Approx(M).epsilon(1e-10));
       // ... while turning only the base changes it (the check above is not vacuous), by > 1e-6
-      CHECK(std::abs(integrated_effective_mass(r.model, d, turned.base, turned.theta, r.ee, t) - M) > 1e-6 * M);
+      CHECK(std::abs(integrated_effective_mass(r.model, d, turned.base, turned.theta, r.ee, t) - M) >
+            1e-6 * M);
     }
   }
 }
@@ -444,11 +454,11 @@ namespace {
 
 Target paper_target(const Vector3& r_tp) {
   Target t;
-  t.mass = 200;                                // Tables 2 and 5
-  t.inertia = 100 * Matrix3::Identity();       // Tables 2 and 5
-  t.attitude = Quaternion::Identity();         // "Euler angle [0, 0, 0] deg"
-  t.contact_offset = r_tp;                     // Sections 5.1 and 5.2
-  t.normal = Vector3::UnitX();                 // u_n = [1, 0, 0]
+  t.mass = 200;                           // Tables 2 and 5
+  t.inertia = 100 * Matrix3::Identity();  // Tables 2 and 5
+  t.attitude = Quaternion::Identity();    // "Euler angle [0, 0, 0] deg"
+  t.contact_offset = r_tp;                // Sections 5.1 and 5.2
+  t.normal = Vector3::UnitX();            // u_n = [1, 0, 0]
   t.validate();
   return t;
 }
@@ -496,15 +506,17 @@ std::vector<std::vector<double>> grid(int n, const std::vector<double>& values) 
 }
 
 void print_table(const char* title, const std::vector<Row>& rows, const std::vector<RowResult>& res) {
-  std::printf("\n%s\n%-36s %9s %9s %9s %9s %9s %s\n", title, "configuration (deg)", "paper", "ours", "box min",
-              "box max", "rel.err", "in box(+-0.1%)");
+  std::printf("\n%s\n%-36s %9s %9s %9s %9s %9s %s\n", title, "configuration (deg)", "paper", "ours",
+              "box min", "box max", "rel.err", "in box(+-0.1%)");
   for (size_t i = 0; i < rows.size(); ++i) {
     std::string cfg = "[";
-    for (size_t j = 0; j < rows[i].deg.size(); ++j) cfg += (j ? ", " : "") + std::to_string(static_cast<int>(rows[i].deg[j]));
+    for (size_t j = 0; j < rows[i].deg.size(); ++j)
+      cfg += (j ? ", " : "") + std::to_string(static_cast<int>(rows[i].deg[j]));
     cfg += "]";
     const bool in = rows[i].paper >= res[i].lo * 0.999 && rows[i].paper <= res[i].hi * 1.001;
-    std::printf("%-36s %9.4f %9.4f %9.4f %9.4f %+8.3f%% %s\n", cfg.c_str(), rows[i].paper, res[i].at_listed, res[i].lo,
-                res[i].hi, 100 * (res[i].at_listed - rows[i].paper) / rows[i].paper, in ? "yes" : "NO");
+    std::printf("%-36s %9.4f %9.4f %9.4f %9.4f %+8.3f%% %s\n", cfg.c_str(), rows[i].paper, res[i].at_listed,
+                res[i].lo, res[i].hi, 100 * (res[i].at_listed - rows[i].paper) / rows[i].paper,
+                in ? "yes" : "NO");
   }
   std::fflush(stdout);
 }
@@ -516,9 +528,9 @@ TEST_CASE("Table 3: integrated effective mass of the 3-DOF robot", "[paper]") {
   Data d(r.model);
   const Target t = paper_target(Vector3(-0.25, 0.15, 0.0));
   // Table 3, column "Integrated Effective Mass (kg)"
-  const std::vector<Row> rows{{{36, 30, -4}, 1.555},   {{85, -41, 11}, 1.648}, {{-75, 30, 12}, 3.679},
-                              {{10, 86, -76}, 4.299},  {{0, 90, -90}, 5.817},  {{30, 21, -56}, 5.926},
-                              {{54, -30, -5}, 7.446},  {{-10, -18, 30}, 9.635}, {{46, -45, 0}, 13.74},
+  const std::vector<Row> rows{{{36, 30, -4}, 1.555},  {{85, -41, 11}, 1.648},  {{-75, 30, 12}, 3.679},
+                              {{10, 86, -76}, 4.299}, {{0, 90, -90}, 5.817},   {{30, 21, -56}, 5.926},
+                              {{54, -30, -5}, 7.446}, {{-10, -18, 30}, 9.635}, {{46, -45, 0}, 13.74},
                               {{-6, 20, -7}, 21.093}};
   // [0, 90, -90] is exact in degrees: 0.1 % (the paper prints four digits)
   Eigen::Vector3d exact(0, deg(90), deg(-90));
@@ -530,8 +542,8 @@ TEST_CASE("Table 3: integrated effective mass of the 3-DOF robot", "[paper]") {
   for (const auto& row : rows) res.push_back(evaluate_row(r, d, t, row, g));
   print_table("Table 3 (3-DOF), M_ie in kg; box = 3x3x3 grid of +-0.5 deg", rows, res);
   for (size_t i = 0; i < rows.size(); ++i) {
-    INFO("row " << i << ": paper " << rows[i].paper << ", ours " << res[i].at_listed << ", box [" << res[i].lo << ", "
-                << res[i].hi << "]");
+    INFO("row " << i << ": paper " << rows[i].paper << ", ours " << res[i].at_listed << ", box [" << res[i].lo
+                << ", " << res[i].hi << "]");
     CHECK(rows[i].paper >= res[i].lo * (1 - 1e-3));
     CHECK(rows[i].paper <= res[i].hi * (1 + 1e-3));
   }
@@ -542,11 +554,12 @@ TEST_CASE("Table 6: integrated effective mass of the 7-DOF robot", "[paper]") {
   Data d(r.model);
   const Target t = paper_target(Vector3(-0.25, 0.15, 0.1));
   // Table 6, column "Integrated Effective Mass (kg)"
-  const std::vector<Row> rows{{{0, 29, 54, 10, -10, 120, 32}, 4.875},    {{10, -2, 160, 0, 33, -5, 80}, 7.876},
-                              {{55, -22, 45, 11, 36, -10, 160}, 2.848},  {{-10, 30, 60, -45, 0, 22, 4}, 3.061},
-                              {{23, 33, -64, 145, 34, 88, 60}, 3.167},   {{74, -20, 2, 19, 112, 75, -10}, 5.003},
-                              {{5, 100, 26, -69, 20, 108, -66}, 2.513},  {{100, 23, 126, -6, 34, 34, -1}, 1.658},
-                              {{1, 110, -90, 90, 14, 150, 45}, 2.677},   {{-36, 88, 46, 123, -110, 15, 0}, 1.495}};
+  const std::vector<Row> rows{
+      {{0, 29, 54, 10, -10, 120, 32}, 4.875},   {{10, -2, 160, 0, 33, -5, 80}, 7.876},
+      {{55, -22, 45, 11, 36, -10, 160}, 2.848}, {{-10, 30, 60, -45, 0, 22, 4}, 3.061},
+      {{23, 33, -64, 145, 34, 88, 60}, 3.167},  {{74, -20, 2, 19, 112, 75, -10}, 5.003},
+      {{5, 100, 26, -69, 20, 108, -66}, 2.513}, {{100, 23, 126, -6, 34, 34, -1}, 1.658},
+      {{1, 110, -90, 90, 14, 150, 45}, 2.677},  {{-36, 88, 46, 123, -110, 15, 0}, 1.495}};
   // the box: the 2^7 corners at +-0.5 deg (the centre is the listed configuration itself)
   const auto corners = grid(7, {-0.5, 0.5});
   std::vector<RowResult> res;
@@ -590,7 +603,8 @@ Model random_chain(int n, unsigned seed) {
 
 }  // namespace
 
-TEST_CASE("inverse effective mass: the articulated-body recursion equals the dense Cholesky path", "[dynamics]") {
+TEST_CASE("inverse effective mass: the articulated-body recursion equals the dense Cholesky path",
+          "[dynamics]") {
   // two independent computations of u^T J_v H^-1 J_v^T u: crba + Cholesky, and the O(n) recursion
   // over articulated inertias that never forms H; they agree to rounding (1e-10 relative)
   Rng rng(31);
@@ -621,7 +635,8 @@ TEST_CASE("inverse effective mass: the articulated-body recursion equals the den
   }
 }
 
-TEST_CASE("sin_cos of the kinematics: within 2 units in the last place of std::sin and std::cos", "[dynamics]") {
+TEST_CASE("sin_cos of the kinematics: within 2 units in the last place of std::sin and std::cos",
+          "[dynamics]") {
   std::mt19937_64 gen(31);
   std::uniform_real_distribution<double> small(-10.0, 10.0), large(-1e5, 1e5);
   double worst_abs = 0, worst_rel = 0;
@@ -651,7 +666,8 @@ TEST_CASE("sin_cos of the kinematics: within 2 units in the last place of std::s
   CHECK(worst_abs <= 2 * std::numeric_limits<double>::epsilon());
   CHECK(worst_rel <= 2 * std::numeric_limits<double>::epsilon());
   // beyond the reduced range, and non-finite: the standard functions
-  for (double x : {1e5 * 1.5, 1e300, std::numeric_limits<double>::infinity(), std::numeric_limits<double>::quiet_NaN()}) {
+  for (double x : {1e5 * 1.5, 1e300, std::numeric_limits<double>::infinity(),
+                   std::numeric_limits<double>::quiet_NaN()}) {
     double s = 0, c = 0;
     ffsr::detail::sin_cos(x, s, c);
     const double S = std::sin(x), C = std::cos(x);
@@ -659,8 +675,10 @@ TEST_CASE("sin_cos of the kinematics: within 2 units in the last place of std::s
   }
 }
 
-TEST_CASE("inverse inertia at a point: a force at p_e + rho is the effective mass of a frame there -- form gradient against central differences",
-          "[dynamics]") {
+TEST_CASE(
+    "inverse inertia at a point: a force at p_e + rho is the effective mass of a frame there -- form "
+    "gradient against central differences",
+    "[dynamics]") {
   // Lambda^-1 = J H^-1 J^T at the end-effector's body origin. Three independent checks: its linear
   // block and the whole matrix from finite differences of forward kinematics; s^T Lambda^-1 s with
   // s = [u; rho x u] equals the effective mass of the end-effector frame, a different point of the

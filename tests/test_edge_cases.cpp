@@ -18,7 +18,6 @@ using ffsr::test::kRobots;
 
 namespace {
 
-
 Inertia rod(double m, double L) {  // uniform rod along x, centre of mass at mid-length
   return {m, Vector3(L / 2, 0, 0), Vector3(0.0, m * L * L / 12, m * L * L / 12).asDiagonal()};
 }
@@ -98,8 +97,9 @@ TEST_CASE("Edge: a contact normal perpendicular to every direction the end-effec
   CHECK(me <= m.total_mass() + 1e-9);
   // the end-effector cannot approach along z: delta_dot^- = 0 without target motion -> typed error
   t.angular_velocity.setZero();
-  CHECK_THROWS_WITH(simulate_contact(m, BasePose{}, q, m.end_effector(), t, 0.2, {1e9, 1.5, 0.9}, "hunt-crossley"),
-                    Catch::Contains("do not approach"));
+  CHECK_THROWS_WITH(
+      simulate_contact(m, BasePose{}, q, m.end_effector(), t, 0.2, {1e9, 1.5, 0.9}, "hunt-crossley"),
+      Catch::Contains("do not approach"));
 }
 
 TEST_CASE("Edge: c_r = 1 and c_r close to 0", "[edge]") {
@@ -107,7 +107,8 @@ TEST_CASE("Edge: c_r = 1 and c_r close to 0", "[edge]") {
     INFO(name);
     // c_r = 1: no damping, the pure Hertz result (lambda -> 0), no division by zero
     const AnyContactLaw elastic = make_contact_law(name, {1e9, 1.5, 1.0}, 0.2);
-    const double hertz = 1e9 * std::pow(5.0 * 2.5 * 0.04 / (2 * 1e9), 1.5 / 2.5);  // K ((a+1) M v^2 / 2K)^(a/(a+1))
+    const double hertz =
+        1e9 * std::pow(5.0 * 2.5 * 0.04 / (2 * 1e9), 1.5 / 2.5);  // K ((a+1) M v^2 / 2K)^(a/(a+1))
     CHECK(max_force_closed_form(elastic, 5.0) == Approx(hertz).epsilon(1e-12));
     CHECK(max_force_exact(elastic, 5.0) == Approx(hertz).epsilon(1e-12));
     // c_r -> 0: every law stays finite; the exact peak is at least the closed form
@@ -130,8 +131,8 @@ TEST_CASE("Edge: c_r = 1 and c_r close to 0", "[edge]") {
   }
   // the multibody reference at c_r = 0.01 (Flores: f = 79): a very damped contact still separates
   const Model m = model_from_urdf_file(kRobots + "paper_3dof.urdf");
-  const auto r = simulate_contact(m, BasePose{}, deg({0, 90, -90}), m.end_effector(), Target{}, 0.2, {1e9, 1.5, 0.01},
-                                  "flores");
+  const auto r = simulate_contact(m, BasePose{}, deg({0, 90, -90}), m.end_effector(), Target{}, 0.2,
+                                  {1e9, 1.5, 0.01}, "flores");
   CHECK(std::isfinite(r.f_max));
   CHECK(r.restitution >= 0.0);
   CHECK(r.restitution < 0.2);
@@ -159,12 +160,12 @@ TEST_CASE("Edge: tiny and huge masses (1e-3 to 1e6 kg)", "[edge]") {
     // a robot whose every mass and inertia is scaled: M_ie of the robot alone scales with it
     const double s = scale / 500.0;  // base 500 kg -> scale
     const Model m = ModelBuilder("base", {500 * s, Vector3::Zero(), 200 * s * Matrix3::Identity()})
-                        .add_joint("j1", JointType::Revolute, "base", Pose{Vector3(0.6, 0, 0)}, Vector3::UnitZ(), "l1",
-                                   rod(5 * s, 1.4))
-                        .add_joint("j2", JointType::Revolute, "l1", Pose{Vector3(1.4, 0, 0)}, Vector3::UnitZ(), "l2",
-                                   rod(6 * s, 1.6))
-                        .add_joint("j3", JointType::Revolute, "l2", Pose{Vector3(1.6, 0, 0)}, Vector3::UnitZ(), "l3",
-                                   rod(4 * s, 0.5))
+                        .add_joint("j1", JointType::Revolute, "base", Pose{Vector3(0.6, 0, 0)},
+                                   Vector3::UnitZ(), "l1", rod(5 * s, 1.4))
+                        .add_joint("j2", JointType::Revolute, "l1", Pose{Vector3(1.4, 0, 0)},
+                                   Vector3::UnitZ(), "l2", rod(6 * s, 1.6))
+                        .add_joint("j3", JointType::Revolute, "l2", Pose{Vector3(1.6, 0, 0)},
+                                   Vector3::UnitZ(), "l3", rod(4 * s, 0.5))
                         .add_fixed("ee_joint", "l3", Pose{Vector3(0.5, 0, 0)}, "ee", {})
                         .build();
     const Model ref = model_from_urdf_file(kRobots + "paper_3dof.urdf");
@@ -177,7 +178,8 @@ TEST_CASE("Edge: tiny and huge masses (1e-3 to 1e6 kg)", "[edge]") {
     Target t;
     t.mass = scale;
     t.inertia = 0.5 * scale * Matrix3::Identity();
-    const auto r = simulate_contact(m, BasePose{}, q, m.end_effector(), t, 0.2, {1e9, 1.5, 0.9}, "hunt-crossley");
+    const auto r =
+        simulate_contact(m, BasePose{}, q, m.end_effector(), t, 0.2, {1e9, 1.5, 0.9}, "hunt-crossley");
     CHECK(std::isfinite(r.f_max));
     CHECK(r.f_max > 0);
   }
@@ -185,8 +187,8 @@ TEST_CASE("Edge: tiny and huge masses (1e-3 to 1e6 kg)", "[edge]") {
 
 TEST_CASE("Edge: a robot with one joint", "[edge]") {
   const Model m = ModelBuilder("base", {100, Vector3::Zero(), 10 * Matrix3::Identity()})
-                      .add_joint("j1", JointType::Revolute, "base", Pose{Vector3(0.5, 0, 0)}, Vector3::UnitZ(), "arm",
-                                 rod(5, 1.0))
+                      .add_joint("j1", JointType::Revolute, "base", Pose{Vector3(0.5, 0, 0)},
+                                 Vector3::UnitZ(), "arm", rod(5, 1.0))
                       .add_fixed("tip", "arm", Pose{Vector3(1.0, 0, 0)}, "ee", {})
                       .build();
   Data d(m);
@@ -219,10 +221,14 @@ TEST_CASE("Edge: a branched robot with two arms, one of them the end-effector", 
   const Inertia link{4, Vector3(0.5, 0, 0), Vector3(0.01, 0.33, 0.33).asDiagonal()};
   ModelBuilder b("base", {300, Vector3::Zero(), 50 * Matrix3::Identity()});
   b.add_joint("a1", JointType::Revolute, "base", Pose{Vector3(0.5, 0.3, 0)}, Vector3::UnitZ(), "arm_a1", link)
-      .add_joint("a2", JointType::Revolute, "arm_a1", Pose{Vector3(1, 0, 0)}, Vector3::UnitZ(), "arm_a2", link)
-      .add_joint("a3", JointType::Revolute, "arm_a2", Pose{Vector3(1, 0, 0)}, Vector3::UnitZ(), "arm_a3", link)
-      .add_joint("b1", JointType::Revolute, "base", Pose{Vector3(0.5, -0.3, 0)}, Vector3::UnitZ(), "arm_b1", link)
-      .add_joint("b2", JointType::Revolute, "arm_b1", Pose{Vector3(1, 0, 0)}, Vector3::UnitZ(), "arm_b2", link)
+      .add_joint("a2", JointType::Revolute, "arm_a1", Pose{Vector3(1, 0, 0)}, Vector3::UnitZ(), "arm_a2",
+                 link)
+      .add_joint("a3", JointType::Revolute, "arm_a2", Pose{Vector3(1, 0, 0)}, Vector3::UnitZ(), "arm_a3",
+                 link)
+      .add_joint("b1", JointType::Revolute, "base", Pose{Vector3(0.5, -0.3, 0)}, Vector3::UnitZ(), "arm_b1",
+                 link)
+      .add_joint("b2", JointType::Revolute, "arm_b1", Pose{Vector3(1, 0, 0)}, Vector3::UnitZ(), "arm_b2",
+                 link)
       .add_fixed("tool_joint", "arm_a3", Pose{Vector3(1, 0, 0)}, "tool", {});
   // two leaves: the end-effector must be named, and the error lists both
   CHECK_THROWS_WITH(ModelBuilder(b).build(), Catch::Contains("tool") && Catch::Contains("arm_b2"));

@@ -25,7 +25,7 @@ namespace fs = std::filesystem;
 std::vector<std::string> inputs(const std::string& target) {
   std::vector<std::string> files;
   for (const std::string& dir : {std::string(FFSR_SOURCE_DIR) + "/tests/data/fuzz_regressions/" + target,
-                                std::string(FFSR_SOURCE_DIR) + "/fuzz/corpus/" + target}) {
+                                 std::string(FFSR_SOURCE_DIR) + "/fuzz/corpus/" + target}) {
     if (!fs::is_directory(dir)) continue;
     for (const auto& e : fs::directory_iterator(dir))
       if (e.is_regular_file()) files.push_back(e.path().string());

@@ -73,7 +73,8 @@ struct Shared {
 
 const Shared& shared_3dof() {
   static const Shared s = [] {
-    Shared r{model_from_urdf_file(kRobots + "paper_3dof.urdf"), {}, position_task(true), options(180), {}, {}};
+    Shared r{
+        model_from_urdf_file(kRobots + "paper_3dof.urdf"), {}, position_task(true), options(180), {}, {}};
     r.pb = problem_3dof(r.model);
     CaptureOptions paper = r.opt;
     paper.gain = -0.01;
@@ -89,7 +90,8 @@ const Shared& shared_3dof() {
 
 const Shared& shared_7dof_position() {
   static const Shared s = [] {
-    Shared r{model_from_urdf_file(kRobots + "paper_7dof.urdf"), {}, position_task(false), options(157), {}, {}};
+    Shared r{
+        model_from_urdf_file(kRobots + "paper_7dof.urdf"), {}, position_task(false), options(157), {}, {}};
     r.pb = problem_7dof(r.model);
     CaptureOptions paper = r.opt;
     paper.gain = -0.01;
@@ -109,10 +111,11 @@ void check_run(const Shared& s, double bound_M_ie) {
   INFO("global M_ie " << g.run.M_ie << " paper's method " << s.paper.M_ie << " optimum " << g.manifold_optimum
                       << " gap " << g.optimality_gap_percent << " % iterations " << g.shooting_iterations);
   CHECK(g.run.M_ie <= bound_M_ie);
-  CHECK(g.run.M_ie <= s.paper.M_ie);              // never worse than the paper's method
+  CHECK(g.run.M_ie <= s.paper.M_ie);  // never worse than the paper's method
   CHECK(g.reached_manifold_optimum);
   CHECK(g.optimality_gap_percent <= 1.0);
-  CHECK(g.optimality_gap_percent >= -1e-6);       // the optimum is the best the search knows, the reached point among the starts
+  CHECK(g.optimality_gap_percent >=
+        -1e-6);  // the optimum is the best the search knows, the reached point among the starts
   CHECK(g.shooting_iterations >= 1);
   CHECK(g.shooting_iterations <= 8 * g.goals_tried);
   CHECK(g.run.tracking_error <= s.opt.tolerance);
@@ -123,18 +126,21 @@ void check_run(const Shared& s, double bound_M_ie) {
   // the objective reported is M_ie at the reached configuration and base pose (independent recomputation)
   Data d(s.model);
   const Target cap = propagate_target(s.pb.target, s.opt.duration);
-  CHECK(g.objective == Approx(integrated_effective_mass(s.model, d, g.run.base, g.run.theta, s.pb.frame, cap)).epsilon(1e-9));
-  std::printf("\nglobal %d-DOF: M_ie %.3f kg (paper's method %.3f), F_max %.3f kN (%.3f), rate %.3f deg/s (%.3f), "
-              "gap %.3f %%, %d iterations, %ld SLSQP evaluations, search %.3f s\n",
-              s.model.n(), g.run.M_ie, s.paper.M_ie, g.run.f_max_closed_form / 1e3, s.paper.f_max_closed_form / 1e3,
-              g.run.max_joint_rate * 180 / M_PI, s.paper.max_joint_rate * 180 / M_PI, g.optimality_gap_percent,
-              g.shooting_iterations, g.evaluations, g.search_seconds);
+  CHECK(
+      g.objective ==
+      Approx(integrated_effective_mass(s.model, d, g.run.base, g.run.theta, s.pb.frame, cap)).epsilon(1e-9));
+  std::printf(
+      "\nglobal %d-DOF: M_ie %.3f kg (paper's method %.3f), F_max %.3f kN (%.3f), rate %.3f deg/s (%.3f), "
+      "gap %.3f %%, %d iterations, %ld SLSQP evaluations, search %.3f s\n",
+      s.model.n(), g.run.M_ie, s.paper.M_ie, g.run.f_max_closed_form / 1e3, s.paper.f_max_closed_form / 1e3,
+      g.run.max_joint_rate * 180 / M_PI, s.paper.max_joint_rate * 180 / M_PI, g.optimality_gap_percent,
+      g.shooting_iterations, g.evaluations, g.search_seconds);
 }
 
 /// A damped-Newton projection onto the capture manifold written here, apart from the library's
 /// (position rows only; plain Gauss-Newton with a fixed damping and no line search).
-bool test_projection(const Model& m, Data& d, int frame, const BasePose& base, const Vector3& x, const std::array<bool, 3>& axes,
-                     Eigen::VectorXd& q) {
+bool test_projection(const Model& m, Data& d, int frame, const BasePose& base, const Vector3& x,
+                     const std::array<bool, 3>& axes, Eigen::VectorXd& q) {
   for (int it = 0; it < 200; ++it) {
     crba(m, d, base, q);
     const Vector3 e = frame_pose(m, d, frame).p - x;
@@ -165,7 +171,7 @@ TEST_CASE("Global capture, 3-DOF (robots/paper_3dof.toml)", "[global][paper]") {
 
 TEST_CASE("Global capture, 7-DOF position (robots/paper_7dof_position.toml)", "[global][paper]") {
   const Shared& s = shared_7dof_position();
-  check_run(s, 1.35);  // issue 9: <= 1.35 kg (paper 2.70 kg)
+  check_run(s, 1.35);                              // issue 9: <= 1.35 kg (paper 2.70 kg)
   CHECK(s.global.run.f_max_closed_form <= 800.0);  // issue 9: <= 0.80 kN (paper 1.17 kN)
 }
 
@@ -192,8 +198,9 @@ TEST_CASE("Global optimum: no projected random configuration is more than 1 % lo
                << s->global.manifold_optimum);
     CHECK(on >= 900);
     CHECK(lowest >= 0.99 * s->global.manifold_optimum);
-    std::printf("%d-DOF: %d of 1000 random configurations projected, lowest M_ie %.4f kg >= optimum %.4f kg\n", m.n(),
-                on, lowest, s->global.manifold_optimum);
+    std::printf(
+        "%d-DOF: %d of 1000 random configurations projected, lowest M_ie %.4f kg >= optimum %.4f kg\n", m.n(),
+        on, lowest, s->global.manifold_optimum);
   }
 }
 
@@ -295,9 +302,10 @@ TEST_CASE("ffsr-optimize: the global row and its JSON keys (7-DOF pose scenario)
   std::ifstream in(out);
   const nlohmann::json j = nlohmann::json::parse(in);
   const auto& g = j["global"];
-  for (const char* key : {"capture_configuration_deg", "integrated_effective_mass", "f_max_closed_form", "f_max_exact",
-                          "tracking_error", "max_total_momentum", "max_center_of_mass_drift", "manifold_optimum",
-                          "optimality_gap_percent", "shooting_iterations", "max_joint_rate_deg", "search"})
+  for (const char* key :
+       {"capture_configuration_deg", "integrated_effective_mass", "f_max_closed_form", "f_max_exact",
+        "tracking_error", "max_total_momentum", "max_center_of_mass_drift", "manifold_optimum",
+        "optimality_gap_percent", "shooting_iterations", "max_joint_rate_deg", "search"})
     CHECK(g.contains(key));
   for (const char* key : {"method", "starts", "evaluations", "seconds"}) CHECK(g["search"].contains(key));
   CHECK(j["baseline"].contains("max_joint_rate_deg"));
@@ -305,8 +313,8 @@ TEST_CASE("ffsr-optimize: the global row and its JSON keys (7-DOF pose scenario)
   // issue 9: the pose task (one null-space direction) at most 15.70 kg, never worse than the paper's method
   const double M = g["integrated_effective_mass"].get<double>();
   std::printf("\n7-DOF pose: global M_ie %.3f kg (paper's method %.3f kg), gap %.3f %%, rate %.3f deg/s\n", M,
-              j["optimized"]["integrated_effective_mass"].get<double>(), g["optimality_gap_percent"].get<double>(),
-              g["max_joint_rate_deg"].get<double>());
+              j["optimized"]["integrated_effective_mass"].get<double>(),
+              g["optimality_gap_percent"].get<double>(), g["max_joint_rate_deg"].get<double>());
   CHECK(M <= 15.70);
   CHECK(M <= j["optimized"]["integrated_effective_mass"].get<double>());
   CHECK(g["tracking_error"].get<double>() <= 1e-3);

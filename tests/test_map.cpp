@@ -78,16 +78,20 @@ struct Reference {
   ffsr::Target target;
   ffsr::AnyContactLaw law;
   explicit Reference(const std::string& urdf)
-      : model(ffsr::model_from_urdf_file(urdf)), data(model), target(),
+      : model(ffsr::model_from_urdf_file(urdf)),
+        data(model),
+        target(),
         law(ffsr::make_contact_law("herbert-mcwhannell", {1e9, 1.5, 0.9}, approach_speed())) {}
   double approach_speed() {
     target.angular_velocity = Eigen::Vector3d(0, 0, 2.0 * M_PI / 180.0);
     const Eigen::Vector3d u = target.normal_world();
-    return ffsr::approach_velocity(u, 0.2 * u, target.velocity, target.angular_velocity_world(), target.offset_world());
+    return ffsr::approach_velocity(u, 0.2 * u, target.velocity, target.angular_velocity_world(),
+                                   target.offset_world());
   }
   double M_ie(const Eigen::VectorXd& theta_deg) {
     const Eigen::VectorXd theta = theta_deg * (M_PI / 180.0);
-    return ffsr::integrated_effective_mass(model, data, ffsr::BasePose{}, theta, model.end_effector(), target);
+    return ffsr::integrated_effective_mass(model, data, ffsr::BasePose{}, theta, model.end_effector(),
+                                           target);
   }
 };
 
@@ -98,9 +102,10 @@ double rel(double a, double b) { return std::abs(a - b) / std::abs(b); }
 TEST_CASE("map: the 3-DOF map over the full grid at 6 deg peaks at the stretched arm and equals the library",
           "[map][cli]") {
   TempDir dir;
-  const CommandResult r = map_cli({"--urdf", kUrdf3, "--joints-deg", "0,0,0", "--vary", "1,2,3", "--range-deg",
-                                   "-180,180", "--step-deg", "6", "--csv", "m.csv", "--threads", "2"},
-                                  dir.str());
+  const CommandResult r =
+      map_cli({"--urdf", kUrdf3, "--joints-deg", "0,0,0", "--vary", "1,2,3", "--range-deg", "-180,180",
+               "--step-deg", "6", "--csv", "m.csv", "--threads", "2"},
+              dir.str());
   INFO(r.err);
   REQUIRE(r.exit_code == 0);
   CHECK(r.err.empty());  // stderr is a file here, not a terminal: no progress line
@@ -150,9 +155,10 @@ TEST_CASE("map: the 3-DOF map over the full grid at 6 deg peaks at the stretched
 
 TEST_CASE("map: over the paper's ranges (Figure 8) the maximum is the stretched arm alone", "[map][cli]") {
   TempDir dir;
-  const CommandResult r = map_cli({"--urdf", kUrdf3, "--joints-deg", "0,0,0", "--vary", "1,2,3", "--range-deg",
-                                   "-90,90,-120,120,-120,120", "--step-deg", "6", "--csv", "m.csv"},
-                                  dir.str());
+  const CommandResult r =
+      map_cli({"--urdf", kUrdf3, "--joints-deg", "0,0,0", "--vary", "1,2,3", "--range-deg",
+               "-90,90,-120,120,-120,120", "--step-deg", "6", "--csv", "m.csv"},
+              dir.str());
   INFO(r.err);
   REQUIRE(r.exit_code == 0);
   const Csv csv = parse_csv(read_file(dir.str() + "/m.csv"));
@@ -164,16 +170,19 @@ TEST_CASE("map: over the paper's ranges (Figure 8) the maximum is the stretched 
   CHECK(csv.rows[best][1] == 0.0);
   CHECK(csv.rows[best][2] == 0.0);
   size_t near_max = 0;  // other points within 1e-6 of the maximum
-  for (size_t k = 0; k < csv.rows.size(); ++k) near_max += k != best && csv.rows[k][3] >= csv.rows[best][3] * (1 - 1e-6);
+  for (size_t k = 0; k < csv.rows.size(); ++k)
+    near_max += k != best && csv.rows[k][3] >= csv.rows[best][3] * (1 - 1e-6);
   CHECK(near_max == 0u);
-  CHECK_THAT(r.out, Catch::Matchers::Contains("max M_ie = " ) && Catch::Matchers::Contains("at [0, 0, 0] deg"));
+  CHECK_THAT(r.out,
+             Catch::Matchers::Contains("max M_ie = ") && Catch::Matchers::Contains("at [0, 0, 0] deg"));
 }
 
 TEST_CASE("map: per-joint ranges and steps, the joints not varied held at --joints-deg", "[map][cli]") {
   TempDir dir;
-  const CommandResult r = map_cli({"--urdf", kUrdf7, "--joints-deg", "10,20,30,40,50,60,70", "--vary", "2,5",
-                                   "--range-deg", "0,10,-20,-10", "--step-deg", "5,2.5", "--csv", "m.csv", "--quiet"},
-                                  dir.str());
+  const CommandResult r =
+      map_cli({"--urdf", kUrdf7, "--joints-deg", "10,20,30,40,50,60,70", "--vary", "2,5", "--range-deg",
+               "0,10,-20,-10", "--step-deg", "5,2.5", "--csv", "m.csv", "--quiet"},
+              dir.str());
   INFO(r.err);
   REQUIRE(r.exit_code == 0);
   const Csv csv = parse_csv(read_file(dir.str() + "/m.csv"));
@@ -249,15 +258,15 @@ TEST_CASE("map: bad inputs give one error line naming the flag and no output fil
     CHECK(dir.entries().empty());
   }
   TempDir dir;
-  const CommandResult r = map_cli({"--urdf", kUrdf3, "--joints-deg", "0,0,0", "--vary", "1", "--csv", "missing/m.csv"},
-                                  dir.str());
+  const CommandResult r = map_cli(
+      {"--urdf", kUrdf3, "--joints-deg", "0,0,0", "--vary", "1", "--csv", "missing/m.csv"}, dir.str());
   CHECK(r.exit_code == 2);
   CHECK(r.err.find("--csv") != std::string::npos);
   CHECK(r.err.find("missing") != std::string::npos);
   CHECK(dir.entries().empty());
   // exactly at the limit is allowed: 6 x 6 = 36 points
-  const CommandResult ok = map_cli({"--urdf", kUrdf3, "--joints-deg", "0,0,0", "--vary", "1,2", "--step-deg", "60",
-                                    "--max-points", "36", "--csv", "m.csv"},
+  const CommandResult ok = map_cli({"--urdf", kUrdf3, "--joints-deg", "0,0,0", "--vary", "1,2", "--step-deg",
+                                    "60", "--max-points", "36", "--csv", "m.csv"},
                                    dir.str());
   CHECK(ok.exit_code == 0);
 }

@@ -22,7 +22,6 @@ using ffsr::test::kRobots;
 
 namespace {
 
-
 /// Runs ffsr-optimize on a scenario and returns its JSON result (REQUIREs exit 0).
 nlohmann::json run_scenario(const std::string& scenario, const std::string& extra = "") {
   const std::string out = "ffsr_test_optimize_" + std::to_string(std::random_device{}()) + ".json";
@@ -83,7 +82,8 @@ TEST_CASE("The analytic M_ie gradient equals central differences", "[optimize]")
         qp(k) += h;
         qm(k) -= h;
         const double fd = (integrated_effective_mass(m, d, b, qp, m.end_effector(), t) -
-                           integrated_effective_mass(m, d, b, qm, m.end_effector(), t)) / (2 * h);
+                           integrated_effective_mass(m, d, b, qm, m.end_effector(), t)) /
+                          (2 * h);
         INFO(robot << " joint " << k << " analytic " << g(k) << " fd " << fd);
         // central difference error O(h^2) ~ 1e-10 relative to the largest entry
         CHECK(g(k) == Approx(fd).margin(1e-7 * (1 + g.cwiseAbs().maxCoeff())));
@@ -109,11 +109,13 @@ TEST_CASE("Table 4: the 3-DOF scenario", "[optimize][paper]") {
   // with optimization M_ie at most 1.4 kg (paper 1.22), F_max lowered by at least 50 % (paper 57.86 %)
   CHECK(o["integrated_effective_mass"].get<double>() <= 1.4);
   CHECK(j["force_reduction_percent"].get<double>() >= 50.0);
-  std::printf("\nTable 4 (3-DOF): plain %s M_ie %.3f F %.3f kN | optimized %s M_ie %.3f F %.3f kN | -%.2f %% M_ie, -%.2f %% F\n",
-              b["capture_configuration_deg"].dump().c_str(), b["integrated_effective_mass"].get<double>(),
-              b["f_max_closed_form"].get<double>() / 1e3, o["capture_configuration_deg"].dump().c_str(),
-              o["integrated_effective_mass"].get<double>(), o["f_max_closed_form"].get<double>() / 1e3,
-              j["mass_reduction_percent"].get<double>(), j["force_reduction_percent"].get<double>());
+  std::printf(
+      "\nTable 4 (3-DOF): plain %s M_ie %.3f F %.3f kN | optimized %s M_ie %.3f F %.3f kN | -%.2f %% M_ie, "
+      "-%.2f %% F\n",
+      b["capture_configuration_deg"].dump().c_str(), b["integrated_effective_mass"].get<double>(),
+      b["f_max_closed_form"].get<double>() / 1e3, o["capture_configuration_deg"].dump().c_str(),
+      o["integrated_effective_mass"].get<double>(), o["f_max_closed_form"].get<double>() / 1e3,
+      j["mass_reduction_percent"].get<double>(), j["force_reduction_percent"].get<double>());
 }
 
 TEST_CASE("Table 7: the 7-DOF scenarios", "[optimize][paper]") {
@@ -140,12 +142,15 @@ TEST_CASE("Table 7: the 7-DOF scenarios", "[optimize][paper]") {
   CHECK(position["mass_reduction_percent"].get<double>() >= 75.0);
   CHECK(position["force_reduction_percent"].get<double>() >= 55.0);
   for (const auto* j : {&pose, &position})
-    std::printf("Table 7 (7-DOF, %s): optimized %s M_ie %.3f F %.3f kN | -%.2f %% M_ie, -%.2f %% F (plain M_ie %.3f)\n",
-                (*j)["optimized"]["task"].get<std::string>().c_str(),
-                (*j)["optimized"]["capture_configuration_deg"].dump().c_str(),
-                (*j)["optimized"]["integrated_effective_mass"].get<double>(),
-                (*j)["optimized"]["f_max_closed_form"].get<double>() / 1e3, (*j)["mass_reduction_percent"].get<double>(),
-                (*j)["force_reduction_percent"].get<double>(), b["integrated_effective_mass"].get<double>());
+    std::printf(
+        "Table 7 (7-DOF, %s): optimized %s M_ie %.3f F %.3f kN | -%.2f %% M_ie, -%.2f %% F (plain M_ie "
+        "%.3f)\n",
+        (*j)["optimized"]["task"].get<std::string>().c_str(),
+        (*j)["optimized"]["capture_configuration_deg"].dump().c_str(),
+        (*j)["optimized"]["integrated_effective_mass"].get<double>(),
+        (*j)["optimized"]["f_max_closed_form"].get<double>() / 1e3,
+        (*j)["mass_reduction_percent"].get<double>(), (*j)["force_reduction_percent"].get<double>(),
+        b["integrated_effective_mass"].get<double>());
 }
 
 TEST_CASE("Along a run the momentum stays zero and the quaternion unit", "[optimize]") {
@@ -227,7 +232,9 @@ TEST_CASE("Capture planning failures are typed errors", "[optimize]") {
     ss << in.rdbuf();
     std::string s = ss.str();
     const std::string from = "<joint name=\"joint3\" type=\"continuous\">";
-    s.replace(s.find(from), from.size(), "<joint name=\"joint3\" type=\"revolute\"><limit lower=\"-1.8\" upper=\"-1.6\" effort=\"1\" velocity=\"1\"/>");
+    s.replace(s.find(from), from.size(),
+              "<joint name=\"joint3\" type=\"revolute\"><limit lower=\"-1.8\" upper=\"-1.6\" effort=\"1\" "
+              "velocity=\"1\"/>");
     return s;
   }();
   const Model limited = model_from_urdf_string(urdf_text, "limited");

@@ -68,7 +68,9 @@ std::string read_file(const std::string& path) {
   return ss.str();
 }
 
-void write_text(const std::string& path, const std::string& text) { std::ofstream(path, std::ios::binary) << text; }
+void write_text(const std::string& path, const std::string& text) {
+  std::ofstream(path, std::ios::binary) << text;
+}
 
 bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
 
@@ -247,7 +249,8 @@ TEST_CASE("at most one output may be standard output: an error naming both flags
   const std::vector<Case> cases{
       {{"--quiet", "--json", "-", "--csv", "-"}, {"--json -", "--csv -", "standard output"}},
       {{"--quiet", "--json", "/dev/stdout", "--csv", "-"}, {"--json /dev/stdout", "--csv -"}},
-      {{"contact", "--urdf", kUrdf3, "--joints-deg", "0,90,-90", "--json", "--series", "-"}, {"--json", "--series -"}},
+      {{"contact", "--urdf", kUrdf3, "--joints-deg", "0,90,-90", "--json", "--series", "-"},
+       {"--json", "--series -"}},
   };
   for (const auto& c : cases) {
     const auto r = cli(c.args, tmp.str());
@@ -278,11 +281,12 @@ TEST_CASE("a FIFO read by another thread receives the JSON and stays a FIFO", "[
   check_result(j);
   struct stat st {};
   REQUIRE(::lstat(fifo.c_str(), &st) == 0);
-  CHECK(S_ISFIFO(st.st_mode));  // not renamed over
+  CHECK(S_ISFIFO(st.st_mode));                                                    // not renamed over
   CHECK(tmp.entries() == std::vector<std::string>{"result.fifo", "series.csv"});  // no temporary file left
 }
 
-TEST_CASE("devices: /dev/null is written, not replaced, and /dev/full is a write error naming it", "[output]") {
+TEST_CASE("devices: /dev/null is written, not replaced, and /dev/full is a write error naming it",
+          "[output]") {
   TempDir tmp;
   REQUIRE(is_char_device("/dev/null"));
   const auto r = cli({"--quiet", "--json", "/dev/null", "--csv", "/dev/null"}, tmp.str());
@@ -303,7 +307,7 @@ TEST_CASE("a symbolic link is followed: the target is replaced, the link stays a
   TempDir tmp;
   fs::create_directory(tmp.path() / "data");
   write_text(tmp / "data/result.json", "{\"earlier\": true}\n");
-  fs::create_symlink("data/result.json", tmp.path() / "latest.json");  // relative to the link's folder
+  fs::create_symlink("data/result.json", tmp.path() / "latest.json");      // relative to the link's folder
   fs::create_symlink(tmp / "data/series.csv", tmp.path() / "series.csv");  // dangling: names a new file
   const auto r = cli({"--quiet", "--json", "latest.json", "--csv", "series.csv"}, tmp.str());
   INFO(r.err);
@@ -317,7 +321,8 @@ TEST_CASE("a symbolic link is followed: the target is replaced, the link stays a
   // the temporary files were made next to the targets and renamed: nothing else is left
   CHECK(tmp.entries() == std::vector<std::string>{"data", "latest.json", "series.csv"});
   std::vector<std::string> in_data;
-  for (const auto& e : fs::directory_iterator(tmp.path() / "data")) in_data.push_back(e.path().filename().string());
+  for (const auto& e : fs::directory_iterator(tmp.path() / "data"))
+    in_data.push_back(e.path().filename().string());
   std::sort(in_data.begin(), in_data.end());
   CHECK(in_data == std::vector<std::string>{"result.json", "series.csv"});
 }
@@ -326,7 +331,8 @@ TEST_CASE("a symbolic link is followed: the target is replaced, the link stays a
 // 3. write errors: a full disk, a closed pipe
 // ------------------------------------------------------------------------------------------------
 
-TEST_CASE("a full disk: exit 2 naming the file, no output file left (tmpfs of 64 KiB, root only)", "[output]") {
+TEST_CASE("a full disk: exit 2 naming the file, no output file left (tmpfs of 64 KiB, root only)",
+          "[output]") {
   if (::geteuid() != 0) {
     WARN("skipped: mounting a small tmpfs needs root (the full-disk case is covered by /dev/full)");
     return;
@@ -370,7 +376,8 @@ TEST_CASE("a reader that closed the pipe: exit 2 with one line, not a crash", "[
     check_one_error_line(r, {"standard output", "cannot write"});
   }
   SECTION("inspect --json") {
-    const auto r = run_with_closed_stdout({"inspect", "--urdf", kUrdf3, "--joints-deg", "0,90,-90", "--json"});
+    const auto r =
+        run_with_closed_stdout({"inspect", "--urdf", kUrdf3, "--joints-deg", "0,90,-90", "--json"});
     REQUIRE_FALSE(r.timed_out);
     CHECK(r.exit_code == 2);
     check_one_error_line(r, {"standard output"});
@@ -395,7 +402,8 @@ std::vector<std::string> moved_lines(const std::string& err) {
 
 }  // namespace
 
-TEST_CASE("expect: a result compared with itself passes, a moved value gives exit 4 naming it", "[output][expect]") {
+TEST_CASE("expect: a result compared with itself passes, a moved value gives exit 4 naming it",
+          "[output][expect]") {
   TempDir tmp;
   REQUIRE(cli({"--quiet", "--json", "base.json"}, tmp.str()).exit_code == 0);
   const json base = json::parse(read_file(tmp / "base.json"));
@@ -438,10 +446,10 @@ TEST_CASE("expect: a result compared with itself passes, a moved value gives exi
     json moved = base;
     moved["baseline"]["capture_configuration_deg"][1] =
         base.at("baseline").at("capture_configuration_deg")[1].get<double>() + 0.5;
-    moved["no_such_run"] = {{"rows", 3}};                // stored only
-    moved.erase("force_reduction_percent");              // now only
-    moved["optimized"]["task"] = "pose";                 // a string
-    moved["optimized"]["capture_point"] = {1.0, 2.0};    // another length
+    moved["no_such_run"] = {{"rows", 3}};              // stored only
+    moved.erase("force_reduction_percent");            // now only
+    moved["optimized"]["task"] = "pose";               // a string
+    moved["optimized"]["capture_point"] = {1.0, 2.0};  // another length
     const auto r = expect_with(moved);
     CHECK(r.exit_code == 4);
     const auto lines = moved_lines(r.err);
@@ -507,7 +515,8 @@ TEST_CASE("expect: a bad baseline or tolerance is exit 2 naming it", "[output][e
   }
 }
 
-TEST_CASE("expect: expect and rtol as scenario keys, expect relative to the scenario file", "[output][expect]") {
+TEST_CASE("expect: expect and rtol as scenario keys, expect relative to the scenario file",
+          "[output][expect]") {
   TempDir tmp;
   fs::create_directory(tmp.path() / "s");
   // the paper's scenario with an absolute URDF path and the two keys
@@ -528,5 +537,6 @@ TEST_CASE("expect: expect and rtol as scenario keys, expect relative to the scen
   const auto r = cli({"--config", "s/scenario.toml", "--quiet"}, tmp.str());
   CHECK(r.exit_code == 4);
   CHECK(contains(r.err, "baseline.integrated_effective_mass: stored "));
-  CHECK(cli({"--config", "s/scenario.toml", "--quiet", "--rtol", "1e-6"}, tmp.str()).exit_code == 0);  // flag wins
+  CHECK(cli({"--config", "s/scenario.toml", "--quiet", "--rtol", "1e-6"}, tmp.str()).exit_code ==
+        0);  // flag wins
 }

@@ -70,7 +70,8 @@ figures::Grid mie_grid(const Paper3& p, const std::vector<std::vector<double>>& 
     for (size_t j = 0; j < n1; ++j)
       for (size_t k = 0; k < n2; ++k) {
         th << axes[0][i], axes[1][j], axes.size() > 2 ? axes[2][k] : 0.0;
-        g.values.push_back(integrated_effective_mass(p.model, data, base, th * (M_PI / 180), p.model.end_effector(), p.target));
+        g.values.push_back(integrated_effective_mass(p.model, data, base, th * (M_PI / 180),
+                                                     p.model.end_effector(), p.target));
       }
   return g;
 }
@@ -92,7 +93,8 @@ TEST_CASE("plot: format names and the folder check", "[plot]") {
   CHECK(plot::available());
 }
 
-TEST_CASE("map plots: 3-DOF M_ie slices and heat map and 3-D view with the maximum at the stretched arm", "[plot][paper]") {
+TEST_CASE("map plots: 3-DOF M_ie slices and heat map and 3-D view with the maximum at the stretched arm",
+          "[plot][paper]") {
   const Paper3 p;
   // the ranges of Figure 8 (theta1 in [-90, 90], theta2 and theta3 in [-120, 120] deg) at 10 deg;
   // Eq. 14 evaluated here
@@ -122,7 +124,8 @@ TEST_CASE("map plots: 3-DOF M_ie slices and heat map and 3-D view with the maxim
   CHECK(hp.overlay.at(0).y.at(0) == 0.0);
 
   TempDir dir;
-  const auto png = plot::render({heat, slices, figures::map_cloud(g3, "cloud", "")}, dir.str(), plot::Format::Png);
+  const auto png =
+      plot::render({heat, slices, figures::map_cloud(g3, "cloud", "")}, dir.str(), plot::Format::Png);
   REQUIRE(png.size() == 3);
   check_png(dir / "heat.png", 1000, 700, 16);  // the colour levels
   check_png(dir / "slices.png", 1400, 420, 16);
@@ -136,7 +139,9 @@ TEST_CASE("map plots: 3-DOF M_ie slices and heat map and 3-D view with the maxim
   CHECK_THROWS_AS(figures::map_heat(bad, "x", ""), InputError);
 }
 
-TEST_CASE("capture figures: the drawn arm at T meets the planner's end-effector and the drift curve its drift", "[plot]") {
+TEST_CASE(
+    "capture figures: the drawn arm at T meets the planner's end-effector and the drift curve its drift",
+    "[plot]") {
   const Paper3 p;
   CaptureProblem pb;
   pb.model = &p.model;
@@ -213,12 +218,14 @@ TEST_CASE("main job with --plot: the 3-DOF scenario's figures as PNG and SVG", "
 TEST_CASE("contact --plot (Figure 3) and xi (Figures 4-6)", "[plot][cli]") {
   TempDir dir;
   const std::string urdf = ffsr::test::kRobots + "paper_3dof.urdf";
-  auto r = run_command({kCli, "contact", "--urdf", urdf, "--joints-deg=0,90,-90", "--model", "all", "--plot", dir.str()});
+  auto r = run_command(
+      {kCli, "contact", "--urdf", urdf, "--joints-deg=0,90,-90", "--model", "all", "--plot", dir.str()});
   REQUIRE(r.exit_code == 0);
   check_png(dir / "contact.png", 1000, 700, 8);
   r = run_command({kCli, "xi", "--points", "5", "--csv", dir / "xi.csv", "--plot", dir.str()});
   REQUIRE(r.exit_code == 0);
-  for (const char* f : {"xi_stiffness.png", "xi_approach_speed.png", "xi_restitution.png"}) check_png(dir / f, 1000, 700, 8);
+  for (const char* f : {"xi_stiffness.png", "xi_approach_speed.png", "xi_restitution.png"})
+    check_png(dir / f, 1000, 700, 8);
   // the CSV: xi does not depend on K nor on delta_dot^- (Figures 4 and 5), and equals
   // 1 - F'_max / F_max from the closed form against the exact peak of Eq. 16 (M_ie = 1 kg)
   std::ifstream in(dir / "xi.csv");
@@ -268,7 +275,8 @@ TEST_CASE("map --plot: one, two and three varied joints -- the CSV beside the pi
   check_png(dir / "map_cloud.png", 1000, 700, 16);
   CHECK(r.out.find("wrote " + (dir / "map_slices.png")) != std::string::npos);
   // two joints: the heat map (Figure 9), as SVG
-  r = map({"--vary", "2,3", "--step-deg", "5", "--csv", dir / "m2.csv", "--plot", dir.str(), "--plot-format", "svg"});
+  r = map({"--vary", "2,3", "--step-deg", "5", "--csv", dir / "m2.csv", "--plot", dir.str(), "--plot-format",
+           "svg"});
   REQUIRE(r.exit_code == 0);
   check_svg(dir / "map.svg");
   // one joint: M_ie against the angle
@@ -279,7 +287,8 @@ TEST_CASE("map --plot: one, two and three varied joints -- the CSV beside the pi
   CHECK(fs::exists(one / "m1.csv"));
 }
 
-TEST_CASE("map --plot bad inputs: one error line naming the flag, no CSV and no picture", "[plot][cli][map][errors]") {
+TEST_CASE("map --plot bad inputs: one error line naming the flag, no CSV and no picture",
+          "[plot][cli][map][errors]") {
   const std::string urdf3 = ffsr::test::kRobots + "paper_3dof.urdf";
   const std::string urdf7 = ffsr::test::kRobots + "paper_7dof.urdf";
   struct Case {
@@ -287,17 +296,39 @@ TEST_CASE("map --plot bad inputs: one error line naming the flag, no CSV and no 
     std::string urdf, joints, message;
   };
   const std::vector<Case> cases = {
-      {{"--vary", "1,2,3", "--shard", "1/3", "--plot", "."}, urdf3, "0,0,0", "--plot: a shard holds part of the grid"},
-      {{"--vary", "1,2,3,4", "--step-deg", "90", "--plot", "."}, urdf7, "0,0,0,0,0,0,0", "--plot: pictures are drawn for 1 to 3"},
-      {{"--vary", "1,2,3", "--step-deg", "10", "--slice-deg", "0,0", "--plot", "."}, urdf3, "0,0,0", "--slice-deg"},
-      {{"--vary", "1,2", "--slice-deg", "0,0", "--plot", "."}, urdf3, "0,0,0", "--slice-deg: slices are drawn for three"},
-      {{"--vary", "1,2", "--plot", "no_such_folder"}, urdf3, "0,0,0", "--plot: folder 'no_such_folder' does not exist"},
-      {{"--vary", "1,2", "--plot", ".", "--plot-format", "gif"}, urdf3, "0,0,0", "--plot-format: unknown format 'gif'"},
-      {{"--vary", "1,2,3", "--step-deg", "0.5", "--plot", "."}, urdf3, "0,0,0", "--plot: the grid has 373248000 points"},
+      {{"--vary", "1,2,3", "--shard", "1/3", "--plot", "."},
+       urdf3,
+       "0,0,0",
+       "--plot: a shard holds part of the grid"},
+      {{"--vary", "1,2,3,4", "--step-deg", "90", "--plot", "."},
+       urdf7,
+       "0,0,0,0,0,0,0",
+       "--plot: pictures are drawn for 1 to 3"},
+      {{"--vary", "1,2,3", "--step-deg", "10", "--slice-deg", "0,0", "--plot", "."},
+       urdf3,
+       "0,0,0",
+       "--slice-deg"},
+      {{"--vary", "1,2", "--slice-deg", "0,0", "--plot", "."},
+       urdf3,
+       "0,0,0",
+       "--slice-deg: slices are drawn for three"},
+      {{"--vary", "1,2", "--plot", "no_such_folder"},
+       urdf3,
+       "0,0,0",
+       "--plot: folder 'no_such_folder' does not exist"},
+      {{"--vary", "1,2", "--plot", ".", "--plot-format", "gif"},
+       urdf3,
+       "0,0,0",
+       "--plot-format: unknown format 'gif'"},
+      {{"--vary", "1,2,3", "--step-deg", "0.5", "--plot", "."},
+       urdf3,
+       "0,0,0",
+       "--plot: the grid has 373248000 points"},
   };
   for (const auto& c : cases) {
     TempDir dir;
-    std::vector<std::string> a{kCli, "map", "--urdf", c.urdf, "--joints-deg", c.joints, "--csv", "m.csv", "--quiet"};
+    std::vector<std::string> a{kCli,     "map",   "--urdf", c.urdf,   "--joints-deg",
+                               c.joints, "--csv", "m.csv",  "--quiet"};
     a.insert(a.end(), c.extra.begin(), c.extra.end());
     const auto r = run_command(a, dir.str());
     INFO(c.message << "\n" << r.err);
@@ -308,7 +339,8 @@ TEST_CASE("map --plot bad inputs: one error line naming the flag, no CSV and no 
   }
 }
 
-TEST_CASE("plot bad inputs: a missing folder or an unknown format give one error line and no output", "[plot][cli]") {
+TEST_CASE("plot bad inputs: a missing folder or an unknown format give one error line and no output",
+          "[plot][cli]") {
   TempDir dir;
   const std::string missing = dir / "no_such_folder";
   const std::string urdf = ffsr::test::kRobots + "paper_3dof.urdf";
@@ -319,8 +351,10 @@ TEST_CASE("plot bad inputs: a missing folder or an unknown format give one error
   const std::vector<Case> cases = {
       {{kCli, "--plot", missing, "--quiet"}, "--plot: folder '" + missing + "' does not exist"},
       {{kCli, "--plot", dir.str(), "--plot-format", "gif", "--quiet"}, "--plot-format: unknown format 'gif'"},
-      {{kCli, "contact", "--urdf", urdf, "--joints-deg=0,90,-90", "--plot", missing}, "--plot: folder '" + missing},
-      {{kCli, "contact", "--urdf", urdf, "--joints-deg=0,90,-90", "--plot", dir.str(), "--plot-format", "bmp"},
+      {{kCli, "contact", "--urdf", urdf, "--joints-deg=0,90,-90", "--plot", missing},
+       "--plot: folder '" + missing},
+      {{kCli, "contact", "--urdf", urdf, "--joints-deg=0,90,-90", "--plot", dir.str(), "--plot-format",
+        "bmp"},
        "--plot-format: unknown format 'bmp'"},
       {{kCli, "xi", "--plot", missing}, "--plot: folder '" + missing},
       {{kCli, "xi", "--points", "1"}, "--points: expected 2 to 100000, got 1"},

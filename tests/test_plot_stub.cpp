@@ -21,5 +21,6 @@ TEST_CASE("plot stub: --plot in a build without plotting is a one-line InputErro
     CHECK(std::string(e.what()).find('\n') == std::string::npos);
   }
   // the format is still checked (the error for a bad format comes first, as in the real build)
-  CHECK_THROWS_WITH(plot::parse_format("tiff", "--plot-format"), Catch::StartsWith("--plot-format: unknown format"));
+  CHECK_THROWS_WITH(plot::parse_format("tiff", "--plot-format"),
+                    Catch::StartsWith("--plot-format: unknown format"));
 }

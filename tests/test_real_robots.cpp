@@ -85,7 +85,8 @@ std::vector<LinkMass> masses_of(const std::string& xml, const Bus& bus) {
   return links;
 }
 
-TestRobot load(const std::string& name, const std::string& xml, const UrdfOptions& opt, UrdfReport* rep = nullptr) {
+TestRobot load(const std::string& name, const std::string& xml, const UrdfOptions& opt,
+               UrdfReport* rep = nullptr) {
   TestRobot r{name, model_from_urdf_string(xml, name, opt, rep), masses_of(xml, *opt.bus), -1};
   r.ee = r.model.end_effector();
   return r;
@@ -136,8 +137,8 @@ void check_identities(const TestRobot& r, unsigned seed) {
     }
     // plus the rounding floor of central differences: eps |p| / h of every position, times the mass
     // (500 kg bus a few metres from the origin: ~5e-8 kg m/s, measured residuals 6e-9 .. 3e-8)
-    const double rounding = r.model.total_mass() * std::numeric_limits<double>::epsilon() *
-                            (q.base.position.norm() + 2.0) / 1e-5;
+    const double rounding =
+        r.model.total_mass() * std::numeric_limits<double>::epsilon() * (q.base.position.norm() + 2.0) / 1e-5;
     CHECK(fd_momentum(r, lz, q.base.position).norm() < 1e-9 * scale + rounding);
   }
 }
@@ -201,8 +202,8 @@ TEST_CASE("mimic reduction: H, C, J_bm, M_ie gradient against the full model", "
   const size_t at = xml.find(tag);
   REQUIRE(at != std::string::npos);
   const double mult = -0.7, off = 0.01;
-  const std::string reduced_xml =
-      std::string(xml).replace(at, tag.size(), "<mimic joint=\"panda_finger_joint1\" multiplier=\"-0.7\" offset=\"0.01\"/>");
+  const std::string reduced_xml = std::string(xml).replace(
+      at, tag.size(), "<mimic joint=\"panda_finger_joint1\" multiplier=\"-0.7\" offset=\"0.01\"/>");
   const std::string full_xml = std::string(xml).replace(at, tag.size(), "");
   UrdfOptions opt = samples()[0].opt;
   opt.end_effector = "panda_leftfinger";  // on the leader's body: both fingers' motion matters
@@ -277,7 +278,8 @@ TEST_CASE("mimic reduction: H, C, J_bm, M_ie gradient against the full model", "
   }
 }
 
-TEST_CASE("mimic chains resolve -- loops and unknown leaders are ModelErrors naming the joints", "[model][mimic]") {
+TEST_CASE("mimic chains resolve -- loops and unknown leaders are ModelErrors naming the joints",
+          "[model][mimic]") {
   Rng rng(301);
   auto inertia = [&](double m) { return Inertia{m, rng.vec3(0.3), rng.inertia(0.05 * m)}; };
   auto pose = [&] { return Pose::from_xyz_rpy(rng.vec3(0.6), rng.vec3(M_PI)); };
@@ -292,8 +294,8 @@ TEST_CASE("mimic chains resolve -- loops and unknown leaders are ModelErrors nam
     r.links.push_back({child, in});
   };
   add("j1", JointType::Revolute, "trunk", "l1", 10);
-  add("j2", JointType::Revolute, "l1", "l2", 8);   // mimics j4 (declared before its leader)
-  add("j3", JointType::Prismatic, "l2", "l3", 6);  // mimics j2: a chain j3 -> j2 -> j4
+  add("j2", JointType::Revolute, "l1", "l2", 8);     // mimics j4 (declared before its leader)
+  add("j3", JointType::Prismatic, "l2", "l3", 6);    // mimics j2: a chain j3 -> j2 -> j4
   add("j4", JointType::Revolute, "trunk", "l4", 5);  // another branch
   add("j5", JointType::Revolute, "l3", "l5", 4);
   b.set_mimic("j3", "j2", -0.3, 0.05).set_mimic("j2", "j4", 1.5, 0.2);
@@ -309,11 +311,14 @@ TEST_CASE("mimic chains resolve -- loops and unknown leaders are ModelErrors nam
   check_identities(r, 302);
 
   ModelBuilder loop("base", Inertia{10, Vector3::Zero(), Matrix3::Identity()});
-  loop.add_joint("a", JointType::Revolute, "base", Pose{}, Vector3::UnitZ(), "la", Inertia{1, Vector3::Zero(), Matrix3::Identity()});
-  loop.add_joint("b", JointType::Revolute, "la", Pose{}, Vector3::UnitZ(), "lb", Inertia{1, Vector3::Zero(), Matrix3::Identity()});
+  loop.add_joint("a", JointType::Revolute, "base", Pose{}, Vector3::UnitZ(), "la",
+                 Inertia{1, Vector3::Zero(), Matrix3::Identity()});
+  loop.add_joint("b", JointType::Revolute, "la", Pose{}, Vector3::UnitZ(), "lb",
+                 Inertia{1, Vector3::Zero(), Matrix3::Identity()});
   ModelBuilder unknown = loop;
   loop.set_mimic("a", "b", 1, 0).set_mimic("b", "a", 1, 0);
-  CHECK_THROWS_WITH(loop.build(), Catch::Contains("loop") && Catch::Contains("'a'") && Catch::Contains("'b'"));
+  CHECK_THROWS_WITH(loop.build(),
+                    Catch::Contains("loop") && Catch::Contains("'a'") && Catch::Contains("'b'"));
   unknown.set_mimic("b", "ghost", 1, 0);
   CHECK_THROWS_WITH(unknown.build(), Catch::Contains("'b'") && Catch::Contains("'ghost'"));
   CHECK_THROWS_AS(unknown.build(), ModelError);
@@ -332,7 +337,8 @@ TEST_CASE("the tests/data mimic file loads: the follower moves with its leader",
   CHECK(std::atan2(R2(1, 0), R2(0, 0)) == Approx(0.9).epsilon(1e-14));
 }
 
-TEST_CASE("locked joints: removed from the coordinates, the same system as the full model", "[urdf][real][lock]") {
+TEST_CASE("locked joints: removed from the coordinates, the same system as the full model",
+          "[urdf][real][lock]") {
   if (!have_samples()) return;
   const std::string path = samples_dir() + "/ur5_robot.urdf";
   UrdfOptions opt = samples()[1].opt;
@@ -368,7 +374,9 @@ TEST_CASE("locked joints: removed from the coordinates, the same system as the f
   const Vector3 u = t.normal_world();
   const double inv_me = u.dot(J * H.ldlt().solve(J.transpose() * u));
   CHECK(Ml == Approx(1.0 / (inv_me + t.inverse_mass_along_normal())).epsilon(1e-12));
-  CHECK((frame_pose(locked, dl, locked.end_effector()).p - frame_pose(full, df, full.end_effector()).p).norm() < 1e-12);
+  CHECK(
+      (frame_pose(locked, dl, locked.end_effector()).p - frame_pose(full, df, full.end_effector()).p).norm() <
+      1e-12);
   // a locked leader locks its mimic follower
   UrdfOptions po = samples()[0].opt;
   po.locks = {{"panda_finger_joint1", 0.02}};
@@ -379,7 +387,8 @@ TEST_CASE("locked joints: removed from the coordinates, the same system as the f
   CHECK(panda.nb() == 8);
 }
 
-TEST_CASE("mount invariance: moving the bus frame, compensated, changes neither M_ie nor the end-effector", "[urdf][real]") {
+TEST_CASE("mount invariance: moving the bus frame, compensated, changes neither M_ie nor the end-effector",
+          "[urdf][real]") {
   if (!have_samples()) return;
   const std::string path = samples_dir() + "/kinova.urdf";
   UrdfOptions a = samples()[2].opt;
@@ -429,10 +438,10 @@ TEST_CASE("end-effector offset: the contact point where the fingers close", "[ur
     const BasePose base = rng.base_pose();
     const VectorXd th = rng.vec(8, 1.0);
     VectorXd g1(8), g2(8);
-    const double M1 = integrated_effective_mass_gradient(mo, d1, base, th, mo.end_effector(), t.normal_world(),
-                                                         t.inverse_mass_along_normal(), g1);
-    const double M2 = integrated_effective_mass_gradient(mt, d2, base, th, mt.end_effector(), t.normal_world(),
-                                                         t.inverse_mass_along_normal(), g2);
+    const double M1 = integrated_effective_mass_gradient(mo, d1, base, th, mo.end_effector(),
+                                                         t.normal_world(), t.inverse_mass_along_normal(), g1);
+    const double M2 = integrated_effective_mass_gradient(mt, d2, base, th, mt.end_effector(),
+                                                         t.normal_world(), t.inverse_mass_along_normal(), g2);
     CHECK(M1 == Approx(M2).epsilon(1e-12));
     CHECK((g1 - g2).cwiseAbs().maxCoeff() < 1e-12 * std::max(1.0, g2.cwiseAbs().maxCoeff()));
     const MatrixXd J1 = generalized_jacobian(mo, d1, base, th, mo.end_effector());
@@ -457,9 +466,12 @@ const char* kOddUrdf = R"(<robot name="odd">
 </robot>)";
 }  // namespace
 
-TEST_CASE("inertia repairs: an error naming the link and the option by default -- balance and bounds when asked", "[urdf][repair]") {
-  CHECK_THROWS_WITH(model_from_urdf_string(kOddUrdf, "odd.urdf", UrdfOptions{}),
-                    Catch::Contains("odd.urdf") && Catch::Contains("'odd'") && Catch::Contains("inertia-repair"));
+TEST_CASE(
+    "inertia repairs: an error naming the link and the option by default -- balance and bounds when asked",
+    "[urdf][repair]") {
+  CHECK_THROWS_WITH(
+      model_from_urdf_string(kOddUrdf, "odd.urdf", UrdfOptions{}),
+      Catch::Contains("odd.urdf") && Catch::Contains("'odd'") && Catch::Contains("inertia-repair"));
   UrdfOptions o;
   o.inertia_repair = InertiaRepair::Balance;
   o.min_mass = 1e-3;
@@ -483,7 +495,8 @@ TEST_CASE("inertia repairs: an error naming the link and the option by default -
     (void)model_from_urdf_file(source_path(f), o, &none);
     CHECK(none.repairs.empty());
   }
-  CHECK_THROWS_WITH(parse_inertia_repair("average"), Catch::Contains("inertia-repair") && Catch::Contains("average"));
+  CHECK_THROWS_WITH(parse_inertia_repair("average"),
+                    Catch::Contains("inertia-repair") && Catch::Contains("average"));
 }
 
 TEST_CASE("bad bus and lock options: one error naming the key", "[urdf][real]") {
@@ -505,7 +518,8 @@ TEST_CASE("bad bus and lock options: one error naming the key", "[urdf][real]") 
   CHECK_THAT(error_of(o), Catch::Contains("bus-inertia") && Catch::Contains("triangle"));
   o = samples()[0].opt;
   o.locks = {{"panda_joint9", 0.1}};
-  CHECK_THAT(error_of(o), Catch::Contains("lock-joints") && Catch::Contains("panda_joint9") && Catch::Contains("panda_joint1"));
+  CHECK_THAT(error_of(o), Catch::Contains("lock-joints") && Catch::Contains("panda_joint9") &&
+                              Catch::Contains("panda_joint1"));
   o.locks = {{"panda_hand_joint", 0.0}};
   CHECK_THAT(error_of(o), Catch::Contains("lock-joints") && Catch::Contains("fixed"));
   o.locks = {{"panda_joint4", 0.5}};  // limits [-3.0718, -0.0698]
@@ -523,8 +537,8 @@ TEST_CASE("ffsr-optimize runs a capture scenario on each sample (tests/data/<rob
     const std::string json_path = tmp.str() + "/out.json";
     const auto r = ffsr::test::run_command(
         {FFSR_CLI, "--config", source_path(std::string("tests/data/") + robot + ".toml"), "--urdf",
-         samples_dir() + "/" + (std::string(robot) == "ur5" ? "ur5_robot" : robot) + ".urdf", "--json", json_path,
-         "--quiet"},
+         samples_dir() + "/" + (std::string(robot) == "ur5" ? "ur5_robot" : robot) + ".urdf", "--json",
+         json_path, "--quiet"},
         tmp.str());
     INFO(robot << "\nstdout: " << r.out << "\nstderr: " << r.err);
     REQUIRE(r.exit_code == 0);
@@ -542,8 +556,9 @@ TEST_CASE("ffsr-optimize runs a capture scenario on each sample (tests/data/<rob
 TEST_CASE("ffsr-optimize inspect: what was done to the file, and bad keys", "[cli][real]") {
   if (!have_samples()) return;
   const std::string panda = samples_dir() + "/panda.urdf";
-  const std::vector<std::string> base{FFSR_CLI, "inspect", "--urdf", panda, "--end-effector", "panda_hand",
-                                      "--joints-deg", "0,-30,0,-120,0,90,45,0.02"};
+  const std::vector<std::string> base{
+      FFSR_CLI,         "inspect",    "--urdf",       panda,
+      "--end-effector", "panda_hand", "--joints-deg", "0,-30,0,-120,0,90,45,0.02"};
   auto run = [&](std::vector<std::string> extra) {
     std::vector<std::string> a = base;
     a.insert(a.end(), extra.begin(), extra.end());
@@ -566,12 +581,18 @@ TEST_CASE("ffsr-optimize inspect: what was done to the file, and bad keys", "[cl
       {{"--bus-mass", "500", "--bus-inertia", "1,1,5"}, "bus-inertia"},
       {{"--mount-xyz", "0.6,0,0.4"}, "--mount-xyz"},
       {{"--bus-mass", "500", "--bus-inertia", "90,80,100", "--lock-joints", "nonexistent=0"}, "nonexistent"},
-      {{"--bus-mass", "500", "--bus-inertia", "90,80,100", "--lock-joints", "panda_joint8=0"}, "panda_joint8"},
-      {{"--bus-mass", "500", "--bus-inertia", "90,80,100", "--lock-joints", "panda_joint4=0.5"}, "panda_joint4"},
-      {{"--bus-mass", "500", "--bus-inertia", "90,80,100", "--inertia-repair", "average"}, "--inertia-repair"},
-      {{"--bus-mass", "500", "--bus-inertia", "90,80,100", "--end-effector-offset", "0,0"}, "--end-effector-offset"},
-      {{"--bus-mass", "500", "--bus-inertia", "90,80,100", "--end-effector-offset", "0,nan,0"}, "--end-effector-offset"},
-      {{"--bus-mass", "500", "--bus-inertia", "90,80,100", "--lock-joints", "panda_joint7=0.1"}, "panda_finger_joint1"},
+      {{"--bus-mass", "500", "--bus-inertia", "90,80,100", "--lock-joints", "panda_joint8=0"},
+       "panda_joint8"},
+      {{"--bus-mass", "500", "--bus-inertia", "90,80,100", "--lock-joints", "panda_joint4=0.5"},
+       "panda_joint4"},
+      {{"--bus-mass", "500", "--bus-inertia", "90,80,100", "--inertia-repair", "average"},
+       "--inertia-repair"},
+      {{"--bus-mass", "500", "--bus-inertia", "90,80,100", "--end-effector-offset", "0,0"},
+       "--end-effector-offset"},
+      {{"--bus-mass", "500", "--bus-inertia", "90,80,100", "--end-effector-offset", "0,nan,0"},
+       "--end-effector-offset"},
+      {{"--bus-mass", "500", "--bus-inertia", "90,80,100", "--lock-joints", "panda_joint7=0.1"},
+       "panda_finger_joint1"},
   };
   for (const auto& b : bad) {
     const auto r = run(b.args);

@@ -123,7 +123,8 @@ TEST_CASE("robust: 4 shards merged equal the unsharded run to the last digit", "
   other.erase("stiffness_nominal");
   std::ofstream(dir / "other1.json") << other.dump();
   const CommandResult mixed =
-      robust({"--merge", dir / "shard0.json", dir / "other1.json", dir / "shard2.json", dir / "shard3.json"}, dir.str());
+      robust({"--merge", dir / "shard0.json", dir / "other1.json", dir / "shard2.json", dir / "shard3.json"},
+             dir.str());
   CHECK(mixed.exit_code == 2);
   CHECK(mixed.err.find("differ in 'estimator'") != std::string::npos);
   // a shard whose per-sample stiffness list lost a value
@@ -131,13 +132,15 @@ TEST_CASE("robust: 4 shards merged equal the unsharded run to the last digit", "
   cut["stiffness"].erase(cut["stiffness"].size() - 1);
   std::ofstream(dir / "cut1.json") << cut.dump();
   const CommandResult lost =
-      robust({"--merge", dir / "shard0.json", dir / "cut1.json", dir / "shard2.json", dir / "shard3.json"}, dir.str());
+      robust({"--merge", dir / "shard0.json", dir / "cut1.json", dir / "shard2.json", dir / "shard3.json"},
+             dir.str());
   CHECK(lost.exit_code == 2);
   CHECK(lost.err.find("'stiffness' lists do not hold one value per sample") != std::string::npos);
   CHECK(std::count(lost.err.begin(), lost.err.end(), '\n') == 1);
 }
 
-TEST_CASE("robust: sample i depends on (seed, i) only -- p95 of 1e3 against 2e4 samples -- no NaN", "[robust]") {
+TEST_CASE("robust: sample i depends on (seed, i) only -- p95 of 1e3 against 2e4 samples -- no NaN",
+          "[robust]") {
   TempDir dir;
   Args a{"--config", kScenario, "--samples", "20000", "--json", dir / "big.json", "--csv", dir / "big.csv"};
   a.insert(a.end(), kGiven.begin(), kGiven.end());
@@ -173,7 +176,8 @@ TEST_CASE("robust: sample i depends on (seed, i) only -- p95 of 1e3 against 2e4 
   CHECK(cb["hi"].get<double>() - cb["lo"].get<double>() < cs["hi"].get<double>() - cs["lo"].get<double>());
   const json os = ss["order_statistics"]["p95_ci95"];
   CHECK(os["method"] == "order-statistics");
-  CHECK(cs["hi"].get<double>() - cs["lo"].get<double>() < 0.5 * (os["hi"].get<double>() - os["lo"].get<double>()));
+  CHECK(cs["hi"].get<double>() - cs["lo"].get<double>() <
+        0.5 * (os["hi"].get<double>() - os["lo"].get<double>()));
   // and the distribution-free interval of the order statistics holds the conditional estimate too
   CHECK(os["lo"].get<double>() <= p95_big);
   CHECK(p95_big < os["hi"].get<double>());
@@ -191,13 +195,15 @@ TEST_CASE("robust: sample i depends on (seed, i) only -- p95 of 1e3 against 2e4 
   long rows = 0;
   while (std::getline(csv, line)) {
     ++rows;
-    if (line.find("nan") != std::string::npos || line.find("inf") != std::string::npos) FAIL("non-finite value: " << line);
+    if (line.find("nan") != std::string::npos || line.find("inf") != std::string::npos)
+      FAIL("non-finite value: " << line);
   }
   CHECK(rows == 20000);
   CHECK(big.out.find("nan") == std::string::npos);
 }
 
-TEST_CASE("robust: the 95th percentile from 1e3 and from 1e5 samples within 1 % (exact model, issue 12)", "[robust]") {
+TEST_CASE("robust: the 95th percentile from 1e3 and from 1e5 samples within 1 % (exact model, issue 12)",
+          "[robust]") {
   TempDir dir;
   Args a{"--config", kScenario, "--samples", "100000", "--json", dir / "big.json"};
   a.insert(a.end(), kGiven.begin(), kGiven.end());
@@ -210,7 +216,8 @@ TEST_CASE("robust: the 95th percentile from 1e3 and from 1e5 samples within 1 % 
   // the first 1000 samples of the 1e5 run are the 1e3 run's (sample i depends on (seed, i) only);
   // every block of 1000 of them estimates the p95 within 1 % of the 1e5 estimate
   const auto f = jb["configurations"][0]["f_max"].get<std::vector<double>>();
-  const auto K = jb["stiffness"].get<std::vector<double>>(), alpha = jb["exponent"].get<std::vector<double>>();
+  const auto K = jb["stiffness"].get<std::vector<double>>(),
+             alpha = jb["exponent"].get<std::vector<double>>();
   ffsr::Spread law;
   law.law = ffsr::Spread::Law::LogNormal;
   law.scale = 0.587;  // the example's K: log-normal, sigma 0.587 about 1e9
@@ -249,19 +256,35 @@ TEST_CASE("robust: bad inputs give one error line naming the key, exit 2, no out
     std::string expected;
   };
   const std::vector<Case> cases{
-      {"target-mass = { law = \"normal\", relative-std = -0.1 }", {}, "uncertainty.target-mass.relative-std: a spread must be non-negative, got -0.1"},
-      {"spin = { law = \"normal\", std = -0.2 }", {}, "uncertainty.spin.std: a spread must be non-negative, got -0.2"},
-      {"restitution = { law = \"uniform\", min = 0.95, max = 0.6 }", {}, "uncertainty.restitution: min (0.95) is greater than max (0.6)"},
-      {"normal = { law = \"cone\", angle-deg = 95 }", {}, "uncertainty.normal: the cone half-angle must be at most 90 deg"},
+      {"target-mass = { law = \"normal\", relative-std = -0.1 }",
+       {},
+       "uncertainty.target-mass.relative-std: a spread must be non-negative, got -0.1"},
+      {"spin = { law = \"normal\", std = -0.2 }",
+       {},
+       "uncertainty.spin.std: a spread must be non-negative, got -0.2"},
+      {"restitution = { law = \"uniform\", min = 0.95, max = 0.6 }",
+       {},
+       "uncertainty.restitution: min (0.95) is greater than max (0.6)"},
+      {"normal = { law = \"cone\", angle-deg = 95 }",
+       {},
+       "uncertainty.normal: the cone half-angle must be at most 90 deg"},
       {"colour = { law = \"normal\", std = 1 }", {}, "uncertainty.colour: unknown uncertain quantity"},
       {"samples = 0", {}, "uncertainty.samples: must be at least 1"},
       {"seed = 1.5", {}, "uncertainty.seed: must be an integer"},
       {"seed = \"abc\"", {}, "uncertainty.seed: must be an integer"},
-      {"stiffness = { law = \"log-normal\", sigma = 0.5, scale = 2 }", {}, "uncertainty.stiffness.scale: unknown parameter"},
+      {"stiffness = { law = \"log-normal\", sigma = 0.5, scale = 2 }",
+       {},
+       "uncertainty.stiffness.scale: unknown parameter"},
       {"stiffness = { law = \"gamma\", sigma = 0.5 }", {}, "uncertainty.stiffness.law: unknown law 'gamma'"},
-      {"spin = { law = \"normal\", relative-std = 0.1 }", {}, "uncertainty.spin: a vector takes an absolute spread"},
-      {"contact-point = { law = \"uniform\", half-width = -0.02 }", {}, "uncertainty.contact-point.half-width: a spread must be non-negative, got -0.02"},
-      {"contact-point = { law = \"log-normal\", sigma = 0.1 }", {}, "uncertainty.contact-point: a vector takes a 'normal' or 'uniform' law"},
+      {"spin = { law = \"normal\", relative-std = 0.1 }",
+       {},
+       "uncertainty.spin: a vector takes an absolute spread"},
+      {"contact-point = { law = \"uniform\", half-width = -0.02 }",
+       {},
+       "uncertainty.contact-point.half-width: a spread must be non-negative, got -0.02"},
+      {"contact-point = { law = \"log-normal\", sigma = 0.1 }",
+       {},
+       "uncertainty.contact-point: a vector takes a 'normal' or 'uniform' law"},
       {"contact-point = 0.02", {}, "uncertainty.contact-point: expected a table"},
       {"samples = 10", {"--samples", "0"}, "--samples: must be at least 1"},
       {"samples = 10", {"--seed", "-3"}, "--seed: expected a non-negative integer, got '-3'"},
@@ -301,8 +324,10 @@ TEST_CASE("robust: bad inputs give one error line naming the key, exit 2, no out
   CHECK(j["configurations"][0]["tail"][0]["parameters"]["stiffness"] == 2e9);  // no spread: the flag's value
 }
 
-TEST_CASE("robust-force: the main job's global run minimizes CVaR_95 -- robust shows it beside the nominal global run",
-          "[robust][global]") {
+TEST_CASE(
+    "robust-force: the main job's global run minimizes CVaR_95 -- robust shows it beside the nominal global "
+    "run",
+    "[robust][global]") {
 #if defined(FFSR_SANITIZED) && !defined(__OPTIMIZE__)
   // three 7-DOF plans and three global searches at -O0 with ASan take about as long as ctest's per-test
   // limit: skipped there (.ci/run builds its sanitizer stage with -O1, where it runs); the robust
@@ -328,13 +353,14 @@ TEST_CASE("robust-force: the main job's global run minimizes CVaR_95 -- robust s
   }
   // the search lowered the measure it minimizes, below the paper's method's configuration
   CHECK(r["global"]["cvar95"].get<double>() < r["optimized"]["cvar95"].get<double>());
-  CHECK(j["global"]["objective_value"].get<double>() == Approx(r["global"]["cvar95"].get<double>()).epsilon(1e-12));
+  CHECK(j["global"]["objective_value"].get<double>() ==
+        Approx(r["global"]["cvar95"].get<double>()).epsilon(1e-12));
   // the nominal values of the robust configuration are its row: M_ie and F_max
   CHECK(j["global"]["integrated_effective_mass"].get<double>() > 0);
 
   // robust: plain, optimized, the nominal global run (mass) and the robust one, on common samples
-  const CommandResult rb =
-      robust({"--config", kScenario, "--samples", "10000", "--json", dir / "robust.json", "--quiet"}, dir.str());
+  const CommandResult rb = robust(
+      {"--config", kScenario, "--samples", "10000", "--json", dir / "robust.json", "--quiet"}, dir.str());
   INFO(rb.err);
   REQUIRE(rb.exit_code == 0);
   const json k = read_json(dir / "robust.json");
@@ -353,7 +379,8 @@ TEST_CASE("robust-force: the main job's global run minimizes CVaR_95 -- robust s
   const json& cmp = k["robust_vs_global"];
   INFO("p95 global " << gc["summary"]["p95"] << ", robust " << rc["summary"]["p95"] << "; ratio " << cmp);
   CHECK(rc["summary"]["p95"].get<double>() < gc["summary"]["p95"].get<double>());
-  CHECK(cmp["p95_ratio"].get<double>() == Approx(rc["summary"]["p95"].get<double>() / gc["summary"]["p95"].get<double>()));
+  CHECK(cmp["p95_ratio"].get<double>() ==
+        Approx(rc["summary"]["p95"].get<double>() / gc["summary"]["p95"].get<double>()));
   CHECK(cmp["p95_ratio_ci95"]["hi"].get<double>() < 1.0);
   CHECK(rc["nominal"]["M_ie"].get<double>() > gc["nominal"]["M_ie"].get<double>());
   CHECK(rb.out.find("robust against global on the same samples: p95 -") != std::string::npos);
@@ -384,8 +411,9 @@ TEST_CASE("robust --json -: the JSON alone on standard output, the table on stan
   CHECK(ci["lo"].is_number());
   CHECK(j["configurations"][0]["summary"]["p95_ci95"]["hi"].is_number());
   // with the stiffness known the percentiles are order statistics, and the table says the bound is missing
-  const std::string known_k = write(dir, "known_k.toml", scenario_with("samples = 50\nseed = 3\n"
-                                                                       "target-mass = { law = \"uniform\", relative = 0.1 }"));
+  const std::string known_k = write(dir, "known_k.toml",
+                                    scenario_with("samples = 50\nseed = 3\n"
+                                                  "target-mass = { law = \"uniform\", relative = 0.1 }"));
   Args k{"--config", known_k, "--json", dir / "known_k.json"};
   k.insert(k.end(), kGiven.begin(), kGiven.end());
   const CommandResult rk = robust(k, dir.str());
@@ -412,7 +440,8 @@ TEST_CASE("robust --json -: the JSON alone on standard output, the table on stan
   CHECK(dir.entries().empty());
 }
 
-TEST_CASE("robust --plot: the CDF and histogram per configuration, from a run and from merged shards", "[robust][plot]") {
+TEST_CASE("robust --plot: the CDF and histogram per configuration, from a run and from merged shards",
+          "[robust][plot]") {
   TempDir dir;
   Args a{"--config", kScenario, "--samples", "400", "--plot", dir.str(), "--json", dir / "r.json"};
   a.insert(a.end(), kGiven.begin(), kGiven.end());

@@ -17,7 +17,6 @@ using ffsr::test::kRobots;
 
 namespace {
 
-
 // The paper's target (Sections 5.1 and 5.2): 200 kg, diag(100,100,100), identity attitude.
 Target paper_target(bool seven_dof) {
   Target t;
@@ -38,21 +37,21 @@ struct Row {
 TEST_CASE("Table 3: the CVODE multibody F_max and the model accuracy of Eq. 32", "[simulate][paper]") {
   const Model m = model_from_urdf_file(kRobots + "paper_3dof.urdf");
   // Table 3: capture configuration, "Proposed Method" and "Numerical Integration Method" columns (kN)
-  const std::vector<Row> rows = {
-      {deg({36, 30, -4}), 0.834, 0.844},    {deg({85, -41, 11}), 0.863, 0.873},
-      {deg({-75, 30, 12}), 1.397, 1.414},   {deg({10, 86, -76}), 1.534, 1.552},
-      {deg({0, 90, -90}), 1.840, 1.861},    {deg({30, 21, -56}), 1.860, 1.882},
-      {deg({54, -30, -5}), 2.133, 2.158},   {deg({-10, -18, 30}), 2.490, 2.519},
-      {deg({46, -45, 0}), 3.081, 3.119},    {deg({-6, 20, -7}), 3.985, 4.036}};
+  const std::vector<Row> rows = {{deg({36, 30, -4}), 0.834, 0.844},  {deg({85, -41, 11}), 0.863, 0.873},
+                                 {deg({-75, 30, 12}), 1.397, 1.414}, {deg({10, 86, -76}), 1.534, 1.552},
+                                 {deg({0, 90, -90}), 1.840, 1.861},  {deg({30, 21, -56}), 1.860, 1.882},
+                                 {deg({54, -30, -5}), 2.133, 2.158}, {deg({-10, -18, 30}), 2.490, 2.519},
+                                 {deg({46, -45, 0}), 3.081, 3.119},  {deg({-6, 20, -7}), 3.985, 4.036}};
   for (const Row& r : rows) {
-    const MultibodyContactResult mb = simulate_contact(m, BasePose{}, r.q, m.end_effector(), paper_target(false), 0.2,
-                                                       kPaperContact, "herbert-mcwhannell");
+    const MultibodyContactResult mb = simulate_contact(
+        m, BasePose{}, r.q, m.end_effector(), paper_target(false), 0.2, kPaperContact, "herbert-mcwhannell");
     const AnyContactLaw law = make_contact_law("herbert-mcwhannell", kPaperContact, mb.approach_velocity);
     const double closed = max_force_closed_form(law, mb.integrated_effective_mass);
     const double exact = max_force_exact(law, mb.integrated_effective_mass);
     const double accuracy = model_accuracy(closed, mb.f_max);
-    INFO("q = " << (r.q * 180 / M_PI).transpose() << "  M_ie " << mb.integrated_effective_mass << "  multibody "
-                << mb.f_max << " N (paper " << r.paper_numerical_kN * 1e3 << ")  accuracy " << accuracy << " %");
+    INFO("q = " << (r.q * 180 / M_PI).transpose() << "  M_ie " << mb.integrated_effective_mass
+                << "  multibody " << mb.f_max << " N (paper " << r.paper_numerical_kN * 1e3 << ")  accuracy "
+                << accuracy << " %");
     // the paper's rows are rounded to whole degrees (see the dynamics tests): 2.5 % (issue 3)
     CHECK(mb.f_max == Approx(r.paper_numerical_kN * 1e3).epsilon(0.025));
     CHECK(accuracy > 98.5);
@@ -64,7 +63,8 @@ TEST_CASE("Table 3: the CVODE multibody F_max and the model accuracy of Eq. 32",
   }
 }
 
-TEST_CASE("Table 6: multibody F_max beside the paper's, against the single-body exact peak", "[simulate][paper]") {
+TEST_CASE("Table 6: multibody F_max beside the paper's, against the single-body exact peak",
+          "[simulate][paper]") {
   const Model m = model_from_urdf_file(kRobots + "paper_7dof.urdf");
   const std::vector<Row> rows = {{deg({0, 29, 54, 10, -10, 120, 32}), 1.664, 1.659},
                                  {deg({10, -2, 160, 0, 33, -5, 80}), 2.218, 2.213},
@@ -76,16 +76,18 @@ TEST_CASE("Table 6: multibody F_max beside the paper's, against the single-body 
                                  {deg({100, 23, 126, -6, 34, 34, -1}), 0.871, 0.869},
                                  {deg({1, 110, -90, 90, 14, 150, 45}), 1.161, 1.158},
                                  {deg({-36, 88, 46, 123, -110, 15, 0}), 0.819, 0.817}};
-  std::printf("\nTable 6 (7-DOF): M_ie, closed form, CVODE multibody, accuracy; the paper's numerical column\n");
+  std::printf(
+      "\nTable 6 (7-DOF): M_ie, closed form, CVODE multibody, accuracy; the paper's numerical column\n");
   for (const Row& r : rows) {
-    const MultibodyContactResult mb = simulate_contact(m, BasePose{}, r.q, m.end_effector(), paper_target(true), 0.2,
-                                                       kPaperContact, "herbert-mcwhannell");
+    const MultibodyContactResult mb = simulate_contact(
+        m, BasePose{}, r.q, m.end_effector(), paper_target(true), 0.2, kPaperContact, "herbert-mcwhannell");
     const AnyContactLaw law = make_contact_law("herbert-mcwhannell", kPaperContact, mb.approach_velocity);
     const double closed = max_force_closed_form(law, mb.integrated_effective_mass);
     const double exact = max_force_exact(law, mb.integrated_effective_mass);
-    std::printf("  M_ie %7.4f kg  closed %7.4f kN  multibody %7.4f kN  accuracy %6.2f %%   paper %.3f kN (%.3f)\n",
-                mb.integrated_effective_mass, closed / 1e3, mb.f_max / 1e3, model_accuracy(closed, mb.f_max),
-                r.paper_numerical_kN, r.paper_closed_kN);
+    std::printf(
+        "  M_ie %7.4f kg  closed %7.4f kN  multibody %7.4f kN  accuracy %6.2f %%   paper %.3f kN (%.3f)\n",
+        mb.integrated_effective_mass, closed / 1e3, mb.f_max / 1e3, model_accuracy(closed, mb.f_max),
+        r.paper_numerical_kN, r.paper_closed_kN);
     // delta_dot^- = 0.2 - (w_t x r_tp)_x, w_t x r_tp = (wy rz - wz ry) = (-0.5*0.1 - 2*0.15) deg/s m
     CHECK(mb.approach_velocity == Approx(0.2 + (0.5 * 0.1 + 2 * 0.15) * M_PI / 180).epsilon(1e-9));
     CHECK(mb.f_max == Approx(exact).epsilon(0.005));
@@ -129,13 +131,18 @@ TEST_CASE("Multibody contact conserves momentum, and energy without damping", "[
   MultibodyContactOptions o;
   o.robot_contact_offset = Vector3(0.05, -0.08, 0.07);
   for (double c_r : {0.7, 1.0}) {
-    const MultibodyContactResult r = simulate_contact(m, base, q, m.end_effector(), t, 0.3, {1e9, 1.5, c_r}, "hunt-crossley", o);
+    const MultibodyContactResult r =
+        simulate_contact(m, base, q, m.end_effector(), t, 0.3, {1e9, 1.5, c_r}, "hunt-crossley", o);
     const double scale = r.momentum_start.norm() + t.mass * 0.3;
     INFO("offset, c_r " << c_r << " dP " << (r.momentum_end - r.momentum_start).transpose());
     CHECK((r.momentum_end - r.momentum_start).norm() < 1e-9 * scale);
-    if (c_r == 1.0) CHECK(r.energy_end == Approx(r.energy_start).epsilon(1e-7));
-    else CHECK(r.energy_end < r.energy_start);
-    CHECK(r.approach_velocity == Approx(0.3 - t.normal_world().dot(t.velocity + t.angular_velocity_world().cross(t.offset_world()))).epsilon(1e-9));
+    if (c_r == 1.0)
+      CHECK(r.energy_end == Approx(r.energy_start).epsilon(1e-7));
+    else
+      CHECK(r.energy_end < r.energy_start);
+    CHECK(r.approach_velocity ==
+          Approx(0.3 - t.normal_world().dot(t.velocity + t.angular_velocity_world().cross(t.offset_world())))
+              .epsilon(1e-9));
   }
 }
 
@@ -155,15 +162,15 @@ TEST_CASE("Multibody contact: series, errors", "[simulate]") {
   away.velocity = Vector3(0.5, 0, 0);
   CHECK_THROWS_AS(simulate_contact(m, BasePose{}, q, m.end_effector(), away, 0.2, kPaperContact, "gonthier"),
                   InputError);
-  CHECK_THROWS_AS(simulate_contact(m, BasePose{}, q, m.end_effector(), paper_target(false), 0.2, {-1, 1.5, 0.9},
-                                   "gonthier"),
+  CHECK_THROWS_AS(simulate_contact(m, BasePose{}, q, m.end_effector(), paper_target(false), 0.2,
+                                   {-1, 1.5, 0.9}, "gonthier"),
                   InputError);
-  CHECK_THROWS_WITH(simulate_contact(m, BasePose{}, q, m.end_effector(), paper_target(false), 0.2, kPaperContact,
-                                     "no-such-law"),
+  CHECK_THROWS_WITH(simulate_contact(m, BasePose{}, q, m.end_effector(), paper_target(false), 0.2,
+                                     kPaperContact, "no-such-law"),
                     Catch::Contains("hunt-crossley"));
   MultibodyContactOptions tiny;
   tiny.max_num_steps = 3;
-  CHECK_THROWS_AS(simulate_contact(m, BasePose{}, q, m.end_effector(), paper_target(false), 0.2, kPaperContact,
-                                   "gonthier", tiny),
+  CHECK_THROWS_AS(simulate_contact(m, BasePose{}, q, m.end_effector(), paper_target(false), 0.2,
+                                   kPaperContact, "gonthier", tiny),
                   Error);
 }

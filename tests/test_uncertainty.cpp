@@ -50,7 +50,8 @@ Spread uniform_range(double min, double max) {
 
 }  // namespace
 
-TEST_CASE("sampler: splitmix64 test vector, mt19937_64 stream, sample i depends on (seed, i) only", "[uncertainty]") {
+TEST_CASE("sampler: splitmix64 test vector, mt19937_64 stream, sample i depends on (seed, i) only",
+          "[uncertainty]") {
   // SplitMix64 reference output for state 0 (Steele et al. 2014; the first output of the generator).
   CHECK(detail::splitmix64(0) == 0xE220A8397B1DCDAFULL);
   // our uniform is the top 53 bits of the standard engine seeded from (seed, i)
@@ -63,7 +64,8 @@ TEST_CASE("sampler: splitmix64 test vector, mt19937_64 stream, sample i depends 
   spec[Quantity::TargetMass] = law(Spread::Law::Normal, 0.1, true);
   spec[Quantity::Stiffness] = law(Spread::Law::LogNormal, 0.5);
   const UncertainNominal nom = paper_nominal();
-  const UncertainSample a = draw_sample(spec, nom, 123), b = draw_sample(spec, nom, 123), c = draw_sample(spec, nom, 124);
+  const UncertainSample a = draw_sample(spec, nom, 123), b = draw_sample(spec, nom, 123),
+                        c = draw_sample(spec, nom, 124);
   CHECK(a.target.mass == b.target.mass);
   CHECK(a.contact.K == b.contact.K);
   CHECK(a.target.mass != c.target.mass);
@@ -71,12 +73,13 @@ TEST_CASE("sampler: splitmix64 test vector, mt19937_64 stream, sample i depends 
   CHECK(draw_sample(spec, nom, 123).target.mass != a.target.mass);
 }
 
-TEST_CASE("laws: moments of normal, uniform, log-normal and the cone within 5 standard errors", "[uncertainty]") {
+TEST_CASE("laws: moments of normal, uniform, log-normal and the cone within 5 standard errors",
+          "[uncertainty]") {
   UncertaintySpec spec;
   spec.seed = 3;
   spec[Quantity::TargetMass] = law(Spread::Law::Normal, 0.1, true);  // 200 kg +- 20 kg
-  spec[Quantity::ApproachSpeed] = law(Spread::Law::Uniform, 0.05);     // U[0.15, 0.25]
-  spec[Quantity::Stiffness] = law(Spread::Law::LogNormal, 0.6);       // median 1e9
+  spec[Quantity::ApproachSpeed] = law(Spread::Law::Uniform, 0.05);   // U[0.15, 0.25]
+  spec[Quantity::Stiffness] = law(Spread::Law::LogNormal, 0.6);      // median 1e9
   spec[Quantity::Normal] = law(Spread::Law::Cone, 30 * M_PI / 180);
   spec[Quantity::ContactOffset] = law(Spread::Law::Normal, 0.02);
   REQUIRE_NOTHROW(validate(spec));
@@ -112,17 +115,18 @@ TEST_CASE("laws: moments of normal, uniform, log-normal and the cone within 5 st
   CHECK(std::abs(off2 / N - 3 * 4e-4) < 5 * std::sqrt(6.0) * 4e-4 / std::sqrt(N));
 }
 
-TEST_CASE("physical or redrawn: inertia triangle inequality, 0 < c_r <= 1, mass > 0, bounds", "[uncertainty]") {
+TEST_CASE("physical or redrawn: inertia triangle inequality, 0 < c_r <= 1, mass > 0, bounds",
+          "[uncertainty]") {
   UncertaintySpec spec;
   spec.seed = 11;
   UncertainNominal nom = paper_nominal();
   nom.target.inertia = Vector3(60, 100, 150).asDiagonal();  // close to the triangle limit (150 < 160)
   spec[Quantity::TargetInertia] = law(Spread::Law::Normal, 0.3, true);
   spec[Quantity::TargetInertia].axes = 20 * M_PI / 180;
-  spec[Quantity::TargetMass] = law(Spread::Law::Normal, 0.6, true);     // often negative before the rule
-  spec[Quantity::Restitution] = law(Spread::Law::Normal, 0.2);         // around 0.9: often > 1
+  spec[Quantity::TargetMass] = law(Spread::Law::Normal, 0.6, true);  // often negative before the rule
+  spec[Quantity::Restitution] = law(Spread::Law::Normal, 0.2);       // around 0.9: often > 1
   spec[Quantity::Stiffness] = law(Spread::Law::LogNormal, 1.0);
-  spec[Quantity::Stiffness].min = 5e8;                                 // a bounded law
+  spec[Quantity::Stiffness].min = 5e8;  // a bounded law
   spec[Quantity::Stiffness].max = 2e9;
   REQUIRE_NOTHROW(validate(spec));
   int redraws = 0;
@@ -168,9 +172,12 @@ TEST_CASE("per-sample M_ie and F_max agree with the direct library computation",
     const SampleForce f = sample_force(G, s, "herbert-mcwhannell", ForceModel::Exact);
     CHECK(f.M_ie == Approx(M_ie).epsilon(1e-12));
     CHECK(f.approach_velocity == Approx(v_in).epsilon(1e-12));
-    CHECK(f.f_max == Approx(max_force_exact(make_contact_law("herbert-mcwhannell", s.contact, v_in), M_ie)).epsilon(1e-10));
+    CHECK(f.f_max == Approx(max_force_exact(make_contact_law("herbert-mcwhannell", s.contact, v_in), M_ie))
+                         .epsilon(1e-10));
     const SampleForce c = sample_force(G, s, "herbert-mcwhannell", ForceModel::Closed);
-    CHECK(c.f_max == Approx(max_force_closed_form(make_contact_law("herbert-mcwhannell", s.contact, v_in), M_ie)).epsilon(1e-10));
+    CHECK(c.f_max ==
+          Approx(max_force_closed_form(make_contact_law("herbert-mcwhannell", s.contact, v_in), M_ie))
+              .epsilon(1e-10));
   }
   // the robust objective is the nearest-rank 95th percentile of those forces
   std::vector<UncertainSample> set;
@@ -180,11 +187,13 @@ TEST_CASE("per-sample M_ie and F_max agree with the direct library computation",
     f.push_back(sample_force(G, set.back(), "hunt-crossley", ForceModel::Exact).f_max);
   }
   std::sort(f.begin(), f.end());
-  CHECK(robust_force_p95(m, data, base, theta, frame, set, "hunt-crossley") == f[37]);  // ceil(0.95 * 40) = 38th
+  CHECK(robust_force_p95(m, data, base, theta, frame, set, "hunt-crossley") ==
+        f[37]);  // ceil(0.95 * 40) = 38th
 }
 
-TEST_CASE("multibody force of a sample: same M_ie and delta_dot^- as the closed path, peak near the exact one",
-          "[uncertainty]") {
+TEST_CASE(
+    "multibody force of a sample: same M_ie and delta_dot^- as the closed path, peak near the exact one",
+    "[uncertainty]") {
   const Model m = model_from_urdf_file(kRobots + "paper_3dof.urdf");
   Data data(m);
   const BasePose base;
@@ -229,7 +238,9 @@ TEST_CASE("multibody force of a sample: same M_ie and delta_dot^- as the closed 
   CHECK(moved >= 2);
 }
 
-TEST_CASE("p95 confidence interval: ranks from the binomial law, coverage at least 95 % on draws of a known law", "[uncertainty]") {
+TEST_CASE(
+    "p95 confidence interval: ranks from the binomial law, coverage at least 95 % on draws of a known law",
+    "[uncertainty]") {
   // the ranks against binomial sums by the product recurrence (no lgamma), for a few n
   for (std::size_t n : {72u, 100u, 1000u, 4003u}) {
     // cdf[k] = P(B <= k), B ~ Bin(n, 0.95): ln P(B = k) by the ratio recurrence from ln P(B = 0)
@@ -282,7 +293,8 @@ TEST_CASE("p95 confidence interval: ranks from the binomial law, coverage at lea
   CHECK(coverage < 0.975);
 }
 
-TEST_CASE("summary: nearest-rank percentiles, mean and deviation of 1..100 -- parallel_for = serial", "[uncertainty]") {
+TEST_CASE("summary: nearest-rank percentiles, mean and deviation of 1..100 -- parallel_for = serial",
+          "[uncertainty]") {
   std::vector<double> v;
   for (int k = 100; k >= 1; --k) v.push_back(k);
   const ForceSummary s = summarize(v);
@@ -292,8 +304,9 @@ TEST_CASE("summary: nearest-rank percentiles, mean and deviation of 1..100 -- pa
   CHECK(s.p99 == 99);
   CHECK(s.max == 100);
   CHECK(s.mean == 50.5);
-  CHECK(s.std == Approx(std::sqrt(100.0 * 101.0 / 12.0)).epsilon(1e-14));  // sd (n - 1) of 1..n: sqrt(n(n+1)/12)
-  CHECK(nearest_rank(std::vector<double>{1, 2, 3}, 50) == 2);               // ceil(1.5) = 2nd
+  CHECK(s.std ==
+        Approx(std::sqrt(100.0 * 101.0 / 12.0)).epsilon(1e-14));  // sd (n - 1) of 1..n: sqrt(n(n+1)/12)
+  CHECK(nearest_rank(std::vector<double>{1, 2, 3}, 50) == 2);     // ceil(1.5) = 2nd
   CHECK_THROWS_AS(summarize({1.0, std::nan("")}), NumericalError);
 
   UncertaintySpec spec;
@@ -303,7 +316,11 @@ TEST_CASE("summary: nearest-rank percentiles, mean and deviation of 1..100 -- pa
   parallel_for(0, 500, 1, [&](std::uint64_t i) { serial[i] = draw_sample(spec, nom, i).target.mass; });
   parallel_for(0, 500, 2, [&](std::uint64_t i) { threaded[i] = draw_sample(spec, nom, i).target.mass; });
   CHECK(serial == threaded);
-  CHECK_THROWS_AS(parallel_for(0, 100, 2, [](std::uint64_t i) { if (i == 37) throw InputError("x"); }), InputError);
+  CHECK_THROWS_AS(parallel_for(0, 100, 2,
+                               [](std::uint64_t i) {
+                                 if (i == 37) throw InputError("x");
+                               }),
+                  InputError);
 }
 
 TEST_CASE("validate: bad spreads name the key", "[uncertainty]") {
@@ -339,16 +356,18 @@ TEST_CASE("validate: bad spreads name the key", "[uncertainty]") {
 // the robust objective of the global search: CVaR_95 of the exact F_max and its gradient
 // ------------------------------------------------------------------------------------------------
 
-TEST_CASE("the exact force peak scales as M^(alpha/(alpha+1)) for the eight laws (the robust objective's premise)",
-          "[uncertainty][robust]") {
+TEST_CASE(
+    "the exact force peak scales as M^(alpha/(alpha+1)) for the eight laws (the robust objective's premise)",
+    "[uncertainty][robust]") {
   for (std::string_view name : contact_law_names())
-    for (const ContactParams& cp : {ContactParams{1e9, 1.5, 0.9}, ContactParams{3e7, 1.0, 0.3},
-                                    ContactParams{5e10, 2.2, 0.6}})
+    for (const ContactParams& cp :
+         {ContactParams{1e9, 1.5, 0.9}, ContactParams{3e7, 1.0, 0.3}, ContactParams{5e10, 2.2, 0.6}})
       for (double v : {0.01, 0.2, 1.0}) {
         const AnyContactLaw law = make_contact_law(name, cp, v);
         const double f1 = max_force_exact(law, 1.0), p = cp.alpha / (cp.alpha + 1.0);
         for (double M : {1e-3, 0.37, 12.5, 4e3}) {
-          INFO(name << " K " << cp.K << " alpha " << cp.alpha << " c_r " << cp.c_r << " v " << v << " M " << M);
+          INFO(name << " K " << cp.K << " alpha " << cp.alpha << " c_r " << cp.c_r << " v " << v << " M "
+                    << M);
           CHECK(max_force_exact(law, M) == Approx(f1 * std::pow(M, p)).epsilon(1e-10));
         }
       }
@@ -418,8 +437,10 @@ TEST_CASE("robust objective: CVaR_95 and p95 against the per-sample forces, its 
 // target's mass, inertia, centre of mass (contact-offset), spin and the contact parameters cannot
 // make a robust optimum differ. Checked here over pairs of random configurations; with a 30 deg
 // normal cone, or the contact point uncertain by 2 cm, some pairs rank differently.
-TEST_CASE("robust objective: with the normal and the contact point known, CVaR_95 and p95 rank configurations as the nominal M_ie does",
-          "[uncertainty][robust]") {
+TEST_CASE(
+    "robust objective: with the normal and the contact point known, CVaR_95 and p95 rank configurations as "
+    "the nominal M_ie does",
+    "[uncertainty][robust]") {
   const Model m = model_from_urdf_file(kRobots + "paper_7dof.urdf");
   Data data(m);
   const int frame = m.end_effector();
@@ -487,8 +508,10 @@ TEST_CASE("robust objective: with the normal and the contact point known, CVaR_9
   CHECK(moved.second > 0);
 }
 
-TEST_CASE("the single-body F_max scales as K^(1/(alpha+1)), closed and exact, eight laws (the conditional estimator's premise)",
-          "[uncertainty][robust]") {
+TEST_CASE(
+    "the single-body F_max scales as K^(1/(alpha+1)), closed and exact, eight laws (the conditional "
+    "estimator's premise)",
+    "[uncertainty][robust]") {
   for (std::string_view name : contact_law_names())
     for (const ContactParams& cp : {ContactParams{1e9, 1.5, 0.9}, ContactParams{3e7, 1.0, 0.3},
                                     ContactParams{5e10, 2.2, 0.6}, ContactParams{2e8, 0.7, 1.0}})
@@ -497,16 +520,20 @@ TEST_CASE("the single-body F_max scales as K^(1/(alpha+1)), closed and exact, ei
         const AnyContactLaw l1 = make_contact_law(name, cp, v);
         for (double ratio : {1e-3, 0.31, 7.0, 2e3}) {
           const AnyContactLaw l2 = make_contact_law(name, {cp.K * ratio, cp.alpha, cp.c_r}, v);
-          INFO(name << " K " << cp.K << " alpha " << cp.alpha << " c_r " << cp.c_r << " v " << v << " ratio " << ratio);
-          CHECK(max_force_exact(l2, 3.7) == Approx(max_force_exact(l1, 3.7) * std::pow(ratio, a)).epsilon(1e-10));
+          INFO(name << " K " << cp.K << " alpha " << cp.alpha << " c_r " << cp.c_r << " v " << v << " ratio "
+                    << ratio);
+          CHECK(max_force_exact(l2, 3.7) ==
+                Approx(max_force_exact(l1, 3.7) * std::pow(ratio, a)).epsilon(1e-10));
           CHECK(max_force_closed_form(l2, 3.7) ==
                 Approx(max_force_closed_form(l1, 3.7) * std::pow(ratio, a)).epsilon(1e-10));
         }
       }
 }
 
-TEST_CASE("scalar_law: the CDF of the truncated law is the sampler's (Kolmogorov-Smirnov), its density the CDF's slope",
-          "[uncertainty]") {
+TEST_CASE(
+    "scalar_law: the CDF of the truncated law is the sampler's (Kolmogorov-Smirnov), its density the CDF's "
+    "slope",
+    "[uncertainty]") {
   struct Case {
     const char* what;
     Quantity q;
@@ -562,9 +589,11 @@ TEST_CASE("scalar_law: the CDF of the truncated law is the sampler's (Kolmogorov
     CHECK(scalar_law(c.sp, c.q, c.x0, x.front()).cdf < 1e-3);
     CHECK(scalar_law(c.sp, c.q, c.x0, x.back()).cdf > 1 - 1e-3);
   }
-  CHECK_THROWS_AS(scalar_law(Spread{}, Quantity::Stiffness, 1e9, 1e9), InputError);                       // fixed
-  CHECK_THROWS_AS(scalar_law(law(Spread::Law::Normal, 0.0), Quantity::Stiffness, 1e9, 1e9), InputError);  // no spread
-  CHECK_THROWS_AS(scalar_law(law(Spread::Law::Normal, 0.1), Quantity::Spin, 0.0, 0.0), InputError);       // a vector
+  CHECK_THROWS_AS(scalar_law(Spread{}, Quantity::Stiffness, 1e9, 1e9), InputError);  // fixed
+  CHECK_THROWS_AS(scalar_law(law(Spread::Law::Normal, 0.0), Quantity::Stiffness, 1e9, 1e9),
+                  InputError);  // no spread
+  CHECK_THROWS_AS(scalar_law(law(Spread::Law::Normal, 0.1), Quantity::Spin, 0.0, 0.0),
+                  InputError);  // a vector
   Spread nowhere = law(Spread::Law::Uniform, 0.1, true);
   nowhere.min = 2e9;  // U[0.9e9, 1.1e9] above 2e9: nothing left
   CHECK_THROWS_AS(scalar_law(nowhere, Quantity::Stiffness, 1e9, 1e9), NumericalError);
@@ -582,7 +611,8 @@ std::vector<double> forces_of_stiffness(const std::vector<double>& K, double c, 
 
 }  // namespace
 
-TEST_CASE("stiffness-conditional percentiles: exact when F_max depends on K alone, whatever the sample", "[uncertainty][robust]") {
+TEST_CASE("stiffness-conditional percentiles: exact when F_max depends on K alone, whatever the sample",
+          "[uncertainty][robust]") {
   const double z95 = 1.6448536269514722, z99 = 2.3263478740408408, alpha = 1.5, c = 3.0e-2;
   for (std::size_t n : {1u, 7u, 1000u}) {
     INFO("n = " << n);
@@ -613,8 +643,10 @@ TEST_CASE("stiffness-conditional percentiles: exact when F_max depends on K alon
   }
 }
 
-TEST_CASE("stiffness-conditional percentiles: unbiased, less scatter than order statistics, the delta-method interval covers 95 %",
-          "[uncertainty][robust]") {
+TEST_CASE(
+    "stiffness-conditional percentiles: unbiased, less scatter than order statistics, the delta-method "
+    "interval covers 95 %",
+    "[uncertainty][robust]") {
   // ln F = ln c + ln K / (alpha + 1) with ln c ~ N(0, 0.1^2) and ln K ~ N(ln 1e9, 0.587^2): ln F is
   // normal, so the law's 95th percentile is known in closed form.
   const double sc = 0.1, sk = 0.587, alpha = 1.5, a = 1.0 / (alpha + 1.0), z95 = 1.6448536269514722;
@@ -645,16 +677,18 @@ TEST_CASE("stiffness-conditional percentiles: unbiased, less scatter than order 
     CHECK(s.order.p95 == summarize(f).p95);
   }
   const double mean_c = sum_c / sets, rms_c = std::sqrt(sum2_c / sets), rms_o = std::sqrt(sum2_o / sets);
-  INFO("conditional: bias " << mean_c << ", rms " << rms_c << "; order statistics: bias " << sum_o / sets << ", rms "
-                            << rms_o << "; coverage " << covered << "/" << sets);
+  INFO("conditional: bias " << mean_c << ", rms " << rms_c << "; order statistics: bias " << sum_o / sets
+                            << ", rms " << rms_o << "; coverage " << covered << "/" << sets);
   CHECK(std::abs(mean_c) < 4 * rms_c / std::sqrt(double(sets)));  // unbiased to the sampling error
-  CHECK(rms_c < 0.4 * rms_o);  // here the stiffness carries 86 % of the variance of ln F
+  CHECK(rms_c < 0.4 * rms_o);     // here the stiffness carries 86 % of the variance of ln F
   CHECK(covered >= 0.92 * sets);  // nominal 95 %: 380 of 400, binomial sd 4.4
   CHECK(covered <= 0.98 * sets);
 }
 
-TEST_CASE("paired p95 ratio of two configurations: exact for a scaled force, covers 95 % on a known law, narrower than unpaired",
-          "[uncertainty][robust]") {
+TEST_CASE(
+    "paired p95 ratio of two configurations: exact for a scaled force, covers 95 % on a known law, narrower "
+    "than unpaired",
+    "[uncertainty][robust]") {
   const double sc = 0.1, sk = 0.587, alpha = 1.5, a = 1.0 / (alpha + 1.0), z95 = 1.6448536269514722;
   const Spread ln = law(Spread::Law::LogNormal, sk);
   // b = lambda a on every sample: the ratio is lambda and nothing varies between the two estimates
@@ -675,7 +709,8 @@ TEST_CASE("paired p95 ratio of two configurations: exact for a scaled force, cov
   // ln F_a = ln c + ln K / (alpha + 1), ln F_b = ln F_a + 0.02 + 0.05 z': both normal, so the true
   // ratio of the 95th percentiles is known in closed form
   const double sb = 0.05, shift = 0.02;
-  const double sa_tot = std::sqrt(sc * sc + a * a * sk * sk), sb_tot = std::sqrt(sc * sc + sb * sb + a * a * sk * sk);
+  const double sa_tot = std::sqrt(sc * sc + a * a * sk * sk),
+               sb_tot = std::sqrt(sc * sc + sb * sb + a * a * sk * sk);
   const double truth = std::exp(shift + z95 * (sb_tot - sa_tot));
   const int sets = 400, n = 1000;
   std::mt19937_64 rng(2027);
@@ -704,7 +739,8 @@ TEST_CASE("paired p95 ratio of two configurations: exact for a scaled force, cov
   CHECK(covered <= 0.98 * sets);
   CHECK(paired < 0.6 * unpaired);  // what the samples share cancels
   // the two configurations must share the samples
-  CHECK_THROWS_AS(compare_p95_stiffness_conditional(fa, std::vector<double>(3, 1.0), K, A, ln, 1e9), InputError);
+  CHECK_THROWS_AS(compare_p95_stiffness_conditional(fa, std::vector<double>(3, 1.0), K, A, ln, 1e9),
+                  InputError);
 }
 
 TEST_CASE("stiffness-conditional percentiles: bad inputs", "[uncertainty][robust]") {

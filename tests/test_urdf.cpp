@@ -67,7 +67,8 @@ bool contains(const std::string& s, const std::string& part) { return s.find(par
 
 }  // namespace
 
-TEST_CASE("malformed or unphysical URDF files are rejected with a message naming file and element", "[urdf]") {
+TEST_CASE("malformed or unphysical URDF files are rejected with a message naming file and element",
+          "[urdf]") {
   const std::vector<BadFile> cases{
       {"not_xml.urdf", Kind::Model, {"malformed URDF"}},
       {"empty.urdf", Kind::Model, {"malformed URDF"}},
@@ -203,15 +204,17 @@ TEST_CASE("the paper robots load with the paper's masses and inertias", "[urdf][
   for (int i = 0; i <= 3; ++i) {
     INFO("3-DOF body " << i);
     CHECK(m3.body(i).inertia.mass == mass3[static_cast<size_t>(i)]);
-    CHECK((m3.body(i).inertia.I - Matrix3(I3[static_cast<size_t>(i)].asDiagonal())).cwiseAbs().maxCoeff() < 1e-12);
+    CHECK((m3.body(i).inertia.I - Matrix3(I3[static_cast<size_t>(i)].asDiagonal())).cwiseAbs().maxCoeff() <
+          1e-12);
   }
   CHECK(m3.frame(m3.end_effector()).name == "ee");
   CHECK(m3.joint_names() == std::vector<std::string>{"joint1", "joint2", "joint3"});
 
   const Model m7 = model_from_urdf_file(source_path("robots/paper_7dof.urdf"));
   const std::vector<double> mass7{1000, 5, 5, 10, 10, 5, 5, 8};
-  const std::vector<Vector3> I7{{500, 500, 500}, {0.01, 0.02, 0.02}, {0.02, 0.01, 0.02}, {0.84, 0.01, 0.84},
-                                {0.01, 0.84, 0.84}, {0.02, 0.02, 0.01}, {0.02, 0.02, 0.01}, {0.03, 0.03, 0.01}};
+  const std::vector<Vector3> I7{{500, 500, 500},    {0.01, 0.02, 0.02}, {0.02, 0.01, 0.02},
+                                {0.84, 0.01, 0.84}, {0.01, 0.84, 0.84}, {0.02, 0.02, 0.01},
+                                {0.02, 0.02, 0.01}, {0.03, 0.03, 0.01}};
   REQUIRE(m7.n() == 7);
   for (int i = 0; i <= 7; ++i) {
     INFO("7-DOF body " << i);
@@ -254,15 +257,19 @@ TEST_CASE("a fixed child merges its mass: same H as the robot built in code", "[
   const Matrix3 I_tool = X_tool.R * tool_own.I * X_tool.R.transpose();
   const double m = arm.mass + tool_own.mass;
   const Vector3 c = (arm.mass * arm.com + tool_own.mass * c_tool) / m;
-  auto shift = [](double mk, const Vector3& d) { return Matrix3(mk * (d.squaredNorm() * Matrix3::Identity() - d * d.transpose())); };
-  const Inertia merged{m, c, arm.I + shift(arm.mass, arm.com - c) + I_tool + shift(tool_own.mass, c_tool - c)};
+  auto shift = [](double mk, const Vector3& d) {
+    return Matrix3(mk * (d.squaredNorm() * Matrix3::Identity() - d * d.transpose()));
+  };
+  const Inertia merged{m, c,
+                       arm.I + shift(arm.mass, arm.com - c) + I_tool + shift(tool_own.mass, c_tool - c)};
 
   const Model in_code =
       ModelBuilder("base", {200, {0.1, 0, 0}, Vector3(50, 60, 70).asDiagonal()})
-          .add_joint("shoulder", JointType::Revolute, "base", Pose::from_xyz_rpy({0.3, 0.1, 0.2}, {0.1, 0.2, 0.3}),
-                     Vector3(0, 1, 1), "arm", merged)
-          .add_joint("wrist", JointType::Revolute, "arm", X_tool * Pose::from_xyz_rpy({0.1, 0, 0}, {0.4, 0, 0}),
-                     Vector3::UnitX(), "hand", {1.5, {0.1, 0, 0}, Vector3(0.002, 0.006, 0.006).asDiagonal()})
+          .add_joint("shoulder", JointType::Revolute, "base",
+                     Pose::from_xyz_rpy({0.3, 0.1, 0.2}, {0.1, 0.2, 0.3}), Vector3(0, 1, 1), "arm", merged)
+          .add_joint("wrist", JointType::Revolute, "arm",
+                     X_tool * Pose::from_xyz_rpy({0.1, 0, 0}, {0.4, 0, 0}), Vector3::UnitX(), "hand",
+                     {1.5, {0.1, 0, 0}, Vector3(0.002, 0.006, 0.006).asDiagonal()})
           .add_fixed("ee_mount", "hand", Pose{{0.2, 0, 0}, Matrix3::Identity()}, "ee", Inertia{})
           .build();
 
@@ -281,8 +288,10 @@ TEST_CASE("a fixed child merges its mass: same H as the robot built in code", "[
     const Eigen::VectorXd theta = rng.vec(2, 2.0);
     INFO("config " << k);
     // same robot, two routes: rounding only, 1e-12 relative
-    CHECK(rel_err(MatrixXd(crba(from_file, d1, base, theta)), MatrixXd(crba(in_code, d2, base, theta))) < 1e-12);
-    CHECK((frame_pose(from_file, d1, from_file.end_effector()).p - frame_pose(in_code, d2, in_code.end_effector()).p)
+    CHECK(rel_err(MatrixXd(crba(from_file, d1, base, theta)), MatrixXd(crba(in_code, d2, base, theta))) <
+          1e-12);
+    CHECK((frame_pose(from_file, d1, from_file.end_effector()).p -
+           frame_pose(in_code, d2, in_code.end_effector()).p)
               .norm() < 1e-12);
   }
 }
@@ -309,7 +318,8 @@ TEST_CASE("a prismatic joint moves its child along the normalized axis", "[urdf]
 
 TEST_CASE("joints are ordered depth-first, siblings in file order", "[urdf]") {
   const Model m = model_from_urdf_file(source_path("tests/data/sibling_order.urdf"), "zz");
-  CHECK(m.joint_names() == std::vector<std::string>{"zulu_joint", "mike_joint", "alpha_joint", "bravo_joint"});
+  CHECK(m.joint_names() ==
+        std::vector<std::string>{"zulu_joint", "mike_joint", "alpha_joint", "bravo_joint"});
   CHECK(m.body(0).name == "base");  // the root, although listed third
   CHECK(m.body(1).name == "z");
   CHECK(m.body(2).name == "zz");
@@ -320,10 +330,12 @@ TEST_CASE("joints are ordered depth-first, siblings in file order", "[urdf]") {
 }
 
 TEST_CASE("gravity is zero by default", "[urdf]") {
-  for (const char* f : {"robots/paper_3dof.urdf", "robots/paper_7dof.urdf", "tests/data/fixed_child_merge.urdf"})
+  for (const char* f :
+       {"robots/paper_3dof.urdf", "robots/paper_7dof.urdf", "tests/data/fixed_child_merge.urdf"})
     CHECK(model_from_urdf_file(source_path(f)).gravity == Vector3::Zero());
   CHECK(ModelBuilder("b", {1, Vector3::Zero(), Matrix3::Identity()})
-            .add_joint("j", JointType::Revolute, "b", Pose{}, Vector3::UnitZ(), "l", {1, Vector3::Zero(), Matrix3::Identity()})
+            .add_joint("j", JointType::Revolute, "b", Pose{}, Vector3::UnitZ(), "l",
+                       {1, Vector3::Zero(), Matrix3::Identity()})
             .build()
             .gravity == Vector3::Zero());
 }
@@ -342,25 +354,34 @@ TEST_CASE("bad trees built in code", "[urdf]") {
     return "no exception";
   };
   const double inf = std::numeric_limits<double>::infinity();
-  CHECK(contains(message([&] { base().add_joint("j", JointType::Revolute, "b", Pose{}, Vector3::UnitZ(), "big", {inf, Vector3::Zero(), Matrix3::Identity()}); }),
+  CHECK(contains(message([&] {
+                   base().add_joint("j", JointType::Revolute, "b", Pose{}, Vector3::UnitZ(), "big",
+                                    {inf, Vector3::Zero(), Matrix3::Identity()});
+                 }),
                  "ModelError: link 'big': inertial values must be finite"));
-  CHECK(contains(message([&] { base().add_joint("j", JointType::Revolute, "b", Pose{}, Vector3::Zero(), "l", ok); }),
-                 "ModelError: joint 'j': axis"));
-  CHECK(contains(message([&] { base().add_joint("j", JointType::Revolute, "nowhere", Pose{}, Vector3::UnitZ(), "l", ok); }),
+  CHECK(contains(
+      message([&] { base().add_joint("j", JointType::Revolute, "b", Pose{}, Vector3::Zero(), "l", ok); }),
+      "ModelError: joint 'j': axis"));
+  CHECK(contains(message([&] {
+                   base().add_joint("j", JointType::Revolute, "nowhere", Pose{}, Vector3::UnitZ(), "l", ok);
+                 }),
                  "ModelError: joint 'j': unknown parent link 'nowhere'"));
   CHECK(contains(message([&] {
-                   base().add_joint("j1", JointType::Revolute, "b", Pose{}, Vector3::UnitZ(), "l", ok)
+                   base()
+                       .add_joint("j1", JointType::Revolute, "b", Pose{}, Vector3::UnitZ(), "l", ok)
                        .add_joint("j2", JointType::Revolute, "b", Pose{}, Vector3::UnitZ(), "l", ok);
                  }),
                  "ModelError: joint 'j2': link 'l' already has a parent"));
   CHECK(contains(message([&] {
-                   base().add_joint("j1", JointType::Revolute, "b", Pose{}, Vector3::UnitZ(), "l1", ok)
+                   base()
+                       .add_joint("j1", JointType::Revolute, "b", Pose{}, Vector3::UnitZ(), "l1", ok)
                        .add_joint("j2", JointType::Prismatic, "b", Pose{}, Vector3::UnitX(), "l2", ok)
                        .build();
                  }),
                  "InputError: the end-effector is ambiguous: the tree has 2 leaf links (l1, l2)"));
   Pose nan_pose;
   nan_pose.p.x() = std::nan("");
-  CHECK(contains(message([&] { base().add_joint("jn", JointType::Revolute, "b", nan_pose, Vector3::UnitZ(), "l", ok); }),
-                 "ModelError: joint 'jn' origin: values must be finite"));
+  CHECK(contains(
+      message([&] { base().add_joint("jn", JointType::Revolute, "b", nan_pose, Vector3::UnitZ(), "l", ok); }),
+      "ModelError: joint 'jn' origin: values must be finite"));
 }

@@ -35,8 +35,8 @@ struct Tolerance {
 /// a changed string or boolean and a change of type are differences too. Top-level keys listed in
 /// `skip` (inputs such as the resolved scenario and the version, not results) are not compared, nor
 /// are the keys of kUncomparedKeys at any depth (wall-clock times and the optimizers' work counters).
-std::vector<std::string> compare_results(const nlohmann::json& stored, const nlohmann::json& now, Tolerance tol,
-                                         const std::vector<std::string>& skip);
+std::vector<std::string> compare_results(const nlohmann::json& stored, const nlohmann::json& now,
+                                         Tolerance tol, const std::vector<std::string>& skip);
 
 // --- definitions ----------------------------------------------------------------------------------
 namespace detail_baseline {
@@ -47,8 +47,8 @@ using nlohmann::json;
 /// Keys of these names (at any depth) are never compared: wall-clock times (global.search.seconds)
 /// and the optimizers' work counters (SLSQP and damped-step evaluations), which move with the last
 /// bit of a gradient -- another compiler, Eigen version or libm -- while the results agree.
-inline constexpr std::array<std::string_view, 4> kUncomparedKeys{"seconds", "evaluations", "damped_evaluations",
-                                                                 "multibody_evaluations"};
+inline constexpr std::array<std::string_view, 4> kUncomparedKeys{
+    "seconds", "evaluations", "damped_evaluations", "multibody_evaluations"};
 inline bool uncompared(const std::string& key) {
   return std::find(kUncomparedKeys.begin(), kUncomparedKeys.end(), key) != kUncomparedKeys.end();
 }
@@ -59,7 +59,8 @@ inline std::string show(const json& v) {
   return v.dump();
 }
 
-inline void compare(const json& a, const json& b, const std::string& path, Tolerance tol, std::vector<std::string>& out) {
+inline void compare(const json& a, const json& b, const std::string& path, Tolerance tol,
+                    std::vector<std::string>& out) {
   const std::string where = path.empty() ? std::string("(top level)") : path;
   if (a.is_number() && b.is_number()) {
     const double x = a.get<double>(), y = b.get<double>();
@@ -71,11 +72,14 @@ inline void compare(const json& a, const json& b, const std::string& path, Toler
     const std::string prefix = path.empty() ? "" : path + ".";
     for (const auto& [key, value] : a.items()) {
       if (uncompared(key)) continue;  // a wall-clock time or a work counter is not a result
-      if (!b.contains(key)) out.push_back(str(prefix, key, ": stored ", show(value), ", now missing"));
-      else compare(value, b.at(key), prefix + key, tol, out);
+      if (!b.contains(key))
+        out.push_back(str(prefix, key, ": stored ", show(value), ", now missing"));
+      else
+        compare(value, b.at(key), prefix + key, tol, out);
     }
     for (const auto& [key, value] : b.items())
-      if (!uncompared(key) && !a.contains(key)) out.push_back(str(prefix, key, ": stored missing, now ", show(value)));
+      if (!uncompared(key) && !a.contains(key))
+        out.push_back(str(prefix, key, ": stored missing, now ", show(value)));
     return;
   }
   if (a.is_array() && b.is_array()) {
@@ -102,7 +106,8 @@ inline nlohmann::json load_baseline(const std::string& path, const std::string& 
   json j = json::parse(ss.str(), nullptr, false);
   if (j.is_discarded())
     throw InputError(str(flag, " ", path, ": not a JSON file (write a baseline with --json FILE)"));
-  if (!j.is_object()) throw InputError(str(flag, " ", path, ": expected a JSON object (a result written with --json)"));
+  if (!j.is_object())
+    throw InputError(str(flag, " ", path, ": expected a JSON object (a result written with --json)"));
   return j;
 }
 

@@ -48,7 +48,9 @@ std::vector<double> parse_list(const std::string& text, const std::string& flag,
       ok = ok || out.size() == c;
       expected += (expected.empty() ? "" : " or ") + std::to_string(c);
     }
-    if (!ok) throw InputError(str(flag, ": expected ", expected, " comma-separated numbers, got ", out.size(), " ('", text, "')"));
+    if (!ok)
+      throw InputError(str(flag, ": expected ", expected, " comma-separated numbers, got ", out.size(), " ('",
+                           text, "')"));
   }
   return out;
 }
@@ -63,25 +65,34 @@ double rad2deg(double rad) { return rad * 180.0 / M_PI; }
 
 void RobotOptions::add_to(CLI::App& app) {
   app.add_option("--urdf", urdf, "Robot URDF file; its root link is the free-floating base")->required();
-  app.add_option("--joints-deg", joints_deg, "Joint angles in degrees, comma-separated, URDF tree order")->required();
-  app.add_option("--end-effector", end_effector, "End-effector frame (a link name); default: the single leaf link");
-  app.add_option("--base-position", base_position, "Base frame origin in the inertial frame, m")->capture_default_str();
-  app.add_option("--base-rpy-deg", base_rpy_deg, "Base attitude, URDF roll,pitch,yaw in degrees")->capture_default_str();
+  app.add_option("--joints-deg", joints_deg, "Joint angles in degrees, comma-separated, URDF tree order")
+      ->required();
+  app.add_option("--end-effector", end_effector,
+                 "End-effector frame (a link name); default: the single leaf link");
+  app.add_option("--base-position", base_position, "Base frame origin in the inertial frame, m")
+      ->capture_default_str();
+  app.add_option("--base-rpy-deg", base_rpy_deg, "Base attitude, URDF roll,pitch,yaw in degrees")
+      ->capture_default_str();
   load.add_to(app);
 }
 
 std::string joint_count_error(size_t got, const Model& model, const std::string& where) {
   std::string names;
   for (const auto& n : model.joint_names()) names += (names.empty() ? "" : ", ") + n;
-  return str("--joints-deg: got ", got, " angles, the robot", where, " has ", model.n(), " joints (", names, ")");
+  return str("--joints-deg: got ", got, " angles, the robot", where, " has ", model.n(), " joints (", names,
+             ")");
 }
 
 void TargetOptions::add_to(CLI::App& app) {
   app.add_option("--target-mass", mass, "Target mass m_t, kg")->capture_default_str();
-  app.add_option("--target-inertia", inertia, "Target inertia about its centre of mass (target frame): Ixx,Iyy,Izz or Ixx,Iyy,Izz,Ixy,Ixz,Iyz, kg m^2")
+  app.add_option("--target-inertia", inertia,
+                 "Target inertia about its centre of mass (target frame): Ixx,Iyy,Izz or "
+                 "Ixx,Iyy,Izz,Ixy,Ixz,Iyz, kg m^2")
       ->capture_default_str();
-  app.add_option("--target-rpy-deg", rpy_deg, "Target attitude, roll,pitch,yaw in degrees")->capture_default_str();
-  app.add_option("--contact-offset", contact_offset, "r_tp: contact point from the target's centre of mass (target frame), m")
+  app.add_option("--target-rpy-deg", rpy_deg, "Target attitude, roll,pitch,yaw in degrees")
+      ->capture_default_str();
+  app.add_option("--contact-offset", contact_offset,
+                 "r_tp: contact point from the target's centre of mass (target frame), m")
       ->capture_default_str();
   app.add_option("--normal", normal, "u_n: contact normal (target frame); normalized")->capture_default_str();
 }
@@ -100,7 +111,8 @@ Matrix3 parse_inertia(const std::string& text, const std::string& flag) {
 
 Target TargetOptions::build() const {
   Target t;
-  if (!std::isfinite(mass) || mass <= 0) throw InputError(str("--target-mass: must be positive and finite, got ", mass));
+  if (!std::isfinite(mass) || mass <= 0)
+    throw InputError(str("--target-mass: must be positive and finite, got ", mass));
   t.mass = mass;
   t.inertia = parse_inertia(inertia, "--target-inertia");
   const Vector3 rpy = parse_vec3(rpy_deg, "--target-rpy-deg") * (M_PI / 180.0);
@@ -120,11 +132,14 @@ Target TargetOptions::build() const {
 void ContactLawOptions::add_to(CLI::App& app, const std::string& model_help) {
   app.add_option("--stiffness", stiffness, "Contact stiffness K, N/m^alpha")->capture_default_str();
   app.add_option("--exponent", exponent, "Contact exponent alpha")->capture_default_str();
-  app.add_option("--restitution", restitution, "Coefficient of restitution c_r, 0 < c_r <= 1")->capture_default_str();
-  app.add_option("--model", model, model_help)->capture_default_str();
-  app.add_option("--approach-speed", approach_speed, "End-effector speed along the normal at first touch, m/s")
+  app.add_option("--restitution", restitution, "Coefficient of restitution c_r, 0 < c_r <= 1")
       ->capture_default_str();
-  app.add_option("--target-angular-velocity-deg", target_angular_velocity_deg, "Target spin (target frame), deg/s")
+  app.add_option("--model", model, model_help)->capture_default_str();
+  app.add_option("--approach-speed", approach_speed,
+                 "End-effector speed along the normal at first touch, m/s")
+      ->capture_default_str();
+  app.add_option("--target-angular-velocity-deg", target_angular_velocity_deg,
+                 "Target spin (target frame), deg/s")
       ->capture_default_str();
   app.add_option("--target-velocity", target_velocity, "Target linear velocity (inertial frame), m/s")
       ->capture_default_str();
@@ -141,7 +156,8 @@ ContactParams ContactLawOptions::params() const {
 }
 
 void ContactLawOptions::set_target_motion(Target& target) const {
-  target.angular_velocity = parse_vec3(target_angular_velocity_deg, "--target-angular-velocity-deg") * (M_PI / 180.0);
+  target.angular_velocity =
+      parse_vec3(target_angular_velocity_deg, "--target-angular-velocity-deg") * (M_PI / 180.0);
   target.velocity = parse_vec3(target_velocity, "--target-velocity");
 }
 
@@ -152,10 +168,12 @@ Robot load_robot(const RobotOptions& o) {
   warn_repairs(r.report);
   r.end_effector = r.model.end_effector();
   const auto q = parse_list(o.joints_deg, "--joints-deg");
-  if (static_cast<int>(q.size()) != r.model.n()) throw InputError(joint_count_error(q.size(), r.model, " in " + o.urdf));
+  if (static_cast<int>(q.size()) != r.model.n())
+    throw InputError(joint_count_error(q.size(), r.model, " in " + o.urdf));
   r.theta = Eigen::Map<const Eigen::VectorXd>(q.data(), static_cast<Eigen::Index>(q.size())) * (M_PI / 180.0);
   r.base.position = parse_vec3(o.base_position, "--base-position");
-  r.base.orientation = Quaternion(rotation_from_rpy(parse_vec3(o.base_rpy_deg, "--base-rpy-deg") * (M_PI / 180.0)));
+  r.base.orientation =
+      Quaternion(rotation_from_rpy(parse_vec3(o.base_rpy_deg, "--base-rpy-deg") * (M_PI / 180.0)));
   return r;
 }
 
@@ -172,11 +190,13 @@ enum class OutputKind { Stdout, Direct, Regular };
 
 /// "path (--flag)", or the path alone when no flag is known; standard output is named as such.
 std::string output_name(const OutputSpec& o) {
-  if (is_stdout_name(o.path)) return o.flag.empty() ? "standard output" : str("standard output (", o.flag, " ", o.path, ")");
+  if (is_stdout_name(o.path))
+    return o.flag.empty() ? "standard output" : str("standard output (", o.flag, " ", o.path, ")");
   return o.flag.empty() ? o.path : str(o.path, " (", o.flag, ")");
 }
 
-[[noreturn]] void throw_write_error(const std::string& name, int err, const char* what = "cannot write the output file") {
+[[noreturn]] void throw_write_error(const std::string& name, int err,
+                                    const char* what = "cannot write the output file") {
   std::string msg = str(name, ": ", what);
   if (err != 0) msg += str(": ", std::strerror(err));
   if (err == EPIPE) msg += " (the reader closed the pipe)";
@@ -192,7 +212,8 @@ OutputKind resolve_output(const std::string& path, const std::string& name, std:
   std::string p = path;
   bool alias = false;  // a name of an open file descriptor: never replaced
   for (int hop = 0;; ++hop) {
-    alias = alias || starts_with(p, "/proc/") || starts_with(p, "/dev/fd/") || p == "/dev/stdout" || p == "/dev/stderr";
+    alias = alias || starts_with(p, "/proc/") || starts_with(p, "/dev/fd/") || p == "/dev/stdout" ||
+            p == "/dev/stderr";
     struct stat st {};
     if (::lstat(p.c_str(), &st) != 0) {
       if (errno != ENOENT) throw_write_error(name, errno);
@@ -207,7 +228,8 @@ OutputKind resolve_output(const std::string& path, const std::string& name, std:
       p = target.is_absolute() ? target.string() : (std::filesystem::path(p).parent_path() / target).string();
       continue;
     }
-    if (S_ISDIR(st.st_mode)) throw InputError(str(name, ": cannot write the output file (it is a directory)"));
+    if (S_ISDIR(st.st_mode))
+      throw InputError(str(name, ": cannot write the output file (it is a directory)"));
     final_path = p;
     return S_ISREG(st.st_mode) && !alias ? OutputKind::Regular : OutputKind::Direct;
   }
@@ -345,7 +367,9 @@ void Outputs::write() const {
   write_outputs(specs);
 }
 
-void write_file_atomic(const std::string& path, const std::string& content) { write_outputs({{"", path, &content}}); }
+void write_file_atomic(const std::string& path, const std::string& content) {
+  write_outputs({{"", path, &content}});
+}
 
 void write_files_atomic(const std::vector<std::pair<std::string, std::string>>& files) {
   std::vector<OutputSpec> specs;
@@ -359,13 +383,17 @@ void flush_stdout() {
   const bool failed = !std::cout || std::fflush(stdout) != 0 || std::ferror(stdout);
   if (failed) {
     // errno names the cause when this flush failed; an earlier failed write may have lost it
-    if (errno == 0) throw InputError("standard output: cannot write (a closed pipe, a full disk or an I/O error)");
+    if (errno == 0)
+      throw InputError("standard output: cannot write (a closed pipe, a full disk or an I/O error)");
     throw_write_error("standard output", errno, "cannot write");
   }
 }
 
 Progress::Progress(std::string label_, bool quiet, std::string unit_)
-    : label(std::move(label_)), unit(std::move(unit_)), start(std::chrono::steady_clock::now()), enabled(!quiet && isatty(fileno(stderr)) != 0) {}
+    : label(std::move(label_)),
+      unit(std::move(unit_)),
+      start(std::chrono::steady_clock::now()),
+      enabled(!quiet && isatty(fileno(stderr)) != 0) {}
 
 void Progress::operator()(double fraction) {
   if (!enabled) return;
@@ -384,7 +412,9 @@ void Progress::operator()(unsigned long long done, unsigned long long total) {
   const double rate = s > 0 ? static_cast<double>(done) / s : 0.0;
   const double left = rate > 0 ? static_cast<double>(total - done) / rate : 0.0;
   std::fprintf(stderr, "\rffsr-optimize: %s %llu/%llu %s (%3.0f%%), %.3g %s/s, %.0f s left   ", label.c_str(),
-               done, total, unit.c_str(), total ? 100.0 * static_cast<double>(done) / static_cast<double>(total) : 100.0, rate, unit.c_str(), left);
+               done, total, unit.c_str(),
+               total ? 100.0 * static_cast<double>(done) / static_cast<double>(total) : 100.0, rate,
+               unit.c_str(), left);
   if (done >= total) std::fprintf(stderr, "\n");
 }
 

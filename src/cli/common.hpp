@@ -24,7 +24,8 @@ constexpr int kExitRegression = 4;
 
 /// Parses "a,b,c" into numbers; throws InputError naming `flag` on a bad or non-finite number or
 /// when the count is not one of `counts` (empty: any count >= 1).
-std::vector<double> parse_list(const std::string& text, const std::string& flag, std::vector<size_t> counts = {});
+std::vector<double> parse_list(const std::string& text, const std::string& flag,
+                               std::vector<size_t> counts = {});
 Vector3 parse_vec3(const std::string& text, const std::string& flag);
 double deg2rad(double deg);
 double rad2deg(double rad);

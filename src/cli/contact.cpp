@@ -32,13 +32,22 @@ Row evaluate(const Robot& r, const Target& target, const ContactOptions& o, cons
   const ContactParams p{o.law.stiffness, o.law.exponent, o.law.restitution};
   MultibodyContactOptions mo;
   mo.record_series = !o.series.empty() || !o.plot.empty();
-  MultibodyContactResult mb =
-      simulate_contact(r.model, r.base, r.theta, r.end_effector, target, o.law.approach_speed, p, law_name, mo);
+  MultibodyContactResult mb = simulate_contact(r.model, r.base, r.theta, r.end_effector, target,
+                                               o.law.approach_speed, p, law_name, mo);
   const AnyContactLaw law = make_contact_law(law_name, p, mb.approach_velocity);
-  Row row{law_name, mb.integrated_effective_mass, mb.approach_velocity,
-          max_force_closed_form(law, mb.integrated_effective_mass), max_force_exact(law, mb.integrated_effective_mass),
-          mb.f_max, 0, relative_error(law), max_deformation(law, mb.integrated_effective_mass), mb.t_at_f_max,
-          mb.contact_duration, mb.restitution, std::move(mb.series)};
+  Row row{law_name,
+          mb.integrated_effective_mass,
+          mb.approach_velocity,
+          max_force_closed_form(law, mb.integrated_effective_mass),
+          max_force_exact(law, mb.integrated_effective_mass),
+          mb.f_max,
+          0,
+          relative_error(law),
+          max_deformation(law, mb.integrated_effective_mass),
+          mb.t_at_f_max,
+          mb.contact_duration,
+          mb.restitution,
+          std::move(mb.series)};
   row.accuracy = model_accuracy(row.f_closed, row.f_multibody);
   row.mb_delta_max = mb.delta_max;
   row.mb_delta_at_f_max = mb.delta_at_f_max;
@@ -107,7 +116,8 @@ int run_contact(const ContactOptions& o) {
     std::ostringstream csv;
     csv << std::setprecision(12) << "model,t_s,force_N,delta_m\n";
     for (const auto& row : rows)
-      for (const auto& s : row.series) csv << row.model << "," << s.t << "," << s.force << "," << s.delta << "\n";
+      for (const auto& s : row.series)
+        csv << row.model << "," << s.t << "," << s.force << "," << s.delta << "\n";
     outputs.set("--series", csv.str());
     outputs.write();
   }
@@ -119,8 +129,12 @@ int run_contact(const ContactOptions& o) {
       j["laws"] = nlohmann::json::array();
       for (const auto& row : rows) j["laws"].push_back(row_json(row));
     }
-    j["parameters"] = {{"stiffness", o.law.stiffness}, {"exponent", o.law.exponent}, {"restitution", o.law.restitution},
-                       {"approach_speed", o.law.approach_speed}, {"urdf", o.robot.urdf}, {"joints_deg", o.robot.joints_deg}};
+    j["parameters"] = {{"stiffness", o.law.stiffness},
+                       {"exponent", o.law.exponent},
+                       {"restitution", o.law.restitution},
+                       {"approach_speed", o.law.approach_speed},
+                       {"urdf", o.robot.urdf},
+                       {"joints_deg", o.robot.joints_deg}};
     j["version"] = FFSR_VERSION;
     std::cout << j.dump(2) << "\n";
     return 0;
@@ -130,14 +144,16 @@ int run_contact(const ContactOptions& o) {
       << "approach velocity delta_dot^-  = " << rows.front().v_in << " m/s (Eq. 10-12)\n\n";
   out << std::left << std::setw(20) << "model" << std::right << std::setw(13) << "closed (N)" << std::setw(13)
       << "exact (N)" << std::setw(15) << "multibody (N)" << std::setw(13) << "accuracy %" << std::setw(10)
-      << "xi %" << std::setw(13) << "duration ms" << std::setw(11) << "c_r real" << "\n";
+      << "xi %" << std::setw(13) << "duration ms" << std::setw(11) << "c_r real"
+      << "\n";
   for (const auto& row : rows)
     out << std::left << std::setw(20) << row.model << std::right << std::fixed << std::setprecision(2)
         << std::setw(13) << row.f_closed << std::setw(13) << row.f_exact << std::setw(15) << row.f_multibody
         << std::setw(13) << row.accuracy << std::setw(10) << row.xi << std::setw(13) << row.duration * 1e3
         << std::setw(11) << std::setprecision(4) << row.restitution << "\n";
   out << "\nclosed: Eq. 24 (F at the maximum deformation); exact: peak of the single-body model Eq. 16;\n"
-         "multibody: CVODE integration of robot + target (Figure 2); accuracy: Eq. 32, closed vs multibody.\n";
+         "multibody: CVODE integration of robot + target (Figure 2); accuracy: Eq. 32, closed vs "
+         "multibody.\n";
   return 0;
 }
 
@@ -145,13 +161,16 @@ int run_contact(const ContactOptions& o) {
 
 void register_contact(CLI::App& app, Action& action) {
   auto o = std::make_shared<ContactOptions>();
-  CLI::App* sub = app.add_subcommand("contact", "Maximum contact force: closed form, exact, and CVODE multibody reference");
+  CLI::App* sub = app.add_subcommand(
+      "contact", "Maximum contact force: closed form, exact, and CVODE multibody reference");
   o->robot.add_to(*sub);
   o->target.add_to(*sub);
   o->law.add_to(*sub, "Hysteresis damping law (Table 1) or 'all'");
-  sub->add_option("--series", o->series, "Write F(t), delta(t) of the multibody run(s) to this CSV file ('-': standard output)");
+  sub->add_option("--series", o->series,
+                  "Write F(t), delta(t) of the multibody run(s) to this CSV file ('-': standard output)");
   sub->add_flag("--json", o->json, "Print one JSON object on stdout");
-  sub->add_option("--plot", o->plot, "Draw the F-delta loop(s) and F(t) (Figure 3) into this (existing) folder");
+  sub->add_option("--plot", o->plot,
+                  "Draw the F-delta loop(s) and F(t) (Figure 3) into this (existing) folder");
   sub->add_option("--plot-format", o->plot_format, "Figure format: png, svg or pdf")->capture_default_str();
   sub->callback([o, &action] { action = [o] { return run_contact(*o); }; });
 }

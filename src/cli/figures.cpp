@@ -44,12 +44,16 @@ Drawing robot_drawing(const Model& model, Data& data, int frame, const CaptureSa
     if (model.body(i).parent == 0) half = std::max(half, model.body(i).tree.p.cwiseAbs().maxCoeff());
   const Matrix3& R0 = data.R[0];
   const Vector3& p0 = data.p[0];
-  auto corner = [&](double a, double b, double c) { return Vector3(p0 + R0 * Vector3(a * half, b * half, c * half)); };
+  auto corner = [&](double a, double b, double c) {
+    return Vector3(p0 + R0 * Vector3(a * half, b * half, c * half));
+  };
   if (planar) {
-    d.lines.push_back({corner(-1, -1, 0), corner(1, -1, 0), corner(1, 1, 0), corner(-1, 1, 0), corner(-1, -1, 0)});
+    d.lines.push_back(
+        {corner(-1, -1, 0), corner(1, -1, 0), corner(1, 1, 0), corner(-1, 1, 0), corner(-1, -1, 0)});
   } else {
     for (int c : {-1, 1})
-      d.lines.push_back({corner(-1, -1, c), corner(1, -1, c), corner(1, 1, c), corner(-1, 1, c), corner(-1, -1, c)});
+      d.lines.push_back(
+          {corner(-1, -1, c), corner(1, -1, c), corner(1, 1, c), corner(-1, 1, c), corner(-1, -1, c)});
     for (int a : {-1, 1})
       for (int b : {-1, 1}) d.lines.push_back({corner(a, b, -1), corner(a, b, 1)});
   }
@@ -70,12 +74,16 @@ Drawing target_drawing(const Target& t, bool planar, double arrow) {
   Drawing d;
   const double h = std::max(0.1, t.contact_offset.cwiseAbs().maxCoeff());
   const Matrix3 R = t.rotation();
-  auto corner = [&](double a, double b, double c) { return Vector3(t.position + R * Vector3(a * h, b * h, c * h)); };
+  auto corner = [&](double a, double b, double c) {
+    return Vector3(t.position + R * Vector3(a * h, b * h, c * h));
+  };
   if (planar) {
-    d.lines.push_back({corner(-1, -1, 0), corner(1, -1, 0), corner(1, 1, 0), corner(-1, 1, 0), corner(-1, -1, 0)});
+    d.lines.push_back(
+        {corner(-1, -1, 0), corner(1, -1, 0), corner(1, 1, 0), corner(-1, 1, 0), corner(-1, -1, 0)});
   } else {
     for (int c : {-1, 1})
-      d.lines.push_back({corner(-1, -1, c), corner(1, -1, c), corner(1, 1, c), corner(-1, 1, c), corner(-1, -1, c)});
+      d.lines.push_back(
+          {corner(-1, -1, c), corner(1, -1, c), corner(1, 1, c), corner(-1, 1, c), corner(-1, -1, c)});
     for (int a : {-1, 1})
       for (int b : {-1, 1}) d.lines.push_back({corner(a, b, -1), corner(a, b, 1)});
   }
@@ -86,7 +94,8 @@ Drawing target_drawing(const Target& t, bool planar, double arrow) {
   if (side.norm() < 1e-6) side = u.cross(Vector3::UnitX());
   side.normalize();
   d.lines.push_back({tail, cp});
-  d.lines.push_back({cp - 0.25 * arrow * u + 0.12 * arrow * side, cp, cp - 0.25 * arrow * u - 0.12 * arrow * side});
+  d.lines.push_back(
+      {cp - 0.25 * arrow * u + 0.12 * arrow * side, cp, cp - 0.25 * arrow * u - 0.12 * arrow * side});
   d.dots.push_back(cp);
   return d;
 }
@@ -102,8 +111,8 @@ std::vector<size_t> instants(size_t n) {
 }
 
 /// Adds a drawing to a 2-D panel (axes a, b of the inertial frame) or a 3-D panel.
-void add(Panel& p, const Drawing& d, int a, int b, int color, double alpha, double width, const std::string& label,
-         const std::string& dot, double dot_scale) {
+void add(Panel& p, const Drawing& d, int a, int b, int color, double alpha, double width,
+         const std::string& label, const std::string& dot, double dot_scale) {
   bool first = true;
   for (const auto& l : d.lines) {
     Curve c;
@@ -134,7 +143,8 @@ void add(Panel& p, const Drawing& d, int a, int b, int color, double alpha, doub
   }
 }
 
-void add(Panel3& p, const Drawing& d, int color, double alpha, double width, const std::string& dot, double dot_scale) {
+void add(Panel3& p, const Drawing& d, int color, double alpha, double width, const std::string& dot,
+         double dot_scale) {
   for (const auto& l : d.lines) {
     Curve3 c;
     c.color = color;
@@ -164,7 +174,8 @@ void add(Panel3& p, const Drawing& d, int color, double alpha, double width, con
 }
 
 /// Smallest singular value of the task rows of J_f at a recorded state (as the planner computes it).
-double task_singular_value(const Model& model, Data& data, int frame, const CaptureSample& s, const CaptureTask& task) {
+double task_singular_value(const Model& model, Data& data, int frame, const CaptureSample& s,
+                           const CaptureTask& task) {
   const Eigen::MatrixXd& Jf = generalized_jacobian(model, data, s.base, s.theta, frame);
   Eigen::MatrixXd Jt(task.rows(), model.n());
   int r = 0;
@@ -185,8 +196,8 @@ double angle_deg(const Quaternion& a, const Quaternion& b) {
 
 }  // namespace
 
-std::vector<plot::Figure> capture(const Model& model, int frame, const Target& target_at_start, double duration,
-                                  const std::vector<CaptureRun>& runs) {
+std::vector<plot::Figure> capture(const Model& model, int frame, const Target& target_at_start,
+                                  double duration, const std::vector<CaptureRun>& runs) {
   Data data(model);
   const Target target = propagate_target(target_at_start, duration);
   // planar: every joint, the end-effector and the contact point stay in one plane z = const
@@ -195,7 +206,8 @@ std::vector<plot::Figure> capture(const Model& model, int frame, const Target& t
   for (const auto& run : runs)
     for (const auto& s : run.result->series) {
       forward_kinematics(model, data, s.base, s.theta);
-      for (int i = 0; i < model.nb() && planar; ++i) planar = std::abs(data.p[static_cast<size_t>(i)].z() - z0) < 1e-6;
+      for (int i = 0; i < model.nb() && planar; ++i)
+        planar = std::abs(data.p[static_cast<size_t>(i)].z() - z0) < 1e-6;
     }
   double reach = 0;
   for (int i = 1; i < model.nb(); ++i) reach += model.body(i).tree.p.norm();
@@ -206,8 +218,8 @@ std::vector<plot::Figure> capture(const Model& model, int frame, const Target& t
     const CaptureResult& res = *runs[r].result;
     const int color = static_cast<int>(r);
     const std::string title = str("Capture process, ", runs[r].label, " run: M_ie = ", fixed(res.M_ie, 3),
-                                  " kg, F#dmax#u = ", fixed(res.f_max_closed_form / 1e3, 2), " kN at T = ",
-                                  fixed(duration, 0), " s");
+                                  " kg, F#dmax#u = ", fixed(res.f_max_closed_form / 1e3, 2),
+                                  " kN at T = ", fixed(duration, 0), " s");
     const auto idx = instants(res.series.size());
     std::vector<Drawing> arms;
     for (size_t k : idx) arms.push_back(robot_drawing(model, data, frame, res.series[k], planar));
@@ -215,7 +227,9 @@ std::vector<plot::Figure> capture(const Model& model, int frame, const Target& t
     Drawing path;
     path.lines.emplace_back();
     for (const auto& s : res.series) path.lines.back().push_back(s.end_effector);
-    auto alpha = [&](size_t i) { return arms.size() < 2 ? 1.0 : 0.2 + 0.8 * double(i) / double(arms.size() - 1); };
+    auto alpha = [&](size_t i) {
+      return arms.size() < 2 ? 1.0 : 0.2 + 0.8 * double(i) / double(arms.size() - 1);
+    };
 
     plot::Figure fig;
     fig.name = "capture_" + runs[r].label;
@@ -229,8 +243,10 @@ std::vector<plot::Figure> capture(const Model& model, int frame, const Target& t
         const bool last = i + 1 == arms.size();
         const size_t first_curve = p.curves.size();
         add(p, arms[i], 0, 1, color, alpha(i), 2.0,
-            i == 0 ? "arm at t = 0" : last ? str("arm at T = ", fixed(duration, 0), " s") : "", i == 0 ? "○" : "●",
-            i == 0 ? 0.9 : 0.7);
+            i == 0 ? "arm at t = 0"
+            : last ? str("arm at T = ", fixed(duration, 0), " s")
+                   : "",
+            i == 0 ? "○" : "●", i == 0 ? 0.9 : 0.7);
         if (i == 0)  // dashed, open joints: told from the arm at T, which has the same colour
           for (size_t c = first_curve; c < p.curves.size(); ++c)
             if (p.curves[c].line_style == 1) p.curves[c].line_style = 3;
@@ -279,7 +295,8 @@ std::vector<plot::Figure> capture(const Model& model, int frame, const Target& t
   drift.title = "base attitude drift";
   drift.ylabel = "rotation from t = 0 (deg)";
   sigma.title = "smallest singular value of the task Jacobian";
-  const bool any_pose = std::any_of(runs.begin(), runs.end(), [](const CaptureRun& r) { return r.task.kind == CaptureTask::Kind::Pose; });
+  const bool any_pose = std::any_of(
+      runs.begin(), runs.end(), [](const CaptureRun& r) { return r.task.kind == CaptureTask::Kind::Pose; });
   sigma.ylabel = any_pose ? "σ#dmin#u of J#dt#u (m/rad, rad/rad)" : "σ#dmin#u of J#dt#u (m/rad)";
   for (Panel* p : {&mie, &fmax, &drift, &sigma}) p->xlabel = "time t (s)";
   plot::Figure joints;
@@ -348,8 +365,8 @@ std::vector<plot::Figure> capture(const Model& model, int frame, const Target& t
 plot::Figure contact(const std::vector<ContactCurve>& curves, double M_ie, double approach_velocity) {
   plot::Figure fig;
   fig.name = "contact";
-  fig.title = str("Contact force (multibody run): M#die#u = ", fixed(M_ie, 3), " kg, δ̇⁻ = ", fixed(approach_velocity, 3),
-                  " m/s");
+  fig.title = str("Contact force (multibody run): M#die#u = ", fixed(M_ie, 3),
+                  " kg, δ̇⁻ = ", fixed(approach_velocity, 3), " m/s");
   fig.cols = 2;
   Panel loop, time;
   loop.title = "F-δ hysteresis loop (Figure 3)";
@@ -434,7 +451,8 @@ void Grid::validate(size_t dims) const {
     if (!std::is_sorted(a.begin(), a.end())) throw InputError("map plot: grid values must be ascending");
     n *= a.size();
   }
-  if (values.size() != n) throw InputError(str("map plot: ", values.size(), " values for a grid of ", n, " points"));
+  if (values.size() != n)
+    throw InputError(str("map plot: ", values.size(), " values for a grid of ", n, " points"));
 }
 
 namespace {
@@ -450,9 +468,10 @@ std::string point_text(const Grid& g, size_t flat) {
 }
 
 size_t nearest(const std::vector<double>& axis, double v) {
-  return static_cast<size_t>(std::min_element(axis.begin(), axis.end(),
-                                              [&](double a, double b) { return std::abs(a - v) < std::abs(b - v); }) -
-                             axis.begin());
+  return static_cast<size_t>(
+      std::min_element(axis.begin(), axis.end(),
+                       [&](double a, double b) { return std::abs(a - v) < std::abs(b - v); }) -
+      axis.begin());
 }
 }  // namespace
 
@@ -461,7 +480,8 @@ plot::Figure map_heat(const Grid& g, const std::string& name, const std::string&
   plot::Figure fig;
   fig.name = name;
   plot::HeatPanel h;
-  const size_t imax = static_cast<size_t>(std::max_element(g.values.begin(), g.values.end()) - g.values.begin());
+  const size_t imax =
+      static_cast<size_t>(std::max_element(g.values.begin(), g.values.end()) - g.values.begin());
   h.title = title.empty() ? str("maximum ", fixed(g.values[imax], 3), " at ", point_text(g, imax)) : title;
   h.xlabel = g.axis_labels[0];
   h.ylabel = g.axis_labels[1];
@@ -487,11 +507,14 @@ plot::Figure map_slices(const Grid& g, const std::vector<double>& point, const s
   if (point.size() != 3) throw InputError("map plot: the slice point needs one value per varied joint");
   plot::Figure fig;
   fig.name = name;
-  const size_t imax = static_cast<size_t>(std::max_element(g.values.begin(), g.values.end()) - g.values.begin());
-  fig.title = title.empty() ? str("grid maximum ", fixed(g.values[imax], 3), " at ", point_text(g, imax)) : title;
+  const size_t imax =
+      static_cast<size_t>(std::max_element(g.values.begin(), g.values.end()) - g.values.begin());
+  fig.title =
+      title.empty() ? str("grid maximum ", fixed(g.values[imax], 3), " at ", point_text(g, imax)) : title;
   fig.cols = 3;
   const size_t n1 = g.axes[1].size(), n2 = g.axes[2].size();
-  const size_t c[3] = {nearest(g.axes[0], point[0]), nearest(g.axes[1], point[1]), nearest(g.axes[2], point[2])};
+  const size_t c[3] = {nearest(g.axes[0], point[0]), nearest(g.axes[1], point[1]),
+                       nearest(g.axes[2], point[2])};
   double lo = *std::min_element(g.values.begin(), g.values.end()), hi = g.values[imax];
   for (int fixed_axis = 0; fixed_axis < 3; ++fixed_axis) {
     const int a = fixed_axis == 0 ? 1 : 0, b = fixed_axis == 2 ? 1 : 2;
@@ -545,7 +568,9 @@ plot::Figure map_cloud(const Grid& g, const std::string& name, const std::string
   // an even stride per axis so that at most max_points remain
   const size_t n0 = g.axes[0].size(), n1 = g.axes[1].size(), n2 = g.axes[2].size();
   size_t stride = 1;
-  while ((n0 + stride - 1) / stride * ((n1 + stride - 1) / stride) * ((n2 + stride - 1) / stride) > max_points) ++stride;
+  while ((n0 + stride - 1) / stride * ((n1 + stride - 1) / stride) * ((n2 + stride - 1) / stride) >
+         max_points)
+    ++stride;
   for (size_t i = 0; i < n0; i += stride)
     for (size_t j = 0; j < n1; j += stride)
       for (size_t k = 0; k < n2; k += stride) {

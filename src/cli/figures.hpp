@@ -26,13 +26,13 @@ struct CaptureRun {
 /// singular value against time, all runs on shared axes) and "joints" (the joint angles).
 /// Forward kinematics and the task Jacobian are recomputed from each recorded state.
 /// Reads the runs' series (record_series must have been on).
-std::vector<plot::Figure> capture(const Model& model, int frame, const Target& target_at_start, double duration,
-                                  const std::vector<CaptureRun>& runs);
+std::vector<plot::Figure> capture(const Model& model, int frame, const Target& target_at_start,
+                                  double duration, const std::vector<CaptureRun>& runs);
 
 /// One contact run of `contact`: F(t), delta(t) and the two marked points of Figure 3.
 struct ContactCurve {
   std::string law;
-  std::vector<double> t, delta, force;  ///< s, m, N
+  std::vector<double> t, delta, force;           ///< s, m, N
   double delta_max = 0, force_at_delta_max = 0;  ///< (delta_max, F'_max)
   double delta_at_f_max = 0, f_max = 0;          ///< (delta'_max, F_max)
 };
@@ -51,8 +51,8 @@ plot::Figure xi(const XiStudy& study);
 
 /// Values over a grid of joint angles: values[i0 * n1 * n2 + i1 * n2 + i2] (last axis fastest).
 struct Grid {
-  std::vector<std::string> axis_labels;      ///< e.g. "θ1 (deg)"
-  std::vector<std::vector<double>> axes;     ///< ascending, 2 or 3 axes
+  std::vector<std::string> axis_labels;   ///< e.g. "θ1 (deg)"
+  std::vector<std::vector<double>> axes;  ///< ascending, 2 or 3 axes
   std::vector<double> values;
   std::string value_label = "M_ie (kg)";
   /// Checks axes and the number of values; InputError otherwise.

@@ -67,15 +67,15 @@ int run_inspect(const InspectOptions& o) {
     return 0;
   }
   std::cout << std::setprecision(6);
-  std::cout << "robot            " << o.robot.urdf << " (" << r.model.n() << " joints, " << r.model.total_mass()
-            << " kg)\n";
-  std::cout << "end-effector     " << r.model.frame(r.end_effector).name << " at [" << ee.p.transpose().format(
-                                                                                              Eigen::IOFormat(6, 0, ", "))
-            << "] m\n";
+  std::cout << "robot            " << o.robot.urdf << " (" << r.model.n() << " joints, "
+            << r.model.total_mass() << " kg)\n";
+  std::cout << "end-effector     " << r.model.frame(r.end_effector).name << " at ["
+            << ee.p.transpose().format(Eigen::IOFormat(6, 0, ", ")) << "] m\n";
   std::cout << "joints           ";
   const auto names = r.model.joint_names();
   for (size_t i = 0; i < names.size(); ++i)
-    std::cout << names[i] << "=" << r.theta(static_cast<Eigen::Index>(i)) * 180.0 / M_PI << (i + 1 < names.size() ? ", " : " deg\n");
+    std::cout << names[i] << "=" << r.theta(static_cast<Eigen::Index>(i)) * 180.0 / M_PI
+              << (i + 1 < names.size() ? ", " : " deg\n");
   print_load_report(r.report);
   std::cout << "direction u      [" << u.transpose().format(Eigen::IOFormat(6, 0, ", ")) << "]\n";
   std::cout << "effective mass   m_e  = " << m_e << " kg   (Eq. 4)\n";
@@ -89,7 +89,8 @@ int run_inspect(const InspectOptions& o) {
 
 void register_inspect(CLI::App& app, Action& action) {
   auto opts = std::make_shared<InspectOptions>();
-  CLI::App* sub = app.add_subcommand("inspect", "Evaluate one configuration: H, J_f, effective mass and M_ie");
+  CLI::App* sub =
+      app.add_subcommand("inspect", "Evaluate one configuration: H, J_f, effective mass and M_ie");
   opts->robot.add_to(*sub);
   opts->target.add_to(*sub);
   sub->add_flag("--json", opts->json, "Print one JSON object on stdout");

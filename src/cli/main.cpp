@@ -14,8 +14,10 @@ int main(int argc, char** argv) {
   // with EPIPE, reported like any other write error (one line, exit 2), instead of killing the
   // process with SIGPIPE.
   std::signal(SIGPIPE, SIG_IGN);
-  CLI::App app{"ffsr-optimize: capture-configuration optimization for free-floating space robots (ffsr " FFSR_VERSION ")",
-               "ffsr-optimize"};
+  CLI::App app{
+      "ffsr-optimize: capture-configuration optimization for free-floating space robots (ffsr " FFSR_VERSION
+      ")",
+      "ffsr-optimize"};
   app.set_version_flag("--version", FFSR_VERSION);
   Action action;
   register_inspect(app, action);

@@ -80,27 +80,32 @@ Grid parse_grid(const MapOptions& o, int n_joints) {
   Grid g;
   for (double j : joints) {
     if (j != std::floor(j) || j < 1 || j > n_joints)
-      throw InputError(str("--vary: joint ", j, " is not one of 1..", n_joints, " (the robot in ", o.robot.urdf, " has ",
-                           n_joints, " joints, numbered from 1 in URDF tree order)"));
+      throw InputError(str("--vary: joint ", j, " is not one of 1..", n_joints, " (the robot in ",
+                           o.robot.urdf, " has ", n_joints, " joints, numbered from 1 in URDF tree order)"));
     for (const Axis& a : g.axes)
       if (a.joint == static_cast<int>(j) - 1) throw InputError(str("--vary: joint ", j, " is given twice"));
     g.axes.push_back({static_cast<int>(j) - 1, 0, 0, 0});
   }
   const size_t k = g.axes.size();
-  const auto range = parse_list(o.range_deg, "--range-deg", k == 1 ? std::vector<size_t>{2} : std::vector<size_t>{2, 2 * k});
-  const auto step = parse_list(o.step_deg, "--step-deg", k == 1 ? std::vector<size_t>{1} : std::vector<size_t>{1, k});
+  const auto range =
+      parse_list(o.range_deg, "--range-deg", k == 1 ? std::vector<size_t>{2} : std::vector<size_t>{2, 2 * k});
+  const auto step =
+      parse_list(o.step_deg, "--step-deg", k == 1 ? std::vector<size_t>{1} : std::vector<size_t>{1, k});
   double total = 1.0;
   for (size_t i = 0; i < k; ++i) {
     Axis& a = g.axes[i];
-    const double lo = range.size() == 2 ? range[0] : range[2 * i], hi = range.size() == 2 ? range[1] : range[2 * i + 1];
+    const double lo = range.size() == 2 ? range[0] : range[2 * i],
+                 hi = range.size() == 2 ? range[1] : range[2 * i + 1];
     a.step = step.size() == 1 ? step[0] : step[i];
     if (!(a.step > 0)) throw InputError(str("--step-deg: the step must be positive, got ", a.step));
     if (!(lo < hi))
-      throw InputError(str("--range-deg: the range of joint ", a.joint + 1, " is ", lo == hi ? "empty" : "inverted",
-                           " (from ", lo, " to ", hi, "; expected lo < hi)"));
+      throw InputError(str("--range-deg: the range of joint ", a.joint + 1, " is ",
+                           lo == hi ? "empty" : "inverted", " (from ", lo, " to ", hi,
+                           "; expected lo < hi)"));
     a.lo = lo;
     const double r = (hi - lo) / a.step;
-    if (!(r < 9.0e15)) throw InputError(str("--step-deg: the step ", a.step, " is too small for the range ", lo, ",", hi));
+    if (!(r < 9.0e15))
+      throw InputError(str("--step-deg: the step ", a.step, " is too small for the range ", lo, ",", hi));
     a.count = static_cast<std::uint64_t>(std::ceil(r - 1e-9));  // half-open [lo, hi), tolerant of rounding
     if (a.count == 0) a.count = 1;
     total *= static_cast<double>(a.count);
@@ -116,19 +121,23 @@ Grid parse_grid(const MapOptions& o, int n_joints) {
 struct Shard {
   std::uint64_t k = 0, n = 1;
   /// The first point of part j of a grid of `size` points.
-  std::uint64_t begin(std::uint64_t size, std::uint64_t j) const { return j * (size / n) + std::min(j, size % n); }
+  std::uint64_t begin(std::uint64_t size, std::uint64_t j) const {
+    return j * (size / n) + std::min(j, size % n);
+  }
 };
 
 Shard parse_shard(const std::string& text) {
   auto fail = [&]() -> Shard {
-    throw InputError(str("--shard: expected K/N with integers 0 <= K < N (for example 0/4), got '", text, "'"));
+    throw InputError(
+        str("--shard: expected K/N with integers 0 <= K < N (for example 0/4), got '", text, "'"));
   };
   const size_t slash = text.find('/');
   if (slash == std::string::npos) return fail();
   Shard s;
   const std::string a = text.substr(0, slash), b = text.substr(slash + 1);
   for (const auto* part : {&a, &b})
-    if (part->empty() || part->size() > 18 || part->find_first_not_of("0123456789") != std::string::npos) return fail();
+    if (part->empty() || part->size() > 18 || part->find_first_not_of("0123456789") != std::string::npos)
+      return fail();
   s.k = std::stoull(a);
   s.n = std::stoull(b);
   if (s.n < 1 || s.k >= s.n) return fail();
@@ -210,7 +219,7 @@ struct Worker {
   Eigen::VectorXd theta;
   std::vector<char> text;
   std::vector<double> angles;
-  double* values = nullptr;        // M_ie by point index - first_point, when the grid is plotted
+  double* values = nullptr;  // M_ie by point index - first_point, when the grid is plotted
   std::uint64_t first_point = 0;
   // the largest and smallest M_ie seen, and where (smallest point index on ties)
   double max_M = -1, min_M = std::numeric_limits<double>::infinity();
@@ -218,8 +227,17 @@ struct Worker {
 
   Worker(const Model& m, const Grid& g, const AnyContactLaw& l, const Robot& r, const Vector3& u_, double tim,
          size_t block)
-      : model(m), grid(g), law(l), base(r.base), frame(r.end_effector), u(u_), target_inverse_mass(tim), data(m),
-        theta(r.theta), text((g.axes.size() + 2) * 32 * block + 1), angles(g.axes.size()) {}
+      : model(m),
+        grid(g),
+        law(l),
+        base(r.base),
+        frame(r.end_effector),
+        u(u_),
+        target_inverse_mass(tim),
+        data(m),
+        theta(r.theta),
+        text((g.axes.size() + 2) * 32 * block + 1),
+        angles(g.axes.size()) {}
 
   /// Evaluates points [first, last) and formats their rows into `text`; returns the byte count.
   size_t run(std::uint64_t first, std::uint64_t last) {
@@ -234,8 +252,9 @@ struct Worker {
         rest /= ax.count;
         theta(ax.joint) = angles[a] * (M_PI / 180.0);  // as load_robot converts --joints-deg
       }
-      const double M = integrated_effective_mass_fast(model, data, base, theta, frame, u, target_inverse_mass);  // Eq. 14
-      const double F = max_force_closed_form(law, M);                                                  // Eq. 24
+      const double M =
+          integrated_effective_mass_fast(model, data, base, theta, frame, u, target_inverse_mass);  // Eq. 14
+      const double F = max_force_closed_form(law, M);                                               // Eq. 24
       if (values) values[idx - first_point] = M;
       if (M > max_M) max_M = M, argmax = idx;
       if (M < min_M) min_M = M, argmin = idx;
@@ -274,12 +293,14 @@ std::vector<plot::Figure> map_figures(const Grid& grid, const std::vector<std::s
   }
   g.values = std::move(values);
   std::string joints;
-  for (const Axis& a : grid.axes) joints += (joints.empty() ? "" : ", ") + names[static_cast<size_t>(a.joint)];
+  for (const Axis& a : grid.axes)
+    joints += (joints.empty() ? "" : ", ") + names[static_cast<size_t>(a.joint)];
   if (grid.axes.size() == 1) {
     plot::Figure fig;
     fig.name = "map";
     plot::Panel p;
-    const size_t imax = static_cast<size_t>(std::max_element(g.values.begin(), g.values.end()) - g.values.begin());
+    const size_t imax =
+        static_cast<size_t>(std::max_element(g.values.begin(), g.values.end()) - g.values.begin());
     p.title = str("M_ie over ", joints, ": maximum ", g.values[imax], " kg at ", g.axes[0][imax], " deg");
     p.xlabel = g.axis_labels[0];
     p.ylabel = g.value_label;
@@ -309,13 +330,14 @@ int run_map(const MapOptions& o) {
   o.law.set_target_motion(target);
   if (!std::isfinite(o.law.approach_speed)) throw InputError("--approach-speed: must be finite");
   const ContactParams params = o.law.params();
-  if (o.law.model == "all") throw InputError("--model: map evaluates one law; 'all' is for the contact subcommand");
+  if (o.law.model == "all")
+    throw InputError("--model: map evaluates one law; 'all' is for the contact subcommand");
   const Vector3 u = target.normal_world();
   const double v_in = approach_velocity(u, Vector3(o.law.approach_speed * u), target.velocity,
                                         target.angular_velocity_world(), target.offset_world());  // Eq. 10-12
   if (!(v_in > 0))
-    throw InputError(str("--approach-speed: the end-effector does not approach the target (delta_dot^- = ", v_in,
-                         " m/s); increase the approach speed"));
+    throw InputError(str("--approach-speed: the end-effector does not approach the target (delta_dot^- = ",
+                         v_in, " m/s); increase the approach speed"));
   const AnyContactLaw law = [&] {
     try {
       return make_contact_law(o.law.model, params, v_in);
@@ -343,7 +365,8 @@ int run_map(const MapOptions& o) {
       throw InputError(str("--plot: pictures are drawn for 1 to 3 varied joints, got ", grid.axes.size(),
                            " (the CSV holds every point)"));
     if (shard.n > 1)
-      throw InputError("--plot: a shard holds part of the grid only; run the whole grid (--shard 0/1) to plot it");
+      throw InputError(
+          "--plot: a shard holds part of the grid only; run the whole grid (--shard 0/1) to plot it");
     if (grid.size > kMaxPlotPoints)
       throw InputError(str("--plot: the grid has ", grid.size, " points; pictures are drawn for at most ",
                            kMaxPlotPoints, " (use a coarser --step-deg)"));
@@ -419,14 +442,16 @@ int run_map(const MapOptions& o) {
   if (error) std::rethrow_exception(error);
   // the pictures before the CSV is committed: a failed drawing leaves no CSV behind
   std::vector<std::string> drawn;
-  if (plotting) drawn = plot::render(map_figures(grid, r.model.joint_names(), std::move(values), slice_deg), o.plot, plot_format);
+  if (plotting)
+    drawn = plot::render(map_figures(grid, r.model.joint_names(), std::move(values), slice_deg), o.plot,
+                         plot_format);
   out.commit();
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
   std::ostream& os = o.csv == "-" ? std::cerr : std::cout;
   os << "map: " << count << " of " << grid.size << " points (shard " << shard.k << "/" << shard.n << ") in "
-     << seconds << " s, " << (seconds > 0 ? static_cast<double>(count) / seconds : 0.0) << " points/s on " << threads
-     << " thread" << (threads > 1 ? "s" : "") << "\n";
+     << seconds << " s, " << (seconds > 0 ? static_cast<double>(count) / seconds : 0.0) << " points/s on "
+     << threads << " thread" << (threads > 1 ? "s" : "") << "\n";
   if (count > 0) {
     const Worker* hi = workers[0].get();
     const Worker* lo = workers[0].get();
@@ -434,8 +459,8 @@ int run_map(const MapOptions& o) {
       if (w->max_M > hi->max_M || (w->max_M == hi->max_M && w->argmax < hi->argmax)) hi = w.get();
       if (w->min_M < lo->min_M || (w->min_M == lo->min_M && w->argmin < lo->argmin)) lo = w.get();
     }
-    os << "max M_ie = " << hi->max_M << " kg at " << point_deg(grid, hi->argmax) << " deg; min M_ie = " << lo->min_M
-       << " kg at " << point_deg(grid, lo->argmin) << " deg\n";
+    os << "max M_ie = " << hi->max_M << " kg at " << point_deg(grid, hi->argmax)
+       << " deg; min M_ie = " << lo->min_M << " kg at " << point_deg(grid, lo->argmin) << " deg\n";
   }
   if (o.csv != "-") os << "wrote " << o.csv << "\n";
   for (const std::string& f : drawn) os << "wrote " << f << "\n";
@@ -447,30 +472,41 @@ int run_map(const MapOptions& o) {
 void register_map(CLI::App& app, Action& action) {
   using namespace map_impl;
   auto o = std::make_shared<MapOptions>();
-  CLI::App* sub = app.add_subcommand("map", "M_ie (Eq. 14) and closed-form F_max (Eq. 24) over a grid of joint angles");
+  CLI::App* sub =
+      app.add_subcommand("map", "M_ie (Eq. 14) and closed-form F_max (Eq. 24) over a grid of joint angles");
   o->robot.add_to(*sub);
   o->target.add_to(*sub);
   o->law.add_to(*sub, "Hysteresis damping law (Table 1) of the F_max column");
-  sub->add_option("--vary", o->vary, "Joints to vary, 1-based in URDF tree order, e.g. 1,2,3; the others stay at --joints-deg")
+  sub->add_option("--vary", o->vary,
+                  "Joints to vary, 1-based in URDF tree order, e.g. 1,2,3; the others stay at --joints-deg")
       ->required();
-  sub->add_option("--range-deg", o->range_deg,
-                  "Half-open range lo,hi of every varied joint, or lo1,hi1,lo2,hi2,... one pair per varied joint, deg")
+  sub->add_option(
+         "--range-deg", o->range_deg,
+         "Half-open range lo,hi of every varied joint, or lo1,hi1,lo2,hi2,... one pair per varied joint, deg")
       ->capture_default_str();
-  sub->add_option("--step-deg", o->step_deg, "Grid step, one for all or one per varied joint, deg")->capture_default_str();
-  sub->add_option("--csv", o->csv, "Output CSV (one row per point: varied angles deg, M_ie kg, F_max N); '-' for stdout")
+  sub->add_option("--step-deg", o->step_deg, "Grid step, one for all or one per varied joint, deg")
+      ->capture_default_str();
+  sub->add_option("--csv", o->csv,
+                  "Output CSV (one row per point: varied angles deg, M_ie kg, F_max N); '-' for stdout")
       ->required();
   sub->add_option("--shard", o->shard,
-                  "Evaluate the K-th of N contiguous parts of the grid (K/N, 0 <= K < N); only part 0 writes the header, "
+                  "Evaluate the K-th of N contiguous parts of the grid (K/N, 0 <= K < N); only part 0 writes "
+                  "the header, "
                   "so the parts concatenated in order are the whole CSV")
       ->capture_default_str();
-  sub->add_option("--threads", o->threads, "Worker threads; 0: all cores")->check(CLI::Range(0U, 1024U))->capture_default_str();
-  sub->add_option("--max-points", o->max_points, "Refuse grids with more points than this")->capture_default_str();
-  sub->add_option("--plot", o->plot,
-                  "Draw the map into this (existing) folder: M_ie against one joint, a heat map for two (Figure 9), "
-                  "slices and a 3-D view for three (Figures 8, 9)");
+  sub->add_option("--threads", o->threads, "Worker threads; 0: all cores")
+      ->check(CLI::Range(0U, 1024U))
+      ->capture_default_str();
+  sub->add_option("--max-points", o->max_points, "Refuse grids with more points than this")
+      ->capture_default_str();
+  sub->add_option(
+      "--plot", o->plot,
+      "Draw the map into this (existing) folder: M_ie against one joint, a heat map for two (Figure 9), "
+      "slices and a 3-D view for three (Figures 8, 9)");
   sub->add_option("--plot-format", o->plot_format, "Figure format: png, svg or pdf")->capture_default_str();
   sub->add_option("--slice-deg", o->slice_deg,
-                  "Three varied joints: the point the slices go through, one angle per varied joint, deg (default 0,0,0)");
+                  "Three varied joints: the point the slices go through, one angle per varied joint, deg "
+                  "(default 0,0,0)");
   sub->add_flag("--quiet", o->quiet, "No progress line");
   sub->callback([o, &action] { action = [o] { return run_map(*o); }; });
 }

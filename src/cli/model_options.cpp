@@ -13,19 +13,26 @@ void ModelLoadOptions::add_to(CLI::App& app) {
   auto vec = [&](const char* name, std::vector<double>& v, const char* help) {
     return app.add_option(name, v, help)->delimiter(',')->allow_extra_args(false);
   };
-  bus_mass_opt_ = app.add_option("--bus-mass", bus_mass, "Mount the URDF on a spacecraft bus of this mass, kg (the bus is the base)");
+  bus_mass_opt_ = app.add_option("--bus-mass", bus_mass,
+                                 "Mount the URDF on a spacecraft bus of this mass, kg (the bus is the base)");
   mount_opts_ = {
-      vec("--bus-inertia", bus_inertia, "Bus inertia about its centre of mass (bus frame): Ixx,Iyy,Izz[,Ixy,Ixz,Iyz], kg m^2"),
+      vec("--bus-inertia", bus_inertia,
+          "Bus inertia about its centre of mass (bus frame): Ixx,Iyy,Izz[,Ixy,Ixz,Iyz], kg m^2"),
       vec("--bus-com", bus_com, "Bus centre of mass in the bus frame, m (default 0,0,0)"),
       vec("--mount-xyz", mount_xyz, "Position of the URDF's root link in the bus frame, m (default 0,0,0)"),
-      vec("--mount-rpy-deg", mount_rpy_deg, "Attitude of the URDF's root link in the bus frame, roll,pitch,yaw deg (default 0,0,0)")};
-  app.add_option("--lock-joints", lock_joints, "Joints frozen at a value, name=value (rad or m), comma-separated")
+      vec("--mount-rpy-deg", mount_rpy_deg,
+          "Attitude of the URDF's root link in the bus frame, roll,pitch,yaw deg (default 0,0,0)")};
+  app.add_option("--lock-joints", lock_joints,
+                 "Joints frozen at a value, name=value (rad or m), comma-separated")
       ->delimiter(',')
       ->allow_extra_args(false);
-  app.add_option("--inertia-repair", inertia_repair, "Inertias breaking the triangle inequality: none (error) or balance")
+  app.add_option("--inertia-repair", inertia_repair,
+                 "Inertias breaking the triangle inequality: none (error) or balance")
       ->capture_default_str();
-  app.add_option("--min-mass", min_mass, "Links lighter than this get this mass, kg (0: off)")->capture_default_str();
-  app.add_option("--min-inertia", min_inertia, "Principal moments below this are raised to it, kg m^2 (0: off)")
+  app.add_option("--min-mass", min_mass, "Links lighter than this get this mass, kg (0: off)")
+      ->capture_default_str();
+  app.add_option("--min-inertia", min_inertia,
+                 "Principal moments below this are raised to it, kg m^2 (0: off)")
       ->capture_default_str();
   vec("--end-effector-offset", end_effector_offset, "Contact point in the end-effector frame, m (x,y,z)");
 }
@@ -53,7 +60,8 @@ UrdfOptions ModelLoadOptions::build(const std::string& end_effector) const {
     if (!std::isfinite(bus_mass) || bus_mass <= 0)
       throw InputError(str("--bus-mass: must be positive and finite, got ", bus_mass));
     if (bus_inertia.size() != 3 && bus_inertia.size() != 6)
-      throw InputError(str("--bus-inertia: expected 3 or 6 numbers with --bus-mass, got ", bus_inertia.size()));
+      throw InputError(
+          str("--bus-inertia: expected 3 or 6 numbers with --bus-mass, got ", bus_inertia.size()));
     Bus bus;
     bus.mass = bus_mass;
     for (double x : bus_inertia)
@@ -86,14 +94,16 @@ UrdfOptions ModelLoadOptions::build(const std::string& end_effector) const {
   } catch (const InputError& e) {
     throw InputError(str("--", e.what()));
   }
-  if (!std::isfinite(min_mass) || min_mass < 0) throw InputError(str("--min-mass: must be >= 0, got ", min_mass));
+  if (!std::isfinite(min_mass) || min_mass < 0)
+    throw InputError(str("--min-mass: must be >= 0, got ", min_mass));
   if (!std::isfinite(min_inertia) || min_inertia < 0)
     throw InputError(str("--min-inertia: must be >= 0, got ", min_inertia));
   u.min_mass = min_mass;
   u.min_inertia = min_inertia;
   if (!end_effector_offset.empty()) {
     if (end_effector_offset.size() != 3)
-      throw InputError(str("--end-effector-offset: expected 3 finite numbers, got ", end_effector_offset.size()));
+      throw InputError(
+          str("--end-effector-offset: expected 3 finite numbers, got ", end_effector_offset.size()));
     u.end_effector_offset = vec3_or_zero(end_effector_offset, "--end-effector-offset");
   }
   return u;
@@ -140,9 +150,12 @@ nlohmann::json repairs_json(const UrdfReport& report) {
 nlohmann::json report_json(const UrdfReport& report) {
   nlohmann::json mimic = nlohmann::json::array(), locked = nlohmann::json::array();
   for (const auto& m : report.mimics)
-    mimic.push_back({{"joint", m.joint}, {"leader", m.leader}, {"multiplier", m.multiplier}, {"offset", m.offset}});
+    mimic.push_back(
+        {{"joint", m.joint}, {"leader", m.leader}, {"multiplier", m.multiplier}, {"offset", m.offset}});
   for (const auto& l : report.locked) locked.push_back({{"joint", l.first}, {"value", l.second}});
-  return {{"merged_links", report.merged_links}, {"mimic_joints", mimic}, {"locked_joints", locked},
+  return {{"merged_links", report.merged_links},
+          {"mimic_joints", mimic},
+          {"locked_joints", locked},
           {"model_repairs", repairs_json(report)}};
 }
 

@@ -33,8 +33,9 @@ bool available() { return FFSR_WITH_PLOT != 0; }
 
 void require_available(const std::string& flag) {
   if (!available())
-    throw InputError(str(flag, ": this ffsr-optimize was built without plotting (PLplot not found or "
-                               "-DFFSR_WITH_PLOT=OFF); install libplplot-dev and plplot-driver-cairo and rebuild"));
+    throw InputError(str(flag,
+                         ": this ffsr-optimize was built without plotting (PLplot not found or "
+                         "-DFFSR_WITH_PLOT=OFF); install libplplot-dev and plplot-driver-cairo and rebuild"));
 }
 
 Format parse_format(const std::string& text, const std::string& flag) {
@@ -46,9 +47,12 @@ Format parse_format(const std::string& text, const std::string& flag) {
 
 const char* extension(Format f) {
   switch (f) {
-    case Format::Png: return "png";
-    case Format::Svg: return "svg";
-    case Format::Pdf: return "pdf";
+    case Format::Png:
+      return "png";
+    case Format::Svg:
+      return "svg";
+    case Format::Pdf:
+      return "pdf";
   }
   return "png";
 }
@@ -71,13 +75,13 @@ Format check_request(const std::string& dir, const std::string& format) {
 
 std::array<int, 3> palette(int i) {
   static constexpr std::array<std::array<int, 3>, kPaletteSize> okabe_ito{{{0, 114, 178},
-                                                                          {213, 94, 0},
-                                                                          {0, 158, 115},
-                                                                          {204, 121, 167},
-                                                                          {230, 159, 0},
-                                                                          {86, 180, 233},
-                                                                          {0, 0, 0},
-                                                                          {136, 34, 85}}};
+                                                                           {213, 94, 0},
+                                                                           {0, 158, 115},
+                                                                           {204, 121, 167},
+                                                                           {230, 159, 0},
+                                                                           {86, 180, 233},
+                                                                           {0, 0, 0},
+                                                                           {136, 34, 85}}};
   return okabe_ito[static_cast<size_t>(((i % kPaletteSize) + kPaletteSize) % kPaletteSize)];
 }
 
@@ -91,9 +95,12 @@ constexpr double kScale = 0.75;
 
 const char* device(Format f) {
   switch (f) {
-    case Format::Png: return "pngcairo";
-    case Format::Svg: return "svgcairo";
-    case Format::Pdf: return "pdfcairo";
+    case Format::Png:
+      return "pngcairo";
+    case Format::Svg:
+      return "svgcairo";
+    case Format::Pdf:
+      return "pdfcairo";
   }
   return "pngcairo";
 }
@@ -173,7 +180,8 @@ class Renderer {
   }
 
   void draw(const Panel& p, const Cell& cell) {
-    const bool has_legend = std::any_of(p.curves.begin(), p.curves.end(), [](const Curve& c) { return !c.label.empty(); });
+    const bool has_legend =
+        std::any_of(p.curves.begin(), p.curves.end(), [](const Curve& c) { return !c.label.empty(); });
     double vx0, vx1, vy0, vy1;
     viewport(cell, p.legend_outside && has_legend ? 250 : 0, vx0, vx1, vy0, vy1);
     double xmin, xmax, ymin, ymax;
@@ -197,7 +205,8 @@ class Renderer {
     // corner would hide some, the y range grows upwards until the box fits above the curves
     int corner = 0;
     if (has_legend && !p.legend_outside) {
-      const long entries = std::count_if(p.curves.begin(), p.curves.end(), [](const Curve& c) { return !c.label.empty(); });
+      const long entries =
+          std::count_if(p.curves.begin(), p.curves.end(), [](const Curve& c) { return !c.label.empty(); });
       const double box_w = 0.34, box_h = std::min(0.6, 0.03 + 0.085 * static_cast<double>(entries));
       long hidden = 0;
       corner = emptiest_corner(p.curves, tx, xmin, xmax, ymin, ymax, box_w, box_h, hidden);
@@ -294,23 +303,24 @@ class Renderer {
     PLFLT w = 0, h = 0;
     const PLINT horizontal = corner == 1 || corner == 3 ? PL_POSITION_LEFT : PL_POSITION_RIGHT;
     const PLINT vertical = corner >= 2 ? PL_POSITION_BOTTOM : PL_POSITION_TOP;
-    const PLINT pos = outside ? (PL_POSITION_RIGHT | PL_POSITION_OUTSIDE)
-                              : (horizontal | vertical | PL_POSITION_INSIDE);
+    const PLINT pos =
+        outside ? (PL_POSITION_RIGHT | PL_POSITION_OUTSIDE) : (horizontal | vertical | PL_POSITION_INSIDE);
     pls_.schr(0, kScale);
-    pls_.legend(&w, &h, PL_LEGEND_BACKGROUND | PL_LEGEND_BOUNDING_BOX, pos, outside ? 0.02 : 0.01, outside ? 0.0 : 0.01,
-                0.06, 0, kText, 1, 0, 0, static_cast<PLINT>(text.size()), opt.data(), 0.8, 0.8, 1.7, 0.0, text_colors.data(),
-                text.data(), box_i.data(), box_i.data(), box_f.data(), box_f.data(), line_colors.data(),
-                line_styles.data(), line_widths.data(), symbol_colors.data(), symbol_scales.data(),
-                symbol_numbers.data(), symbols.data());
+    pls_.legend(&w, &h, PL_LEGEND_BACKGROUND | PL_LEGEND_BOUNDING_BOX, pos, outside ? 0.02 : 0.01,
+                outside ? 0.0 : 0.01, 0.06, 0, kText, 1, 0, 0, static_cast<PLINT>(text.size()), opt.data(),
+                0.8, 0.8, 1.7, 0.0, text_colors.data(), text.data(), box_i.data(), box_i.data(), box_f.data(),
+                box_f.data(), line_colors.data(), line_styles.data(), line_widths.data(),
+                symbol_colors.data(), symbol_scales.data(), symbol_numbers.data(), symbols.data());
     pls_.schr(0, kScale);
   }
 
   /// tick: the major tick interval per axis (0: PLplot's choice, by the data range alone)
-  void box3(const std::string& xl, const std::string& yl, const std::string& zl, double xtick = 0, double ytick = 0,
-            double ztick = 0) {
+  void box3(const std::string& xl, const std::string& yl, const std::string& zl, double xtick = 0,
+            double ytick = 0, double ztick = 0) {
     pls_.col0(kText);
     pls_.width(1.0);
-    pls_.box3("bnstu", xl.c_str(), xtick, 0, "bnstu", yl.c_str(), ytick, 0, "bcdmnstuv", zl.c_str(), ztick, 0);
+    pls_.box3("bnstu", xl.c_str(), xtick, 0, "bnstu", yl.c_str(), ytick, 0, "bcdmnstuv", zl.c_str(), ztick,
+              0);
   }
 
   void draw(const Panel3& p, const Cell& cell) {
@@ -329,8 +339,7 @@ class Renderer {
     auto side = [&](double r) { return 1.2 * std::max(0.5, r / d); };  // a flat axis keeps room for its ticks
     pls_.vpor(cell.x0 + 0.01, cell.x1 - 0.01, cell.y0 + 0.02, cell.y1 - 0.05);
     pls_.wind(-1.0, 1.0, -0.9, 1.5);
-    pls_.w3d(side(x1 - x0), side(y1 - y0), side(z1 - z0), x0, x1, y0, y1, z0, z1, p.altitude,
-             p.azimuth);
+    pls_.w3d(side(x1 - x0), side(y1 - y0), side(z1 - z0), x0, x1, y0, y1, z0, z1, p.altitude, p.azimuth);
     // PLplot picks the ticks by the data range alone; an axis drawn short gets a coarser interval (a
     // 1-2-5 step of at least half its range: two or three labels), or its labels run into each other
     auto tick = [&](double r) {
@@ -381,8 +390,8 @@ class Renderer {
     PLINT n_values[] = {static_cast<PLINT>(levels.size())};
     const PLFLT* values[] = {levels.data()};
     pls_.schr(0, kScale * (0.9));
-    pls_.colorbar(&w, &h, kind, PL_POSITION_RIGHT | PL_POSITION_OUTSIDE, 0.02, 0.0, 0.035, 1.0, 0, kText, 1, 0, 0,
-                  0, 0, 1, &label_opt, labels, 1, axis, ticks, sub_ticks, n_values, values);
+    pls_.colorbar(&w, &h, kind, PL_POSITION_RIGHT | PL_POSITION_OUTSIDE, 0.02, 0.0, 0.035, 1.0, 0, kText, 1,
+                  0, 0, 0, 0, 1, &label_opt, labels, 1, axis, ticks, sub_ticks, n_values, values);
     pls_.schr(0, kScale);
   }
 
@@ -398,7 +407,8 @@ class Renderer {
     }
     std::vector<PLFLT*> rows(static_cast<size_t>(nx));
     std::vector<PLFLT> z(p.z);
-    for (PLINT i = 0; i < nx; ++i) rows[static_cast<size_t>(i)] = z.data() + static_cast<size_t>(i) * static_cast<size_t>(ny);
+    for (PLINT i = 0; i < nx; ++i)
+      rows[static_cast<size_t>(i)] = z.data() + static_cast<size_t>(i) * static_cast<size_t>(ny);
     std::vector<PLFLT> shade(static_cast<size_t>(p.levels + 1)), cont(static_cast<size_t>(p.contours));
     for (int k = 0; k <= p.levels; ++k) shade[static_cast<size_t>(k)] = zmin + (zmax - zmin) * k / p.levels;
     for (int k = 0; k < p.contours; ++k)
@@ -409,8 +419,8 @@ class Renderer {
     const double xmin = p.x.front(), xmax = p.x.back(), ymin = p.y.front(), ymax = p.y.back();
     pls_.wind(xmin, xmax, ymin, ymax);
     viridis(pls_);
-    pls_.shades(rows.data(), nx, ny, nullptr, xmin, xmax, ymin, ymax, shade.data(), static_cast<PLINT>(shade.size()),
-                1.0, 0, 0.0, plfill, true, nullptr, nullptr);
+    pls_.shades(rows.data(), nx, ny, nullptr, xmin, xmax, ymin, ymax, shade.data(),
+                static_cast<PLINT>(shade.size()), 1.0, 0, 0.0, plfill, true, nullptr, nullptr);
     std::vector<PLFLT> xg(p.x), yg(p.y);
     PLcGrid grid{xg.data(), yg.data(), nullptr, nx, ny, 0};
     pls_.col0(kText);
@@ -552,7 +562,8 @@ std::vector<std::string> render(const std::vector<Figure>& figures, const std::s
     ::dup2(log_fd, 2);
     try {
       if (!driver_present(device(format))) {
-        std::fprintf(stderr, "@@error PLplot has no '%s' driver (install plplot-driver-cairo)\n", device(format));
+        std::fprintf(stderr, "@@error PLplot has no '%s' driver (install plplot-driver-cairo)\n",
+                     device(format));
         ::_exit(5);
       }
       for (size_t k = 0; k < figures.size(); ++k) {
@@ -577,8 +588,10 @@ std::vector<std::string> render(const std::vector<Figure>& figures, const std::s
   {
     std::istringstream in(read_text(log));
     for (std::string line; std::getline(in, line);) {
-      if (line.rfind("@@figure ", 0) == 0) current = line.substr(9);
-      else if (line.rfind("@@error ", 0) == 0) error = line.substr(8);
+      if (line.rfind("@@figure ", 0) == 0)
+        current = line.substr(9);
+      else if (line.rfind("@@error ", 0) == 0)
+        error = line.substr(8);
       else if (!line.empty() && line.find_first_not_of(" *") != std::string::npos && plplot_message.empty())
         plplot_message = line;
       if (line.find("PLPLOT ERROR") != std::string::npos || line.find("ABORTING") != std::string::npos) {

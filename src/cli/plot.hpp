@@ -42,15 +42,15 @@ std::array<int, 3> palette(int i);
 
 /// A curve or a set of markers in a 2-D panel.
 struct Curve {
-  std::string label;        ///< legend entry; empty: not in the legend
+  std::string label;  ///< legend entry; empty: not in the legend
   std::vector<double> x, y;
-  int color = 0;            ///< palette index
-  int line_style = 1;       ///< PLplot line style 1..8 (1 solid, 2 short dashes, ...); 0: no line
+  int color = 0;       ///< palette index
+  int line_style = 1;  ///< PLplot line style 1..8 (1 solid, 2 short dashes, ...); 0: no line
   double width = 2.0;
-  std::string symbol;       ///< glyph drawn at every point (e.g. "●", "*"); empty: none
+  std::string symbol;  ///< glyph drawn at every point (e.g. "●", "*"); empty: none
   double symbol_scale = 1.0;
-  double alpha = 1.0;       ///< opacity (1 opaque), for fading drawings
-  bool fill = false;        ///< draw the closed polygon filled (with alpha)
+  double alpha = 1.0;  ///< opacity (1 opaque), for fading drawings
+  bool fill = false;   ///< draw the closed polygon filled (with alpha)
 };
 
 /// Axes with curves. Limits empty: from the data (with a 5 % margin).
@@ -59,7 +59,7 @@ struct Panel {
   std::vector<Curve> curves;
   bool equal_aspect = false;  ///< one metre is as long on both axes (drawings of the robot)
   bool log_x = false;
-  std::vector<double> limits;  ///< {xmin, xmax, ymin, ymax} or empty
+  std::vector<double> limits;   ///< {xmin, xmax, ymin, ymax} or empty
   bool legend_outside = false;  ///< legend to the right of the axes instead of inside
 };
 
@@ -86,8 +86,8 @@ struct Panel3 {
 struct HeatPanel {
   std::string title, xlabel, ylabel, zlabel;
   std::vector<double> x, y, z;
-  int levels = 20;      ///< colour levels
-  int contours = 10;    ///< contour lines
+  int levels = 20;             ///< colour levels
+  int contours = 10;           ///< contour lines
   std::vector<Curve> overlay;  ///< markers on top (for example the maximum)
   double zmin = 0, zmax = 0;   ///< colour range; equal: from the data
 };

@@ -68,11 +68,12 @@ double number(const toml::node& n, const std::string& key) {
 }
 
 Spread parse_spread(Quantity q, const toml::table& t, const std::string& key) {
-  static const std::set<std::string> known{"law",  "std",   "relative-std", "half-width", "relative", "min",
-                                           "max",  "sigma", "angle-deg",    "axes-deg"};
+  static const std::set<std::string> known{"law", "std", "relative-std", "half-width", "relative",
+                                           "min", "max", "sigma",        "angle-deg",  "axes-deg"};
   for (const auto& [k, v] : t)
     if (!known.count(std::string(k.str())))
-      throw InputError(str(key, ".", k.str(), ": unknown parameter; expected law, std, relative-std, half-width, ",
+      throw InputError(str(key, ".", k.str(),
+                           ": unknown parameter; expected law, std, relative-std, half-width, ",
                            "relative, min, max, sigma, angle-deg or axes-deg"));
   const auto law = t["law"].value<std::string>();
   if (!law) throw InputError(str(key, ": missing law (normal, uniform, log-normal or cone)"));
@@ -82,10 +83,18 @@ Spread parse_spread(Quantity q, const toml::table& t, const std::string& key) {
   };
   Spread sp;
   const auto sd = get("std"), rsd = get("relative-std"), hw = get("half-width"), rel = get("relative"),
-             lo = get("min"), hi = get("max"), sigma = get("sigma"), angle = get("angle-deg"), axes = get("axes-deg");
-  for (const auto& [name, v] : {std::pair{"std", sd}, {"relative-std", rsd}, {"half-width", hw}, {"relative", rel},
-                                {"sigma", sigma}, {"angle-deg", angle}, {"axes-deg", axes}})
-    if (v && *v < 0) throw InputError(str(key, ".", name, ": a spread must be non-negative, got ", detail::short_number(*v)));
+             lo = get("min"), hi = get("max"), sigma = get("sigma"), angle = get("angle-deg"),
+             axes = get("axes-deg");
+  for (const auto& [name, v] : {std::pair{"std", sd},
+                                {"relative-std", rsd},
+                                {"half-width", hw},
+                                {"relative", rel},
+                                {"sigma", sigma},
+                                {"angle-deg", angle},
+                                {"axes-deg", axes}})
+    if (v && *v < 0)
+      throw InputError(
+          str(key, ".", name, ": a spread must be non-negative, got ", detail::short_number(*v)));
   // spin is given in deg/s, the library takes rad/s
   const double unit = q == Quantity::Spin ? M_PI / 180.0 : 1.0;
   auto one_of = [&](std::initializer_list<std::pair<const char*, std::optional<double>>> opts) {
@@ -118,14 +127,16 @@ Spread parse_spread(Quantity q, const toml::table& t, const std::string& key) {
     if (!angle) throw InputError(str(key, ": the cone law needs angle-deg (half-angle)"));
     sp.scale = *angle * M_PI / 180.0;
   } else {
-    throw InputError(str(key, ".law: unknown law '", *law, "'; expected normal, uniform, log-normal or cone"));
+    throw InputError(
+        str(key, ".law: unknown law '", *law, "'; expected normal, uniform, log-normal or cone"));
   }
   if (q == Quantity::TargetInertia && sp.law != Spread::Law::Cone && !sp.relative)
     throw InputError(str(key, ": the inertia takes a relative spread (relative-std or relative)"));
   if (lo) sp.min = *lo * unit;
   if (hi) sp.max = *hi * unit;
   if (axes) sp.axes = *axes * M_PI / 180.0;
-  if (axes && q != Quantity::TargetInertia) throw InputError(str(key, ".axes-deg: only the inertia takes it"));
+  if (axes && q != Quantity::TargetInertia)
+    throw InputError(str(key, ".axes-deg: only the inertia takes it"));
   return sp;
 }
 
@@ -212,7 +223,8 @@ plot::Figure robust_figure(const nlohmann::json& summary) {
   plot::Figure fig;
   fig.name = "robust";
   fig.title = str("F_max over ", summary["samples"].get<std::uint64_t>(), " samples (",
-                  summary["force_model"].get<std::string>(), " model, seed ", summary["seed"].get<std::uint64_t>(), ")");
+                  summary["force_model"].get<std::string>(), " model, seed ",
+                  summary["seed"].get<std::uint64_t>(), ")");
   fig.cols = 2;
   fig.width = 1200;
   fig.height = 700;
@@ -258,7 +270,8 @@ plot::Figure robust_figure(const nlohmann::json& summary) {
     cdf.curves.push_back(std::move(line));
     cdf.curves.push_back(std::move(p95));
     std::vector<double> count(kBins, 0.0);
-    for (double x : f) count[static_cast<std::size_t>(std::min(kBins - 1, static_cast<int>((x - lo) / w)))] += 1.0 / n;
+    for (double x : f)
+      count[static_cast<std::size_t>(std::min(kBins - 1, static_cast<int>((x - lo) / w)))] += 1.0 / n;
     plot::Curve steps;
     steps.label = c["name"].get<std::string>();
     steps.color = color;
@@ -309,9 +322,13 @@ nlohmann::json extremes(const UncertainSample& s, const UncertaintySpec& spec) {
 nlohmann::json interval_json(const ForceSummary::Interval& ci, bool delta) {
   // a bound that does not exist (too few samples) is left out: the JSON has no null
   nlohmann::json out;
-  if (delta) out = {{"method", "delta"}, {"log_standard_error", ci.log_standard_error}, {"coverage", ci.coverage}};
+  if (delta)
+    out = {{"method", "delta"}, {"log_standard_error", ci.log_standard_error}, {"coverage", ci.coverage}};
   else
-    out = {{"method", "order-statistics"}, {"lower_rank", ci.lower}, {"upper_rank", ci.upper}, {"coverage", ci.coverage}};
+    out = {{"method", "order-statistics"},
+           {"lower_rank", ci.lower},
+           {"upper_rank", ci.upper},
+           {"coverage", ci.coverage}};
   if (ci.has_lo) out["lo"] = ci.lo;
   if (ci.has_hi) out["hi"] = ci.hi;
   return out;
@@ -329,7 +346,10 @@ nlohmann::json summary_json(const ForceSummary& s) {
           {"estimator", conditional ? "stiffness-conditional" : "order-statistics"},
           {"p95_ci95", interval_json(s.p95_ci, conditional)},
           {"order_statistics",
-           {{"p50", s.order.p50}, {"p95", s.order.p95}, {"p99", s.order.p99}, {"p95_ci95", interval_json(s.order.p95_ci, false)}}}};
+           {{"p50", s.order.p50},
+            {"p95", s.order.p95},
+            {"p99", s.order.p99},
+            {"p95_ci95", interval_json(s.order.p95_ci, false)}}}};
 }
 
 /// The summary JSON's names of Spread::Law, in the enum's order (written by run_robust, read back by
@@ -361,22 +381,27 @@ std::string extremes_text(const nlohmann::json& ex) {
 
 /// The terminal table of a summary JSON (a run or a merge: the same struct).
 void print_summary(const nlohmann::json& j, std::ostream& out) {
-  out << std::left << std::setw(14) << "configuration" << std::right << std::setw(12) << "nominal M_ie" << std::setw(11)
-      << "nominal F" << std::setw(10) << "mean" << std::setw(10) << "std" << std::setw(10) << "p50" << std::setw(10)
-      << "p95" << std::setw(10) << "p99" << std::setw(10) << "max" << "\n";
+  out << std::left << std::setw(14) << "configuration" << std::right << std::setw(12) << "nominal M_ie"
+      << std::setw(11) << "nominal F" << std::setw(10) << "mean" << std::setw(10) << "std" << std::setw(10)
+      << "p50" << std::setw(10) << "p95" << std::setw(10) << "p99" << std::setw(10) << "max"
+      << "\n";
   out << std::left << std::setw(14) << "" << std::right << std::setw(12) << "(kg)" << std::setw(11) << "(kN)"
-      << std::setw(60) << "F_max over the samples (kN)" << "\n";
+      << std::setw(60) << "F_max over the samples (kN)"
+      << "\n";
   for (const auto& c : j["configurations"]) {
     const auto& s = c["summary"];
-    out << std::left << std::setw(14) << c["name"].get<std::string>() << std::right << std::fixed << std::setprecision(3)
-        << std::setw(12) << c["nominal"]["M_ie"].get<double>() << std::setw(11) << c["nominal"]["f_max"].get<double>() / 1e3;
-    for (const char* k : {"mean", "std", "p50", "p95", "p99", "max"}) out << std::setw(10) << s[k].get<double>() / 1e3;
+    out << std::left << std::setw(14) << c["name"].get<std::string>() << std::right << std::fixed
+        << std::setprecision(3) << std::setw(12) << c["nominal"]["M_ie"].get<double>() << std::setw(11)
+        << c["nominal"]["f_max"].get<double>() / 1e3;
+    for (const char* k : {"mean", "std", "p50", "p95", "p99", "max"})
+      out << std::setw(10) << s[k].get<double>() / 1e3;
     out << "\n";
   }
   const bool conditional = j.value("estimator", "order-statistics") == "stiffness-conditional";
   if (conditional) {
     // the percentiles above are the stiffness-conditional ones; the order statistics beside them
-    out << "p50, p95, p99: the law's percentiles conditional on the stiffness (the single-body F_max scales as"
+    out << "p50, p95, p99: the law's percentiles conditional on the stiffness (the single-body F_max scales "
+           "as"
         << " K^(1/(alpha+1)); README); mean, std, max: the samples'."
         << "\norder statistics of the same samples, p95 (kN):";
     const char* sep = " ";
@@ -389,18 +414,21 @@ void print_summary(const nlohmann::json& j, std::ostream& out) {
   }
   // how well the samples pin the 95th percentile of the law down
   out << "95 % confidence interval of the 95th percentile ("
-      << (conditional ? "conditional on the stiffness, delta method" : "order statistics, distribution-free") << "), kN:";
+      << (conditional ? "conditional on the stiffness, delta method" : "order statistics, distribution-free")
+      << "), kN:";
   const char* sep = "\n  ";
   for (const auto& c : j["configurations"]) {
     const auto& ci = c["summary"]["p95_ci95"];
     auto bound = [&ci](const char* key, const char* none) {
       std::ostringstream os;
-      if (!ci.contains(key)) os << none;
-      else os << std::fixed << std::setprecision(3) << ci[key].get<double>() / 1e3;
+      if (!ci.contains(key))
+        os << none;
+      else
+        os << std::fixed << std::setprecision(3) << ci[key].get<double>() / 1e3;
       return os.str();
     };
-    out << sep << c["name"].get<std::string>() << " [" << bound("lo", "-") << ", " << bound("hi", "none: too few samples")
-        << "]";
+    out << sep << c["name"].get<std::string>() << " [" << bound("lo", "-") << ", "
+        << bound("hi", "none: too few samples") << "]";
     sep = ", ";
   }
   out << "\n";
@@ -418,13 +446,14 @@ void print_summary(const nlohmann::json& j, std::ostream& out) {
     out << "\n";
   }
   for (const auto& c : j["configurations"]) {
-    out << "\nlargest F_max, " << c["name"].get<std::string>() << " (score: z for normal laws, ln(x/x0)/sigma, "
+    out << "\nlargest F_max, " << c["name"].get<std::string>()
+        << " (score: z for normal laws, ln(x/x0)/sigma, "
         << "[-1, 1] in a uniform range, angle/half-angle in the cone):\n";
     for (const auto& t : c["tail"])
       out << "  sample " << std::setw(7) << t["index"].get<std::uint64_t>() << "  F_max " << std::fixed
           << std::setprecision(3) << t["f_max"].get<double>() / 1e3 << " kN  M_ie " << t["M_ie"].get<double>()
-          << " kg  delta_dot " << std::setprecision(4) << t["approach_velocity"].get<double>() << " m/s  extreme: "
-          << extremes_text(t["extreme"]) << "\n";
+          << " kg  delta_dot " << std::setprecision(4) << t["approach_velocity"].get<double>()
+          << " m/s  extreme: " << extremes_text(t["extreme"]) << "\n";
   }
 }
 
@@ -447,7 +476,8 @@ void finish_summary(nlohmann::json& j) {
   }
   for (auto& c : j["configurations"]) {
     const std::vector<double> f = c["f_max"].get<std::vector<double>>();
-    c["summary"] = summary_json(conditional ? summarize_stiffness_conditional(f, K, alpha, law, K0) : summarize(f));
+    c["summary"] =
+        summary_json(conditional ? summarize_stiffness_conditional(f, K, alpha, law, K0) : summarize(f));
     auto tail = c["tail"];
     std::vector<nlohmann::json> t(tail.begin(), tail.end());
     std::stable_sort(t.begin(), t.end(), [](const nlohmann::json& a, const nlohmann::json& b) {
@@ -502,8 +532,8 @@ int run_merge(const RobustOptions& o) {
     return a["shard"]["first"].get<std::uint64_t>() < b["shard"]["first"].get<std::uint64_t>();
   });
   const nlohmann::json& first = parts.front();
-  for (const char* key : {"seed", "samples", "uncertainty", "force_model", "law", "scenario", "estimator",
-                          "stiffness_nominal"})
+  for (const char* key :
+       {"seed", "samples", "uncertainty", "force_model", "law", "scenario", "estimator", "stiffness_nominal"})
     for (const auto& p : parts)
       if (p.contains(key) != first.contains(key) || (p.contains(key) && p[key] != first[key]))
         throw InputError(str("--merge: the summaries differ in '", key, "': they are not shards of one run"));
@@ -513,7 +543,8 @@ int run_merge(const RobustOptions& o) {
     const auto& p = parts[i];
     const std::uint64_t a = p["shard"]["first"], b = p["shard"]["end"];
     if (a != next)
-      throw InputError(str("--merge: samples ", next, " to ", a, " are ", a > next ? "missing" : "in two shards"));
+      throw InputError(
+          str("--merge: samples ", next, " to ", a, " are ", a > next ? "missing" : "in two shards"));
     next = b;
     if (p["configurations"].size() != first["configurations"].size())
       throw InputError("--merge: the summaries have different configurations");
@@ -531,7 +562,8 @@ int run_merge(const RobustOptions& o) {
     }
   }
   if (next != first["samples"].get<std::uint64_t>())
-    throw InputError(str("--merge: the shards cover samples 0 to ", next, " of ", first["samples"].get<std::uint64_t>()));
+    throw InputError(
+        str("--merge: the shards cover samples 0 to ", next, " of ", first["samples"].get<std::uint64_t>()));
   for (const char* key : {"stiffness", "exponent"})
     if (m.contains(key) && (!m[key].is_array() || m[key].size() != next))
       throw InputError(str("--merge: the summaries' '", key, "' lists do not hold one value per sample"));
@@ -544,9 +576,9 @@ int run_merge(const RobustOptions& o) {
   if (!o.plot.empty()) drawn = plot::render({robust_figure(m)}, o.plot, plot_format);
   outputs.write();
   std::ostream& out = outputs.table();
-  out << "ffsr-optimize " << FFSR_VERSION << " robust: merged " << parts.size() << " shard summaries, " << next
-            << " samples (seed " << m["seed"].get<std::uint64_t>() << ", " << m["force_model"].get<std::string>()
-            << " F_max)\n\n";
+  out << "ffsr-optimize " << FFSR_VERSION << " robust: merged " << parts.size() << " shard summaries, "
+      << next << " samples (seed " << m["seed"].get<std::uint64_t>() << ", "
+      << m["force_model"].get<std::string>() << " F_max)\n\n";
   print_summary(m, out);
   for (const std::string& f : drawn) out << "wrote " << f << "\n";
   return 0;
@@ -576,10 +608,15 @@ int run_robust(RobustOptions& o, CLI::App& app) {  // by reference: the file's k
   apply_scenario_keys(root, app, where);
 
   ForceModel force_model;
-  if (o.force_model == "closed") force_model = ForceModel::Closed;
-  else if (o.force_model == "exact") force_model = ForceModel::Exact;
-  else if (o.force_model == "multibody") force_model = ForceModel::Multibody;
-  else throw InputError(str("--force-model: unknown model '", o.force_model, "'; expected closed, exact or multibody"));
+  if (o.force_model == "closed")
+    force_model = ForceModel::Closed;
+  else if (o.force_model == "exact")
+    force_model = ForceModel::Exact;
+  else if (o.force_model == "multibody")
+    force_model = ForceModel::Multibody;
+  else
+    throw InputError(
+        str("--force-model: unknown model '", o.force_model, "'; expected closed, exact or multibody"));
   std::uint64_t shard_k = 0, shard_n = 1;
   {
     const size_t slash = o.shard.find('/');
@@ -587,9 +624,11 @@ int run_robust(RobustOptions& o, CLI::App& app) {  // by reference: the file's k
     shard_k = parse_count(o.shard.substr(0, slash), "--shard");
     shard_n = parse_count(o.shard.substr(slash + 1), "--shard");
     if (shard_n < 1) throw InputError("--shard: N must be at least 1");
-    if (shard_k >= shard_n) throw InputError(str("--shard: K must be less than N (K counts from 0), got ", o.shard));
+    if (shard_k >= shard_n)
+      throw InputError(str("--shard: K must be less than N (K counts from 0), got ", o.shard));
   }
-  if (o.threads < 1 || o.threads > 1024) throw InputError(str("--threads: must be in [1, 1024], got ", o.threads));
+  if (o.threads < 1 || o.threads > 1024)
+    throw InputError(str("--threads: must be in [1, 1024], got ", o.threads));
 
   o.scenario.config = o.config;
   const Scenario sc = prepare_scenario(o.scenario, app, urdf_cli);
@@ -601,8 +640,8 @@ int run_robust(RobustOptions& o, CLI::App& app) {  // by reference: the file's k
   std::vector<Configuration> configs;
   if (!o.capture_joints_deg.empty()) {
     if (static_cast<int>(o.capture_joints_deg.size()) != model.n())
-      throw InputError(str("--capture-joints-deg: got ", o.capture_joints_deg.size(), " angles, the robot has ",
-                           model.n(), " joints"));
+      throw InputError(str("--capture-joints-deg: got ", o.capture_joints_deg.size(),
+                           " angles, the robot has ", model.n(), " joints"));
     Configuration c;
     c.name = "given";
     c.theta = Eigen::Map<const Eigen::VectorXd>(o.capture_joints_deg.data(), model.n()) * (M_PI / 180.0);
@@ -610,9 +649,11 @@ int run_robust(RobustOptions& o, CLI::App& app) {  // by reference: the file's k
       if (!std::isfinite(x)) throw InputError("--capture-joints-deg: values must be finite");
     if (o.capture_base_position.size() != 3) throw InputError("--capture-base-position: expected 3 numbers");
     if (o.capture_base_rpy_deg.size() != 3) throw InputError("--capture-base-rpy-deg: expected 3 numbers");
-    c.base.position = Vector3(o.capture_base_position[0], o.capture_base_position[1], o.capture_base_position[2]);
+    c.base.position =
+        Vector3(o.capture_base_position[0], o.capture_base_position[1], o.capture_base_position[2]);
     const Vector3 rpy(o.capture_base_rpy_deg[0], o.capture_base_rpy_deg[1], o.capture_base_rpy_deg[2]);
-    if (!c.base.position.allFinite() || !rpy.allFinite()) throw InputError("--capture-base-position/--capture-base-rpy-deg: values must be finite");
+    if (!c.base.position.allFinite() || !rpy.allFinite())
+      throw InputError("--capture-base-position/--capture-base-rpy-deg: values must be finite");
     c.base.orientation = Quaternion(rotation_from_rpy(rpy * (M_PI / 180.0)));
     configs.push_back(std::move(c));
   } else {
@@ -652,10 +693,13 @@ int run_robust(RobustOptions& o, CLI::App& app) {  // by reference: the file's k
   const std::uint64_t total_work = count * (1 + configs.size());
   std::atomic<std::uint64_t> work_done{0};
   auto report = [&](std::uint64_t) { progress(work_done.load(), total_work); };
-  parallel_for(0, count, o.threads, [&](std::uint64_t i) {
-    samples[i] = draw_sample(spec, nominal, first + i);
-    work_done.fetch_add(1);
-  }, report);
+  parallel_for(
+      0, count, o.threads,
+      [&](std::uint64_t i) {
+        samples[i] = draw_sample(spec, nominal, first + i);
+        work_done.fetch_add(1);
+      },
+      report);
   Data data(model);
   UncertaintySpec fixed;  // the nominal sample: no spread
   fixed.seed = spec.seed;
@@ -665,16 +709,22 @@ int run_robust(RobustOptions& o, CLI::App& app) {  // by reference: the file's k
     const Matrix6 G = robot_inverse_inertia(model, data, c.base, c.theta, pb.frame);
     if (force_model == ForceModel::Multibody) {
       c.nominal = sample_force_multibody(model, c.base, c.theta, pb.frame, nominal_sample, pb.law);
-      parallel_for(0, count, o.threads, [&](std::uint64_t i) {
-        c.forces[i] = sample_force_multibody(model, c.base, c.theta, pb.frame, samples[i], pb.law);
-        work_done.fetch_add(1);
-      }, report);
+      parallel_for(
+          0, count, o.threads,
+          [&](std::uint64_t i) {
+            c.forces[i] = sample_force_multibody(model, c.base, c.theta, pb.frame, samples[i], pb.law);
+            work_done.fetch_add(1);
+          },
+          report);
     } else {
       c.nominal = sample_force(G, nominal_sample, pb.law, force_model);
-      parallel_for(0, count, o.threads, [&](std::uint64_t i) {
-        c.forces[i] = sample_force(G, samples[i], pb.law, force_model);
-        work_done.fetch_add(1);
-      }, report);
+      parallel_for(
+          0, count, o.threads,
+          [&](std::uint64_t i) {
+            c.forces[i] = sample_force(G, samples[i], pb.law, force_model);
+            work_done.fetch_add(1);
+          },
+          report);
     }
   }
   progress(total_work, total_work);  // ends the line if one was shown
@@ -695,8 +745,11 @@ int run_robust(RobustOptions& o, CLI::App& app) {  // by reference: the file's k
       const Spread& sp = spec.spread[q];
       if (sp.law == Spread::Law::Fixed) continue;
       // an absent bound is left out (the JSON has no null)
-      nlohmann::json e = {{"law", kLawNames[static_cast<int>(sp.law)]}, {"scale", sp.scale}, {"relative", sp.relative},
-                          {"range", sp.has_range}, {"axes", sp.axes}};
+      nlohmann::json e = {{"law", kLawNames[static_cast<int>(sp.law)]},
+                          {"scale", sp.scale},
+                          {"relative", sp.relative},
+                          {"range", sp.has_range},
+                          {"axes", sp.axes}};
       if (std::isfinite(sp.min)) e["min"] = sp.min;
       if (std::isfinite(sp.max)) e["max"] = sp.max;
       u[quantity_label(q)] = e;
@@ -728,7 +781,9 @@ int run_robust(RobustOptions& o, CLI::App& app) {  // by reference: the file's k
     cj["base_position"] = to_json(Eigen::VectorXd(c.base.position));
     const Eigen::Vector4d q = c.base.orientation.coeffs();
     cj["base_quaternion_wxyz"] = {q(3), q(0), q(1), q(2)};
-    cj["nominal"] = {{"M_ie", c.nominal.M_ie}, {"approach_velocity", c.nominal.approach_velocity}, {"f_max", c.nominal.f_max}};
+    cj["nominal"] = {{"M_ie", c.nominal.M_ie},
+                     {"approach_velocity", c.nominal.approach_velocity},
+                     {"f_max", c.nominal.f_max}};
     std::vector<double> f(count);
     for (std::uint64_t i = 0; i < count; ++i) f[i] = c.forces[i].f_max;
     cj["f_max"] = f;
@@ -740,9 +795,12 @@ int run_robust(RobustOptions& o, CLI::App& app) {  // by reference: the file's k
     cj["tail"] = nlohmann::json::array();
     for (std::size_t t = 0; t < k; ++t) {
       const auto i = order[t];
-      cj["tail"].push_back({{"index", first + i}, {"f_max", f[i]}, {"M_ie", c.forces[i].M_ie},
+      cj["tail"].push_back({{"index", first + i},
+                            {"f_max", f[i]},
+                            {"M_ie", c.forces[i].M_ie},
                             {"approach_velocity", c.forces[i].approach_velocity},
-                            {"extreme", extremes(samples[i], spec)}, {"parameters", sample_json(samples[i])}});
+                            {"extreme", extremes(samples[i], spec)},
+                            {"parameters", sample_json(samples[i])}});
     }
     j["configurations"].push_back(std::move(cj));
   }
@@ -752,20 +810,23 @@ int run_robust(RobustOptions& o, CLI::App& app) {  // by reference: the file's k
   if (!o.csv.empty()) {
     std::ostringstream c;
     c << std::setprecision(12)
-      << "configuration,sample,target_mass,Ixx,Iyy,Izz,Ixy,Ixz,Iyz,offset_x,offset_y,offset_z,normal_x,normal_y,"
-         "normal_z,spin_x_deg,spin_y_deg,spin_z_deg,velocity_x,velocity_y,velocity_z,approach_speed,stiffness,"
+      << "configuration,sample,target_mass,Ixx,Iyy,Izz,Ixy,Ixz,Iyz,offset_x,offset_y,offset_z,normal_x,"
+         "normal_y,"
+         "normal_z,spin_x_deg,spin_y_deg,spin_z_deg,velocity_x,velocity_y,velocity_z,approach_speed,"
+         "stiffness,"
          "exponent,restitution,robot_offset_x,robot_offset_y,robot_offset_z,M_ie,delta_dot,F_max\n";
     for (const auto& cf : configs)
       for (std::uint64_t i = 0; i < count; ++i) {
         const UncertainSample& s = samples[i];
         const Matrix3& I = s.target.inertia;
         const Vector3 w = s.target.angular_velocity * (180.0 / M_PI);
-        c << cf.name << "," << first + i << "," << s.target.mass << "," << I(0, 0) << "," << I(1, 1) << "," << I(2, 2)
-          << "," << I(0, 1) << "," << I(0, 2) << "," << I(1, 2);
+        c << cf.name << "," << first + i << "," << s.target.mass << "," << I(0, 0) << "," << I(1, 1) << ","
+          << I(2, 2) << "," << I(0, 1) << "," << I(0, 2) << "," << I(1, 2);
         for (const Vector3* v : {&s.target.contact_offset, &s.target.normal, &w, &s.target.velocity})
           c << "," << (*v)(0) << "," << (*v)(1) << "," << (*v)(2);
-        c << "," << s.approach_speed << "," << s.contact.K << "," << s.contact.alpha << "," << s.contact.c_r << ","
-          << s.robot_offset(0) << "," << s.robot_offset(1) << "," << s.robot_offset(2) << "," << cf.forces[i].M_ie << "," << cf.forces[i].approach_velocity << "," << cf.forces[i].f_max << "\n";
+        c << "," << s.approach_speed << "," << s.contact.K << "," << s.contact.alpha << "," << s.contact.c_r
+          << "," << s.robot_offset(0) << "," << s.robot_offset(1) << "," << s.robot_offset(2) << ","
+          << cf.forces[i].M_ie << "," << cf.forces[i].approach_velocity << "," << cf.forces[i].f_max << "\n";
       }
     outputs.set("--csv", c.str());
   }
@@ -774,10 +835,10 @@ int run_robust(RobustOptions& o, CLI::App& app) {  // by reference: the file's k
   outputs.write();
 
   std::ostream& out = outputs.table();
-  out << "ffsr-optimize " << FFSR_VERSION << " robust: " << where << " (" << model.n() << " joints, " << pb.law
-            << ", " << o.force_model << " F_max)\n"
-            << spec.samples << " samples, seed " << spec.seed << "; this run: samples " << first << " to " << end
-            << " (shard " << shard_k << "/" << shard_n << "), " << redraws << " redraws by the physical rules\n\n";
+  out << "ffsr-optimize " << FFSR_VERSION << " robust: " << where << " (" << model.n() << " joints, "
+      << pb.law << ", " << o.force_model << " F_max)\n"
+      << spec.samples << " samples, seed " << spec.seed << "; this run: samples " << first << " to " << end
+      << " (shard " << shard_k << "/" << shard_n << "), " << redraws << " redraws by the physical rules\n\n";
   print_summary(j, out);
   for (const std::string& f : drawn) out << "wrote " << f << "\n";
   return 0;
@@ -803,7 +864,8 @@ UncertaintySpec read_uncertainty_table(const std::string& config, const std::str
   return spec;
 }
 
-std::shared_ptr<RobustForceObjective> scenario_robust_objective(const Scenario& sc, const UncertaintySpec& spec) {
+std::shared_ptr<RobustForceObjective> scenario_robust_objective(const Scenario& sc,
+                                                                const UncertaintySpec& spec) {
   UncertainNominal nominal;
   nominal.target = propagate_target(sc.problem.target, sc.capture.duration);
   nominal.contact = sc.problem.contact;
@@ -819,29 +881,42 @@ std::shared_ptr<RobustForceObjective> scenario_robust_objective(const Scenario& 
 void register_robust(CLI::App& app, Action& action) {
   auto o = std::make_shared<RobustOptions>();
   CLI::App* sub = app.add_subcommand(
-      "robust", "Monte Carlo of F_max over the scenario's [uncertainty] table, for the planned capture configurations");
-  sub->add_option("--config", o->config, "Scenario file (TOML) with an [uncertainty] table")->check(CLI::ExistingFile);
+      "robust",
+      "Monte Carlo of F_max over the scenario's [uncertainty] table, for the planned capture configurations");
+  sub->add_option("--config", o->config, "Scenario file (TOML) with an [uncertainty] table")
+      ->check(CLI::ExistingFile);
   // before the scenario's keys: here --seed (and a scenario's `seed`) is the Monte Carlo seed, not the
   // global search's (add_scenario_options leaves an existing --seed alone)
   sub->add_option("--seed", o->seed, "Seed, a non-negative integer (overrides uncertainty.seed)");
   add_scenario_options(*sub, o->scenario);
-  sub->add_option("--force-model", o->force_model, "F_max per sample: closed (Eq. 24), exact (Eq. 16) or multibody (CVODE)")
+  sub->add_option("--force-model", o->force_model,
+                  "F_max per sample: closed (Eq. 24), exact (Eq. 16) or multibody (CVODE)")
       ->capture_default_str();
   sub->add_option("--samples", o->samples, "Number of samples (overrides uncertainty.samples)");
   sub->add_option("--threads", o->threads, "Worker threads")->capture_default_str();
-  sub->add_option("--shard", o->shard, "Evaluate only shard K of N (K = 0..N-1) of the samples")->capture_default_str();
+  sub->add_option("--shard", o->shard, "Evaluate only shard K of N (K = 0..N-1) of the samples")
+      ->capture_default_str();
   sub->add_option("--capture-joints-deg", o->capture_joints_deg,
-                  "Evaluate this capture configuration instead of planning (deg; --joints-deg is the scenario's start)")
-      ->delimiter(',')->allow_extra_args(false);
-  sub->add_option("--capture-base-position", o->capture_base_position, "Base position of that configuration, m")
-      ->delimiter(',')->allow_extra_args(false);
-  sub->add_option("--capture-base-rpy-deg", o->capture_base_rpy_deg, "Base attitude of that configuration, deg")
-      ->delimiter(',')->allow_extra_args(false);
-  sub->add_option("--merge", o->merge, "Merge these shard summaries (JSON files of --json) exactly; no scenario needed");
-  sub->add_option("--json", o->json, "Write the summary (with every sample's F_max, for merging) to this JSON file");
+                  "Evaluate this capture configuration instead of planning (deg; --joints-deg is the "
+                  "scenario's start)")
+      ->delimiter(',')
+      ->allow_extra_args(false);
+  sub->add_option("--capture-base-position", o->capture_base_position,
+                  "Base position of that configuration, m")
+      ->delimiter(',')
+      ->allow_extra_args(false);
+  sub->add_option("--capture-base-rpy-deg", o->capture_base_rpy_deg,
+                  "Base attitude of that configuration, deg")
+      ->delimiter(',')
+      ->allow_extra_args(false);
+  sub->add_option("--merge", o->merge,
+                  "Merge these shard summaries (JSON files of --json) exactly; no scenario needed");
+  sub->add_option("--json", o->json,
+                  "Write the summary (with every sample's F_max, for merging) to this JSON file");
   sub->add_option("--csv", o->csv, "Write one row per sample and configuration to this CSV file");
-  sub->add_option("--plot", o->plot,
-                  "Draw the CDF and the histogram of F_max per configuration into this (existing) folder (robust.png)");
+  sub->add_option(
+      "--plot", o->plot,
+      "Draw the CDF and the histogram of F_max per configuration into this (existing) folder (robust.png)");
   sub->add_option("--plot-format", o->plot_format, "Figure format: png, svg or pdf")->capture_default_str();
   sub->add_flag("--quiet", o->quiet, "No progress line");
   sub->callback([o, sub, &action] { action = [o, sub] { return run_robust(*o, *sub); }; });

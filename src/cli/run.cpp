@@ -28,11 +28,24 @@ namespace {
 
 using detail::str;
 
-
 /// Keys a scenario file must name (the others have defaults).
-const char* const kRequired[] = {"urdf", "joints-deg", "target-mass", "target-inertia", "target-position",
-                                 "target-angular-velocity-deg", "contact-offset", "normal", "model", "stiffness",
-                                 "exponent", "restitution", "approach-speed", "task", "duration", "step", "gain",
+const char* const kRequired[] = {"urdf",
+                                 "joints-deg",
+                                 "target-mass",
+                                 "target-inertia",
+                                 "target-position",
+                                 "target-angular-velocity-deg",
+                                 "contact-offset",
+                                 "normal",
+                                 "model",
+                                 "stiffness",
+                                 "exponent",
+                                 "restitution",
+                                 "approach-speed",
+                                 "task",
+                                 "duration",
+                                 "step",
+                                 "gain",
                                  "tolerance"};
 
 Vector3 vec3(const std::vector<double>& v, const char* key) {
@@ -58,7 +71,8 @@ CaptureTask parse_task(const std::string& kind, const std::string& axes, const s
               axes.find('z') != std::string::npos};
   } else if (kind == "pose") {
     t.kind = CaptureTask::Kind::Pose;
-    if (!final_rpy.empty()) t.final_orientation = rotation_from_rpy(vec3(final_rpy, "final-rpy-deg") * (M_PI / 180.0));
+    if (!final_rpy.empty())
+      t.final_orientation = rotation_from_rpy(vec3(final_rpy, "final-rpy-deg") * (M_PI / 180.0));
   } else {
     throw InputError(str("--", key, ": unknown task '", kind, "'; expected 'position' or 'pose'"));
   }
@@ -107,7 +121,6 @@ nlohmann::json result_json(const CaptureResult& r, const CaptureTask& task, doub
           {"steps", r.steps}};
 }
 
-
 /// Which keys came from the command line: they are not resolved against the scenario's folder.
 struct FromCommandLine {
   bool urdf = false, expect = false;
@@ -138,7 +151,8 @@ Scenario prepare_scenario(RunOptions o, const CLI::App& app, bool urdf_on_comman
   UrdfReport report;
   auto model_ptr = std::make_unique<Model>([&] {
     if (builtin && !urdf_on_command_line && o.urdf == "paper_3dof.urdf")
-      return model_from_urdf_string(kPaper3dofUrdf, "built-in paper_3dof.urdf", o.load.build(o.end_effector), &report);
+      return model_from_urdf_string(kPaper3dofUrdf, "built-in paper_3dof.urdf", o.load.build(o.end_effector),
+                                    &report);
     o.urdf = next_to_config(o.urdf, urdf_on_command_line);
     return model_from_urdf_file(o.urdf, o.load.build(o.end_effector), &report);
   }());
@@ -148,7 +162,8 @@ Scenario prepare_scenario(RunOptions o, const CLI::App& app, bool urdf_on_comman
   CaptureProblem pb;
   pb.model = &model;
   pb.frame = model.end_effector();
-  if (static_cast<int>(o.joints_deg.size()) != model.n()) throw InputError(joint_count_error(o.joints_deg.size(), model, ""));
+  if (static_cast<int>(o.joints_deg.size()) != model.n())
+    throw InputError(joint_count_error(o.joints_deg.size(), model, ""));
   pb.theta = Eigen::Map<const Eigen::VectorXd>(o.joints_deg.data(), model.n()) * (M_PI / 180.0);
   for (double x : o.joints_deg) finite(x, "joints-deg");
   pb.base.position = vec3(o.base_position, "base-position");
@@ -159,7 +174,8 @@ Scenario prepare_scenario(RunOptions o, const CLI::App& app, bool urdf_on_comman
     throw InputError(str("--target-inertia: expected 3 or 6 numbers, got ", o.target_inertia.size()));
   {
     std::ostringstream s;
-    for (size_t i = 0; i < o.target_inertia.size(); ++i) s << (i ? "," : "") << std::setprecision(17) << o.target_inertia[i];
+    for (size_t i = 0; i < o.target_inertia.size(); ++i)
+      s << (i ? "," : "") << std::setprecision(17) << o.target_inertia[i];
     t.inertia = parse_inertia(s.str(), "--target-inertia");
   }
   t.position = vec3(o.target_position, "target-position");
@@ -175,7 +191,8 @@ Scenario prepare_scenario(RunOptions o, const CLI::App& app, bool urdf_on_comman
   } catch (const InputError& e) {
     throw InputError(str("--target-mass/--target-inertia: ", e.what()));
   }
-  pb.contact = {finite(o.stiffness, "stiffness"), finite(o.exponent, "exponent"), finite(o.restitution, "restitution")};
+  pb.contact = {finite(o.stiffness, "stiffness"), finite(o.exponent, "exponent"),
+                finite(o.restitution, "restitution")};
   try {
     validate(pb.contact, "contact");
   } catch (const InputError& e) {
@@ -188,11 +205,13 @@ Scenario prepare_scenario(RunOptions o, const CLI::App& app, bool urdf_on_comman
   }
   pb.law = o.model;
   pb.approach_speed = finite(o.approach_speed, "approach-speed");
-  if (pb.approach_speed <= 0) throw InputError(str("--approach-speed: must be positive, got ", pb.approach_speed));
+  if (pb.approach_speed <= 0)
+    throw InputError(str("--approach-speed: must be positive, got ", pb.approach_speed));
 
   const CaptureTask task = parse_task(o.task, o.task_axes, o.final_rpy_deg, "task");
   const CaptureTask baseline_task =
-      o.baseline_task.empty() ? task : parse_task(o.baseline_task, o.task_axes, o.final_rpy_deg, "baseline-task");
+      o.baseline_task.empty() ? task
+                              : parse_task(o.baseline_task, o.task_axes, o.final_rpy_deg, "baseline-task");
   CaptureOptions opt;
   opt.duration = finite(o.duration, "duration");
   opt.step = finite(o.step, "step");
@@ -201,26 +220,31 @@ Scenario prepare_scenario(RunOptions o, const CLI::App& app, bool urdf_on_comman
   opt.tolerance = finite(o.tolerance, "tolerance");
   opt.orientation_tolerance = finite(o.orientation_tolerance_deg, "orientation-tolerance-deg") * M_PI / 180.0;
   if (o.duration <= 0) throw InputError(str("--duration: must be positive, got ", o.duration));
-  if (o.step <= 0 || o.step > o.duration) throw InputError(str("--step: must be in (0, duration], got ", o.step));
+  if (o.step <= 0 || o.step > o.duration)
+    throw InputError(str("--step: must be in (0, duration], got ", o.step));
   if (o.tolerance <= 0) throw InputError(str("--tolerance: must be positive, got ", o.tolerance));
   // multibody-force has no gradient: the paper's method descends M_ie, the global search ranks by the CVODE peak
   // multibody-force and robust-force have no gradient the paper's method could use: it descends M_ie
   if (o.objective == "mass" || o.objective == "multibody-force" || o.objective == "robust-force")
     opt.objective = CaptureObjective::IntegratedEffectiveMass;
-  else if (o.objective == "exact-force") opt.objective = CaptureObjective::ExactMaxForce;
+  else if (o.objective == "exact-force")
+    opt.objective = CaptureObjective::ExactMaxForce;
   else
     throw InputError(str("--objective: unknown objective '", o.objective,
                          "'; expected 'mass', 'exact-force', 'multibody-force' or 'robust-force'"));
   if (o.objective == "robust-force" && o.config.empty())
-    throw InputError("--objective: robust-force needs a scenario file (--config) with an [uncertainty] table");
+    throw InputError(
+        "--objective: robust-force needs a scenario file (--config) with an [uncertainty] table");
   parse_seed(o.seed);
   if (o.global_starts < 1) throw InputError(str("--global-starts: must be >= 1, got ", o.global_starts));
-  if (app.get_option("--max-joint-rate-deg")->count() > 0 && !(finite(o.max_joint_rate_deg, "max-joint-rate-deg") > 0))
+  if (app.get_option("--max-joint-rate-deg")->count() > 0 &&
+      !(finite(o.max_joint_rate_deg, "max-joint-rate-deg") > 0))
     throw InputError(str("--max-joint-rate-deg: must be positive, got ", o.max_joint_rate_deg));
   if (opt.gain != 0.0 && task.rows() >= model.n())
     throw InputError(str("--gain: the ", o.task, " task has ", task.rows(), " rows and the robot ", model.n(),
                          " joints: no null space to optimize in (set gain = 0 or constrain fewer axes)"));
-  Scenario sc{std::move(o), where, builtin, std::move(model_ptr), pb, task, baseline_task, opt, std::move(report)};
+  Scenario sc{std::move(o), where,         builtin, std::move(model_ptr), pb,
+              task,         baseline_task, opt,     std::move(report)};
   sc.problem.model = sc.model.get();
   return sc;
 }
@@ -241,7 +265,8 @@ std::pair<CaptureResult, CaptureResult> plan_plain_and_optimized(const Scenario&
       throw NumericalError(str(label, " run: ", e.what()));
     }
   };
-  CaptureResult base_run = labelled("plain", [&] { return plan_capture(sc.problem, sc.baseline_task, plain); });
+  CaptureResult base_run =
+      labelled("plain", [&] { return plan_capture(sc.problem, sc.baseline_task, plain); });
   CaptureResult opt_run = labelled("optimized", [&] { return plan_capture(sc.problem, sc.task, opt); });
   return {std::move(base_run), std::move(opt_run)};
 }
@@ -286,14 +311,15 @@ GlobalRun run_global(const Scenario& sc, const CaptureResult& paper_run, GlobalO
   }
   const CaptureSetup setup = prepare_capture(sc.problem, sc.task, opt);
   r.paper_objective =
-      evaluate_capture(sc.problem, setup, paper_run.base, paper_run.theta, objective, {}, robust.get()).objective;
+      evaluate_capture(sc.problem, setup, paper_run.base, paper_run.theta, objective, {}, robust.get())
+          .objective;
   return r;
 }
 
 namespace {
 
-void add_global_json(nlohmann::json& j, const GlobalRun& g, const CaptureResult& base_run, const CaptureTask& task,
-                     const RunOptions& o) {
+void add_global_json(nlohmann::json& j, const GlobalRun& g, const CaptureResult& base_run,
+                     const CaptureTask& task, const RunOptions& o) {
   const GlobalCaptureResult& r = g.result;
   nlohmann::json x = result_json(r.run, task, 0.0);
   x["objective"] = o.objective;
@@ -313,7 +339,8 @@ void add_global_json(nlohmann::json& j, const GlobalRun& g, const CaptureResult&
     // the ranked local optima of M_ie at the reached base pose: how far the mass and force optima are apart
     nlohmann::json ranked = nlohmann::json::array();
     for (const ManifoldPoint& p : r.search.local_optima)
-      if (p.objective > 0) ranked.push_back({{"integrated_effective_mass", p.M_ie}, {"f_max_multibody", p.objective}});
+      if (p.objective > 0)
+        ranked.push_back({{"integrated_effective_mass", p.M_ie}, {"f_max_multibody", p.objective}});
     x["search"]["ranked_local_optima"] = ranked;
     x["f_max_multibody"] = r.objective;
     j["optimized"]["f_max_multibody"] = g.paper_objective;
@@ -322,31 +349,36 @@ void add_global_json(nlohmann::json& j, const GlobalRun& g, const CaptureResult&
   j["global_mass_reduction_percent"] = 100.0 * (base_run.M_ie - r.run.M_ie) / base_run.M_ie;
   j["global_force_reduction_percent"] =
       100.0 * (base_run.f_max_closed_form - r.run.f_max_closed_form) / base_run.f_max_closed_form;
-  j["global_exact_force_reduction_percent"] = 100.0 * (base_run.f_max_exact - r.run.f_max_exact) / base_run.f_max_exact;
+  j["global_exact_force_reduction_percent"] =
+      100.0 * (base_run.f_max_exact - r.run.f_max_exact) / base_run.f_max_exact;
 }
 
-void print_global_notes(std::ostream& out, const GlobalRun& g, const CaptureResult& opt_run, const RunOptions& o) {
+void print_global_notes(std::ostream& out, const GlobalRun& g, const CaptureResult& opt_run,
+                        const RunOptions& o) {
   const GlobalCaptureResult& r = g.result;
   const bool mb = o.objective == "multibody-force";
   const double unit = mb || o.objective == "exact-force" || o.objective == "robust-force" ? 1e3 : 1.0;
   const char* u = unit == 1.0 ? " kg" : " kN";
   out << std::fixed << std::setprecision(3) << "global (" << o.objective << ", seed " << o.seed
       << "): reached " << r.objective / unit << u << ", manifold optimum at the reached base pose "
-      << r.manifold_optimum / unit << u << " (gap " << r.optimality_gap_percent << " %), " << r.shooting_iterations
-      << " reaching run(s), " << r.goals_tried << " goal(s) tried"
-      << (r.goals_out_of_limits > 0 ? " (" + std::to_string(r.goals_out_of_limits) + " behind a joint limit)" : "")
-      << "; search: " << r.search.method << ", " << r.search.starts << " starts, "
-      << r.evaluations << " evaluations" << (mb ? ", " + std::to_string(r.objective_evaluations) + " CVODE runs" : "")
-      << ", " << r.search_seconds << " s\n";
+      << r.manifold_optimum / unit << u << " (gap " << r.optimality_gap_percent << " %), "
+      << r.shooting_iterations << " reaching run(s), " << r.goals_tried << " goal(s) tried"
+      << (r.goals_out_of_limits > 0 ? " (" + std::to_string(r.goals_out_of_limits) + " behind a joint limit)"
+                                    : "")
+      << "; search: " << r.search.method << ", " << r.search.starts << " starts, " << r.evaluations
+      << " evaluations" << (mb ? ", " + std::to_string(r.objective_evaluations) + " CVODE runs" : "") << ", "
+      << r.search_seconds << " s\n";
   if (!r.reached_manifold_optimum)
-    out << "note: the better optima at the reached base pose lie on other components of the self-motion manifold; "
+    out << "note: the better optima at the reached base pose lie on other components of the self-motion "
+           "manifold; "
            "the servo reached none of them\n";
   if (mb)
-    out << "CVODE multibody F_max: optimization " << g.paper_objective / 1e3 << " kN, global " << r.objective / 1e3
-        << " kN\n";
-  out << "largest joint rate: optimization " << opt_run.max_joint_rate * 180.0 / M_PI << " deg/s (not limited), global "
-      << r.run.max_joint_rate * 180.0 / M_PI << " deg/s ("
-      << (o.max_joint_rate_deg > 0 ? "limit " + std::to_string(o.max_joint_rate_deg) + " deg/s" : std::string("not limited"))
+    out << "CVODE multibody F_max: optimization " << g.paper_objective / 1e3 << " kN, global "
+        << r.objective / 1e3 << " kN\n";
+  out << "largest joint rate: optimization " << opt_run.max_joint_rate * 180.0 / M_PI
+      << " deg/s (not limited), global " << r.run.max_joint_rate * 180.0 / M_PI << " deg/s ("
+      << (o.max_joint_rate_deg > 0 ? "limit " + std::to_string(o.max_joint_rate_deg) + " deg/s"
+                                   : std::string("not limited"))
       << ")\n";
 }
 
@@ -367,8 +399,10 @@ int run_scenario(RunOptions options, const CLI::App& app, FromCommandLine cli) {
   outputs.add("--csv", o.csv);
   nlohmann::json expected;
   Tolerance tol{o.rtol, o.atol};
-  if (!std::isfinite(o.rtol) || o.rtol < 0) throw InputError(str("--rtol: must be finite and >= 0, got ", o.rtol));
-  if (!std::isfinite(o.atol) || o.atol < 0) throw InputError(str("--atol: must be finite and >= 0, got ", o.atol));
+  if (!std::isfinite(o.rtol) || o.rtol < 0)
+    throw InputError(str("--rtol: must be finite and >= 0, got ", o.rtol));
+  if (!std::isfinite(o.atol) || o.atol < 0)
+    throw InputError(str("--atol: must be finite and >= 0, got ", o.atol));
   if (!o.expect.empty()) {
     o.expect = next_to_config(o.expect, cli.expect);
     expected = load_baseline(o.expect, "--expect");
@@ -387,7 +421,8 @@ int run_scenario(RunOptions options, const CLI::App& app, FromCommandLine cli) {
   // --- the two runs ------------------------------------------------------------------------------
   const auto [base_run, opt_run] = plan_plain_and_optimized(sc, o.quiet);
   const double mass_red = 100.0 * (base_run.M_ie - opt_run.M_ie) / base_run.M_ie;
-  const double force_red = 100.0 * (base_run.f_max_closed_form - opt_run.f_max_closed_form) / base_run.f_max_closed_form;
+  const double force_red =
+      100.0 * (base_run.f_max_closed_form - opt_run.f_max_closed_form) / base_run.f_max_closed_form;
   const double exact_red = 100.0 * (base_run.f_max_exact - opt_run.f_max_exact) / base_run.f_max_exact;
   std::optional<GlobalRun> global;
   std::shared_ptr<RobustForceObjective> robust;  // robust-force: the search's sample set
@@ -452,9 +487,10 @@ int run_scenario(RunOptions options, const CLI::App& app, FromCommandLine cli) {
   std::string robust_note;
   if (robust) {
     Data data(model);
-    nlohmann::json rj = {{"measure", "CVaR_95 (mean of the largest 5 %) and p95 (nearest rank) of the exact F_max, N"},
-                         {"samples", robust->samples().size()},
-                         {"seed", robust_objective_seed(robust_spec)}};
+    nlohmann::json rj = {
+        {"measure", "CVaR_95 (mean of the largest 5 %) and p95 (nearest rank) of the exact F_max, N"},
+        {"samples", robust->samples().size()},
+        {"seed", robust_objective_seed(robust_spec)}};
     std::ostringstream note;
     note << std::fixed << std::setprecision(3) << "robust-force over " << robust->samples().size()
          << " samples (seed " << robust_objective_seed(robust_spec) << "): CVaR_95 / p95 of the exact F_max";
@@ -463,8 +499,8 @@ int run_scenario(RunOptions options, const CLI::App& app, FromCommandLine cli) {
     for (const auto& [name, r] : rows) {
       const auto v = robust->value(robot_inverse_inertia(model, data, r->base, r->theta, pb.frame));
       rj[name] = {{"cvar95", v.cvar95}, {"p95", v.p95}};
-      note << (r == &base_run ? ": " : ", ") << (r == &base_run ? "plain" : name) << " " << v.cvar95 / 1e3 << " / "
-           << v.p95 / 1e3 << " kN";
+      note << (r == &base_run ? ": " : ", ") << (r == &base_run ? "plain" : name) << " " << v.cvar95 / 1e3
+           << " / " << v.p95 / 1e3 << " kN";
     }
     j["robust"] = rj;
     robust_note = note.str() + "\n";
@@ -483,9 +519,10 @@ int run_scenario(RunOptions options, const CLI::App& app, FromCommandLine cli) {
         c << (run == &base_run ? "baseline" : run == &opt_run ? "optimized" : "global") << "," << s.t;
         for (Eigen::Index i = 0; i < s.theta.size(); ++i) c << "," << s.theta(i) * 180.0 / M_PI;
         const auto& q = s.base.orientation;
-        c << "," << s.base.position.x() << "," << s.base.position.y() << "," << s.base.position.z() << "," << q.w()
-          << "," << q.x() << "," << q.y() << "," << q.z() << "," << s.end_effector.x() << "," << s.end_effector.y()
-          << "," << s.end_effector.z() << "," << s.M_ie << "," << s.f_max_estimate << "\n";
+        c << "," << s.base.position.x() << "," << s.base.position.y() << "," << s.base.position.z() << ","
+          << q.w() << "," << q.x() << "," << q.y() << "," << q.z() << "," << s.end_effector.x() << ","
+          << s.end_effector.y() << "," << s.end_effector.z() << "," << s.M_ie << "," << s.f_max_estimate
+          << "\n";
       }
     }
     csv = c.str();
@@ -505,40 +542,44 @@ int run_scenario(RunOptions options, const CLI::App& app, FromCommandLine cli) {
   const int w = 8 * model.n() + 4;
   out << std::left << std::setw(24) << "" << std::setw(w) << "Capture configuration (deg)" << std::right
       << std::setw(11) << "M_ie (kg)" << std::setw(14) << "F_max (kN)" << std::setw(14) << "exact (kN)"
-      << std::setw(15) << "tracking (m)" << "\n";
+      << std::setw(15) << "tracking (m)"
+      << "\n";
   auto row = [&](const char* label, const CaptureResult& r) {
-    out << std::left << std::setw(24) << label << std::setw(w) << deg_list(r.theta) << std::right << std::fixed
-        << std::setprecision(3) << std::setw(11) << r.M_ie << std::setw(14) << r.f_max_closed_form / 1e3
-        << std::setw(14) << r.f_max_exact / 1e3 << std::setw(15) << std::scientific << std::setprecision(2)
-        << r.tracking_error << std::fixed << "\n";
+    out << std::left << std::setw(24) << label << std::setw(w) << deg_list(r.theta) << std::right
+        << std::fixed << std::setprecision(3) << std::setw(11) << r.M_ie << std::setw(14)
+        << r.f_max_closed_form / 1e3 << std::setw(14) << r.f_max_exact / 1e3 << std::setw(15)
+        << std::scientific << std::setprecision(2) << r.tracking_error << std::fixed << "\n";
   };
   row("Without optimization", base_run);
   row("With optimization", opt_run);
   if (global) row("Global", global->result.run);
-  out << std::left << std::setw(24 + w) << "Reduction (optimization)" << std::right << std::fixed << std::setprecision(2)
-      << std::setw(10) << mass_red << "%" << std::setw(13) << force_red << "%" << std::setw(13) << exact_red << "%\n";
+  out << std::left << std::setw(24 + w) << "Reduction (optimization)" << std::right << std::fixed
+      << std::setprecision(2) << std::setw(10) << mass_red << "%" << std::setw(13) << force_red << "%"
+      << std::setw(13) << exact_red << "%\n";
   if (global) {
     const CaptureResult& g = global->result.run;
     out << std::left << std::setw(24 + w) << "Reduction (global)" << std::right << std::setw(10)
         << 100.0 * (base_run.M_ie - g.M_ie) / base_run.M_ie << "%" << std::setw(13)
-        << 100.0 * (base_run.f_max_closed_form - g.f_max_closed_form) / base_run.f_max_closed_form << "%" << std::setw(13)
-        << 100.0 * (base_run.f_max_exact - g.f_max_exact) / base_run.f_max_exact << "%\n";
+        << 100.0 * (base_run.f_max_closed_form - g.f_max_closed_form) / base_run.f_max_closed_form << "%"
+        << std::setw(13) << 100.0 * (base_run.f_max_exact - g.f_max_exact) / base_run.f_max_exact << "%\n";
     print_global_notes(out, *global, opt_run, o);
-  out << robust_note;
+    out << robust_note;
   }
   out << "\n";
-  out << std::setprecision(4) << "capture point [" << base_run.capture_point.transpose().format(Eigen::IOFormat(4, 0, ", "))
+  out << std::setprecision(4) << "capture point ["
+      << base_run.capture_point.transpose().format(Eigen::IOFormat(4, 0, ", "))
       << "] m, approach velocity delta_dot^- = " << base_run.approach_velocity << " m/s\n"
       << "base drift: plain " << base_run.base_position_drift * 1e3 << " mm / "
-      << base_run.base_attitude_drift * 180.0 / M_PI << " deg, optimized " << opt_run.base_position_drift * 1e3
-      << " mm / " << opt_run.base_attitude_drift * 180.0 / M_PI << " deg\n"
-      << "tasks: plain " << (baseline_task.kind == CaptureTask::Kind::Pose ? "pose" : "position") << ", optimized "
-      << (task.kind == CaptureTask::Kind::Pose ? "pose" : "position")
+      << base_run.base_attitude_drift * 180.0 / M_PI << " deg, optimized "
+      << opt_run.base_position_drift * 1e3 << " mm / " << opt_run.base_attitude_drift * 180.0 / M_PI
+      << " deg\n"
+      << "tasks: plain " << (baseline_task.kind == CaptureTask::Kind::Pose ? "pose" : "position")
+      << ", optimized " << (task.kind == CaptureTask::Kind::Pose ? "pose" : "position")
       << "; F_max: Eq. 24 closed form; exact: peak of the single-body model (Eq. 16)\n";
   if (base_run.damped_steps + opt_run.damped_steps > 0)
-    out << "note: near a singularity the pseudo-inverse was damped in " << base_run.damped_steps + opt_run.damped_steps
-        << " evaluations (smallest singular value " << std::min(base_run.min_singular_value, opt_run.min_singular_value)
-        << ")\n";
+    out << "note: near a singularity the pseudo-inverse was damped in "
+        << base_run.damped_steps + opt_run.damped_steps << " evaluations (smallest singular value "
+        << std::min(base_run.min_singular_value, opt_run.min_singular_value) << ")\n";
 
   // --- regression run: every number of the result against the stored one -------------------------
   if (!o.expect.empty()) {
@@ -567,39 +608,50 @@ void add_scenario_options(CLI::App& app, RunOptions& o) {
   vec("--base-position", o.base_position, "Initial base position, m");
   vec("--base-rpy-deg", o.base_rpy_deg, "Initial base attitude (roll, pitch, yaw), deg");
   app.add_option("--target-mass", o.target_mass, "Target mass, kg");
-  vec("--target-inertia", o.target_inertia, "Target inertia: Ixx,Iyy,Izz[,Ixy,Ixz,Iyz], kg m^2 (target frame)");
+  vec("--target-inertia", o.target_inertia,
+      "Target inertia: Ixx,Iyy,Izz[,Ixy,Ixz,Iyz], kg m^2 (target frame)");
   vec("--target-position", o.target_position, "Target centre of mass at t = 0, m");
   vec("--target-rpy-deg", o.target_rpy_deg, "Target attitude at t = 0, deg");
   vec("--target-angular-velocity-deg", o.target_angular_velocity_deg, "Target spin (target frame), deg/s");
   vec("--target-velocity", o.target_velocity, "Target linear velocity, m/s");
-  vec("--contact-offset", o.contact_offset, "r_tp: contact point from the target centre of mass (target frame), m");
+  vec("--contact-offset", o.contact_offset,
+      "r_tp: contact point from the target centre of mass (target frame), m");
   vec("--normal", o.normal, "u_n: contact normal (target frame)");
   app.add_option("--model", o.model, "Hysteresis damping law (Table 1)");
   app.add_option("--stiffness", o.stiffness, "K, N/m^alpha");
   app.add_option("--exponent", o.exponent, "alpha");
   app.add_option("--restitution", o.restitution, "c_r, 0 < c_r <= 1");
-  app.add_option("--approach-speed", o.approach_speed, "End-effector speed along the normal at the capture, m/s");
+  app.add_option("--approach-speed", o.approach_speed,
+                 "End-effector speed along the normal at the capture, m/s");
   app.add_option("--task", o.task, "Optimized run's task: position or pose");
-  app.add_option("--task-axes", o.task_axes, "Position task: constrained inertial axes, e.g. xy")->capture_default_str();
+  app.add_option("--task-axes", o.task_axes, "Position task: constrained inertial axes, e.g. xy")
+      ->capture_default_str();
   app.add_option("--baseline-task", o.baseline_task, "Plain run's task (default: the optimized run's)");
-  vec("--final-rpy-deg", o.final_rpy_deg, "Pose task: final end-effector orientation (default: hold the initial)");
+  vec("--final-rpy-deg", o.final_rpy_deg,
+      "Pose task: final end-effector orientation (default: hold the initial)");
   app.add_option("--duration", o.duration, "Task time T, s");
   app.add_option("--step", o.step, "RK4 step, s");
   app.add_option("--gain", o.gain, "rho of Eq. 30 (< 0 lowers the objective)");
   app.add_option("--feedback", o.feedback, "Tracking feedback gain, 1/s")->capture_default_str();
   app.add_option("--tolerance", o.tolerance, "Required capture-point accuracy, m");
-  app.add_option("--orientation-tolerance-deg", o.orientation_tolerance_deg, "Pose task: required orientation accuracy, deg")
+  app.add_option("--orientation-tolerance-deg", o.orientation_tolerance_deg,
+                 "Pose task: required orientation accuracy, deg")
       ->capture_default_str();
-  app.add_option("--objective", o.objective,
-                 "mass (M_ie, the paper's), exact-force, or multibody-force (CVODE peak; global search only, the "
-                 "paper's method then descends M_ie)")
+  app.add_option(
+         "--objective", o.objective,
+         "mass (M_ie, the paper's), exact-force, or multibody-force (CVODE peak; global search only, the "
+         "paper's method then descends M_ie)")
       ->capture_default_str();
-  app.add_option("--global", o.global, "Also run the global capture optimization (true/false)")->capture_default_str();
+  app.add_option("--global", o.global, "Also run the global capture optimization (true/false)")
+      ->capture_default_str();
   if (!app.get_option_no_throw("--seed"))  // robust registers its own (Monte Carlo) --seed first
-    app.add_option("--seed", o.seed, "Seed of the global search's random starts (non-negative integer)")->capture_default_str();
-  app.add_option("--max-joint-rate-deg", o.max_joint_rate_deg,
-                 "Global run: largest joint rate, deg/s (> 0; default: not limited; the paper's method is not limited)");
-  app.add_option("--global-starts", o.global_starts, "Global search: random starts (>= 1)")->capture_default_str();
+    app.add_option("--seed", o.seed, "Seed of the global search's random starts (non-negative integer)")
+        ->capture_default_str();
+  app.add_option(
+      "--max-joint-rate-deg", o.max_joint_rate_deg,
+      "Global run: largest joint rate, deg/s (> 0; default: not limited; the paper's method is not limited)");
+  app.add_option("--global-starts", o.global_starts, "Global search: random starts (>= 1)")
+      ->capture_default_str();
 }
 
 void register_run(CLI::App& app, Action& action, int argc, char** argv) {
@@ -611,20 +663,25 @@ void register_run(CLI::App& app, Action& action, int argc, char** argv) {
     if (a == "--expect" || a.rfind("--expect=", 0) == 0) from_cli.expect = true;
     if (a == "inspect" || a == "contact" || a == "xi" || a == "map" || a == "robust") break;
   }
-  app.set_config("--config", "", "Scenario file (TOML); every key is also a flag. Default: the built-in paper 3-DOF scenario");
+  app.set_config(
+      "--config", "",
+      "Scenario file (TOML); every key is also a flag. Default: the built-in paper 3-DOF scenario");
   app.config_formatter(std::make_shared<ScenarioConfig>());  // [uncertainty] is the robust command's
   app.get_config_ptr()->check(CLI::ExistingFile);
   app.allow_config_extras(CLI::config_extras_mode::error);  // an unknown key in a scenario is an error
   add_scenario_options(app, *o);
   app.add_option("--json", o->json,
-                 "Write the result (with the resolved scenario and the version) to this JSON file ('-': standard output)");
-  app.add_option("--csv", o->csv, "Write the time series of both runs to this CSV file ('-': standard output)");
+                 "Write the result (with the resolved scenario and the version) to this JSON file ('-': "
+                 "standard output)");
+  app.add_option("--csv", o->csv,
+                 "Write the time series of both runs to this CSV file ('-': standard output)");
   app.add_option("--expect", o->expect,
                  "Regression run: compare every number of the result with this stored --json result; exit 4 "
                  "when one moved (relative to the scenario file)");
   app.add_option("--rtol", o->rtol, "--expect: relative tolerance")->capture_default_str();
   app.add_option("--atol", o->atol, "--expect: absolute floor for values near zero")->capture_default_str();
-  app.add_option("--plot", o->plot, "Draw the capture process and time histories into this (existing) folder");
+  app.add_option("--plot", o->plot,
+                 "Draw the capture process and time histories into this (existing) folder");
   app.add_option("--plot-format", o->plot_format, "Figure format: png, svg or pdf")->capture_default_str();
   app.add_flag("--quiet", o->quiet, "No progress line");
   app.callback([o, &app, &action, from_cli] {

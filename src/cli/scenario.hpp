@@ -35,9 +35,9 @@ struct RunOptions {
   std::vector<double> final_rpy_deg;
   double duration = 0, step = 0, gain = 0, feedback = 1.0, tolerance = 0, orientation_tolerance_deg = 0.5;
   std::string objective = "mass";
-  bool global = true;                 ///< the third row: global capture optimization (issue 9)
-  std::string seed = "1";             ///< parsed by the command, so a bad value is a one-line error naming the key
-  double max_joint_rate_deg = 0;      ///< 0: not set (the global run is then not rate limited)
+  bool global = true;      ///< the third row: global capture optimization (issue 9)
+  std::string seed = "1";  ///< parsed by the command, so a bad value is a one-line error naming the key
+  double max_joint_rate_deg = 0;  ///< 0: not set (the global run is then not rate limited)
   int global_starts = 32;
   std::string json, csv, plot, plot_format = "png";
   std::string expect;  ///< a stored result to compare with (regression run)
@@ -93,7 +93,8 @@ UncertaintySpec read_uncertainty_table(const std::string& config, const std::str
 inline std::uint64_t robust_objective_seed(const UncertaintySpec& spec) { return spec.seed + 1; }
 /// The robust-force objective of a scenario: spec.samples samples (seed robust_objective_seed)
 /// around the nominal target at T, the scenario's contact and law.
-std::shared_ptr<RobustForceObjective> scenario_robust_objective(const Scenario& sc, const UncertaintySpec& spec);
+std::shared_ptr<RobustForceObjective> scenario_robust_objective(const Scenario& sc,
+                                                                const UncertaintySpec& spec);
 
 /// CLI11's TOML reader for the main job: drops the [uncertainty] table (read by `robust` with a
 /// full TOML parser: CLI11 2.1 does not parse its inline tables), keeps every other key.

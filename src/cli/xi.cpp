@@ -32,7 +32,8 @@ std::vector<double> spaced(double a, double b, int n, bool log) {
 
 int run_xi(const XiOptions& o) {
   using detail::str;
-  if (o.points < 2 || o.points > 100000) throw InputError(str("--points: expected 2 to 100000, got ", o.points));
+  if (o.points < 2 || o.points > 100000)
+    throw InputError(str("--points: expected 2 to 100000, got ", o.points));
   const ContactParams base{o.stiffness, o.exponent, o.restitution};
   try {
     validate(base, "contact");
@@ -50,14 +51,30 @@ int run_xi(const XiOptions& o) {
     return os.str();
   };
   const std::string fixed_k = "K = " + g(o.stiffness) + " N/m^" + g(o.exponent),
-                    fixed_v = "δ̇⁻ = " + g(o.approach_speed) + " m/s", fixed_c = "c#dr#u = " + g(o.restitution);
+                    fixed_v = "δ̇⁻ = " + g(o.approach_speed) + " m/s",
+                    fixed_c = "c#dr#u = " + g(o.restitution);
   std::vector<figures::XiStudy> studies(3);
-  studies[0] = {"xi_stiffness", "ξ against K (Figure 4): " + fixed_v + ", " + fixed_c, "contact stiffness K (N/m^α)",
-                true, spaced(1e7, 1e11, o.points, true), laws, {}};
-  studies[1] = {"xi_approach_speed", "ξ against δ̇⁻ (Figure 5): " + fixed_k + ", " + fixed_c,
-                "initial relative contact velocity δ̇⁻ (m/s)", true, spaced(0.01, 1.0, o.points, true), laws, {}};
-  studies[2] = {"xi_restitution", "ξ against c#dr#u (Figure 6): " + fixed_k + ", " + fixed_v,
-                "coefficient of restitution c#dr#u", false, spaced(0.1, 1.0, o.points, false), laws, {}};
+  studies[0] = {"xi_stiffness",
+                "ξ against K (Figure 4): " + fixed_v + ", " + fixed_c,
+                "contact stiffness K (N/m^α)",
+                true,
+                spaced(1e7, 1e11, o.points, true),
+                laws,
+                {}};
+  studies[1] = {"xi_approach_speed",
+                "ξ against δ̇⁻ (Figure 5): " + fixed_k + ", " + fixed_c,
+                "initial relative contact velocity δ̇⁻ (m/s)",
+                true,
+                spaced(0.01, 1.0, o.points, true),
+                laws,
+                {}};
+  studies[2] = {"xi_restitution",
+                "ξ against c#dr#u (Figure 6): " + fixed_k + ", " + fixed_v,
+                "coefficient of restitution c#dr#u",
+                false,
+                spaced(0.1, 1.0, o.points, false),
+                laws,
+                {}};
   std::ostringstream csv;
   csv << std::setprecision(12) << "study,parameter,law,xi_percent\n";
   const char* column[] = {"stiffness", "approach_speed", "restitution"};
@@ -81,8 +98,10 @@ int run_xi(const XiOptions& o) {
     for (const auto& st : studies) figs.push_back(figures::xi(st));
     plot::render(figs, o.plot, plot_format);
   }
-  if (o.csv.empty()) std::cout << csv.str();
-  else write_file_atomic(o.csv, csv.str());
+  if (o.csv.empty())
+    std::cout << csv.str();
+  else
+    write_file_atomic(o.csv, csv.str());
   return 0;
 }
 
@@ -91,10 +110,13 @@ int run_xi(const XiOptions& o) {
 void register_xi(CLI::App& app, Action& action) {
   auto o = std::make_shared<XiOptions>();
   CLI::App* sub = app.add_subcommand(
-      "xi", "Relative error xi of the closed-form maximum force against K, delta_dot^- and c_r (Figures 4-6)");
-  sub->add_option("--stiffness", o->stiffness, "K held fixed in the other studies, N/m^alpha")->capture_default_str();
+      "xi",
+      "Relative error xi of the closed-form maximum force against K, delta_dot^- and c_r (Figures 4-6)");
+  sub->add_option("--stiffness", o->stiffness, "K held fixed in the other studies, N/m^alpha")
+      ->capture_default_str();
   sub->add_option("--exponent", o->exponent, "Contact exponent alpha")->capture_default_str();
-  sub->add_option("--restitution", o->restitution, "c_r held fixed in the other studies")->capture_default_str();
+  sub->add_option("--restitution", o->restitution, "c_r held fixed in the other studies")
+      ->capture_default_str();
   sub->add_option("--approach-speed", o->approach_speed, "delta_dot^- held fixed in the other studies, m/s")
       ->capture_default_str();
   sub->add_option("--points", o->points, "Values per study")->capture_default_str();

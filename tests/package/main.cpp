@@ -25,9 +25,12 @@ ffsr::Model paper_3dof() {
   using namespace ffsr;
   auto at = [](double x) { return Pose{Vector3(x, 0, 0), Matrix3::Identity()}; };
   return ModelBuilder("base", {500, Vector3::Zero(), 200 * Matrix3::Identity()})
-      .add_joint("j1", JointType::Revolute, "base", at(0.6), Vector3::UnitZ(), "link1", link(5, 0.7, 0.01, 0.82))
-      .add_joint("j2", JointType::Revolute, "link1", at(1.4), Vector3::UnitZ(), "link2", link(6, 0.8, 0.01, 1.28))
-      .add_joint("j3", JointType::Revolute, "link2", at(1.6), Vector3::UnitZ(), "link3", link(4, 0.25, 0.0, 0.09))
+      .add_joint("j1", JointType::Revolute, "base", at(0.6), Vector3::UnitZ(), "link1",
+                 link(5, 0.7, 0.01, 0.82))
+      .add_joint("j2", JointType::Revolute, "link1", at(1.4), Vector3::UnitZ(), "link2",
+                 link(6, 0.8, 0.01, 1.28))
+      .add_joint("j3", JointType::Revolute, "link2", at(1.6), Vector3::UnitZ(), "link3",
+                 link(4, 0.25, 0.0, 0.09))
       .add_fixed("ee_joint", "link3", at(0.5), "ee", Inertia{})
       .build();
 }
@@ -37,7 +40,8 @@ double m_ie(const ffsr::Model& model) {
   const double deg = M_PI / 180;
   const Eigen::VectorXd theta = Eigen::Vector3d(0, 90 * deg, -90 * deg);
   const ffsr::Target target;  // m = 200 kg, I = diag(100), r_tp = [-0.25, 0.15, 0], u_n = x
-  return ffsr::integrated_effective_mass(model, data, ffsr::BasePose{}, theta, model.frame_index("ee"), target);
+  return ffsr::integrated_effective_mass(model, data, ffsr::BasePose{}, theta, model.frame_index("ee"),
+                                         target);
 }
 
 }  // namespace

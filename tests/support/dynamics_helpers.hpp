@@ -16,14 +16,14 @@
 
 namespace ffsr_test {
 
+using Eigen::MatrixXd;
+using Eigen::VectorXd;
 using ffsr::BasePose;
 using ffsr::Inertia;
 using ffsr::Matrix3;
 using ffsr::Quaternion;
 using ffsr::Vector3;
 using ffsr::Vector6;
-using Eigen::MatrixXd;
-using Eigen::VectorXd;
 
 inline std::string source_path(const std::string& rel) { return std::string(FFSR_SOURCE_DIR) + "/" + rel; }
 
@@ -67,7 +67,8 @@ struct Rng {
   /// A physical inertia: principal moments (b+c, a+c, a+b) of second moments a, b, c >= 0 (so the
   /// triangle inequality holds), rotated by a random rotation: full, non-diagonal.
   Matrix3 inertia(double scale) {
-    const double a = uniform(0.05, 1.0) * scale, b = uniform(0.05, 1.0) * scale, c = uniform(0.05, 1.0) * scale;
+    const double a = uniform(0.05, 1.0) * scale, b = uniform(0.05, 1.0) * scale,
+                 c = uniform(0.05, 1.0) * scale;
     const Matrix3 R = rotation();
     return R * Vector3(b + c, a + c, a + b).asDiagonal() * R.transpose();
   }
@@ -121,7 +122,8 @@ using Chart = std::function<Config(const Config& q, const VectorXd& v, double h)
 inline Config advance_library(const Config& q, const VectorXd& v, double h) {
   Config r = q;
   r.base.position = q.base.position + h * v.head<3>();
-  const Matrix3 R = ffsr::rotation_from_vector(h * Vector3(v.segment<3>(3))) * q.base.orientation.normalized().toRotationMatrix();
+  const Matrix3 R = ffsr::rotation_from_vector(h * Vector3(v.segment<3>(3))) *
+                    q.base.orientation.normalized().toRotationMatrix();
   r.base.orientation = Quaternion(R);
   r.theta = q.theta + h * v.tail(v.size() - 6);
   return r;
@@ -172,7 +174,8 @@ inline Chart advance_com_chart(const TestRobot& r) {
     ffsr::Data d(r.model);
     const Vector3 g0 = system_com(r, link_states(r, d, q));
     Config moved = q;
-    const Matrix3 R = ffsr::rotation_from_vector(h * Vector3(v.segment<3>(3))) * q.base.orientation.normalized().toRotationMatrix();
+    const Matrix3 R = ffsr::rotation_from_vector(h * Vector3(v.segment<3>(3))) *
+                      q.base.orientation.normalized().toRotationMatrix();
     moved.base.orientation = Quaternion(R);
     moved.theta = q.theta + h * v.tail(v.size() - 6);
     const Vector3 g1 = system_com(r, link_states(r, d, moved));
@@ -201,7 +204,8 @@ inline std::vector<LinkVelocity> fd_link_velocities(const TestRobot& r, const Co
   const auto sm = link_states(r, d, chart(q, v, -h));
   std::vector<LinkVelocity> out;
   for (size_t i = 0; i < s0.size(); ++i)
-    out.push_back({(sp[i].c - sm[i].c) / (2 * h), angular_velocity_fd(sp[i].R, sm[i].R, s0[i].R, h), s0[i].c, s0[i].R});
+    out.push_back(
+        {(sp[i].c - sm[i].c) / (2 * h), angular_velocity_fd(sp[i].R, sm[i].R, s0[i].R, h), s0[i].c, s0[i].R});
   return out;
 }
 
@@ -210,7 +214,8 @@ inline double fd_kinetic_energy(const TestRobot& r, const std::vector<LinkVeloci
   double T = 0;
   for (size_t i = 0; i < lv.size(); ++i) {
     const Inertia& in = r.links[i].inertia;
-    T += 0.5 * in.mass * lv[i].vc.squaredNorm() + 0.5 * lv[i].w.dot(lv[i].R * in.I * lv[i].R.transpose() * lv[i].w);
+    T += 0.5 * in.mass * lv[i].vc.squaredNorm() +
+         0.5 * lv[i].w.dot(lv[i].R * in.I * lv[i].R.transpose() * lv[i].w);
   }
   return T;
 }
@@ -231,7 +236,8 @@ inline Vector6 fd_momentum(const TestRobot& r, const std::vector<LinkVelocity>& 
 inline MatrixXd fd_inertia_matrix(const TestRobot& r, const Config& q, const Chart& chart, double h = 1e-5) {
   const long nv = r.model.nv();
   const size_t nl = r.links.size();
-  std::vector<Eigen::Matrix<double, 3, Eigen::Dynamic>> Jv(nl, Eigen::Matrix<double, 3, Eigen::Dynamic>::Zero(3, nv)),
+  std::vector<Eigen::Matrix<double, 3, Eigen::Dynamic>> Jv(
+      nl, Eigen::Matrix<double, 3, Eigen::Dynamic>::Zero(3, nv)),
       Jw(nl, Eigen::Matrix<double, 3, Eigen::Dynamic>::Zero(3, nv));
   std::vector<Matrix3> Rs(nl);
   for (long k = 0; k < nv; ++k) {
@@ -251,7 +257,8 @@ inline MatrixXd fd_inertia_matrix(const TestRobot& r, const Config& q, const Cha
 }
 
 /// The 6 x nv Jacobian [linear; angular] of a frame, by central differences along the chart.
-inline MatrixXd fd_frame_jacobian(const TestRobot& r, const Config& q, int frame, const Chart& chart, double h = 1e-5) {
+inline MatrixXd fd_frame_jacobian(const TestRobot& r, const Config& q, int frame, const Chart& chart,
+                                  double h = 1e-5) {
   const long nv = r.model.nv();
   ffsr::Data d(r.model);
   auto pose = [&](const Config& c) {

@@ -40,10 +40,11 @@ inline std::string read_binary(const std::string& path) {
 inline PngImage decode_png(const std::string& path) {
   const std::string f = read_binary(path);
   static const char sig[] = "\x89PNG\r\n\x1a\n";
-  if (f.size() < 33 || f.compare(0, 8, std::string(sig, 8)) != 0) throw std::runtime_error(path + ": not a PNG");
+  if (f.size() < 33 || f.compare(0, 8, std::string(sig, 8)) != 0)
+    throw std::runtime_error(path + ": not a PNG");
   auto be32 = [&](size_t at) {
-    return uint32_t(uint8_t(f[at])) << 24 | uint32_t(uint8_t(f[at + 1])) << 16 | uint32_t(uint8_t(f[at + 2])) << 8 |
-           uint32_t(uint8_t(f[at + 3]));
+    return uint32_t(uint8_t(f[at])) << 24 | uint32_t(uint8_t(f[at + 1])) << 16 |
+           uint32_t(uint8_t(f[at + 2])) << 8 | uint32_t(uint8_t(f[at + 3]));
   };
   PngImage img;
   std::string idat;
@@ -71,8 +72,8 @@ inline PngImage decode_png(const std::string& path) {
   const size_t stride = size_t(img.width) * size_t(img.channels);
   std::vector<uint8_t> raw((stride + 1) * img.height);
   uLongf raw_len = static_cast<uLongf>(raw.size());
-  if (uncompress(raw.data(), &raw_len, reinterpret_cast<const Bytef*>(idat.data()), static_cast<uLong>(idat.size())) !=
-          Z_OK ||
+  if (uncompress(raw.data(), &raw_len, reinterpret_cast<const Bytef*>(idat.data()),
+                 static_cast<uLong>(idat.size())) != Z_OK ||
       raw_len != raw.size())
     throw std::runtime_error(path + ": IDAT does not inflate to the image size");
   img.pixels.assign(stride * img.height, 0);
@@ -86,16 +87,25 @@ inline PngImage decode_png(const std::string& path) {
       const int a = i >= bpp ? out[i - bpp] : 0, b = up ? up[i] : 0, c = (up && i >= bpp) ? up[i - bpp] : 0;
       int pred = 0;
       switch (filter) {
-        case 0: pred = 0; break;
-        case 1: pred = a; break;
-        case 2: pred = b; break;
-        case 3: pred = (a + b) / 2; break;
+        case 0:
+          pred = 0;
+          break;
+        case 1:
+          pred = a;
+          break;
+        case 2:
+          pred = b;
+          break;
+        case 3:
+          pred = (a + b) / 2;
+          break;
         case 4: {
           const int p = a + b - c, pa = std::abs(p - a), pb = std::abs(p - b), pc = std::abs(p - c);
           pred = (pa <= pb && pa <= pc) ? a : (pb <= pc ? b : c);
           break;
         }
-        default: throw std::runtime_error(path + ": bad scanline filter");
+        default:
+          throw std::runtime_error(path + ": bad scanline filter");
       }
       out[i] = uint8_t(in[i] + pred);
     }

@@ -60,7 +60,8 @@ inline bool solve_spd6(const Matrix6& A, const Vector6& b, Vector6& x) {
 /// from about kArticulatedMinJoints joints on (see integrated_effective_mass_fast).
 /// Reads the kinematics (data.R, data.p, data.S). Writes data.IA, data.pA, data.U, data.D, data.u,
 /// data.A. Allocation-free. Throws NumericalError when an articulated inertia is not positive definite.
-inline double inverse_effective_mass_articulated(const Model& model, Data& data, int frame, const Vector3& u) {
+inline double inverse_effective_mass_articulated(const Model& model, Data& data, int frame,
+                                                 const Vector3& u) {
   detail::check_unit_direction(u, "effective_mass");
   if (frame < 0 || frame >= static_cast<int>(model.frames().size()))
     throw InputError(detail::str("effective_mass: frame index ", frame, " out of range"));
@@ -70,7 +71,8 @@ inline double inverse_effective_mass_articulated(const Model& model, Data& data,
                                      "' overflows double precision"));
   const int nb = model.nb();
   if (nb - 1 != model.n())  // a mimic joint couples bodies through one coordinate: not a tree recursion
-    throw InputError("inverse_effective_mass_articulated: the model has mimic joints; use inverse_effective_mass");
+    throw InputError(
+        "inverse_effective_mass_articulated: the model has mimic joints; use inverse_effective_mass");
   const int ee = model.frame(frame).body;
   const Vector3& p0 = data.p[0];
   Vector6 f;
@@ -79,7 +81,8 @@ inline double inverse_effective_mass_articulated(const Model& model, Data& data,
     const auto ui = static_cast<size_t>(i);
     const Inertia& in = model.body(i).inertia;
     const Matrix3& Ri = data.R[ui];
-    data.IA[ui] = SpatialInertia::from_com(in.mass, data.p[ui] + Ri * in.com - p0, Ri * in.I * Ri.transpose()).matrix();
+    data.IA[ui] =
+        SpatialInertia::from_com(in.mass, data.p[ui] + Ri * in.com - p0, Ri * in.I * Ri.transpose()).matrix();
     data.pA[ui].setZero();
   }
   data.pA[static_cast<size_t>(ee)] = -f;
@@ -91,7 +94,8 @@ inline double inverse_effective_mass_articulated(const Model& model, Data& data,
     U.noalias() = data.IA[ui] * S;
     const double D = S.dot(U);
     if (!(D > 0.0))
-      throw NumericalError(detail::str("effective_mass: the articulated inertia is not positive definite (joint ", i, ")"));
+      throw NumericalError(
+          detail::str("effective_mass: the articulated inertia is not positive definite (joint ", i, ")"));
     data.D(i - 1) = D;
     const double ui_ = -S.dot(data.pA[ui]);
     data.u(i - 1) = ui_;

@@ -21,9 +21,11 @@ inline const Eigen::MatrixXd& crba(const Model& model, Data& data, const BasePos
     const auto ui = static_cast<size_t>(i);
     const Inertia& in = model.body(i).inertia;
     const Matrix3& Ri = data.R[ui];
-    data.Ic[ui] = SpatialInertia::from_com(in.mass, data.p[ui] + Ri * in.com - p0, Ri * in.I * Ri.transpose());
+    data.Ic[ui] =
+        SpatialInertia::from_com(in.mass, data.p[ui] + Ri * in.com - p0, Ri * in.I * Ri.transpose());
   }
-  for (int i = nb - 1; i > 0; --i) data.Ic[static_cast<size_t>(model.body(i).parent)] += data.Ic[static_cast<size_t>(i)];
+  for (int i = nb - 1; i > 0; --i)
+    data.Ic[static_cast<size_t>(model.body(i).parent)] += data.Ic[static_cast<size_t>(i)];
 
   Eigen::MatrixXd& H = data.H;
   H.setZero();
@@ -48,8 +50,10 @@ inline const Eigen::MatrixXd& crba(const Model& model, Data& data, const BasePos
   // the entries is not finite exactly when an entry is not, or when finite entries sum past 1.8e308
   // (an overflow too); Eigen's vectorized sum costs a third of the entry-by-entry test.
   if (!std::isfinite(H.sum()))
-    throw NumericalError(detail::str("crba: the inertia matrix H is not finite: the model's lengths, masses or the "
-                                     "joint positions overflow double precision (", model.source, ")"));
+    throw NumericalError(
+        detail::str("crba: the inertia matrix H is not finite: the model's lengths, masses or the "
+                    "joint positions overflow double precision (",
+                    model.source, ")"));
   return H;
 }
 
@@ -62,7 +66,8 @@ inline void cholesky(const Eigen::MatrixXd& A, Eigen::MatrixXd& L, const char* w
   for (Eigen::Index j = 0; j < n; ++j) {
     double d = A(j, j);
     for (Eigen::Index k = 0; k < j; ++k) d -= L(j, k) * L(j, k);
-    if (!(d > 0.0)) throw NumericalError(str(where, ": the inertia matrix is not positive definite (pivot ", j, ")"));
+    if (!(d > 0.0))
+      throw NumericalError(str(where, ": the inertia matrix is not positive definite (pivot ", j, ")"));
     const double ljj = std::sqrt(d);
     L(j, j) = ljj;
     for (Eigen::Index i = j + 1; i < n; ++i) {

@@ -10,18 +10,21 @@ namespace detail {
 /// w = J^T [f; m] for the origin of `frame` (J the 6x(6+n) point Jacobian, linear rows first): the
 /// generalized force that a force f at the point and a couple m produce. A unit force u at the point
 /// p_e + rho is the pair (u, rho x u). Reads the kinematics. Writes data.w.
-inline void jacobian_transpose_times(const Model& model, Data& data, int frame, const Vector3& f, const Vector3& m) {
+inline void jacobian_transpose_times(const Model& model, Data& data, int frame, const Vector3& f,
+                                     const Vector3& m) {
   const Vector3 pe = frame_pose(model, data, frame).p;
-  if (!pe.allFinite()) throw NumericalError(str("effective_mass: the position of frame '", model.frame(frame).name,
-                                                "' overflows double precision"));
+  if (!pe.allFinite())
+    throw NumericalError(str("effective_mass: the position of frame '", model.frame(frame).name,
+                             "' overflows double precision"));
   data.w.setZero();
   data.w.head<3>() = f;
   data.w.segment<3>(3) = (pe - data.p[0]).cross(f) + m;
   for (int i = model.frame(frame).body; i > 0; i = model.body(i).parent) {
     const auto S = data.S.col(i - 1);
-    data.w(6 + model.body(i).coord) += model.body(i).joint.type == JointType::Revolute
-                        ? S.tail<3>().dot((pe - data.p[static_cast<size_t>(i)]).cross(f)) + S.tail<3>().dot(m)
-                        : S.head<3>().dot(f);
+    data.w(6 + model.body(i).coord) +=
+        model.body(i).joint.type == JointType::Revolute
+            ? S.tail<3>().dot((pe - data.p[static_cast<size_t>(i)]).cross(f)) + S.tail<3>().dot(m)
+            : S.head<3>().dot(f);
   }
 }
 
@@ -38,7 +41,8 @@ inline void check_frame(const Model& model, int frame, const char* where) {
 
 inline void check_unit_direction(const Vector3& u, const char* where) {
   require_finite_all(u, where, "direction u");
-  if (std::abs(u.norm() - 1.0) > 1e-9) throw InputError(str(where, ": direction u must be a unit vector, |u| = ", u.norm()));
+  if (std::abs(u.norm() - 1.0) > 1e-9)
+    throw InputError(str(where, ": direction u must be a unit vector, |u| = ", u.norm()));
 }
 
 }  // namespace detail
@@ -110,8 +114,8 @@ inline double integrated_effective_mass(const Model& model, Data& data, const Ba
 namespace ffsr {
 
 namespace detail {
-inline double inverse_inertia_form_gradient_factored(const Model& model, Data& data, int frame, const Vector6& s,
-                                                     Eigen::Ref<Eigen::VectorXd> grad);
+inline double inverse_inertia_form_gradient_factored(const Model& model, Data& data, int frame,
+                                                     const Vector6& s, Eigen::Ref<Eigen::VectorXd> grad);
 }  // namespace detail
 
 /// Analytic gradient in the joint angles of the quadratic form q = s^T Lambda^-1 s of the robot's
@@ -137,8 +141,8 @@ inline double inverse_inertia_form_gradient(const Model& model, Data& data, int 
 namespace detail {
 /// inverse_inertia_form_gradient with data.L already the Cholesky factor of data.H (callers that
 /// evaluate several forms at one configuration factorize once). No argument checks.
-inline double inverse_inertia_form_gradient_factored(const Model& model, Data& data, int frame, const Vector6& s,
-                                                     Eigen::Ref<Eigen::VectorXd> grad) {
+inline double inverse_inertia_form_gradient_factored(const Model& model, Data& data, int frame,
+                                                     const Vector6& s, Eigen::Ref<Eigen::VectorXd> grad) {
   const Vector3 u = s.head<3>(), mc = s.tail<3>();
   detail::jacobian_transpose_times(model, data, frame, u, mc);
   data.y = data.w;
@@ -150,14 +154,18 @@ inline double inverse_inertia_form_gradient_factored(const Model& model, Data& d
   // velocities and momenta of the bodies for the generalized velocity y
   data.V[0] = data.y.head<6>();
   for (int i = 1; i < nb; ++i)
-    data.V[static_cast<size_t>(i)] = data.V[static_cast<size_t>(model.body(i).parent)] + data.S.col(i - 1) * data.y(6 + model.body(i).coord);
+    data.V[static_cast<size_t>(i)] = data.V[static_cast<size_t>(model.body(i).parent)] +
+                                     data.S.col(i - 1) * data.y(6 + model.body(i).coord);
   for (int i = 0; i < nb; ++i) {
     const auto ui = static_cast<size_t>(i);
     const Inertia& in = model.body(i).inertia;
     const Matrix3& Ri = data.R[ui];
-    data.F[ui] = SpatialInertia::from_com(in.mass, data.p[ui] + Ri * in.com - p0, Ri * in.I * Ri.transpose()) * data.V[ui];
+    data.F[ui] =
+        SpatialInertia::from_com(in.mass, data.p[ui] + Ri * in.com - p0, Ri * in.I * Ri.transpose()) *
+        data.V[ui];
   }
-  for (int i = nb - 1; i > 0; --i) data.F[static_cast<size_t>(model.body(i).parent)] += data.F[static_cast<size_t>(i)];
+  for (int i = nb - 1; i > 0; --i)
+    data.F[static_cast<size_t>(model.body(i).parent)] += data.F[static_cast<size_t>(i)];
   const int ee_body = model.frame(frame).body;
   const Vector3 pe = frame_pose(model, data, frame).p;
   const Vector6& Vee = data.V[static_cast<size_t>(ee_body)];

@@ -12,7 +12,8 @@ namespace ffsr {
 /// Reads base, theta, v, tau. Writes what crba and rnea write, data.L, and a. Throws NumericalError
 /// if H is not positive definite.
 inline void forward_dynamics(const Model& model, Data& data, const BasePose& base,
-                             const Eigen::Ref<const Eigen::VectorXd>& theta, const Eigen::Ref<const Eigen::VectorXd>& v,
+                             const Eigen::Ref<const Eigen::VectorXd>& theta,
+                             const Eigen::Ref<const Eigen::VectorXd>& v,
                              const Eigen::Ref<const Eigen::VectorXd>& tau, Eigen::VectorXd& a) {
   detail::require_size(tau.size(), model.nv(), "forward_dynamics", "tau");
   detail::require_finite_all(tau, "forward_dynamics", "tau");

@@ -13,8 +13,9 @@ inline const Eigen::MatrixXd& frame_jacobian(const Model& model, Data& data, int
     throw InputError(detail::str("frame_jacobian: frame index ", frame, " out of range"));
   Eigen::MatrixXd& J = data.J;
   const Vector3 pe = frame_pose(model, data, frame).p;
-  if (!pe.allFinite()) throw NumericalError(detail::str("frame_jacobian: the position of frame '", model.frame(frame).name,
-                                                        "' overflows double precision"));
+  if (!pe.allFinite())
+    throw NumericalError(detail::str("frame_jacobian: the position of frame '", model.frame(frame).name,
+                                     "' overflows double precision"));
   const Vector3 d0 = pe - data.p[0];
   J.setZero();
   J.topLeftCorner<3, 3>().setIdentity();
@@ -41,7 +42,8 @@ inline const Eigen::MatrixXd& frame_jacobian(const Model& model, Data& data, int
 inline const Eigen::MatrixXd& generalized_jacobian(const Model& model, Data& data) {
   const int n = model.n();
   const Eigen::LLT<Matrix6> Hb(data.H.topLeftCorner<6, 6>());
-  if (Hb.info() != Eigen::Success) throw NumericalError("generalized_jacobian: the base inertia H_b is singular");
+  if (Hb.info() != Eigen::Success)
+    throw NumericalError("generalized_jacobian: the base inertia H_b is singular");
   data.HbInv_Hbm = data.H.topRightCorner(6, n);
   Hb.solveInPlace(data.HbInv_Hbm);
   data.Jf.noalias() = data.J.rightCols(n);
@@ -52,7 +54,8 @@ inline const Eigen::MatrixXd& generalized_jacobian(const Model& model, Data& dat
 /// Convenience: crba, frame_jacobian and generalized_jacobian at one configuration.
 /// Writes the kinematics, data.H, data.J and data.Jf. Returns data.Jf.
 inline const Eigen::MatrixXd& generalized_jacobian(const Model& model, Data& data, const BasePose& base,
-                                                   const Eigen::Ref<const Eigen::VectorXd>& theta, int frame) {
+                                                   const Eigen::Ref<const Eigen::VectorXd>& theta,
+                                                   int frame) {
   crba(model, data, base, theta);
   frame_jacobian(model, data, frame);
   return generalized_jacobian(model, data);

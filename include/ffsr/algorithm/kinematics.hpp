@@ -7,8 +7,8 @@ namespace ffsr {
 namespace detail {
 
 /// Checks the configuration arguments of a public entry point (sizes, finiteness, quaternion).
-inline void check_configuration(const Model& model, const BasePose& base, const Eigen::Ref<const Eigen::VectorXd>& theta,
-                                const char* where) {
+inline void check_configuration(const Model& model, const BasePose& base,
+                                const Eigen::Ref<const Eigen::VectorXd>& theta, const char* where) {
   require_size(theta.size(), model.n(), where, "theta");
   require_finite_all(theta, where, "theta");
   require_finite_all(base.position, where, "base position");

@@ -16,7 +16,9 @@ void for_each_body_velocity(const Model& model, const Data& data, const Eigen::R
   // w_i and the velocity of the body point at the base origin, u_i (a spatial velocity about p0)
   std::vector<Vector6> Vs(static_cast<size_t>(nb));  // small, off the hot path
   Vs[0] = v.head<6>();
-  for (int i = 1; i < nb; ++i) Vs[static_cast<size_t>(i)] = Vs[static_cast<size_t>(model.body(i).parent)] + data.S.col(i - 1) * v(6 + model.body(i).coord);
+  for (int i = 1; i < nb; ++i)
+    Vs[static_cast<size_t>(i)] =
+        Vs[static_cast<size_t>(model.body(i).parent)] + data.S.col(i - 1) * v(6 + model.body(i).coord);
   for (int i = 0; i < nb; ++i) {
     const auto ui = static_cast<size_t>(i);
     const Vector3 c = data.p[ui] + data.R[ui] * model.body(i).inertia.com;
@@ -42,7 +44,8 @@ inline Vector6 momentum(const Model& model, const Data& data, const Eigen::Ref<c
 
 /// Kinetic energy, summed body by body: sum of 1/2 m |v_c|^2 + 1/2 w^T I w.
 /// Reads the kinematics (forward_kinematics) and v.
-inline double kinetic_energy(const Model& model, const Data& data, const Eigen::Ref<const Eigen::VectorXd>& v) {
+inline double kinetic_energy(const Model& model, const Data& data,
+                             const Eigen::Ref<const Eigen::VectorXd>& v) {
   double T = 0;
   for_each_body_velocity(model, data, v, [&](int i, const Vector3& w, const Vector3& vc, const Vector3&) {
     const Inertia& in = model.body(i).inertia;

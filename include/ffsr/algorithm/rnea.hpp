@@ -26,7 +26,8 @@ inline const Eigen::VectorXd& rnea(const Model& model, Data& data, const BasePos
   // of the base-fixed origin is its classical acceleration minus w0 x v0; gravity enters as a
   // fictitious upward acceleration of the base.
   data.V[0] << R0.transpose() * v0, R0.transpose() * w0;
-  data.A[0] << R0.transpose() * (a.head<3>() - w0.cross(v0) - model.gravity), R0.transpose() * a.segment<3>(3);
+  data.A[0] << R0.transpose() * (a.head<3>() - w0.cross(v0) - model.gravity),
+      R0.transpose() * a.segment<3>(3);
   const int nb = model.nb();
   auto body_force = [&](int i) {
     const auto ui = static_cast<size_t>(i);
@@ -68,8 +69,9 @@ inline const Eigen::VectorXd& rnea(const Model& model, Data& data, const BasePos
     const Pose& X = data.Xup[ui];
     const Vector6& f = data.F[ui];
     // a coordinate that drives several joints (mimics) gets the sum: tau = T^T tau_full
-    data.tau(6 + b.coord) += b.multiplier * (b.joint.type == JointType::Revolute ? b.joint.axis.dot(f.tail<3>())
-                                                                                  : b.joint.axis.dot(f.head<3>()));
+    data.tau(6 + b.coord) +=
+        b.multiplier *
+        (b.joint.type == JointType::Revolute ? b.joint.axis.dot(f.tail<3>()) : b.joint.axis.dot(f.head<3>()));
     // force transform child -> parent: f_p = R f_c, n_p = R n_c + p x (R f_c)
     const Vector3 fp = X.R * f.head<3>();
     data.F[static_cast<size_t>(b.parent)].head<3>() += fp;

@@ -73,8 +73,8 @@ class HertzDamped {
 
   const ContactParams& params() const { return p_; }
   double approach_velocity() const { return v0_; }  ///< δ̇⁻ [m/s]
-  double f() const { return f_; }                     ///< f(c_r) of Table 1 (Eq. 22)
-  double lambda() const { return lambda_; }           ///< λ = f K / δ̇⁻ (Eq. 22)
+  double f() const { return f_; }                   ///< f(c_r) of Table 1 (Eq. 22)
+  double lambda() const { return lambda_; }         ///< λ = f K / δ̇⁻ (Eq. 22)
 
   /// F(δ, δ̇) of Eq. 15 [N]; 0 for δ <= 0 and clamped at 0 (never pulls). NaN propagates.
   double force(double delta, double delta_dot) const;
@@ -112,10 +112,9 @@ class HertzDamped {
 };
 
 /// Run-time choice of the law (the CLI's `--model NAME`). One entry per policy of damping.hpp.
-using AnyContactLaw =
-    std::variant<HertzDamped<HuntCrossley>, HertzDamped<HerbertMcWhannell>,
-                 HertzDamped<LankaraniNikravesh>, HertzDamped<LeeWang>, HertzDamped<Flores>,
-                 HertzDamped<Gonthier>, HertzDamped<ZhiyingQishao>, HertzDamped<HuGuo>>;
+using AnyContactLaw = std::variant<HertzDamped<HuntCrossley>, HertzDamped<HerbertMcWhannell>,
+                                   HertzDamped<LankaraniNikravesh>, HertzDamped<LeeWang>, HertzDamped<Flores>,
+                                   HertzDamped<Gonthier>, HertzDamped<ZhiyingQishao>, HertzDamped<HuGuo>>;
 
 /// Number of laws in AnyContactLaw.
 inline constexpr std::size_t num_contact_laws = std::variant_size_v<AnyContactLaw>;
@@ -126,7 +125,7 @@ constexpr std::array<std::string_view, num_contact_laws> contact_law_names();
 /// Builds the law called `name` (one of contact_law_names()); InputError for an unknown name (the
 /// message lists the valid ones) or invalid parameters.
 inline AnyContactLaw make_contact_law(std::string_view name, const ContactParams& p,
-                               double approach_velocity);
+                                      double approach_velocity);
 
 // The common methods on the run-time choice (each a std::visit of the member of the same name).
 inline std::string_view contact_law_name(const AnyContactLaw& law);
@@ -148,8 +147,8 @@ inline double relative_error(const AnyContactLaw& law);
 /// target's linear and angular velocity, r = r_tp from the target's mass centre to the contact
 /// point; all in the inertial frame. InputError for non-finite entries or |u| not 1 (to 1e-9).
 inline double approach_velocity(const Eigen::Vector3d& u, const Eigen::Vector3d& v_e,
-                         const Eigen::Vector3d& v_t, const Eigen::Vector3d& omega_t,
-                         const Eigen::Vector3d& r);
+                                const Eigen::Vector3d& v_t, const Eigen::Vector3d& omega_t,
+                                const Eigen::Vector3d& r);
 
 /// Model accuracy of Eq. 32, in percent: (1 - |F_model - F_exact| / F_exact) × 100.
 /// InputError unless both are finite and F_exact > 0; NumericalError if the result overflows.
@@ -219,7 +218,7 @@ inline double contact_G(double f, double s) { return contact_G_lost(f, 1.0 - s);
 inline double contact_log_G_lost(double f, double t) {
   const double G = contact_G_lost(f, t);
   if (G >= std::numeric_limits<double>::min()) return std::log(G);
-  const double u = t / (1.0 + f);            // G = u (1 - u/2 - ...), u tiny here
+  const double u = t / (1.0 + f);  // G = u (1 - u/2 - ...), u tiny here
   return std::log(t) - std::log1p(f) + std::log1p(-0.5 * u);
 }
 
@@ -253,7 +252,10 @@ inline PeakRate contact_peak(double f, double alpha) {
   for (int it = 0; it < 200; ++it) {
     const double vx = v(x);
     if (vx == 0.0) break;
-    if (vx < 0.0) lo = x; else hi = x;
+    if (vx < 0.0)
+      lo = x;
+    else
+      hi = x;
     const double dv = slope(near_touch ? 1.0 - x : x);
     double next = x - vx / dv;
     if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
@@ -263,8 +265,7 @@ inline PeakRate contact_peak(double f, double alpha) {
     x = next;
     if (done) return near_touch ? PeakRate{1.0 - x, x} : PeakRate{x, 1.0 - x};
   }
-  if (v(x) != 0.0)
-    throw NumericalError(str("contact_peak: no convergence for f = ", f, ", alpha = ", alpha));
+  if (v(x) != 0.0) throw NumericalError(str("contact_peak: no convergence for f = ", f, ", alpha = ", alpha));
   return near_touch ? PeakRate{1.0 - x, x} : PeakRate{x, 1.0 - x};
 }
 
@@ -281,13 +282,11 @@ inline double require_finite_result(double x, std::string_view where, const char
 
 inline void require_positive_mass(double M_ie, std::string_view where) {
   if (!(M_ie > 0.0) || !std::isfinite(M_ie))
-    throw InputError(str(where, ": integrated effective mass M_ie must be positive and finite, got ",
-                         M_ie));
+    throw InputError(str(where, ": integrated effective mass M_ie must be positive and finite, got ", M_ie));
 }
 
 template <std::size_t... I>
-constexpr std::array<std::string_view, num_contact_laws> contact_law_names_impl(
-    std::index_sequence<I...>) {
+constexpr std::array<std::string_view, num_contact_laws> contact_law_names_impl(std::index_sequence<I...>) {
   return {std::variant_alternative_t<I, AnyContactLaw>::name...};
 }
 
@@ -315,8 +314,8 @@ inline void validate(const ContactParams& p, const char* where) {
   if (!(p.alpha > 0.0) || !std::isfinite(p.alpha))
     throw InputError(detail::str(where, ": exponent alpha must be positive and finite, got ", p.alpha));
   if (!(p.c_r > 0.0 && p.c_r <= 1.0))
-    throw InputError(detail::str(where, ": coefficient of restitution c_r must satisfy 0 < c_r <= 1, got ",
-                                 p.c_r));
+    throw InputError(
+        detail::str(where, ": coefficient of restitution c_r must satisfy 0 < c_r <= 1, got ", p.c_r));
 }
 
 template <class Damping>
@@ -327,10 +326,9 @@ HertzDamped<Damping>::HertzDamped(const ContactParams& p, double approach_veloci
   if (!std::isfinite(approach_velocity))
     throw InputError(str(where, ": approach velocity must be finite, got ", approach_velocity));
   if (!(approach_velocity > 0.0))
-    throw InputError(str(where, ": approach velocity must be positive (the bodies approach), got ",
-                         approach_velocity,
-                         approach_velocity < 0.0 ? ": the bodies are receding"
-                                                 : ": the bodies do not approach"));
+    throw InputError(
+        str(where, ": approach velocity must be positive (the bodies approach), got ", approach_velocity,
+            approach_velocity < 0.0 ? ": the bodies are receding" : ": the bodies do not approach"));
   v0_ = approach_velocity;
   f_ = Damping::factor(p.c_r);
   if (!(f_ >= 0.0) || !std::isfinite(f_))
@@ -343,9 +341,10 @@ HertzDamped<Damping>::HertzDamped(const ContactParams& p, double approach_veloci
   // Finite inputs can still overflow the law's constants (an approach velocity of 1e200 m/s, or
   // K = 1e300 with a tiny approach velocity): an error, not a law that answers inf or NaN.
   if (!std::isfinite(lambda_) || !std::isfinite(zeta_))
-    throw InputError(str(where, ": the parameters overflow double precision (lambda = f K / approach velocity = ",
-                         lambda_, ", zeta = ", zeta_, " for K = ", p.K, ", alpha = ", p.alpha, ", approach velocity ",
-                         approach_velocity, ")"));
+    throw InputError(
+        str(where, ": the parameters overflow double precision (lambda = f K / approach velocity = ", lambda_,
+            ", zeta = ", zeta_, " for K = ", p.K, ", alpha = ", p.alpha, ", approach velocity ",
+            approach_velocity, ")"));
 }
 
 template <class Damping>
@@ -354,7 +353,7 @@ double HertzDamped<Damping>::force(double delta, double delta_dot) const {
   const double g = p_.K + lambda_ * delta_dot;  // the force is pushing while K + λ δ̇ > 0
   if (!(g > 0.0)) return g <= 0.0 ? 0.0 : g;    // never pulls; NaN propagates
   const double P = std::pow(delta, p_.alpha);
-  return P == 0.0 ? 0.0 : P * g;                // δ^α underflowing to 0 times a huge g is 0, not NaN
+  return P == 0.0 ? 0.0 : P * g;  // δ^α underflowing to 0 times a huge g is 0, not NaN
 }
 
 template <class Damping>
@@ -382,13 +381,15 @@ double HertzDamped<Damping>::max_deformation(double M_ie) const {
 
 template <class Damping>
 double HertzDamped<Damping>::max_force_estimate(double M_ie) const {
-  return detail::require_finite_result(p_.K * std::pow(max_deformation(M_ie), p_.alpha), name, "F'_max", M_ie);
+  return detail::require_finite_result(p_.K * std::pow(max_deformation(M_ie), p_.alpha), name, "F'_max",
+                                       M_ie);
 }
 
 template <class Damping>
 double HertzDamped<Damping>::max_force_closed_form(double M_ie) const {
   detail::require_positive_mass(M_ie, name);
-  return detail::require_finite_result(zeta_ * std::pow(M_ie, p_.alpha / (p_.alpha + 1.0)), name, "F_max", M_ie);
+  return detail::require_finite_result(zeta_ * std::pow(M_ie, p_.alpha / (p_.alpha + 1.0)), name, "F_max",
+                                       M_ie);
 }
 
 template <class Damping>
@@ -401,8 +402,9 @@ ForcePeak HertzDamped<Damping>::exact_peak(double M_ie) const {
   pk.force = p_.K * std::pow(pk.deformation, p_.alpha) * (1.0 + f_ * s);
   // δ(t*) underflowing to 0 (a peak within ~1e-300 of first touch) would report F = 0: not an answer.
   if (!(pk.deformation > 0.0))
-    throw NumericalError(detail::str(name, ": the force peak is too close to first touch to be represented (f = ",
-                                     f_, ", alpha = ", p_.alpha, ", M_ie = ", M_ie, " kg)"));
+    throw NumericalError(
+        detail::str(name, ": the force peak is too close to first touch to be represented (f = ", f_,
+                    ", alpha = ", p_.alpha, ", M_ie = ", M_ie, " kg)"));
   detail::require_finite_result(pk.deformation, name, "deformation at the force peak", M_ie);
   detail::require_finite_result(pk.force, name, "exact F_max", M_ie);
   return pk;
@@ -493,8 +495,8 @@ inline double model_accuracy(double F_model, double F_exact) {
     throw InputError(detail::str("model_accuracy: F_exact must be positive and finite, got ", F_exact));
   const double accuracy = (1.0 - std::abs(F_model - F_exact) / F_exact) * 100.0;  // Eq. 32
   if (!std::isfinite(accuracy))  // |F_model - F_exact| / F_exact overflows, e.g. F_exact = 1e-310 N
-    throw NumericalError(detail::str("model_accuracy: the accuracy is not representable for F_model = ", F_model,
-                                     ", F_exact = ", F_exact));
+    throw NumericalError(detail::str("model_accuracy: the accuracy is not representable for F_model = ",
+                                     F_model, ", F_exact = ", F_exact));
   return accuracy;
 }
 

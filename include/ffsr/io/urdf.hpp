@@ -41,9 +41,9 @@ enum class InertiaRepair { None, Balance };
 
 /// How a URDF is turned into a Model.
 struct UrdfOptions {
-  std::string end_effector;                        ///< link name; empty: the single leaf link
-  std::optional<Vector3> end_effector_offset;      ///< contact point in the end-effector frame
-  std::optional<Bus> bus;                          ///< mount the robot on a bus
+  std::string end_effector;                           ///< link name; empty: the single leaf link
+  std::optional<Vector3> end_effector_offset;         ///< contact point in the end-effector frame
+  std::optional<Bus> bus;                             ///< mount the robot on a bus
   std::vector<std::pair<std::string, double>> locks;  ///< joint name, value (rad or m)
   /// Balance: raise the two smaller principal moments of a link just enough (by half the deficit
   /// each) that the largest equals their sum (the triangle inequality; cf. MuJoCo's balanceinertia).
@@ -66,12 +66,14 @@ struct UrdfReport {
     std::string joint, leader;
     double multiplier, offset;
   };
-  std::vector<Mimic> mimics;                            ///< resolved to independent leaders
+  std::vector<Mimic> mimics;                           ///< resolved to independent leaders
   std::vector<std::pair<std::string, double>> locked;  ///< every joint fixed at a value (with followers)
   std::vector<ModelRepair> repairs;
 };
 
-inline const char* inertia_repair_name(InertiaRepair r) { return r == InertiaRepair::Balance ? "balance" : "none"; }
+inline const char* inertia_repair_name(InertiaRepair r) {
+  return r == InertiaRepair::Balance ? "balance" : "none";
+}
 /// "none" or "balance"; throws InputError naming the option otherwise.
 inline InertiaRepair parse_inertia_repair(const std::string& s) {
   if (s == "none") return InertiaRepair::None;
@@ -92,7 +94,8 @@ inline void require_utf8(const std::string& xml, const std::string& source) {
     if (c == 0 || len == 0 || i + len > n)
       throw ModelError(str(source, ": not a text file in UTF-8 (byte ", i, ")"));
     for (size_t k = 1; k < len; ++k)
-      if ((b[i + k] >> 6) != 0x2) throw ModelError(str(source, ": not a text file in UTF-8 (byte ", i + k, ")"));
+      if ((b[i + k] >> 6) != 0x2)
+        throw ModelError(str(source, ": not a text file in UTF-8 (byte ", i + k, ")"));
     i += len;
   }
 }
@@ -146,7 +149,7 @@ inline Inertia urdf_inertia(const urdf::Link& link) {
 inline Inertia repaired_inertia(const Inertia& in, const std::string& link, const UrdfOptions& o,
                                 std::vector<ModelRepair>& repairs) {
   Inertia out = in;
-  if (!in.I.allFinite() || !std::isfinite(in.mass)) return out;  // validation reports it
+  if (!in.I.allFinite() || !std::isfinite(in.mass)) return out;    // validation reports it
   if (o.min_mass > 0 && out.mass >= 0 && out.mass < o.min_mass) {  // a negative mass stays an error
     repairs.push_back({link, "mass raised to min-mass", {out.mass}, {o.min_mass}});
     out.mass = o.min_mass;
@@ -157,7 +160,10 @@ inline Inertia repaired_inertia(const Inertia& in, const std::string& link, cons
   const Vector3 before = e;
   if (o.min_inertia > 0 && e.minCoeff() < o.min_inertia) {
     for (int k = 0; k < 3; ++k) e(k) = std::max(e(k), o.min_inertia);
-    repairs.push_back({link, "principal moments raised to min-inertia", {before(0), before(1), before(2)}, {e(0), e(1), e(2)}});
+    repairs.push_back({link,
+                       "principal moments raised to min-inertia",
+                       {before(0), before(1), before(2)},
+                       {e(0), e(1), e(2)}});
   }
   const double tol = 1e-9 * std::max(1.0, e.cwiseAbs().maxCoeff());  // validate_inertia's tolerance
   if (o.inertia_repair == InertiaRepair::Balance && e(2) > e(0) + e(1) + tol) {
@@ -165,7 +171,8 @@ inline Inertia repaired_inertia(const Inertia& in, const std::string& link, cons
     const double deficit = e(2) - e(0) - e(1);
     e(0) += 0.5 * deficit;
     e(1) += 0.5 * deficit;
-    repairs.push_back({link, "principal moments balanced (triangle inequality)", {b(0), b(1), b(2)}, {e(0), e(1), e(2)}});
+    repairs.push_back(
+        {link, "principal moments balanced (triangle inequality)", {b(0), b(1), b(2)}, {e(0), e(1), e(2)}});
   }
   if (e != before) out.I = es.eigenvectors() * e.asDiagonal() * es.eigenvectors().transpose();
   return out;
@@ -184,7 +191,8 @@ inline std::map<std::string, int> joint_order_in_file(const std::string& xml) {
   doc.Parse(xml.c_str());
   const TiXmlElement* robot = doc.FirstChildElement("robot");
   int k = 0;
-  for (const TiXmlElement* j = robot ? robot->FirstChildElement("joint") : nullptr; j; j = j->NextSiblingElement("joint"))
+  for (const TiXmlElement* j = robot ? robot->FirstChildElement("joint") : nullptr; j;
+       j = j->NextSiblingElement("joint"))
     if (const char* name = j->Attribute("name")) order.emplace(name, k++);
   return order;
 }
@@ -202,7 +210,8 @@ inline void reject_joint_loops(const std::string& xml, const std::string& source
     std::string joint, child;
   };
   std::map<std::string, std::vector<Edge>> children;  // parent link -> joints to its children
-  for (const TiXmlElement* j = robot ? robot->FirstChildElement("joint") : nullptr; j; j = j->NextSiblingElement("joint")) {
+  for (const TiXmlElement* j = robot ? robot->FirstChildElement("joint") : nullptr; j;
+       j = j->NextSiblingElement("joint")) {
     const TiXmlElement* p = j->FirstChildElement("parent");
     const TiXmlElement* c = j->FirstChildElement("child");
     const char* parent = p ? p->Attribute("link") : nullptr;
@@ -238,7 +247,8 @@ inline void reject_joint_loops(const std::string& xml, const std::string& source
         for (size_t i = k + 1; i < path.size(); ++i)
           loop += str("'", path[i].via, "' ('", path[i - 1].link, "' -> '", path[i].link, "'), ");
         loop += str("'", e.joint, "' ('", top.link, "' -> '", e.child, "')");
-        throw ModelError(str(source, ": the joints ", loop, " form a closed loop (closed loops are not supported)"));
+        throw ModelError(
+            str(source, ": the joints ", loop, " form a closed loop (closed loops are not supported)"));
       }
       if (st == 0) {
         st = 1;
@@ -268,7 +278,8 @@ inline Model model_from_urdf_string(const std::string& xml, const std::string& s
       throw ModelError(str(source, ": malformed URDF: ", e.what()));
     }
     if (!urdf)
-      throw ModelError(str(source, ": malformed URDF", capture.messages.empty() ? "" : ": " + capture.messages));
+      throw ModelError(
+          str(source, ": malformed URDF", capture.messages.empty() ? "" : ": " + capture.messages));
     urdf_errors = capture.messages;
   }
   // urdfdom's links own their children through shared_ptr: a loop in a malformed file is a cycle that
@@ -293,8 +304,8 @@ inline Model model_from_urdf_string(const std::string& xml, const std::string& s
     for (const auto& jp : urdf->joints_) {
       const auto [it, inserted] = parent_joint_of.emplace(jp.second->child_link_name, jp.first);
       if (!inserted)
-        throw ModelError(str(source, ": link '", jp.second->child_link_name, "' has two parent joints ('", it->second,
-                             "' and '", jp.first, "'): closed loops are not supported"));
+        throw ModelError(str(source, ": link '", jp.second->child_link_name, "' has two parent joints ('",
+                             it->second, "' and '", jp.first, "'): closed loops are not supported"));
     }
   }
   const std::map<std::string, int> file_order = detail::joint_order_in_file(xml);
@@ -317,15 +328,20 @@ inline Model model_from_urdf_string(const std::string& xml, const std::string& s
         throw InputError(str("lock-joints: unknown joint '", name, "'; the moving joints are: ", list));
       }
       const urdf::Joint& j = *it->second;
-      if (j.type == urdf::Joint::FIXED) throw InputError(str("lock-joints: joint '", name, "' is a fixed joint already"));
-      if (j.type != urdf::Joint::REVOLUTE && j.type != urdf::Joint::PRISMATIC && j.type != urdf::Joint::CONTINUOUS)
+      if (j.type == urdf::Joint::FIXED)
+        throw InputError(str("lock-joints: joint '", name, "' is a fixed joint already"));
+      if (j.type != urdf::Joint::REVOLUTE && j.type != urdf::Joint::PRISMATIC &&
+          j.type != urdf::Joint::CONTINUOUS)
         throw InputError(str("lock-joints: joint '", name, "' is not revolute, continuous or prismatic"));
-      if (!std::isfinite(value)) throw InputError(str("lock-joints: joint '", name, "': the value must be finite"));
-      if (j.type != urdf::Joint::CONTINUOUS && j.limits && !(j.limits->lower == 0.0 && j.limits->upper == 0.0) &&
+      if (!std::isfinite(value))
+        throw InputError(str("lock-joints: joint '", name, "': the value must be finite"));
+      if (j.type != urdf::Joint::CONTINUOUS && j.limits &&
+          !(j.limits->lower == 0.0 && j.limits->upper == 0.0) &&
           (value < j.limits->lower || value > j.limits->upper))
-        throw InputError(str("lock-joints: '", name, "=", value, "' is outside the joint's limits [", j.limits->lower, ", ",
-                             j.limits->upper, "]"));
-      if (!locked.emplace(name, value).second) throw InputError(str("lock-joints: joint '", name, "' is locked twice"));
+        throw InputError(str("lock-joints: '", name, "=", value, "' is outside the joint's limits [",
+                             j.limits->lower, ", ", j.limits->upper, "]"));
+      if (!locked.emplace(name, value).second)
+        throw InputError(str("lock-joints: joint '", name, "' is locked twice"));
     }
     // The value a joint is locked at: its own, or through its mimic leaders (q_f = m q_l + o).
     auto lock_value = [&](const urdf::Joint& j) -> std::optional<double> {
@@ -350,7 +366,8 @@ inline Model model_from_urdf_string(const std::string& xml, const std::string& s
       try {
         validate_inertia(in, "link '" + l.name + "'", false);
       } catch (const ModelError& e) {
-        throw ModelError(str(e.what(), " (to load the file as it is: inertia-repair = \"balance\", min-mass, min-inertia)"));
+        throw ModelError(str(
+            e.what(), " (to load the file as it is: inertia-repair = \"balance\", min-mass, min-inertia)"));
       }
       return in;
     };
@@ -372,10 +389,15 @@ inline Model model_from_urdf_string(const std::string& xml, const std::string& s
       builder.emplace(bus.name, Inertia{bus.mass, bus.com, bus.inertia});
       builder->add_fixed("mount", bus.name, bus.mount, root->name, root_inertia);
     } else {
-      const char* hint = "; to mount the arm on a spacecraft bus give bus-mass, bus-inertia, bus-com, mount-xyz, mount-rpy-deg";
-      if (!root->inertial) throw ModelError(str("base link '", root->name, "': has no <inertial> (the base needs a mass", hint, ")"));
+      const char* hint =
+          "; to mount the arm on a spacecraft bus give bus-mass, bus-inertia, bus-com, mount-xyz, "
+          "mount-rpy-deg";
+      if (!root->inertial)
+        throw ModelError(
+            str("base link '", root->name, "': has no <inertial> (the base needs a mass", hint, ")"));
       if (root->inertial->mass <= 0)
-        throw ModelError(str("base link '", root->name, "': mass must be positive, got ", root->inertial->mass, hint));
+        throw ModelError(
+            str("base link '", root->name, "': mass must be positive, got ", root->inertial->mass, hint));
       builder.emplace(root->name, root_inertia);
     }
     builder->set_source(source);
@@ -386,11 +408,13 @@ inline Model model_from_urdf_string(const std::string& xml, const std::string& s
       stack.pop_back();
       std::vector<urdf::LinkSharedPtr> children = link->child_links;
       std::sort(children.begin(), children.end(), in_file_order);
-      for (auto it = children.rbegin(); it != children.rend(); ++it) stack.push_back(*it);  // DFS in file order
+      for (auto it = children.rbegin(); it != children.rend(); ++it)
+        stack.push_back(*it);  // DFS in file order
       if (link == root) continue;
       const urdf::JointConstSharedPtr j = link->parent_joint;
       if (!j) throw ModelError(str("link '", link->name, "' has no parent joint"));
-      if (!visited.insert(link->name).second) throw ModelError(str("link '", link->name, "' is reached twice (closed loop)"));
+      if (!visited.insert(link->name).second)
+        throw ModelError(str("link '", link->name, "' is reached twice (closed loop)"));
       const Pose origin = detail::urdf_pose(j->parent_to_joint_origin_transform);
       const Inertia inertia = link_inertia(*link);
       const Vector3 axis(j->axis.x, j->axis.y, j->axis.z);
@@ -401,8 +425,8 @@ inline Model model_from_urdf_string(const std::string& xml, const std::string& s
           if (!axis.allFinite() || axis.norm() < 1e-12)
             throw ModelError(str("joint '", j->name, "': axis must be a finite non-zero vector"));
           builder->add_fixed(j->name, j->parent_link_name,
-                             detail::joint_pose_at(origin, j->type != urdf::Joint::PRISMATIC, axis, *q), link->name,
-                             inertia);
+                             detail::joint_pose_at(origin, j->type != urdf::Joint::PRISMATIC, axis, *q),
+                             link->name, inertia);
           rep.locked.emplace_back(j->name, *q);
           continue;
         }
@@ -413,23 +437,28 @@ inline Model model_from_urdf_string(const std::string& xml, const std::string& s
           break;
         case urdf::Joint::REVOLUTE:
         case urdf::Joint::PRISMATIC: {
-          if (!j->limits) throw ModelError(str("joint '", j->name, "': a revolute or prismatic joint needs <limit>"));
+          if (!j->limits)
+            throw ModelError(str("joint '", j->name, "': a revolute or prismatic joint needs <limit>"));
           const double lo = j->limits->lower, hi = j->limits->upper;
           const bool unlimited = lo == 0.0 && hi == 0.0;  // URDF's default when lower/upper are omitted
-          builder->add_joint(j->name, j->type == urdf::Joint::REVOLUTE ? JointType::Revolute : JointType::Prismatic,
+          builder->add_joint(j->name,
+                             j->type == urdf::Joint::REVOLUTE ? JointType::Revolute : JointType::Prismatic,
                              j->parent_link_name, origin, axis, link->name, inertia,
                              unlimited ? -std::numeric_limits<double>::infinity() : lo,
                              unlimited ? std::numeric_limits<double>::infinity() : hi);
           break;
         }
         case urdf::Joint::CONTINUOUS:
-          builder->add_joint(j->name, JointType::Revolute, j->parent_link_name, origin, axis, link->name, inertia);
+          builder->add_joint(j->name, JointType::Revolute, j->parent_link_name, origin, axis, link->name,
+                             inertia);
           break;
         default:
-          throw ModelError(str("joint '", j->name, "': unsupported joint type (only revolute, continuous, prismatic "
+          throw ModelError(str("joint '", j->name,
+                               "': unsupported joint type (only revolute, continuous, prismatic "
                                "and fixed are supported)"));
       }
-      if (moving && j->mimic) builder->set_mimic(j->name, j->mimic->joint_name, j->mimic->multiplier, j->mimic->offset);
+      if (moving && j->mimic)
+        builder->set_mimic(j->name, j->mimic->joint_name, j->mimic->multiplier, j->mimic->offset);
     }
     if (visited.size() != urdf->links_.size()) {
       std::string orphans;
@@ -439,7 +468,8 @@ inline Model model_from_urdf_string(const std::string& xml, const std::string& s
     }
     if (!opt.end_effector.empty()) builder->set_end_effector(opt.end_effector);
     if (opt.end_effector_offset) {
-      if (!opt.end_effector_offset->allFinite()) throw InputError("end-effector-offset: expected 3 finite numbers");
+      if (!opt.end_effector_offset->allFinite())
+        throw InputError("end-effector-offset: expected 3 finite numbers");
       builder->set_end_effector_offset(*opt.end_effector_offset);
     }
     Model model = builder->build();
@@ -469,11 +499,13 @@ inline Model model_from_urdf_string(const std::string& xml, const std::string& s
 }
 
 /// Builds a Model from a URDF file with options (see model_from_urdf_string).
-inline Model model_from_urdf_file(const std::string& path, const UrdfOptions& opt, UrdfReport* report = nullptr) {
+inline Model model_from_urdf_file(const std::string& path, const UrdfOptions& opt,
+                                  UrdfReport* report = nullptr) {
   // Only regular files of a sane size: /dev/zero or a FIFO would be read forever.
   std::error_code ec;
   const auto status = std::filesystem::status(path, ec);
-  if (ec || !std::filesystem::exists(status)) throw ModelError(detail::str(path, ": cannot open the URDF file"));
+  if (ec || !std::filesystem::exists(status))
+    throw ModelError(detail::str(path, ": cannot open the URDF file"));
   if (!std::filesystem::is_regular_file(status)) throw ModelError(detail::str(path, ": not a regular file"));
   const auto size = std::filesystem::file_size(path, ec);
   constexpr std::uintmax_t kMaxBytes = 64u << 20;

@@ -42,9 +42,9 @@ struct Data {
     Jf.setZero();
   }
   // --- kinematics (forward_kinematics): world pose of every body frame ---------------------------
-  std::vector<Matrix3> R;   ///< oR_i
-  std::vector<Vector3> p;   ///< origin of body i in o
-  BasePose base;            ///< the base pose the kinematics were computed at
+  std::vector<Matrix3> R;  ///< oR_i
+  std::vector<Vector3> p;  ///< origin of body i in o
+  BasePose base;           ///< the base pose the kinematics were computed at
   /// Joint motion subspace columns in the inertial orientation, about the base frame origin:
   /// [ (p_k - p_0) x z_k ; z_k ] (revolute) or [ z_k ; 0 ] (prismatic).
   Eigen::Matrix<double, 6, Eigen::Dynamic> S;
@@ -53,8 +53,8 @@ struct Data {
   Eigen::MatrixXd H;               ///< (6+n)x(6+n) joint-space inertia
   Eigen::MatrixXd L;               ///< Cholesky factor of H (lower), written by the solves
   // --- Jacobians -------------------------------------------------------------------------------
-  Eigen::MatrixXd J;   ///< 6x(6+n) point Jacobian [J_b J_m] of a frame origin
-  Eigen::MatrixXd Jf;  ///< 6xn generalized Jacobian
+  Eigen::MatrixXd J;     ///< 6x(6+n) point Jacobian [J_b J_m] of a frame origin
+  Eigen::MatrixXd Jf;    ///< 6xn generalized Jacobian
   Eigen::VectorXd w, y;  ///< scratch vectors of size 6+n
   // --- RNEA (body coordinates) ---------------------------------------------------------------
   std::vector<Vector6> V, A, F;

@@ -66,14 +66,14 @@ struct Joint {
 /// One rigid body. Body 0 is the free-floating base; body i > 0 hangs on joint i - 1.
 struct Body {
   std::string name;
-  int parent = -1;      ///< index of the parent body, -1 for the base; parent < own index
-  Joint joint;          ///< the joint from the parent (unused for the base)
-  Pose tree;            ///< joint frame in the parent body frame at zero joint position
-  Inertia inertia;      ///< in this body's frame, fixed-joint children merged in
+  int parent = -1;          ///< index of the parent body, -1 for the base; parent < own index
+  Joint joint;              ///< the joint from the parent (unused for the base)
+  Pose tree;                ///< joint frame in the parent body frame at zero joint position
+  Inertia inertia;          ///< in this body's frame, fixed-joint children merged in
   int coord = -1;           ///< the coordinate (index into theta) that drives the joint (-1 for the base)
   double multiplier = 1.0;  ///< joint position = multiplier * theta(coord) + offset (1, 0 unless a mimic)
   double offset = 0.0;
-  std::string leader;       ///< the joint this one mimics, resolved to an independent joint ("" if none)
+  std::string leader;  ///< the joint this one mimics, resolved to an independent joint ("" if none)
   /// The joint position of this body for the coordinates theta.
   double joint_position(const Eigen::Ref<const Eigen::VectorXd>& theta) const {
     return multiplier * theta(coord) + offset;
@@ -106,8 +106,8 @@ inline void validate_inertia(const Inertia& in, const std::string& what, bool re
     throw ModelError(str(what, ": inertia matrix is not positive semi-definite (smallest principal moment ",
                          e.minCoeff(), ")"));
   if (e(2) > e(0) + e(1) + tol)
-    throw ModelError(str(what, ": principal moments (", e(0), ", ", e(1), ", ", e(2),
-                         ") break the triangle inequality"));
+    throw ModelError(
+        str(what, ": principal moments (", e(0), ", ", e(1), ", ", e(2), ") break the triangle inequality"));
 }
 
 class ModelBuilder;
@@ -182,9 +182,9 @@ class ModelBuilder {
   }
 
   /// Adds a moving joint from the frame `parent` (a link or frame name) to a new link `child`.
-  ModelBuilder& add_joint(const std::string& name, JointType type, const std::string& parent, const Pose& origin,
-                          const Vector3& axis, const std::string& child, const Inertia& inertia,
-                          double lower = -std::numeric_limits<double>::infinity(),
+  ModelBuilder& add_joint(const std::string& name, JointType type, const std::string& parent,
+                          const Pose& origin, const Vector3& axis, const std::string& child,
+                          const Inertia& inertia, double lower = -std::numeric_limits<double>::infinity(),
                           double upper = std::numeric_limits<double>::infinity()) {
     using detail::str;
     const Frame pf = find_parent(parent, name);
@@ -193,7 +193,8 @@ class ModelBuilder {
     if (!axis.allFinite() || axis.norm() < 1e-12)
       throw ModelError(str("joint '", name, "': axis must be a finite non-zero vector"));
     if (std::isnan(lower) || std::isnan(upper) || lower > upper)
-      throw ModelError(str("joint '", name, "': limits must satisfy lower <= upper, got [", lower, ", ", upper, "]"));
+      throw ModelError(
+          str("joint '", name, "': limits must satisfy lower <= upper, got [", lower, ", ", upper, "]"));
     validate_inertia(inertia, "link '" + child + "'", false);
     Body b;
     b.name = child;
@@ -242,7 +243,8 @@ class ModelBuilder {
   /// Makes the moving joint `follower` a mimic of `leader`: q_follower = multiplier * q_leader + offset
   /// (URDF <mimic>). The follower is then no coordinate of its own. Leaders may themselves be mimics
   /// (chains resolve in build()); the joints may be added before or after this call.
-  ModelBuilder& set_mimic(const std::string& follower, const std::string& leader, double multiplier, double offset) {
+  ModelBuilder& set_mimic(const std::string& follower, const std::string& leader, double multiplier,
+                          double offset) {
     if (!std::isfinite(multiplier) || !std::isfinite(offset))
       throw ModelError(detail::str("mimic joint '", follower, "': multiplier and offset must be finite"));
     mimic_.push_back({follower, leader, multiplier, offset});
@@ -266,8 +268,8 @@ class ModelBuilder {
       if (leaves.size() != 1) {
         std::string list;
         for (const auto& l : leaves) list += (list.empty() ? "" : ", ") + l;
-        throw InputError(str("the end-effector is ambiguous: the tree has ", leaves.size(),
-                             " leaf links (", list, "); name one"));
+        throw InputError(str("the end-effector is ambiguous: the tree has ", leaves.size(), " leaf links (",
+                             list, "); name one"));
       }
       m.end_effector_ = m.frame_index(leaves.front());
     }
@@ -352,7 +354,8 @@ class ModelBuilder {
       return nullptr;
     };
     for (const auto& s : mimic_)
-      if (body_of(s.follower) < 0) throw ModelError(str("mimic joint '", s.follower, "': not a moving joint of the model"));
+      if (body_of(s.follower) < 0)
+        throw ModelError(str("mimic joint '", s.follower, "': not a moving joint of the model"));
     for (int i = 1; i < m.nb(); ++i) {
       Body& b = m.bodies_[static_cast<size_t>(i)];
       std::vector<std::string> chain{b.joint.name};

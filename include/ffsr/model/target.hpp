@@ -8,20 +8,21 @@ namespace ffsr {
 
 /// The target of the capture (Section 2.2). Vectors marked (target frame) rotate with it.
 struct Target {
-  double mass = 200.0;                                        ///< m_t, kg
-  Matrix3 inertia = 100.0 * Matrix3::Identity();              ///< I_t about its centre of mass (target frame)
-  Vector3 position = Vector3::Zero();                         ///< centre of mass in o
-  Quaternion attitude = Quaternion::Identity();               ///< oR_t
-  Vector3 velocity = Vector3::Zero();                         ///< v_t, inertial frame
-  Vector3 angular_velocity = Vector3::Zero();                 ///< omega_t (target frame), rad/s
-  Vector3 contact_offset = Vector3(-0.25, 0.15, 0.0);         ///< r_tp (target frame)
-  Vector3 normal = Vector3::UnitX();                          ///< u_n (target frame), unit
+  double mass = 200.0;                                 ///< m_t, kg
+  Matrix3 inertia = 100.0 * Matrix3::Identity();       ///< I_t about its centre of mass (target frame)
+  Vector3 position = Vector3::Zero();                  ///< centre of mass in o
+  Quaternion attitude = Quaternion::Identity();        ///< oR_t
+  Vector3 velocity = Vector3::Zero();                  ///< v_t, inertial frame
+  Vector3 angular_velocity = Vector3::Zero();          ///< omega_t (target frame), rad/s
+  Vector3 contact_offset = Vector3(-0.25, 0.15, 0.0);  ///< r_tp (target frame)
+  Vector3 normal = Vector3::UnitX();                   ///< u_n (target frame), unit
 
   /// Checks every field; throws InputError naming the field. The inertia must be symmetric positive
   /// definite (Eq. 14 inverts it) and satisfy the triangle inequality.
   void validate(const char* where = "target") const {
     using detail::str;
-    if (!std::isfinite(mass) || mass <= 0) throw InputError(str(where, ": mass must be positive and finite, got ", mass));
+    if (!std::isfinite(mass) || mass <= 0)
+      throw InputError(str(where, ": mass must be positive and finite, got ", mass));
     detail::require_finite_all(inertia, where, "inertia");
     detail::require_finite_all(position, where, "position");
     detail::require_finite_all(attitude.coeffs(), where, "attitude");
@@ -37,8 +38,8 @@ struct Target {
     Eigen::SelfAdjointEigenSolver<Matrix3> es(inertia, Eigen::EigenvaluesOnly);
     const Vector3 e = es.eigenvalues();
     if (!(e(0) > 1e-12 * scale) || !(scale > 0))
-      throw InputError(str(where, ": inertia must be positive definite, principal moments (", e(0), ", ", e(1), ", ",
-                           e(2), ")"));
+      throw InputError(str(where, ": inertia must be positive definite, principal moments (", e(0), ", ",
+                           e(1), ", ", e(2), ")"));
     if (e(2) > (e(0) + e(1)) * (1 + 1e-9))
       throw InputError(str(where, ": principal moments (", e(0), ", ", e(1), ", ", e(2),
                            ") break the triangle inequality"));

@@ -52,19 +52,19 @@ struct CaptureTask {
 enum class CaptureObjective { IntegratedEffectiveMass, ExactMaxForce };
 
 struct CaptureOptions {
-  double duration = 180.0;        ///< T, s
-  double step = 0.1;              ///< RK4 step, s
-  double gain = 0.0;              ///< rho of Eq. 30 (< 0 lowers the objective; 0: plain tracking)
-  double feedback = 1.0;          ///< k_p, 1/s, on the position (m) and orientation (rad) error
-  double tolerance = 1e-3;        ///< required end-effector position error at T, m
+  double duration = 180.0;              ///< T, s
+  double step = 0.1;                    ///< RK4 step, s
+  double gain = 0.0;                    ///< rho of Eq. 30 (< 0 lowers the objective; 0: plain tracking)
+  double feedback = 1.0;                ///< k_p, 1/s, on the position (m) and orientation (rad) error
+  double tolerance = 1e-3;              ///< required end-effector position error at T, m
   double orientation_tolerance = 1e-2;  ///< pose task: required orientation error at T, rad
   CaptureObjective objective = CaptureObjective::IntegratedEffectiveMass;
   double singular_value_threshold = 1e-3;  ///< below it the pseudo-inverse is damped
   double max_damping = 1e-2;               ///< largest damping (lambda) of the damped least squares
   bool record_series = false;
-  int record_every = 1;           ///< keep every k-th step in the series
+  int record_every = 1;                  ///< keep every k-th step in the series
   std::function<void(double)> progress;  ///< called with the fraction done (0..1), optional
-  double max_joint_rate = 0;      ///< rad/s; the null-space term is scaled down to respect it (0: not limited)
+  double max_joint_rate = 0;  ///< rad/s; the null-space term is scaled down to respect it (0: not limited)
 };
 
 /// The capture problem: robot, end-effector, initial state, target (its initial state at t = 0),
@@ -85,22 +85,22 @@ struct CaptureSample {
   Eigen::VectorXd theta;
   BasePose base;
   Vector3 end_effector = Vector3::Zero();
-  double M_ie = 0;          ///< with the target at the capture time
+  double M_ie = 0;            ///< with the target at the capture time
   double f_max_estimate = 0;  ///< closed-form F_max at that M_ie
 };
 
 struct CaptureResult {
-  Eigen::VectorXd theta;      ///< capture configuration (rad)
-  BasePose base;              ///< base pose at T
+  Eigen::VectorXd theta;  ///< capture configuration (rad)
+  BasePose base;          ///< base pose at T
   Vector3 end_effector = Vector3::Zero();
   Vector3 capture_point = Vector3::Zero();
-  double tracking_error = 0;  ///< |p_e(T) - capture point| on the task's constrained axes, m
-  double capture_distance = 0;  ///< |p_e(T) - capture point| in 3-D (differs for a task on fewer axes), m
-  double orientation_error = 0;  ///< pose task: angle between the reached and desired orientation, rad
-  double base_position_drift = 0;   ///< |p_0(T) - p_0(0)|, m
-  double base_attitude_drift = 0;   ///< rotation angle between the base attitudes at 0 and T, rad
+  double tracking_error = 0;       ///< |p_e(T) - capture point| on the task's constrained axes, m
+  double capture_distance = 0;     ///< |p_e(T) - capture point| in 3-D (differs for a task on fewer axes), m
+  double orientation_error = 0;    ///< pose task: angle between the reached and desired orientation, rad
+  double base_position_drift = 0;  ///< |p_0(T) - p_0(0)|, m
+  double base_attitude_drift = 0;  ///< rotation angle between the base attitudes at 0 and T, rad
   double M_ie = 0;
-  double approach_velocity = 0;     ///< delta_dot^- at the capture
+  double approach_velocity = 0;  ///< delta_dot^- at the capture
   double f_max_closed_form = 0;
   double f_max_exact = 0;
   double max_momentum = 0;          ///< largest |total momentum| along the run (checked each step)
@@ -134,7 +134,8 @@ inline Target propagate_target(const Target& t0, double t) {
   Vector3 w = t0.angular_velocity;  // body frame
   auto wdot = [&](const Vector3& x) { return Vector3(Iinv * (-x.cross(I * x))); };
   for (long k = 0; k < nsteps; ++k) {
-    const Vector3 k1 = wdot(w), k2 = wdot(w + 0.5 * h * k1), k3 = wdot(w + 0.5 * h * k2), k4 = wdot(w + h * k3);
+    const Vector3 k1 = wdot(w), k2 = wdot(w + 0.5 * h * k1), k3 = wdot(w + 0.5 * h * k2),
+                  k4 = wdot(w + h * k3);
     const Vector3 wn = w + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4);
     R = R * rotation_from_vector(0.5 * h * (w + wn));  // midpoint rotation, body frame
     w = wn;
@@ -191,21 +192,21 @@ struct LineReference {
 /// and direction, the contact law at the capture's approach velocity, the line reference and the task
 /// rows. Made (and every input checked) by prepare_capture.
 struct CaptureSetup {
-  Target capture_target;      ///< the target at T
-  Vector3 x_cap = Vector3::Zero();  ///< capture point
-  Vector3 u_cap = Vector3::UnitX(); ///< inertial contact normal at T
-  double target_inv_mass = 0; ///< the target's inverse mass along the normal (Eq. 14)
-  double v_in = 0;            ///< delta_dot^- at the capture
+  Target capture_target;             ///< the target at T
+  Vector3 x_cap = Vector3::Zero();   ///< capture point
+  Vector3 u_cap = Vector3::UnitX();  ///< inertial contact normal at T
+  double target_inv_mass = 0;        ///< the target's inverse mass along the normal (Eq. 14)
+  double v_in = 0;                   ///< delta_dot^- at the capture
   AnyContactLaw law;
   LineReference line;
   Matrix3 R_end = Matrix3::Identity();  ///< pose task: the end-effector orientation at T
-  std::vector<int> rows;      ///< rows of J_f (and of the 6-D error) that the task constrains
+  std::vector<int> rows;                ///< rows of J_f (and of the 6-D error) that the task constrains
 };
 
 /// Checks the problem, task and options (the errors of plan_capture, named after `where`) and builds
 /// the capture setup. Runs crba at the initial state.
-inline CaptureSetup prepare_capture(const CaptureProblem& pb, const CaptureTask& task, const CaptureOptions& opt,
-                                    const char* where = "plan_capture") {
+inline CaptureSetup prepare_capture(const CaptureProblem& pb, const CaptureTask& task,
+                                    const CaptureOptions& opt, const char* where = "plan_capture") {
   using detail::str;
   if (!pb.model) throw InputError(str(where, ": no model"));
   const Model& model = *pb.model;
@@ -216,7 +217,8 @@ inline CaptureSetup prepare_capture(const CaptureProblem& pb, const CaptureTask&
   pb.target.validate(str(where, ": target").c_str());
   validate(pb.contact, where);
   auto positive = [&](double x, const char* what) {
-    if (!std::isfinite(x) || x <= 0) throw InputError(str(where, ": ", what, " must be positive and finite, got ", x));
+    if (!std::isfinite(x) || x <= 0)
+      throw InputError(str(where, ": ", what, " must be positive and finite, got ", x));
   };
   positive(opt.duration, "duration");
   positive(opt.step, "step");
@@ -228,7 +230,9 @@ inline CaptureSetup prepare_capture(const CaptureProblem& pb, const CaptureTask&
   if (opt.feedback < 0) throw InputError(str(where, ": feedback gain must be >= 0"));
   if (!std::isfinite(opt.max_joint_rate) || opt.max_joint_rate < 0)
     throw InputError(str(where, ": max joint rate must be >= 0 (0: not limited), got ", opt.max_joint_rate));
-  if (opt.duration / opt.step > 1e7) throw InputError(str(where, ": duration / step = ", opt.duration / opt.step, " steps is too many (at most 1e7)"));
+  if (opt.duration / opt.step > 1e7)
+    throw InputError(
+        str(where, ": duration / step = ", opt.duration / opt.step, " steps is too many (at most 1e7)"));
   if (opt.record_every < 1) throw InputError(str(where, ": record_every must be >= 1"));
   const int m = task.rows();
   if (m < 1) throw InputError(str(where, ": the task constrains no axis"));
@@ -237,16 +241,24 @@ inline CaptureSetup prepare_capture(const CaptureProblem& pb, const CaptureTask&
                          " joints: no null space to optimize in (use gain 0 or a smaller task)"));
 
   // The capture: the target's contact point, normal and attitude at T.
-  CaptureSetup s{propagate_target(pb.target, opt.duration), {}, {}, 0, 0,
-                 make_contact_law("hunt-crossley", ContactParams{}, 1.0), {}, {}, {}};
+  CaptureSetup s{propagate_target(pb.target, opt.duration),
+                 {},
+                 {},
+                 0,
+                 0,
+                 make_contact_law("hunt-crossley", ContactParams{}, 1.0),
+                 {},
+                 {},
+                 {}};
   s.x_cap = s.capture_target.contact_point();
   s.u_cap = s.capture_target.normal_world();
   s.target_inv_mass = s.capture_target.inverse_mass_along_normal();
   s.v_in = approach_velocity(s.u_cap, Vector3(pb.approach_speed * s.u_cap), s.capture_target.velocity,
                              s.capture_target.angular_velocity_world(), s.capture_target.offset_world());
   if (!(s.v_in > 0))
-    throw InputError(str(where, ": at the capture the end-effector does not approach the target (delta_dot^- = ",
-                         s.v_in, " m/s); increase the approach speed"));
+    throw InputError(
+        str(where, ": at the capture the end-effector does not approach the target (delta_dot^- = ", s.v_in,
+            " m/s); increase the approach speed"));
   s.law = make_contact_law(pb.law, pb.contact, s.v_in);
 
   Data data(model);
@@ -277,15 +289,15 @@ struct GradientPolicy {
   double f_scale = 1.0, alpha = 1.5;  ///< exact force: F = f_scale M^(alpha/(alpha+1)) (Eq. 16 scaling)
   Eigen::VectorXd grad;
   bool active() const { return gain != 0.0; }
-  void operator()(const Model& model, Data& data, const CaptureProblem& pb, const CaptureSetup& s, double /*t*/,
-                  const BasePose& base, const Eigen::VectorXd& theta, const Eigen::MatrixXd& Nproj,
-                  Eigen::VectorXd& qd_null) {
+  void operator()(const Model& model, Data& data, const CaptureProblem& pb, const CaptureSetup& s,
+                  double /*t*/, const BasePose& base, const Eigen::VectorXd& theta,
+                  const Eigen::MatrixXd& Nproj, Eigen::VectorXd& qd_null) {
     const int n = model.n();
     grad.resize(n);
     integrated_effective_mass_gradient(model, data, base, theta, pb.frame, s.u_cap, s.target_inv_mass, grad);
     if (objective == CaptureObjective::ExactMaxForce) {
       const double M = 1.0 / (data.w.dot(data.y) + s.target_inv_mass);  // y = H^-1 w after the gradient
-      grad *= f_scale * std::pow(M, -1.0 / (alpha + 1));  // dF/dM dM/dtheta
+      grad *= f_scale * std::pow(M, -1.0 / (alpha + 1));                // dF/dM dM/dtheta
     }
     // joint limits: repulsive gradient inside 10 % of the range
     for (int k = 0; k < n; ++k) {
@@ -315,8 +327,9 @@ struct ServoPolicy {
   double gain = 0.0;  ///< k, 1/s; 0: 10 / T
   Eigen::VectorXd err;
   bool active() const { return theta_goal.size() > 0; }
-  void operator()(const Model& model, Data&, const CaptureProblem&, const CaptureSetup& s, double, const BasePose&,
-                  const Eigen::VectorXd& theta, const Eigen::MatrixXd& Nproj, Eigen::VectorXd& qd_null) {
+  void operator()(const Model& model, Data&, const CaptureProblem&, const CaptureSetup& s, double,
+                  const BasePose&, const Eigen::VectorXd& theta, const Eigen::MatrixXd& Nproj,
+                  Eigen::VectorXd& qd_null) {
     err = theta_goal - theta;
     for (int k = 0; k < model.n(); ++k) {
       const Joint& j = model.joint(k);
@@ -336,7 +349,8 @@ struct ServoPolicy {
 /// `where`). Runs crba many times.
 template <class Policy>
 CaptureResult integrate_capture(const CaptureProblem& pb, const CaptureTask& task, const CaptureOptions& opt,
-                                const CaptureSetup& setup, Policy& policy, const char* where = "plan_capture") {
+                                const CaptureSetup& setup, Policy& policy,
+                                const char* where = "plan_capture") {
   using detail::str;
   const Model& model = *pb.model;
   const int n = model.n();
@@ -405,8 +419,10 @@ CaptureResult integrate_capture(const CaptureProblem& pb, const CaptureTask& tas
         double a = 1.0;
         for (int k = 0; k < n; ++k) {
           const double b = qd_null(k), c = theta_dot(k);
-          if (b > 0) a = std::min(a, (L - c) / b);
-          else if (b < 0) a = std::min(a, (-L - c) / b);
+          if (b > 0)
+            a = std::min(a, (L - c) / b);
+          else if (b < 0)
+            a = std::min(a, (-L - c) / b);
         }
         qd_null *= std::max(a, 0.0);
       }
@@ -463,10 +479,11 @@ CaptureResult integrate_capture(const CaptureProblem& pb, const CaptureTask& tas
     {
       vgen << k_b[0], k_th[0];
       res.max_momentum = std::max(res.max_momentum, momentum(model, data, vgen).norm());
-      for_each_body_velocity(model, data, vgen, [&](int i, const Vector3& w, const Vector3& vc, const Vector3&) {
-        const Inertia& in = model.body(i).inertia;
-        res.max_body_momentum = std::max(res.max_body_momentum, in.mass * vc.norm() + (in.I * w).norm());
-      });
+      for_each_body_velocity(
+          model, data, vgen, [&](int i, const Vector3& w, const Vector3& vc, const Vector3&) {
+            const Inertia& in = model.body(i).inertia;
+            res.max_body_momentum = std::max(res.max_body_momentum, in.mass * vc.norm() + (in.I * w).norm());
+          });
       const Vector3 com = data.p[0] + data.Ic[0].h / data.Ic[0].m;
       if (k == 0) com0 = com;
       res.max_com_drift = std::max(res.max_com_drift, (com - com0).norm());
@@ -477,8 +494,10 @@ CaptureResult integrate_capture(const CaptureProblem& pb, const CaptureTask& tas
       const double err = std::sqrt(err2);
       res.max_tracking_error = std::max(res.max_tracking_error, err);
       if (err > divergence)
-        throw NumericalError(str(where, ": the end-effector cannot follow the line to the capture point (tracking "
-                                 "error ", err, " m at t = ", t, " s); the point may be out of reach"));
+        throw NumericalError(str(where,
+                                 ": the end-effector cannot follow the line to the capture point (tracking "
+                                 "error ",
+                                 err, " m at t = ", t, " s); the point may be out of reach"));
     }
     k_q[0] = quat_rate(base.orientation, k_b[0].tail<3>());
     stage(base, theta, k_b[0], k_q[0], k_th[0], 0.5 * h, b2, th2);
@@ -500,8 +519,8 @@ CaptureResult integrate_capture(const CaptureProblem& pb, const CaptureTask& tas
     for (int j = 0; j < n; ++j) {
       const Joint& jt = model.joint(j);
       if (theta(j) < jt.lower - 1e-9 || theta(j) > jt.upper + 1e-9)
-        throw JointLimitError(str(where, ": joint '", jt.name, "' left its limits [", jt.lower, ", ", jt.upper,
-                                 "] rad at t = ", t + h, " s (", theta(j), " rad)"));
+        throw JointLimitError(str(where, ": joint '", jt.name, "' left its limits [", jt.lower, ", ",
+                                  jt.upper, "] rad at t = ", t + h, " s (", theta(j), " rad)"));
     }
     ++res.steps;
     if (opt.record_series && ((k + 1) % opt.record_every == 0 || k + 1 == nsteps)) sample(t + h);
@@ -519,7 +538,8 @@ CaptureResult integrate_capture(const CaptureProblem& pb, const CaptureTask& tas
     if (r < 3) e2 += (ee.p(r) - x_cap(r)) * (ee.p(r) - x_cap(r));
   res.tracking_error = std::sqrt(e2);
   res.capture_distance = (ee.p - x_cap).norm();
-  res.orientation_error = task.kind == CaptureTask::Kind::Pose ? rotation_angle(setup.R_end * ee.R.transpose()) : 0.0;
+  res.orientation_error =
+      task.kind == CaptureTask::Kind::Pose ? rotation_angle(setup.R_end * ee.R.transpose()) : 0.0;
   res.base_position_drift = (base.position - pb.base.position).norm();
   res.base_attitude_drift = rotation_angle(base.orientation.toRotationMatrix() *
                                            pb.base.orientation.normalized().toRotationMatrix().transpose());
@@ -542,7 +562,8 @@ CaptureResult integrate_capture(const CaptureProblem& pb, const CaptureTask& tas
 /// gradient policy with gain rho, the RK4 integration. Throws InputError for bad arguments
 /// (including rho != 0 on a task without a null space), NumericalError when the capture point is not
 /// reached within the tolerance or a joint leaves its limits.
-inline CaptureResult plan_capture(const CaptureProblem& pb, const CaptureTask& task, const CaptureOptions& opt) {
+inline CaptureResult plan_capture(const CaptureProblem& pb, const CaptureTask& task,
+                                  const CaptureOptions& opt) {
   const CaptureSetup setup = prepare_capture(pb, task, opt);
   GradientPolicy policy;
   policy.gain = opt.gain;

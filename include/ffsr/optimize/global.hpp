@@ -50,22 +50,26 @@ enum class GlobalObjective { Mass, ExactForce, MultibodyForce, RobustForce };
 /// The objective's name as the command spells it.
 inline const char* objective_name(GlobalObjective o) {
   switch (o) {
-    case GlobalObjective::Mass: return "mass";
-    case GlobalObjective::ExactForce: return "exact-force";
-    case GlobalObjective::MultibodyForce: return "multibody-force";
-    case GlobalObjective::RobustForce: return "robust-force";
+    case GlobalObjective::Mass:
+      return "mass";
+    case GlobalObjective::ExactForce:
+      return "exact-force";
+    case GlobalObjective::MultibodyForce:
+      return "multibody-force";
+    case GlobalObjective::RobustForce:
+      return "robust-force";
   }
   return "?";
 }
 
 struct ManifoldSearchOptions {
-  int starts = 32;                        ///< random starts of the multistart
-  std::uint64_t seed = 1;                 ///< seed of std::mt19937_64
+  int starts = 32;         ///< random starts of the multistart
+  std::uint64_t seed = 1;  ///< seed of std::mt19937_64
   GlobalObjective objective = GlobalObjective::Mass;
-  double constraint_tolerance = 1e-10;    ///< |c| accepted as on the manifold (m, rad)
-  int max_local_evaluations = 300;        ///< SLSQP budget per start
-  MultibodyContactOptions multibody;      ///< for the multibody-force objective
-  int max_ranked = 8;                     ///< multibody-force: local optima ranked (the best by M_ie)
+  double constraint_tolerance = 1e-10;  ///< |c| accepted as on the manifold (m, rad)
+  int max_local_evaluations = 300;      ///< SLSQP budget per start
+  MultibodyContactOptions multibody;    ///< for the multibody-force objective
+  int max_ranked = 8;                   ///< multibody-force: local optima ranked (the best by M_ie)
   /// robust-force: CVaR_95 of the exact F_max over this fixed sample set (robust_objective.hpp),
   /// minimized by SLSQP with its gradient. Shared by copies of the options; not thread-safe.
   std::shared_ptr<RobustForceObjective> robust;
@@ -80,20 +84,21 @@ struct ManifoldPoint {
 
 struct ManifoldSearchResult {
   ManifoldPoint best;
-  std::vector<ManifoldPoint> local_optima;  ///< distinct, sorted by M_ie (robust-force: by CVaR_95; multibody-force: objective 0 = not ranked)
+  std::vector<ManifoldPoint>
+      local_optima;  ///< distinct, sorted by M_ie (robust-force: by CVaR_95; multibody-force: objective 0 = not ranked)
   std::string method;
-  int starts = 0;             ///< starts drawn (plus extra starts given)
-  int projected_starts = 0;   ///< starts that the projection put on the manifold
-  long evaluations = 0;       ///< objective (M_ie and gradient) evaluations of SLSQP
+  int starts = 0;                  ///< starts drawn (plus extra starts given)
+  int projected_starts = 0;        ///< starts that the projection put on the manifold
+  long evaluations = 0;            ///< objective (M_ie and gradient) evaluations of SLSQP
   long objective_evaluations = 0;  ///< multibody-force: CVODE simulations
   double seconds = 0;
 };
 
 /// The task residual c(theta) at a fixed base pose and its Jacobian (see the top of this file).
 /// Runs crba and frame_jacobian. Writes r (task rows) and, if J is given, J (rows x n).
-inline void capture_residual(const Model& model, Data& data, const CaptureProblem& pb, const CaptureTask& task,
-                             const CaptureSetup& s, const BasePose& base, const Eigen::VectorXd& theta,
-                             Eigen::VectorXd& r, Eigen::MatrixXd* J) {
+inline void capture_residual(const Model& model, Data& data, const CaptureProblem& pb,
+                             const CaptureTask& task, const CaptureSetup& s, const BasePose& base,
+                             const Eigen::VectorXd& theta, Eigen::VectorXd& r, Eigen::MatrixXd* J) {
   const int n = model.n();
   crba(model, data, base, theta);
   const Pose ee = frame_pose(model, data, pb.frame);
@@ -109,7 +114,8 @@ inline void capture_residual(const Model& model, Data& data, const CaptureProble
   frame_jacobian(model, data, pb.frame);
   Eigen::MatrixXd Jm(6, n);
   Jm.topRows<3>() = data.J.topRightCorner(3, n);
-  Jm.bottomRows<3>() = -0.5 * (R.trace() * Matrix3::Identity() - R.transpose()) * data.J.bottomRightCorner(3, n);
+  Jm.bottomRows<3>() =
+      -0.5 * (R.trace() * Matrix3::Identity() - R.transpose()) * data.J.bottomRightCorner(3, n);
   J->resize(m, n);
   for (int i = 0; i < m; ++i) J->row(i) = Jm.row(s.rows[static_cast<size_t>(i)]);
 }
@@ -130,9 +136,9 @@ inline bool within_limits(const Model& model, const Eigen::VectorXd& theta) {
 
 /// Damped Newton (Levenberg-Marquardt with step halving) on c(theta) = 0 at a fixed base pose.
 /// Returns true and the projected theta when |c| <= tol within the iteration budget.
-inline bool project_to_manifold(const Model& model, Data& data, const CaptureProblem& pb, const CaptureTask& task,
-                                const CaptureSetup& s, const BasePose& base, Eigen::VectorXd& theta, double tol,
-                                int max_iterations = 100) {
+inline bool project_to_manifold(const Model& model, Data& data, const CaptureProblem& pb,
+                                const CaptureTask& task, const CaptureSetup& s, const BasePose& base,
+                                Eigen::VectorXd& theta, double tol, int max_iterations = 100) {
   Eigen::VectorXd r, r2, trial;
   Eigen::MatrixXd J;
   capture_residual(model, data, pb, task, s, base, theta, r, &J);
@@ -202,7 +208,8 @@ inline double slsqp_objective(unsigned n, const double* x, double* grad, void* p
   return M;
 }
 
-inline void slsqp_constraints(unsigned m, double* result, unsigned n, const double* x, double* grad, void* p) {
+inline void slsqp_constraints(unsigned m, double* result, unsigned n, const double* x, double* grad,
+                              void* p) {
   auto& c = *static_cast<SlsqpContext*>(p);
   c.theta = Eigen::Map<const Eigen::VectorXd>(x, n);
   capture_residual(*c.model, *c.data, *c.pb, *c.task, *c.setup, *c.base, c.theta, c.r, grad ? &c.J : nullptr);
@@ -224,13 +231,19 @@ inline ManifoldPoint evaluate_capture(const CaptureProblem& pb, const CaptureSet
   const Model& model = *pb.model;
   Data data(model);
   crba(model, data, base, theta);
-  ManifoldPoint p{theta, 1.0 / (inverse_effective_mass(model, data, pb.frame, s.u_cap) + s.target_inv_mass), 0};
+  ManifoldPoint p{theta, 1.0 / (inverse_effective_mass(model, data, pb.frame, s.u_cap) + s.target_inv_mass),
+                  0};
   switch (objective) {
-    case GlobalObjective::Mass: p.objective = p.M_ie; break;
-    case GlobalObjective::ExactForce: p.objective = max_force_exact(s.law, p.M_ie); break;
+    case GlobalObjective::Mass:
+      p.objective = p.M_ie;
+      break;
+    case GlobalObjective::ExactForce:
+      p.objective = max_force_exact(s.law, p.M_ie);
+      break;
     case GlobalObjective::MultibodyForce:
-      p.objective = simulate_contact(model, base, theta, pb.frame, s.capture_target, pb.approach_speed, pb.contact,
-                                     pb.law, mo).f_max;
+      p.objective = simulate_contact(model, base, theta, pb.frame, s.capture_target, pb.approach_speed,
+                                     pb.contact, pb.law, mo)
+                        .f_max;
       break;
     case GlobalObjective::RobustForce:
       if (!robust) throw InputError("evaluate_capture: the robust-force objective needs its sample set");
@@ -247,9 +260,11 @@ inline ManifoldPoint evaluate_capture(const CaptureProblem& pb, const CaptureSet
 namespace detail {
 /// search_capture_manifold with `random_starts` random starts (0: the extra starts only, the local
 /// optima near them). Does not check the options.
-inline ManifoldSearchResult search_manifold(const CaptureProblem& pb, const CaptureTask& task, const CaptureSetup& s,
-                                            const BasePose& base, const ManifoldSearchOptions& so,
-                                            const std::vector<Eigen::VectorXd>& extra_starts, int random_starts);
+inline ManifoldSearchResult search_manifold(const CaptureProblem& pb, const CaptureTask& task,
+                                            const CaptureSetup& s, const BasePose& base,
+                                            const ManifoldSearchOptions& so,
+                                            const std::vector<Eigen::VectorXd>& extra_starts,
+                                            int random_starts);
 }  // namespace detail
 
 inline ManifoldSearchResult search_capture_manifold(const CaptureProblem& pb, const CaptureTask& task,
@@ -260,8 +275,10 @@ inline ManifoldSearchResult search_capture_manifold(const CaptureProblem& pb, co
   if (!pb.model) throw InputError("search_capture_manifold: no model");
   detail::check_configuration(*pb.model, base, pb.theta, "search_capture_manifold");
   if (so.starts < 1) throw InputError(str("search_capture_manifold: starts must be >= 1, got ", so.starts));
-  if (!(so.constraint_tolerance > 0)) throw InputError("search_capture_manifold: constraint tolerance must be positive");
-  if (so.max_local_evaluations < 1) throw InputError("search_capture_manifold: max_local_evaluations must be >= 1");
+  if (!(so.constraint_tolerance > 0))
+    throw InputError("search_capture_manifold: constraint tolerance must be positive");
+  if (so.max_local_evaluations < 1)
+    throw InputError("search_capture_manifold: max_local_evaluations must be >= 1");
   if (so.max_ranked < 1) throw InputError("search_capture_manifold: max_ranked must be >= 1");
   return detail::search_manifold(pb, task, s, base, so, extra_starts, so.starts);
 }
@@ -278,7 +295,8 @@ inline ManifoldSearchResult detail::search_manifold(const CaptureProblem& pb, co
   Data data(model);
   ManifoldSearchResult res;
   const bool robust = so.objective == GlobalObjective::RobustForce;
-  if (robust && !so.robust) throw InputError("search_capture_manifold: the robust-force objective needs its sample set");
+  if (robust && !so.robust)
+    throw InputError("search_capture_manifold: the robust-force objective needs its sample set");
   res.method = so.objective == GlobalObjective::MultibodyForce
                    ? "multistart NLopt SLSQP on M_ie, local optima ranked by the CVODE multibody peak"
                : robust ? "multistart NLopt SLSQP on CVaR_95 of the exact F_max over the sample set"
@@ -289,14 +307,16 @@ inline ManifoldSearchResult detail::search_manifold(const CaptureProblem& pb, co
     Eigen::VectorXd q(n);
     for (int k = 0; k < n; ++k) {
       const Joint& j = model.joint(k);
-      const double lo = std::isfinite(j.lower) ? j.lower : -M_PI, hi = std::isfinite(j.upper) ? j.upper : M_PI;
+      const double lo = std::isfinite(j.lower) ? j.lower : -M_PI,
+                   hi = std::isfinite(j.upper) ? j.upper : M_PI;
       q(k) = lo + (hi - lo) * detail::unit_uniform(rng);
     }
     starts.push_back(std::move(q));
   }
   res.starts = static_cast<int>(starts.size());
 
-  detail::SlsqpContext ctx{&model, &data, &pb, &task, &s, &base, robust ? so.robust.get() : nullptr, 0, {}, {}, {}, {}};
+  detail::SlsqpContext ctx{&model, &data, &pb, &task, &s, &base, robust ? so.robust.get() : nullptr,
+                           0,      {},    {},  {},    {}};
   const int m = task.rows();
   nlopt::opt local(nlopt::LD_SLSQP, static_cast<unsigned>(n));
   local.set_min_objective(detail::slsqp_objective, &ctx);
@@ -315,7 +335,8 @@ inline ManifoldSearchResult detail::search_manifold(const CaptureProblem& pb, co
 
   std::vector<ManifoldPoint> found;
   for (Eigen::VectorXd q : starts) {
-    if (q.size() != n || !q.allFinite()) throw InputError("search_capture_manifold: an extra start has the wrong size or is not finite");
+    if (q.size() != n || !q.allFinite())
+      throw InputError("search_capture_manifold: an extra start has the wrong size or is not finite");
     if (!detail::project_to_manifold(model, data, pb, task, s, base, q, so.constraint_tolerance)) continue;
     if (!detail::within_limits(model, q)) continue;
     ++res.projected_starts;
@@ -329,13 +350,15 @@ inline ManifoldSearchResult detail::search_manifold(const CaptureProblem& pb, co
     }
     Eigen::VectorXd th = Eigen::Map<const Eigen::VectorXd>(x.data(), n);
     // SLSQP satisfies c = 0 to its tolerance; a few Newton steps put the point back exactly on C
-    if (!detail::project_to_manifold(model, data, pb, task, s, base, th, so.constraint_tolerance, 20)) continue;
+    if (!detail::project_to_manifold(model, data, pb, task, s, base, th, so.constraint_tolerance, 20))
+      continue;
     if (!detail::within_limits(model, th)) continue;
     crba(model, data, base, th);
     const double M = 1.0 / (inverse_effective_mass(model, data, pb.frame, s.u_cap) + s.target_inv_mass);
     if (!std::isfinite(M)) continue;
     // the value the local optima are compared by: M_ie, or CVaR_95 for robust-force
-    const double v = robust ? so.robust->value(robot_inverse_inertia(model, data, base, th, pb.frame)).cvar95 : M;
+    const double v =
+        robust ? so.robust->value(robot_inverse_inertia(model, data, base, th, pb.frame)).cvar95 : M;
     bool duplicate = false;
     for (ManifoldPoint& p : found)
       if (detail::configuration_distance(model, p.theta, th) < 1e-3) {
@@ -346,9 +369,10 @@ inline ManifoldSearchResult detail::search_manifold(const CaptureProblem& pb, co
   }
   res.evaluations = ctx.evaluations;
   if (found.empty())
-    throw InputError(str("search_capture_manifold: no configuration puts the end-effector on the capture point [",
-                         s.x_cap.transpose(), "] from the base pose at T (", res.starts,
-                         " starts); the capture point is out of reach"));
+    throw InputError(
+        str("search_capture_manifold: no configuration puts the end-effector on the capture point [",
+            s.x_cap.transpose(), "] from the base pose at T (", res.starts,
+            " starts); the capture point is out of reach"));
   std::sort(found.begin(), found.end(),
             [](const ManifoldPoint& a, const ManifoldPoint& b) { return a.objective < b.objective; });
   res.local_optima = found;
@@ -379,27 +403,27 @@ inline ManifoldSearchResult detail::search_manifold(const CaptureProblem& pb, co
 
 struct GlobalCaptureOptions {
   ManifoldSearchOptions search;
-  int max_iterations = 8;      ///< shooting iterations per goal before the goal is given up
-  int max_goals = 6;           ///< local optima tried as goals, best first
-  double gap_percent = 1.0;    ///< required (reached - optimum) / optimum at the reached base pose, %
+  int max_iterations = 8;    ///< shooting iterations per goal before the goal is given up
+  int max_goals = 6;         ///< local optima tried as goals, best first
+  double gap_percent = 1.0;  ///< required (reached - optimum) / optimum at the reached base pose, %
   std::vector<Eigen::VectorXd> extra_starts;  ///< e.g. the paper's method's capture configuration
 };
 
 struct GlobalCaptureResult {
-  CaptureResult run;                 ///< the reaching run (its capture configuration and checks)
-  ManifoldSearchResult search;       ///< the last search, at the reached base pose
-  double objective = 0;              ///< objective at the reached capture configuration
-  double manifold_optimum = 0;       ///< objective at the optimum of C(reached base pose)
-  double optimality_gap_percent = 0; ///< 100 (objective - manifold_optimum) / manifold_optimum
+  CaptureResult run;                  ///< the reaching run (its capture configuration and checks)
+  ManifoldSearchResult search;        ///< the last search, at the reached base pose
+  double objective = 0;               ///< objective at the reached capture configuration
+  double manifold_optimum = 0;        ///< objective at the optimum of C(reached base pose)
+  double optimality_gap_percent = 0;  ///< 100 (objective - manifold_optimum) / manifold_optimum
   /// false: no better optimum than the one reached could be reached (it lies on another component
   /// of the self-motion manifold: the servo ended elsewhere); the gap then exceeds gap_percent
   bool reached_manifold_optimum = true;
-  int shooting_iterations = 0;       ///< reaching runs over every goal tried
+  int shooting_iterations = 0;  ///< reaching runs over every goal tried
   int goals_tried = 0;
-  int goals_out_of_limits = 0;       ///< goals given up because the way to them crosses a joint limit
-  long evaluations = 0;              ///< over every search
-  long objective_evaluations = 0;    ///< multibody simulations over every search
-  double search_seconds = 0;         ///< over every search
+  int goals_out_of_limits = 0;     ///< goals given up because the way to them crosses a joint limit
+  long evaluations = 0;            ///< over every search
+  long objective_evaluations = 0;  ///< multibody simulations over every search
+  double search_seconds = 0;       ///< over every search
 };
 
 /// Global capture planning (see the top of this file). Goals are the local optima of the search at
@@ -433,7 +457,8 @@ inline GlobalCaptureResult plan_capture_global(const CaptureProblem& pb, const C
   const CaptureResult plain = integrate_capture(pb, task, quiet, setup, none, where);
   if (o.max_joint_rate > 0 && plain.max_joint_rate > o.max_joint_rate)
     throw InputError(str(where, ": max joint rate ", o.max_joint_rate * 180 / M_PI,
-                         " deg/s is below what the task alone needs (", plain.max_joint_rate * 180 / M_PI, " deg/s)"));
+                         " deg/s is below what the task alone needs (", plain.max_joint_rate * 180 / M_PI,
+                         " deg/s)"));
 
   GlobalCaptureResult res;
   auto account = [&](const ManifoldSearchResult& sr) {
@@ -448,14 +473,17 @@ inline GlobalCaptureResult plan_capture_global(const CaptureProblem& pb, const C
   std::vector<ManifoldPoint> goals;
   for (const ManifoldPoint& p : first.local_optima)
     if (p.objective > 0) goals.push_back(p);  // multibody-force: the ranked ones
-  auto by_objective = [](const ManifoldPoint& a, const ManifoldPoint& b) { return a.objective < b.objective; };
+  auto by_objective = [](const ManifoldPoint& a, const ManifoldPoint& b) {
+    return a.objective < b.objective;
+  };
   std::stable_sort(goals.begin(), goals.end(), by_objective);
   if (goals.size() > static_cast<size_t>(g.max_goals)) goals.resize(static_cast<size_t>(g.max_goals));
   // and the local optima next to the extra starts and to the task-only run's configuration: on the
   // component of the self-motion manifold the arm is on, so reachable when the better ones are not
   for (const Eigen::VectorXd& x : extra) {
     try {
-      const ManifoldSearchResult near = detail::search_manifold(pb, task, setup, plain.base, g.search, {x}, 0);
+      const ManifoldSearchResult near =
+          detail::search_manifold(pb, task, setup, plain.base, g.search, {x}, 0);
       account(near);
       goals.push_back(near.best);
     } catch (const InputError&) {
@@ -481,8 +509,8 @@ inline GlobalCaptureResult plan_capture_global(const CaptureProblem& pb, const C
         ++res.goals_out_of_limits;
         break;  // the way to this goal crosses a joint limit: next goal
       }
-      const ManifoldPoint reached =
-          evaluate_capture(pb, setup, run.base, run.theta, g.search.objective, g.search.multibody, g.search.robust.get());
+      const ManifoldPoint reached = evaluate_capture(pb, setup, run.base, run.theta, g.search.objective,
+                                                     g.search.multibody, g.search.robust.get());
       if (g.search.objective == GlobalObjective::MultibodyForce) ++res.objective_evaluations;
       // the goal re-optimized locally at the reached base pose
       ManifoldSearchResult local;
@@ -531,9 +559,9 @@ inline GlobalCaptureResult plan_capture_global(const CaptureProblem& pb, const C
     fallback->search_seconds = res.search_seconds;
     return *fallback;
   }
-  throw NumericalError(str(where, ": no capture configuration chosen by the search was reached (", res.goals_tried,
-                           " goals, ", res.goals_out_of_limits, " of them behind a joint limit, ",
-                           res.shooting_iterations, " reaching runs)"));
+  throw NumericalError(str(where, ": no capture configuration chosen by the search was reached (",
+                           res.goals_tried, " goals, ", res.goals_out_of_limits,
+                           " of them behind a joint limit, ", res.shooting_iterations, " reaching runs)"));
 }
 
 }  // namespace ffsr

@@ -43,21 +43,21 @@ namespace ffsr::cvode {
 /// Integrator settings. Tolerances are CVODE's: the local error of y_i is kept below
 /// rtol |y_i| + atol_i. Scale the problem so that y is O(1), or give per-component atol_vector.
 struct Options {
-  double rtol = 1e-10;           ///< relative tolerance (>= 0)
-  double atol = 1e-14;           ///< scalar absolute tolerance (>= 0), unless atol_vector is set
-  Eigen::VectorXd atol_vector;   ///< optional per-component absolute tolerances (size n, >= 0)
-  long max_num_steps = 200000;   ///< steps per call of advance() (> 0): CV_TOO_MUCH_WORK beyond
-  double max_step = 0;           ///< largest step (0: no limit)
-  double initial_step = 0;       ///< first step (0: CVODE's estimate)
-  int max_order = 5;             ///< BDF order limit, 1..5
+  double rtol = 1e-10;          ///< relative tolerance (>= 0)
+  double atol = 1e-14;          ///< scalar absolute tolerance (>= 0), unless atol_vector is set
+  Eigen::VectorXd atol_vector;  ///< optional per-component absolute tolerances (size n, >= 0)
+  long max_num_steps = 200000;  ///< steps per call of advance() (> 0): CV_TOO_MUCH_WORK beyond
+  double max_step = 0;          ///< largest step (0: no limit)
+  double initial_step = 0;      ///< first step (0: CVODE's estimate)
+  int max_order = 5;            ///< BDF order limit, 1..5
 };
 
 /// ydot = f(t, y). ydot has the size of y on entry; every entry must be written.
 using Rhs = std::function<void(double t, const Eigen::Ref<const Eigen::VectorXd>& y,
                                Eigen::Ref<Eigen::VectorXd> ydot)>;
 /// g = g(t, y), n_roots entries. CVODE locates the zeros of each g_i.
-using Roots = std::function<void(double t, const Eigen::Ref<const Eigen::VectorXd>& y,
-                                 Eigen::Ref<Eigen::VectorXd> g)>;
+using Roots =
+    std::function<void(double t, const Eigen::Ref<const Eigen::VectorXd>& y, Eigen::Ref<Eigen::VectorXd> g)>;
 
 namespace detail {
 struct State;
@@ -91,9 +91,9 @@ class Integrator {
   /// Restarts at (t0, y0) with the same f, g and options (CVodeReInit); counters restart.
   void reinit(double t0, const Eigen::VectorXd& y0);
 
-  double t() const;                    ///< time of the last returned solution
-  const Eigen::VectorXd& y() const;    ///< the solution at t()
-  Eigen::Index size() const;           ///< number of states
+  double t() const;                  ///< time of the last returned solution
+  const Eigen::VectorXd& y() const;  ///< the solution at t()
+  Eigen::Index size() const;         ///< number of states
   /// CVODE's internal time t_n (CVodeGetCurrentTime): the end of the last internal step, >= t()
   /// (beyond it after a root or in CV_NORMAL mode).
   double current_time() const;
@@ -170,8 +170,8 @@ struct State {
     if (error) std::rethrow_exception(std::exchange(error, nullptr));
     if (flag < 0)
       throw IntegrationError(ffsr::detail::str("cvode: ", call, " failed with ",
-                                               flag_name(flag, linear_solver), " (", flag, ") at t = ",
-                                               t, message.empty() ? "" : ": ", message));
+                                               flag_name(flag, linear_solver), " (", flag, ") at t = ", t,
+                                               message.empty() ? "" : ": ", message));
   }
 
   N_Vector make_vector(const char* what) {
@@ -205,8 +205,8 @@ struct State {
       s->g(t, ym, gm);
       for (int i = 0; i < s->n_roots; ++i)
         if (!std::isfinite(gm[i]))
-          throw IntegrationError(ffsr::detail::str("cvode: root function ", i, " returned ", gm[i],
-                                                   " at t = ", t));
+          throw IntegrationError(
+              ffsr::detail::str("cvode: root function ", i, " returned ", gm[i], " at t = ", t));
       return 0;
     } catch (...) {
       s->error = std::current_exception();
@@ -218,8 +218,8 @@ struct State {
                             void* user_data) {
     try {
       auto* s = static_cast<State*>(user_data);
-      s->message = ffsr::detail::str(module ? module : "", "::", function ? function : "", ": ",
-                                     msg ? msg : "");
+      s->message =
+          ffsr::detail::str(module ? module : "", "::", function ? function : "", ": ", msg ? msg : "");
     } catch (...) {  // an allocation failure while recording a message: nothing to do
     }
   }
@@ -246,24 +246,22 @@ inline void validate(const Options& o, Eigen::Index n) {
     ffsr::detail::require_size(o.atol_vector.size(), n, w, "atol_vector");
     for (Eigen::Index i = 0; i < n; ++i)
       if (!(o.atol_vector[i] >= 0.0) || !std::isfinite(o.atol_vector[i]))
-        throw InputError(str(w, ": atol_vector[", i, "] must be finite and >= 0, got ",
-                             o.atol_vector[i]));
+        throw InputError(str(w, ": atol_vector[", i, "] must be finite and >= 0, got ", o.atol_vector[i]));
   }
   if (o.max_num_steps <= 0)
     throw InputError(str(w, ": max_num_steps must be positive, got ", o.max_num_steps));
   if (!(o.max_step >= 0.0) || std::isnan(o.max_step))
     throw InputError(str(w, ": max_step must be >= 0 (0: no limit), got ", o.max_step));
   if (!(o.initial_step >= 0.0) || !std::isfinite(o.initial_step))
-    throw InputError(str(w, ": initial_step must be finite and >= 0 (0: automatic), got ",
-                         o.initial_step));
+    throw InputError(str(w, ": initial_step must be finite and >= 0 (0: automatic), got ", o.initial_step));
   if (o.max_order < 1 || o.max_order > 5)
     throw InputError(str(w, ": max_order must be in 1..5 (BDF), got ", o.max_order));
 }
 
 }  // namespace detail
 
-inline Integrator::Integrator(Rhs f, const Eigen::VectorXd& y0, double t0, const Options& opt,
-                              int n_roots, Roots g, std::vector<int> root_directions)
+inline Integrator::Integrator(Rhs f, const Eigen::VectorXd& y0, double t0, const Options& opt, int n_roots,
+                              Roots g, std::vector<int> root_directions)
     : s_(std::make_unique<detail::State>()) {
   using ffsr::detail::str;
   constexpr const char* w = "cvode::Integrator";
@@ -275,11 +273,9 @@ inline Integrator::Integrator(Rhs f, const Eigen::VectorXd& y0, double t0, const
   if (n_roots < 0) throw InputError(str(w, ": n_roots must be >= 0, got ", n_roots));
   if (n_roots > 0 && !g) throw InputError(str(w, ": n_roots = ", n_roots, " but g is empty"));
   if (!root_directions.empty()) {
-    ffsr::detail::require_size(static_cast<long>(root_directions.size()), n_roots, w,
-                               "root_directions");
+    ffsr::detail::require_size(static_cast<long>(root_directions.size()), n_roots, w, "root_directions");
     for (int d : root_directions)
-      if (d < -1 || d > 1)
-        throw InputError(str(w, ": root directions must be -1, 0 or 1, got ", d));
+      if (d < -1 || d > 1) throw InputError(str(w, ": root directions must be -1, 0 or 1, got ", d));
   }
 
   detail::State& s = *s_;
@@ -307,12 +303,10 @@ inline Integrator::Integrator(Rhs f, const Eigen::VectorXd& y0, double t0, const
     s.check(CVodeSStolerances(mem, opt.rtol, opt.atol), "CVodeSStolerances");
   } else {
     s.atol_nv.reset(s.make_vector("atol"));
-    std::copy(opt.atol_vector.data(), opt.atol_vector.data() + s.n,
-              N_VGetArrayPointer(s.atol_nv.get()));
+    std::copy(opt.atol_vector.data(), opt.atol_vector.data() + s.n, N_VGetArrayPointer(s.atol_nv.get()));
     s.check(CVodeSVtolerances(mem, opt.rtol, s.atol_nv.get()), "CVodeSVtolerances");
   }
-  s.A.reset(SUNDenseMatrix(static_cast<sunindextype>(s.n), static_cast<sunindextype>(s.n),
-                           s.ctx.get()));
+  s.A.reset(SUNDenseMatrix(static_cast<sunindextype>(s.n), static_cast<sunindextype>(s.n), s.ctx.get()));
   if (!s.A) throw IntegrationError("cvode: SUNDenseMatrix failed");
   s.LS.reset(SUNLinSol_Dense(s.y_nv.get(), s.A.get(), s.ctx.get()));
   if (!s.LS) throw IntegrationError("cvode: SUNLinSol_Dense failed");
@@ -333,9 +327,8 @@ inline Integrator::Integrator(Rhs f, const Eigen::VectorXd& y0, double t0, const
 inline void Integrator::check_target(double t_target, const char* where) const {
   ffsr::detail::require_finite(t_target, where, "target time");
   if (t_target < s_->t)
-    throw InputError(ffsr::detail::str(where, ": target time ", t_target,
-                                       " is behind the current time ", s_->t,
-                                       " (integration is forward only)"));
+    throw InputError(ffsr::detail::str(where, ": target time ", t_target, " is behind the current time ",
+                                       s_->t, " (integration is forward only)"));
 }
 
 inline Integrator::Status Integrator::finish(int flag, double tret, bool one_step) {
@@ -389,8 +382,7 @@ inline Eigen::VectorXd Integrator::interpolate(double t) const {
 
 inline std::vector<int> Integrator::roots_found() const {
   std::vector<int> info(static_cast<std::size_t>(s_->n_roots), 0);
-  if (s_->n_roots > 0)
-    s_->check(CVodeGetRootInfo(s_->mem.get(), info.data()), "CVodeGetRootInfo");
+  if (s_->n_roots > 0) s_->check(CVodeGetRootInfo(s_->mem.get(), info.data()), "CVodeGetRootInfo");
   return info;
 }
 

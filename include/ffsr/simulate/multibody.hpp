@@ -34,12 +34,12 @@
 namespace ffsr {
 
 struct MultibodyContactOptions {
-  double rtol = 1e-10;              ///< CVODE relative tolerance
-  double atol_position = 1e-15;     ///< m and rad (the states are displacements from the start)
-  double atol_velocity = 1e-13;     ///< m/s and rad/s
-  long max_num_steps = 200000;      ///< CVODE step budget
-  double max_duration = 0;          ///< give up after this contact time (s); 0: 100 x the Hertz estimate
-  bool record_series = false;       ///< keep (t, F, delta) at every internal step
+  double rtol = 1e-10;           ///< CVODE relative tolerance
+  double atol_position = 1e-15;  ///< m and rad (the states are displacements from the start)
+  double atol_velocity = 1e-13;  ///< m/s and rad/s
+  long max_num_steps = 200000;   ///< CVODE step budget
+  double max_duration = 0;       ///< give up after this contact time (s); 0: 100 x the Hertz estimate
+  bool record_series = false;    ///< keep (t, F, delta) at every internal step
   /// rho: the robot's contact point is the end-effector frame's origin plus rho (inertial frame at
   /// the first touch; the point is fixed in the end-effector body). Zero: the origin itself.
   Vector3 robot_contact_offset = Vector3::Zero();
@@ -50,22 +50,22 @@ struct ContactSample {
 };
 
 struct MultibodyContactResult {
-  std::string model;                   ///< contact law name
-  double approach_velocity = 0;        ///< delta_dot^- (m/s)
+  std::string model;                     ///< contact law name
+  double approach_velocity = 0;          ///< delta_dot^- (m/s)
   double integrated_effective_mass = 0;  ///< M_ie at the first touch (kg), Eq. 14
-  double f_max = 0;                    ///< peak contact force (N)
-  double t_at_f_max = 0;               ///< time of the peak from first touch (s)
-  double delta_at_f_max = 0;           ///< deformation at the peak (m)
-  double delta_max = 0;                ///< largest deformation (m)
-  double contact_duration = 0;         ///< time to separation (s)
-  double separation_velocity = 0;      ///< delta_dot at separation (m/s, negative)
-  double restitution = 0;              ///< realized coefficient: -separation_velocity / approach_velocity
+  double f_max = 0;                      ///< peak contact force (N)
+  double t_at_f_max = 0;                 ///< time of the peak from first touch (s)
+  double delta_at_f_max = 0;             ///< deformation at the peak (m)
+  double delta_max = 0;                  ///< largest deformation (m)
+  double contact_duration = 0;           ///< time to separation (s)
+  double separation_velocity = 0;        ///< delta_dot at separation (m/s, negative)
+  double restitution = 0;                ///< realized coefficient: -separation_velocity / approach_velocity
   Vector6 momentum_start = Vector6::Zero();  ///< [P; L about o] of robot + target at first touch
   Vector6 momentum_end = Vector6::Zero();    ///< the same at separation
-  double energy_start = 0;             ///< kinetic energy of robot + target at first touch (J)
-  double energy_end = 0;               ///< the same at separation (equal for c_r = 1)
-  long steps = 0;                      ///< CVODE internal steps
-  std::vector<ContactSample> series;   ///< when requested
+  double energy_start = 0;                   ///< kinetic energy of robot + target at first touch (J)
+  double energy_end = 0;                     ///< the same at separation (equal for c_r = 1)
+  long steps = 0;                            ///< CVODE internal steps
+  std::vector<ContactSample> series;         ///< when requested
 };
 
 namespace detail {
@@ -92,10 +92,10 @@ struct ContactSystem {
   BasePose base0;
   Eigen::VectorXd theta0;
   int frame;
-  Target target;          ///< at the first touch
+  Target target;  ///< at the first touch
   Matrix3 Rt0;
-  Vector3 ct0, r0;        ///< target centre of mass and contact offset (in o) at the first touch
-  Vector3 rho_ee;         ///< the robot's contact point from the end-effector origin, end-effector frame
+  Vector3 ct0, r0;  ///< target centre of mass and contact offset (in o) at the first touch
+  Vector3 rho_ee;   ///< the robot's contact point from the end-effector origin, end-effector frame
   int n;
   // scratch
   Eigen::VectorXd theta, v, tau, a, ydot_scratch, y_scratch;
@@ -103,8 +103,17 @@ struct ContactSystem {
   /// `rho` is the robot's contact point from the end-effector origin, inertial frame at (b, th).
   ContactSystem(const Model& m, const BasePose& b, const Eigen::VectorXd& th, int f, const Target& t,
                 const Vector3& rho = Vector3::Zero())
-      : model(m), data(m), base0(b), theta0(th), frame(f), target(t), n(m.n()),
-        theta(m.n()), v(m.nv()), tau(m.nv()), a(m.nv()) {
+      : model(m),
+        data(m),
+        base0(b),
+        theta0(th),
+        frame(f),
+        target(t),
+        n(m.n()),
+        theta(m.n()),
+        v(m.nv()),
+        tau(m.nv()),
+        a(m.nv()) {
     base0.orientation.normalize();
     Rt0 = target.rotation();
     ct0 = target.position;
@@ -127,7 +136,8 @@ struct ContactSystem {
   Kin kinematics(const Eigen::Ref<const Eigen::VectorXd>& y) {
     Kin k;
     k.base.position = base0.position + y.segment<3>(0);
-    k.base.orientation = Quaternion(rotation_from_vector(y.segment<3>(3)) * base0.orientation.toRotationMatrix());
+    k.base.orientation =
+        Quaternion(rotation_from_vector(y.segment<3>(3)) * base0.orientation.toRotationMatrix());
     theta = theta0 + y.segment(6, n);
     v = y.segment(iv(), 6 + n);
     forward_kinematics(model, data, k.base, theta);
@@ -222,8 +232,8 @@ inline Eigen::VectorXd approach_joint_rates(const Model& model, Data& data, cons
 /// IntegrationError for a CVODE failure, NumericalError if the bodies do not separate.
 inline MultibodyContactResult simulate_contact(const Model& model, const BasePose& base,
                                                const Eigen::Ref<const Eigen::VectorXd>& theta, int frame,
-                                               Target target, double approach_speed, const ContactParams& params,
-                                               std::string_view law_name,
+                                               Target target, double approach_speed,
+                                               const ContactParams& params, std::string_view law_name,
                                                const MultibodyContactOptions& options = {}) {
   using detail::str;
   target.validate("simulate_contact: target");

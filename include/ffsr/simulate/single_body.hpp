@@ -50,17 +50,17 @@ struct SingleBodySeries {
 
 /// Result of simulate_single_body, SI units.
 struct SingleBodyResult {
-  double f_max = 0;               ///< maximum contact force [N]
-  double t_at_f_max = 0;          ///< time of the force peak [s]
-  double delta_at_f_max = 0;      ///< δ'_max, deformation at the force peak [m]
-  double delta_dot_at_f_max = 0;  ///< δ̇ at the force peak [m/s]
-  double delta_max = 0;           ///< maximum deformation (where δ̇ = 0) [m]
-  double t_at_delta_max = 0;      ///< its time [s]
-  double contact_duration = 0;    ///< time from first touch to separation [s]
-  double separation_velocity = 0; ///< δ̇ at separation [m/s] (negative)
-  double restitution = 0;         ///< realized coefficient of restitution, -δ̇_sep/δ̇⁻
-  long num_steps = 0;             ///< CVODE steps taken
-  SingleBodySeries series;        ///< filled when SingleBodyOptions::record_series
+  double f_max = 0;                ///< maximum contact force [N]
+  double t_at_f_max = 0;           ///< time of the force peak [s]
+  double delta_at_f_max = 0;       ///< δ'_max, deformation at the force peak [m]
+  double delta_dot_at_f_max = 0;   ///< δ̇ at the force peak [m/s]
+  double delta_max = 0;            ///< maximum deformation (where δ̇ = 0) [m]
+  double t_at_delta_max = 0;       ///< its time [s]
+  double contact_duration = 0;     ///< time from first touch to separation [s]
+  double separation_velocity = 0;  ///< δ̇ at separation [m/s] (negative)
+  double restitution = 0;          ///< realized coefficient of restitution, -δ̇_sep/δ̇⁻
+  long num_steps = 0;              ///< CVODE steps taken
+  SingleBodySeries series;         ///< filled when SingleBodyOptions::record_series
 };
 
 /// Integrates Eq. 16 with `law` and M_ie > 0 from first touch to separation (see the file
@@ -87,26 +87,24 @@ SingleBodyResult simulate_single_body(const HertzDamped<Damping>& law, double M_
   constexpr const char* where = "simulate_single_body";
   const double delta_ref = law.max_deformation(M_ie);  // validates M_ie
   if (!(opt.max_scaled_duration > 0.0) || !std::isfinite(opt.max_scaled_duration))
-    throw InputError(str(where, ": max_scaled_duration must be positive and finite, got ",
-                         opt.max_scaled_duration));
+    throw InputError(
+        str(where, ": max_scaled_duration must be positive and finite, got ", opt.max_scaled_duration));
   const double v0 = law.approach_velocity();
-  const double T = delta_ref / v0;                            // time unit [s]
-  const double accel_scale = delta_ref / (M_ie * v0 * v0);    // scaled accel = -F * accel_scale
+  const double T = delta_ref / v0;                          // time unit [s]
+  const double accel_scale = delta_ref / (M_ie * v0 * v0);  // scaled accel = -F * accel_scale
   const double f = law.f();
   const double alpha = law.params().alpha;
 
-  auto scaled_force = [&law, delta_ref, v0](double x, double v) {
-    return law.force(delta_ref * x, v0 * v);
-  };
+  auto scaled_force = [&law, delta_ref, v0](double x, double v) { return law.force(delta_ref * x, v0 * v); };
   cvode::Rhs rhs = [scaled_force, accel_scale](double, const Eigen::Ref<const Eigen::VectorXd>& y,
                                                Eigen::Ref<Eigen::VectorXd> ydot) {
     ydot[0] = y[1];
     ydot[1] = -scaled_force(y[0], y[1]) * accel_scale;
   };
   // g0 = (dF/dt) / (δ^(α-1) K δ̇⁻) = α v (1 + f v) + f x a; g1 = v; g2 = x.
-  cvode::Roots roots = [scaled_force, accel_scale, alpha, f](
-                           double, const Eigen::Ref<const Eigen::VectorXd>& y,
-                           Eigen::Ref<Eigen::VectorXd> g) {
+  cvode::Roots roots = [scaled_force, accel_scale, alpha, f](double,
+                                                             const Eigen::Ref<const Eigen::VectorXd>& y,
+                                                             Eigen::Ref<Eigen::VectorXd> g) {
     const double x = y[0], v = y[1];
     const double a = -scaled_force(x, v) * accel_scale;
     // Armed only in compression (v > 0), where the peak lies (at v = 0, dF/dt = λ δ^α δ̈ < 0): in
@@ -137,8 +135,8 @@ SingleBodyResult simulate_single_body(const HertzDamped<Damping>& law, double M_
         opt.record_series ? integ.step(opt.max_scaled_duration) : integ.advance(opt.max_scaled_duration);
     if (opt.record_series) record();
     if (status == cvode::Integrator::Status::Reached)
-      throw NumericalError(str(where, ": no separation within ", opt.max_scaled_duration * T,
-                               " s (", opt.max_scaled_duration, " time units delta_max/v0)"));
+      throw NumericalError(str(where, ": no separation within ", opt.max_scaled_duration * T, " s (",
+                               opt.max_scaled_duration, " time units delta_max/v0)"));
     if (status != cvode::Integrator::Status::Root) continue;
     const std::vector<int> info = integ.roots_found();
     const double x = integ.y()[0], v = integ.y()[1];

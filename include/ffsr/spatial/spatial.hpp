@@ -58,16 +58,38 @@ inline void sin_cos(double x, double& s, double& c) {
   const double r = ((x - k * kP1) - k * kP2) - k * kP3;
   const double z = r * r;
   // sin r = r + r z (-1/3! + z (1/5! - ...)), cos r = 1 - z/2 + z^2 (1/4! - z (1/6! - ...))
-  const double ps = -1.0 / 6 + z * (1.0 / 120 + z * (-1.0 / 5040 + z * (1.0 / 362880 + z * (-1.0 / 39916800 +
-                    z * (1.0 / 6227020800 + z * (-1.0 / 1307674368000 + z * (1.0 / 355687428096000)))))));
-  const double pc = 1.0 / 24 + z * (-1.0 / 720 + z * (1.0 / 40320 + z * (-1.0 / 3628800 + z * (1.0 / 479001600 +
-                    z * (-1.0 / 87178291200 + z * (1.0 / 20922789888000 + z * (-1.0 / 6402373705728000)))))));
+  const double ps =
+      -1.0 / 6 +
+      z * (1.0 / 120 +
+           z * (-1.0 / 5040 +
+                z * (1.0 / 362880 +
+                     z * (-1.0 / 39916800 + z * (1.0 / 6227020800 + z * (-1.0 / 1307674368000 +
+                                                                         z * (1.0 / 355687428096000)))))));
+  const double pc =
+      1.0 / 24 +
+      z * (-1.0 / 720 +
+           z * (1.0 / 40320 +
+                z * (-1.0 / 3628800 + z * (1.0 / 479001600 +
+                                           z * (-1.0 / 87178291200 + z * (1.0 / 20922789888000 +
+                                                                          z * (-1.0 / 6402373705728000)))))));
   const double sr = r + r * z * ps, cr = 1.0 - 0.5 * z + z * z * pc;
   switch (static_cast<long long>(k) & 3) {
-    case 0: s = sr; c = cr; break;
-    case 1: s = cr; c = -sr; break;
-    case 2: s = -sr; c = -cr; break;
-    default: s = -cr; c = sr; break;
+    case 0:
+      s = sr;
+      c = cr;
+      break;
+    case 1:
+      s = cr;
+      c = -sr;
+      break;
+    case 2:
+      s = -sr;
+      c = -cr;
+      break;
+    default:
+      s = -cr;
+      c = sr;
+      break;
   }
 }
 
@@ -94,9 +116,7 @@ inline Matrix3 rotation_from_vector(const Vector3& w) {
 }
 
 /// Angle of the rotation R (radians, in [0, pi]).
-inline double rotation_angle(const Matrix3& R) {
-  return Eigen::AngleAxisd(R).angle();
-}
+inline double rotation_angle(const Matrix3& R) { return Eigen::AngleAxisd(R).angle(); }
 
 /// Spatial cross product for motion vectors, linear first: V x m.
 inline Vector6 cross_motion(const Vector6& V, const Vector6& m) {

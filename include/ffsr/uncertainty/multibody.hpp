@@ -21,7 +21,8 @@ inline SampleForce sample_force_multibody(const Model& model, const BasePose& ba
                                           const MultibodyContactOptions& options = {}) {
   MultibodyContactOptions o = options;
   o.robot_contact_offset = s.robot_offset;
-  const MultibodyContactResult r = simulate_contact(model, base, theta, frame, s.target, s.approach_speed, s.contact, law, o);
+  const MultibodyContactResult r =
+      simulate_contact(model, base, theta, frame, s.target, s.approach_speed, s.contact, law, o);
   return {r.integrated_effective_mass, r.approach_velocity, r.f_max};
 }
 

@@ -131,7 +131,8 @@ class RobustForceObjective {
   void select_tail() {
     for (std::size_t i = 0; i < order_.size(); ++i) order_[i] = i;
     auto larger = [&](std::size_t a, std::size_t b) { return F_[a] > F_[b] || (F_[a] == F_[b] && a < b); };
-    std::nth_element(order_.begin(), order_.begin() + static_cast<std::ptrdiff_t>(tail_ - 1), order_.end(), larger);
+    std::nth_element(order_.begin(), order_.begin() + static_cast<std::ptrdiff_t>(tail_ - 1), order_.end(),
+                     larger);
     std::sort(order_.begin(), order_.begin() + static_cast<std::ptrdiff_t>(tail_), larger);
   }
 

@@ -105,20 +105,20 @@ enum class Quantity {
 inline constexpr std::size_t kNumQuantities = 11;
 /// Scenario keys of the quantities ([uncertainty] table), in the order of Quantity.
 inline constexpr std::array<std::string_view, kNumQuantities> kQuantityNames{
-    "target-mass", "target-inertia", "contact-offset", "normal", "spin", "target-velocity",
-    "approach-speed", "stiffness", "restitution", "exponent", "contact-point"};
+    "target-mass",    "target-inertia", "contact-offset", "normal",   "spin",         "target-velocity",
+    "approach-speed", "stiffness",      "restitution",    "exponent", "contact-point"};
 
 /// The law of one uncertain quantity (see the top of this file). Units are the quantity's own, SI,
 /// except `spin` (rad/s here; the CLI takes deg/s) and the angles (rad).
 struct Spread {
   enum class Law { Fixed, Normal, Uniform, LogNormal, Cone };
   Law law = Law::Fixed;
-  double scale = 0;       ///< normal: std; uniform: half-width; log-normal: sigma; cone: half-angle (rad)
-  bool relative = false;  ///< normal/uniform: scale is a fraction of |x0| (inertia: always relative)
-  bool has_range = false; ///< uniform: support [min, max] (absolute) instead of x0 +- scale
+  double scale = 0;        ///< normal: std; uniform: half-width; log-normal: sigma; cone: half-angle (rad)
+  bool relative = false;   ///< normal/uniform: scale is a fraction of |x0| (inertia: always relative)
+  bool has_range = false;  ///< uniform: support [min, max] (absolute) instead of x0 +- scale
   double min = -std::numeric_limits<double>::infinity();  ///< bounds (all scalar laws): redraw outside
   double max = std::numeric_limits<double>::infinity();
-  double axes = 0;        ///< inertia: largest rotation of the principal axes (rad)
+  double axes = 0;  ///< inertia: largest rotation of the principal axes (rad)
 };
 
 /// One [uncertainty] entry per quantity (Fixed: not uncertain) plus the sample count and the seed.
@@ -154,10 +154,11 @@ struct UncertainSample {
   double approach_speed = 0;
   Vector3 normal_world = Vector3::UnitX();  ///< u = R_t u_n
   Vector3 robot_offset = Vector3::Zero();   ///< rho: the robot's contact point is p_e + rho (inertial frame)
-  Vector6 wrench = (Vector6() << 1, 0, 0, 0, 0, 0).finished();  ///< s = [u; rho x u]: a unit force along u at p_e + rho
-  double approach_velocity = 0;             ///< delta_dot^- (Eq. 10-12)
-  double target_inverse_mass = 0;           ///< 1/m_t + (r x u)^T I^-1 (r x u), target frame
-  int redraws = 0;                          ///< redrawn quantities and samples (physical rules)
+  Vector6 wrench =
+      (Vector6() << 1, 0, 0, 0, 0, 0).finished();  ///< s = [u; rho x u]: a unit force along u at p_e + rho
+  double approach_velocity = 0;                    ///< delta_dot^- (Eq. 10-12)
+  double target_inverse_mass = 0;                  ///< 1/m_t + (r x u)^T I^-1 (r x u), target frame
+  int redraws = 0;                                 ///< redrawn quantities and samples (physical rules)
   std::array<double, kNumQuantities> score{};
 };
 
@@ -221,7 +222,8 @@ class SampleStream {
 /// Draws the sample `index` of `spec` around `nominal` (see the top of this file for the laws and
 /// the redraw rules). Reads spec, nominal. Pure: the same (spec, nominal, index) gives the same
 /// sample. NumericalError when a rule still fails after kMaxRedraws draws.
-inline UncertainSample draw_sample(const UncertaintySpec& spec, const UncertainNominal& nominal, std::uint64_t index);
+inline UncertainSample draw_sample(const UncertaintySpec& spec, const UncertainNominal& nominal,
+                                   std::uint64_t index);
 
 /// G = J_v H^-1 J_v^T, the robot's 3x3 inverse mass matrix at the origin of `frame` (its quadratic
 /// form u^T G u is the denominator of Eq. 4), from six calls of inverse_effective_mass by
@@ -244,7 +246,8 @@ enum class ForceModel { Closed, Exact, Multibody };
 struct SampleForce {
   double M_ie = 0, approach_velocity = 0, f_max = 0;
 };
-inline SampleForce sample_force(const Matrix6& Linv, const UncertainSample& s, std::string_view law, ForceModel model);
+inline SampleForce sample_force(const Matrix6& Linv, const UncertainSample& s, std::string_view law,
+                                ForceModel model);
 
 /// Summary of F_max over a sample set: mean, standard deviation (n - 1), the 50th, 95th and 99th
 /// percentiles and the maximum. The mean, deviation and maximum are those of the sample. The
@@ -270,8 +273,8 @@ struct ForceSummary {
     std::size_t lower = 0, upper = 0;  ///< 1-based ranks (order statistics), 0: none
     double lo = 0, hi = 0;             ///< the bounds
     bool has_lo = false, has_hi = false;
-    double coverage = 0;               ///< P(lo <= true p95 < hi) (order statistics: >= 0.95 when both exist)
-    double log_standard_error = 0;     ///< StiffnessConditional: the standard error of ln p95
+    double coverage = 0;            ///< P(lo <= true p95 < hi) (order statistics: >= 0.95 when both exist)
+    double log_standard_error = 0;  ///< StiffnessConditional: the standard error of ln p95
   } p95_ci;
   /// The order statistics of the sample, whatever the estimator.
   struct Order {
@@ -326,8 +329,8 @@ inline ForceSummary summarize_stiffness_conditional(const std::vector<double>& f
 /// Arguments as summarize_stiffness_conditional, with f_a and f_b by index on the same samples;
 /// InputError for mismatched sizes and the inputs it refuses. No interval for n < 2.
 struct PercentileRatio {
-  double ratio = 1;               ///< p95(b) / p95(a)
-  double lo = 0, hi = 0;          ///< its 95 % interval (paired delta method)
+  double ratio = 1;       ///< p95(b) / p95(a)
+  double lo = 0, hi = 0;  ///< its 95 % interval (paired delta method)
   bool has_interval = false;
   double log_standard_error = 0;  ///< of ln ratio
 };

@@ -37,9 +37,12 @@ inline bool physical_scalar(Quantity q, double x) {
 }
 
 /// The spread of a normal or uniform law in the quantity's units: scale, or scale |x0| when relative.
-inline double absolute_scale(const Spread& sp, double x0) { return sp.relative ? sp.scale * std::abs(x0) : sp.scale; }
+inline double absolute_scale(const Spread& sp, double x0) {
+  return sp.relative ? sp.scale * std::abs(x0) : sp.scale;
+}
 
-inline double draw_scalar(const Spread& sp, Quantity q, double x0, SampleStream& rng, int& redraws, double& score) {
+inline double draw_scalar(const Spread& sp, Quantity q, double x0, SampleStream& rng, int& redraws,
+                          double& score) {
   if (sp.law == Spread::Law::Fixed) {
     score = 0;
     return x0;
@@ -85,7 +88,8 @@ inline Vector3 draw_offset(const Spread& sp, SampleStream& rng, double& score) {
   return sp.scale * d;
 }
 
-inline Matrix3 draw_inertia(const Spread& sp, const Matrix3& I0, SampleStream& rng, int& redraws, double& score) {
+inline Matrix3 draw_inertia(const Spread& sp, const Matrix3& I0, SampleStream& rng, int& redraws,
+                            double& score) {
   score = 0;
   if (sp.law == Spread::Law::Fixed) return I0;
   const Eigen::SelfAdjointEigenSolver<Matrix3> es(I0);
@@ -93,7 +97,8 @@ inline Matrix3 draw_inertia(const Spread& sp, const Matrix3& I0, SampleStream& r
   const Matrix3 V = es.eigenvectors();
   for (int k = 0; k < kMaxRedraws; ++k) {
     Vector3 e;
-    for (int i = 0; i < 3; ++i) e(i) = sp.law == Spread::Law::Normal ? sp.scale * rng.normal() : sp.scale * (2.0 * rng.uniform() - 1.0);
+    for (int i = 0; i < 3; ++i)
+      e(i) = sp.law == Spread::Law::Normal ? sp.scale * rng.normal() : sp.scale * (2.0 * rng.uniform() - 1.0);
     const Vector3 l = l0.cwiseProduct(Vector3::Ones() + e);
     const double lmax = l.maxCoeff();
     if (!(l.minCoeff() > 0.0) || lmax > l.sum() - lmax) {  // positive moments, triangle inequality
@@ -111,8 +116,9 @@ inline Matrix3 draw_inertia(const Spread& sp, const Matrix3& I0, SampleStream& r
     score = sp.scale > 0.0 ? e.cwiseAbs().maxCoeff() / sp.scale : 0.0;
     return I;
   }
-  throw NumericalError(str(quantity_key(Quantity::TargetInertia), ": no principal moments satisfying the triangle inequality in ",
-                           kMaxRedraws, " draws (spread too large)"));
+  throw NumericalError(str(quantity_key(Quantity::TargetInertia),
+                           ": no principal moments satisfying the triangle inequality in ", kMaxRedraws,
+                           " draws (spread too large)"));
 }
 
 inline Vector3 draw_normal(const Spread& sp, const Vector3& n0, SampleStream& rng, double& score) {
@@ -141,15 +147,19 @@ inline void validate(const UncertaintySpec& spec) {
     const std::string key = detail::quantity_key(q);
     if (sp.law == Spread::Law::Fixed) continue;
     if (!std::isfinite(sp.scale) || sp.scale < 0)
-      throw InputError(str(key, ": the spread must be a non-negative finite number, got ", short_number(sp.scale)));
+      throw InputError(
+          str(key, ": the spread must be a non-negative finite number, got ", short_number(sp.scale)));
     if (std::isnan(sp.min) || std::isnan(sp.max) || sp.min > sp.max)
-      throw InputError(str(key, ": min (", short_number(sp.min), ") is greater than max (", short_number(sp.max), ")"));
+      throw InputError(
+          str(key, ": min (", short_number(sp.min), ") is greater than max (", short_number(sp.max), ")"));
     if (sp.has_range && (!std::isfinite(sp.min) || !std::isfinite(sp.max)))
       throw InputError(str(key, ": a uniform law needs finite min and max"));
     if (q == Quantity::Normal) {
-      if (sp.law != Spread::Law::Cone) throw InputError(str(key, ": the normal takes the law 'cone' (angle-deg)"));
+      if (sp.law != Spread::Law::Cone)
+        throw InputError(str(key, ": the normal takes the law 'cone' (angle-deg)"));
       if (sp.scale > M_PI / 2 * (1 + 1e-15))
-        throw InputError(str(key, ": the cone half-angle must be at most 90 deg, got ", short_number(sp.scale * 180 / M_PI), " deg"));
+        throw InputError(str(key, ": the cone half-angle must be at most 90 deg, got ",
+                             short_number(sp.scale * 180 / M_PI), " deg"));
       continue;
     }
     if (sp.law == Spread::Law::Cone) throw InputError(str(key, ": the law 'cone' is for the normal only"));
@@ -157,20 +167,25 @@ inline void validate(const UncertaintySpec& spec) {
       if (sp.law != Spread::Law::Normal && sp.law != Spread::Law::Uniform)
         throw InputError(str(key, ": the inertia takes a 'normal' or 'uniform' law with a relative spread"));
       if (!(sp.axes >= 0 && sp.axes <= M_PI))
-        throw InputError(str(key, ": axes-deg must be in [0, 180], got ", short_number(sp.axes * 180 / M_PI)));
+        throw InputError(
+            str(key, ": axes-deg must be in [0, 180], got ", short_number(sp.axes * 180 / M_PI)));
       if (sp.scale >= 1.0 && sp.law == Spread::Law::Uniform)
-        throw InputError(str(key, ": a relative half-width of ", short_number(sp.scale), " allows non-positive moments (must be < 1)"));
+        throw InputError(str(key, ": a relative half-width of ", short_number(sp.scale),
+                             " allows non-positive moments (must be < 1)"));
       continue;
     }
     if (detail::is_vector_quantity(q)) {
-      if (sp.law == Spread::Law::LogNormal) throw InputError(str(key, ": a vector takes a 'normal' or 'uniform' law"));
+      if (sp.law == Spread::Law::LogNormal)
+        throw InputError(str(key, ": a vector takes a 'normal' or 'uniform' law"));
       if (sp.relative || sp.has_range)
-        throw InputError(str(key, ": a vector takes an absolute spread (std or half-width), not relative or min/max"));
+        throw InputError(
+            str(key, ": a vector takes an absolute spread (std or half-width), not relative or min/max"));
     }
   }
 }
 
-inline UncertainSample draw_sample(const UncertaintySpec& spec, const UncertainNominal& nominal, std::uint64_t index) {
+inline UncertainSample draw_sample(const UncertaintySpec& spec, const UncertainNominal& nominal,
+                                   std::uint64_t index) {
   using Q = Quantity;
   SampleStream rng(spec.seed, index);
   UncertainSample s;
@@ -180,19 +195,24 @@ inline UncertainSample draw_sample(const UncertaintySpec& spec, const UncertainN
   const Matrix3 R = t0.rotation();
   for (int attempt = 0; attempt < kMaxRedraws; ++attempt) {
     s.target = t0;
-    s.target.mass = detail::draw_scalar(spec[Q::TargetMass], Q::TargetMass, t0.mass, rng, s.redraws, sc(Q::TargetMass));
-    s.target.inertia = detail::draw_inertia(spec[Q::TargetInertia], t0.inertia, rng, s.redraws, sc(Q::TargetInertia));
-    s.target.contact_offset = t0.contact_offset + detail::draw_offset(spec[Q::ContactOffset], rng, sc(Q::ContactOffset));
+    s.target.mass =
+        detail::draw_scalar(spec[Q::TargetMass], Q::TargetMass, t0.mass, rng, s.redraws, sc(Q::TargetMass));
+    s.target.inertia =
+        detail::draw_inertia(spec[Q::TargetInertia], t0.inertia, rng, s.redraws, sc(Q::TargetInertia));
+    s.target.contact_offset =
+        t0.contact_offset + detail::draw_offset(spec[Q::ContactOffset], rng, sc(Q::ContactOffset));
     s.target.normal = detail::draw_normal(spec[Q::Normal], t0.normal, rng, sc(Q::Normal));
     s.target.angular_velocity = t0.angular_velocity + detail::draw_offset(spec[Q::Spin], rng, sc(Q::Spin));
-    s.target.velocity = t0.velocity + detail::draw_offset(spec[Q::TargetVelocity], rng, sc(Q::TargetVelocity));
-    s.approach_speed = detail::draw_scalar(spec[Q::ApproachSpeed], Q::ApproachSpeed, nominal.approach_speed, rng,
-                                           s.redraws, sc(Q::ApproachSpeed));
-    s.contact.K = detail::draw_scalar(spec[Q::Stiffness], Q::Stiffness, nominal.contact.K, rng, s.redraws, sc(Q::Stiffness));
-    s.contact.c_r = detail::draw_scalar(spec[Q::Restitution], Q::Restitution, nominal.contact.c_r, rng, s.redraws,
-                                        sc(Q::Restitution));
-    s.contact.alpha = detail::draw_scalar(spec[Q::Exponent], Q::Exponent, nominal.contact.alpha, rng, s.redraws,
-                                          sc(Q::Exponent));
+    s.target.velocity =
+        t0.velocity + detail::draw_offset(spec[Q::TargetVelocity], rng, sc(Q::TargetVelocity));
+    s.approach_speed = detail::draw_scalar(spec[Q::ApproachSpeed], Q::ApproachSpeed, nominal.approach_speed,
+                                           rng, s.redraws, sc(Q::ApproachSpeed));
+    s.contact.K = detail::draw_scalar(spec[Q::Stiffness], Q::Stiffness, nominal.contact.K, rng, s.redraws,
+                                      sc(Q::Stiffness));
+    s.contact.c_r = detail::draw_scalar(spec[Q::Restitution], Q::Restitution, nominal.contact.c_r, rng,
+                                        s.redraws, sc(Q::Restitution));
+    s.contact.alpha = detail::draw_scalar(spec[Q::Exponent], Q::Exponent, nominal.contact.alpha, rng,
+                                          s.redraws, sc(Q::Exponent));
     // drawn last, so that the streams of the other quantities do not depend on whether it is set
     const Vector3 d = detail::draw_offset(spec[Q::ContactPoint], rng, sc(Q::ContactPoint));
     s.target.contact_offset += d;
@@ -200,15 +220,17 @@ inline UncertainSample draw_sample(const UncertaintySpec& spec, const UncertainN
     s.normal_world = R * s.target.normal;
     s.wrench << s.normal_world, s.robot_offset.cross(s.normal_world);
     const Vector3 r = R * s.target.contact_offset;
-    s.approach_velocity = s.approach_speed - s.normal_world.dot(s.target.velocity + (R * s.target.angular_velocity).cross(r));
+    s.approach_velocity =
+        s.approach_speed - s.normal_world.dot(s.target.velocity + (R * s.target.angular_velocity).cross(r));
     if (s.approach_velocity > 0) {
       s.target_inverse_mass = s.target.inverse_mass_along_normal();
       return s;
     }
     ++s.redraws;  // the bodies would not approach: redraw the whole sample
   }
-  throw NumericalError(detail::str("uncertainty: sample ", index, " has the bodies receding (delta_dot^- <= 0) in ",
-                                   kMaxRedraws, " draws; increase the approach speed or narrow the spin/velocity spreads"));
+  throw NumericalError(
+      detail::str("uncertainty: sample ", index, " has the bodies receding (delta_dot^- <= 0) in ",
+                  kMaxRedraws, " draws; increase the approach speed or narrow the spin/velocity spreads"));
 }
 
 inline Matrix3 robot_inverse_mass_matrix(const Model& model, Data& data, const BasePose& base,
@@ -228,21 +250,26 @@ inline Matrix6 robot_inverse_inertia(const Model& model, Data& data, const BaseP
   return inverse_inertia_matrix(model, data, frame);
 }
 
-inline SampleForce sample_force(const Matrix6& Linv, const UncertainSample& s, std::string_view law, ForceModel model) {
+inline SampleForce sample_force(const Matrix6& Linv, const UncertainSample& s, std::string_view law,
+                                ForceModel model) {
   SampleForce f;
   f.M_ie = 1.0 / (s.wrench.dot(Linv * s.wrench) + s.target_inverse_mass);
   f.approach_velocity = s.approach_velocity;
   const AnyContactLaw l = make_contact_law(law, s.contact, s.approach_velocity);
-  if (model == ForceModel::Closed) f.f_max = max_force_closed_form(l, f.M_ie);
-  else if (model == ForceModel::Exact) f.f_max = max_force_exact(l, f.M_ie);
-  else throw InputError("sample_force: the multibody force model is in ffsr/uncertainty/multibody.hpp");
+  if (model == ForceModel::Closed)
+    f.f_max = max_force_closed_form(l, f.M_ie);
+  else if (model == ForceModel::Exact)
+    f.f_max = max_force_exact(l, f.M_ie);
+  else
+    throw InputError("sample_force: the multibody force model is in ffsr/uncertainty/multibody.hpp");
   return f;
 }
 
 inline double nearest_rank(const std::vector<double>& sorted, int percent) {
   const std::size_t n = sorted.size();
   if (n == 0) throw InputError("nearest_rank: no values");
-  if (percent < 1 || percent > 100) throw InputError(detail::str("nearest_rank: percent must be in [1, 100], got ", percent));
+  if (percent < 1 || percent > 100)
+    throw InputError(detail::str("nearest_rank: percent must be in [1, 100], got ", percent));
   const std::size_t rank = (static_cast<std::size_t>(percent) * n + 99) / 100;  // ceil(p n / 100) >= 1
   return sorted[rank - 1];
 }
@@ -256,7 +283,8 @@ inline QuantileRanks quantile_interval(std::size_t n, double q, double confidenc
   // the binomial mass outside [k0, k1] is below 1e-300: the CDF starts at 0 at k0
   const auto k0 = static_cast<std::size_t>(std::max(0.0, std::floor(nd * q - 40 * sd - 40)));
   const auto k1 = static_cast<std::size_t>(std::min(nd, std::ceil(nd * q + 40 * sd + 40)));
-  const double alpha = 0.5 * (1 - confidence), lnq = std::log(q), lnp = std::log1p(-q), lg = std::lgamma(nd + 1);
+  const double alpha = 0.5 * (1 - confidence), lnq = std::log(q), lnp = std::log1p(-q),
+               lg = std::lgamma(nd + 1);
   QuantileRanks r;
   double cdf = 0, below_lower = 0;  // P(B <= k) and P(B <= l - 1)
   bool have_upper = false;
@@ -350,14 +378,17 @@ struct TruncatedLaw {
   const Spread& sp;
   double x0, L, U, cdf_L, Z;
   TruncatedLaw(const Spread& law, Quantity q, double nominal) : sp(law), x0(nominal) {
-    if (!is_scalar_quantity(q)) throw InputError(str("scalar_law: ", quantity_key(q), " is not a scalar quantity"));
+    if (!is_scalar_quantity(q))
+      throw InputError(str("scalar_law: ", quantity_key(q), " is not a scalar quantity"));
     if (!std::isfinite(x0) || !has_density(sp, x0))
-      throw InputError(str("scalar_law: ", quantity_key(q), " has no law with a spread (fixed or zero spread)"));
+      throw InputError(
+          str("scalar_law: ", quantity_key(q), " has no law with a spread (fixed or zero spread)"));
     L = std::max(sp.min, 0.0);
     U = q == Quantity::Restitution ? std::min(sp.max, 1.0) : sp.max;
     cdf_L = base_law(sp, x0, L).cdf;
     Z = base_law(sp, x0, U).cdf - cdf_L;
-    if (!(Z > 0)) throw NumericalError(str("scalar_law: ", quantity_key(q), " puts no probability within its bounds"));
+    if (!(Z > 0))
+      throw NumericalError(str("scalar_law: ", quantity_key(q), " puts no probability within its bounds"));
   }
   LawPoint operator()(double x) const {
     if (x <= L) return {0.0, 0.0};
@@ -375,8 +406,8 @@ inline LawPoint scalar_law(const Spread& sp, Quantity q, double x0, double x) {
 }
 
 inline bool stiffness_conditional_applies(ForceModel model, const Spread& stiffness) {
-  return model != ForceModel::Multibody && stiffness.law != Spread::Law::Fixed && stiffness.law != Spread::Law::Cone &&
-         detail::has_density(stiffness, 1.0);
+  return model != ForceModel::Multibody && stiffness.law != Spread::Law::Fixed &&
+         stiffness.law != Spread::Law::Cone && detail::has_density(stiffness, 1.0);
 }
 
 namespace detail {
@@ -420,11 +451,14 @@ inline double conditional_quantile(const ConditionalCdf& C, double p, double t0)
   double t = std::clamp(t0, lo, hi);
   for (int it = 0; it < 200; ++it) {
     const auto [c, d] = C(t);
-    if (c < p) lo = t;
-    else hi = t;
+    if (c < p)
+      lo = t;
+    else
+      hi = t;
     double next = d > 0 ? t - (c - p) / d : 0.5 * (lo + hi);
     if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
-    if (std::abs(next - t) <= 1e-14 * (1.0 + std::abs(t)) || hi - lo <= 1e-14 * (1.0 + std::abs(t))) return next;
+    if (std::abs(next - t) <= 1e-14 * (1.0 + std::abs(t)) || hi - lo <= 1e-14 * (1.0 + std::abs(t)))
+      return next;
     t = next;
   }
   return t;  // 200 safeguarded steps: the bracket has shrunk far below any printed digit
@@ -447,17 +481,18 @@ inline ForceSummary conditional_summary(const std::vector<double>& f, const std:
                                         ConditionalAtP95* at) {
   const std::size_t n = f.size();
   if (K.size() != n || alpha.size() != n)
-    throw InputError(detail::str("summarize_stiffness_conditional: ", n, " forces, ", K.size(), " stiffnesses and ",
-                                 alpha.size(), " exponents"));
+    throw InputError(detail::str("summarize_stiffness_conditional: ", n, " forces, ", K.size(),
+                                 " stiffnesses and ", alpha.size(), " exponents"));
   if (!(K0 > 0) || !std::isfinite(K0))
-    throw InputError(detail::str("summarize_stiffness_conditional: the nominal stiffness must be positive, got ", K0));
+    throw InputError(
+        detail::str("summarize_stiffness_conditional: the nominal stiffness must be positive, got ", K0));
   const TruncatedLaw law(stiffness, Quantity::Stiffness, K0);  // InputError for a law without spread
   ForceSummary s = summarize(f);  // mean, std, max and the order statistics; checks f finite
   std::vector<double> a(n), b(n);
   for (std::size_t i = 0; i < n; ++i) {
     if (!(f[i] > 0) || !(K[i] > 0) || !std::isfinite(K[i]) || !(alpha[i] > 0) || !std::isfinite(alpha[i]))
-      throw InputError(detail::str("summarize_stiffness_conditional: sample ", i, " has F_max ", f[i], ", K ", K[i],
-                                   ", alpha ", alpha[i], " (all must be positive and finite)"));
+      throw InputError(detail::str("summarize_stiffness_conditional: sample ", i, " has F_max ", f[i], ", K ",
+                                   K[i], ", alpha ", alpha[i], " (all must be positive and finite)"));
     a[i] = alpha[i] + 1.0;
     b[i] = std::log(K[i]) - a[i] * std::log(f[i]);
   }
@@ -491,14 +526,17 @@ inline ForceSummary conditional_summary(const std::vector<double>& f, const std:
 
 }  // namespace detail
 
-inline ForceSummary summarize_stiffness_conditional(const std::vector<double>& f, const std::vector<double>& K,
+inline ForceSummary summarize_stiffness_conditional(const std::vector<double>& f,
+                                                    const std::vector<double>& K,
                                                     const std::vector<double>& alpha, const Spread& stiffness,
                                                     double K0) {
   return detail::conditional_summary(f, K, alpha, stiffness, K0, nullptr);
 }
 
-inline PercentileRatio compare_p95_stiffness_conditional(const std::vector<double>& f_a, const std::vector<double>& f_b,
-                                                         const std::vector<double>& K, const std::vector<double>& alpha,
+inline PercentileRatio compare_p95_stiffness_conditional(const std::vector<double>& f_a,
+                                                         const std::vector<double>& f_b,
+                                                         const std::vector<double>& K,
+                                                         const std::vector<double>& alpha,
                                                          const Spread& stiffness, double K0) {
   const std::size_t n = f_a.size();
   if (f_b.size() != n)
@@ -524,7 +562,8 @@ inline PercentileRatio compare_p95_stiffness_conditional(const std::vector<doubl
   return r;
 }
 
-inline void parallel_for(std::uint64_t begin, std::uint64_t end, int threads, const std::function<void(std::uint64_t)>& f,
+inline void parallel_for(std::uint64_t begin, std::uint64_t end, int threads,
+                         const std::function<void(std::uint64_t)>& f,
                          const std::function<void(std::uint64_t)>& progress) {
   if (end <= begin) return;
   std::atomic<std::uint64_t> next{begin}, done{0};
@@ -573,7 +612,8 @@ inline double robust_force_p95(const Model& model, Data& data, const BasePose& b
   if (samples.empty()) throw InputError("robust_force_p95: no samples");
   const Matrix6 Linv = robot_inverse_inertia(model, data, base, theta, frame);
   std::vector<double> f(samples.size());
-  for (std::size_t i = 0; i < samples.size(); ++i) f[i] = sample_force(Linv, samples[i], law, ForceModel::Exact).f_max;
+  for (std::size_t i = 0; i < samples.size(); ++i)
+    f[i] = sample_force(Linv, samples[i], law, ForceModel::Exact).f_max;
   std::sort(f.begin(), f.end());
   return nearest_rank(f, 95);
 }
