@@ -5,7 +5,7 @@ packages=(cmake ninja-build g++ pkg-config libeigen3-dev liburdfdom-dev libtinyx
           catch2 libcli11-dev nlohmann-json3-dev
           libtomlplusplus-dev
           libplplot-dev plplot-driver-cairo zlib1g-dev)  # figures (--plot; optional) and their test
-packages+=(libnlopt-cxx-dev)  # NLopt: the global capture search (optimize/global.hpp, issue 9)
+packages+=(libnlopt-cxx-dev)  # NLopt: the global capture search (optimize/global.hpp)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
