@@ -1,7 +1,8 @@
 # ctest case package_consumer: install the built ffsr into a fresh prefix, then configure, build and
 # run the consumer project tests/package against that prefix only, as a user would; finally
 # configure it once more with urdfdom and SUNDIALS hidden, where find_package(ffsr) must give
-# ffsr::ffsr alone (a user of the dynamics needs only Eigen). With -DFFSR_SOURCE_DIR it also
+# ffsr::ffsr alone (a user of the dynamics needs only Eigen). It also runs the installed command on
+# the installed scenario share/ffsr/robots/paper_7dof_position.toml. With -DFFSR_SOURCE_DIR it also
 # registers robots/paper_3dof.toml with ffsr_add_scenario_test against a copy of its stored
 # baseline and runs ctest twice: it must pass, then fail naming the value moved in the baseline.
 #
@@ -40,6 +41,33 @@ run_step("cmake --install" "${CMAKE_COMMAND}" --install "${FFSR_BINARY_DIR}" --p
 file(GLOB_RECURSE config_file "${prefix}/*/ffsrConfig.cmake")
 if(NOT config_file)
   message(FATAL_ERROR "package consumer: no ffsrConfig.cmake under ${prefix}")
+endif()
+
+# 1b. the installed command on an installed scenario: share/ffsr/robots/paper_7dof_position.toml
+#     names its URDF relative to itself, so it must resolve inside the installed tree. Run from the
+#     scratch folder (not the source tree), without the global search to keep it short; the
+#     optimized run's M_ie must be ffsr's Table 7 value (2.7134 kg, as in the stored baseline).
+set(installed_scenario "${prefix}/share/ffsr/robots/paper_7dof_position.toml")
+if(NOT EXISTS "${installed_scenario}" OR NOT EXISTS "${prefix}/share/ffsr/robots/paper_7dof.urdf")
+  message(FATAL_ERROR "package consumer: cmake --install did not put robots/ under ${prefix}/share/ffsr/robots")
+endif()
+file(GLOB installed_cli "${prefix}/bin/ffsr-optimize" "${prefix}/bin/ffsr-optimize.exe")
+if(installed_cli)
+  list(GET installed_cli 0 installed_cli)
+  execute_process(COMMAND "${installed_cli}" --config "${installed_scenario}" --global=false --quiet
+                          --json "${WORK_DIR}/installed_run.json"
+                  WORKING_DIRECTORY "${WORK_DIR}" RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "package consumer: the installed ffsr-optimize on ${installed_scenario} failed (${rc}):\n${out}\n${err}")
+  endif()
+  file(READ "${WORK_DIR}/installed_run.json" run_json)
+  string(JSON m_ie GET "${run_json}" optimized integrated_effective_mass)
+  if(NOT m_ie MATCHES "^2\\.713")
+    message(FATAL_ERROR "package consumer: installed scenario gave M_ie = ${m_ie} kg, expected 2.713 kg")
+  endif()
+  message(STATUS "installed ffsr-optimize on share/ffsr/robots/paper_7dof_position.toml: M_ie ${m_ie} kg")
+else()
+  message(STATUS "ffsr was installed without its command (FFSR_BUILD_CLI=OFF): installed scenario not run")
 endif()
 
 # 2. configure: only the fresh prefix, no package registry, the same generator and compiler
