@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Regenerates the README gallery, docs/figures/*.png, from the shipped scenarios with a built
+# Regenerates the figure gallery (docs/results.md), docs/figures/*.png, from the shipped scenarios with a built
 # ffsr-optimize (default build/src/cli/ffsr-optimize; or pass its path). Needs a build with plotting.
 #   scripts/figures.sh [path/to/ffsr-optimize]
 set -euo pipefail
