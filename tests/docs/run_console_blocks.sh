@@ -78,7 +78,7 @@ for file in "${files[@]}"; do
       continue
     fi
     if [ $continuing -eq 1 ]; then
-      pending="${pending%\\}"$'\n'"$text"
+      pending="${pending%\\} $text"
       [[ "$text" =~ \\$ ]] || continuing=0
       continue
     fi
