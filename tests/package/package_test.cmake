@@ -1,6 +1,7 @@
 # Included from tests/CMakeLists.txt. ctest case: install ffsr into a scratch prefix and build the
 # consumer project tests/package against it (find_package(ffsr) with ffsr::ffsr, ffsr::urdf and
-# ffsr::cvode). It needs the whole project built first (cmake --build, then ctest).
+# ffsr::cvode); run the installed ffsr-optimize on share/ffsr/robots/paper_7dof_position.toml. It
+# needs the project built first (cmake --build, then ctest).
 add_test(NAME package_consumer
   COMMAND ${CMAKE_COMMAND}
     -DFFSR_BINARY_DIR=${PROJECT_BINARY_DIR}
