@@ -48,7 +48,7 @@ struct Target {
       throw InputError(str(where, ": principal moments (", e(0), ", ", e(1), ", ", e(2),
                            ") break the triangle inequality"));
     // A positive but denormal mass or inertia (1e-312 kg) has an inverse that overflows: Eq. 14 would
-    // give M_ie = 0 (found by fuzz_numeric).
+    // give M_ie = 0.
     const double inv = inverse_mass_along_normal();
     if (!std::isfinite(inv))
       throw InputError(str(where, ": mass ", mass, " kg and inertia (smallest principal moment ", e(0),
