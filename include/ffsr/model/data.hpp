@@ -53,9 +53,12 @@ struct Data {
   Eigen::MatrixXd H;               ///< (6+n)x(6+n) joint-space inertia
   Eigen::MatrixXd L;               ///< Cholesky factor of H (lower), written by the solves
   // --- Jacobians -------------------------------------------------------------------------------
-  Eigen::MatrixXd J;     ///< 6x(6+n) point Jacobian [J_b J_m] of a frame origin
-  Eigen::MatrixXd Jf;    ///< 6xn generalized Jacobian
-  Eigen::VectorXd w, y;  ///< scratch vectors of size 6+n
+  Eigen::MatrixXd J;   ///< 6x(6+n) point Jacobian [J_b J_m] of a frame origin
+  Eigen::MatrixXd Jf;  ///< 6xn generalized Jacobian
+  /// Scratch vectors of size 6+n: the effective-mass functions write w = J^T s and y (L^-1 w or
+  /// H^-1 w, as each says) and return what they compute from them. The planner (optimize/) takes
+  /// those return values and never reads w or y left by an earlier call.
+  Eigen::VectorXd w, y;
   // --- RNEA (body coordinates) ---------------------------------------------------------------
   std::vector<Vector6> V, A, F;
   std::vector<Pose> Xup;  ///< pose of body i in its parent
@@ -66,7 +69,7 @@ struct Data {
   std::vector<Vector6> pA;  ///< articulated bias forces
   std::vector<Vector6> U;   ///< IA_i S_i
   Eigen::VectorXd D, u;     ///< S_i^T U_i and tau_i - S_i^T pA_i, one per joint
-  std::vector<int> path;    ///< bodies from a leaf to the base (scratch)
+  std::vector<int> path;    ///< bodies from a leaf to the base (scratch of one call, never read after it)
 };
 
 }  // namespace ffsr

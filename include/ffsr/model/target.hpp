@@ -1,8 +1,12 @@
-// ffsr/model/target.hpp -- the tumbling target: a free rigid body with one contact point.
+// ffsr/model/target.hpp -- the tumbling target: a free rigid body with one contact point, and its
+// torque-free propagation (propagate_target).
 #pragma once
 
 #include "ffsr/errors.hpp"
 #include "ffsr/spatial/spatial.hpp"
+
+#include <algorithm>
+#include <cmath>
 
 namespace ffsr {
 
@@ -44,7 +48,7 @@ struct Target {
       throw InputError(str(where, ": principal moments (", e(0), ", ", e(1), ", ", e(2),
                            ") break the triangle inequality"));
     // A positive but denormal mass or inertia (1e-312 kg) has an inverse that overflows: Eq. 14 would
-    // give M_ie = 0 (found by fuzz_numeric).
+    // give M_ie = 0.
     const double inv = inverse_mass_along_normal();
     if (!std::isfinite(inv))
       throw InputError(str(where, ": mass ", mass, " kg and inertia (smallest principal moment ", e(0),
@@ -69,5 +73,35 @@ struct Target {
     return 1.0 / mass + ru.dot(inertia.ldlt().solve(ru));
   }
 };
+
+/// The target at time t: centre of mass drifting with its velocity, attitude and spin from the
+/// torque-free Euler equations (RK4 with a fine step; exact rotation when the inertia is isotropic).
+inline Target propagate_target(const Target& t0, double t) {
+  Target t1 = t0;
+  t1.position = t0.position + t0.velocity * t;
+  const Matrix3 I = t0.inertia;
+  const bool isotropic = (I - I(0, 0) * Matrix3::Identity()).cwiseAbs().maxCoeff() <= 1e-12 * I(0, 0);
+  if (isotropic || t0.angular_velocity.norm() == 0.0) {
+    t1.attitude = Quaternion(t0.rotation() * rotation_from_vector(t0.angular_velocity * t));
+    return t1;
+  }
+  const Matrix3 Iinv = I.inverse();
+  const long nsteps = std::max<long>(1, static_cast<long>(std::ceil(std::abs(t) / 1e-3)));
+  if (nsteps > 100000000) throw InputError("propagate_target: time span too long");
+  const double h = t / static_cast<double>(nsteps);
+  Matrix3 R = t0.rotation();
+  Vector3 w = t0.angular_velocity;  // body frame
+  auto wdot = [&](const Vector3& x) { return Vector3(Iinv * (-x.cross(I * x))); };
+  for (long k = 0; k < nsteps; ++k) {
+    const Vector3 k1 = wdot(w), k2 = wdot(w + 0.5 * h * k1), k3 = wdot(w + 0.5 * h * k2),
+                  k4 = wdot(w + h * k3);
+    const Vector3 wn = w + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4);
+    R = R * rotation_from_vector(0.5 * h * (w + wn));  // midpoint rotation, body frame
+    w = wn;
+  }
+  t1.attitude = Quaternion(R);
+  t1.angular_velocity = w;
+  return t1;
+}
 
 }  // namespace ffsr

@@ -1,4 +1,4 @@
-// ffsr/optimize/global.hpp -- the capture manifold search and the reaching planner (issue 9).
+// ffsr/optimize/global.hpp -- the capture manifold search and the reaching planner.
 //
 // The paper's law (Eq. 30) descends the gradient of the objective in the null space, so it ends in
 // the basin it starts in. Here the capture configuration is chosen first, globally, and the approach
@@ -20,12 +20,12 @@
 //    multibody-force objective, which has no gradient, the distinct local optima of M_ie are ranked
 //    by the CVODE multibody peak (simulate/multibody.hpp), evaluated directly at each of them.
 //    exact-force is a monotone function of M_ie (Eq. 16 scaling), so its optimum is M_ie's.
-//    robust-force (issue 12): SLSQP minimizes CVaR_95 of the exact F_max over a fixed set of
+//    robust-force: SLSQP minimizes CVaR_95 of the exact F_max over a fixed set of
 //    uncertain samples (uncertainty/robust_objective.hpp) with its analytic gradient, under the same
 //    constraints; the optima are compared by that value.
 // 3. Reaching (plan_capture_global). The same line reference and time law as the paper's method,
 //    the task first, and the null space servoing to the chosen configuration (ServoPolicy in
-//    capture.hpp), with the joint-rate limit. The base pose at T depends on the path, so it shoots:
+//    null_space.hpp), with the joint-rate limit. The base pose at T depends on the path, so it shoots:
 //    search at the base pose reached, plan again to the new optimum, until the reached objective is
 //    within `gap_percent` of the manifold optimum at the reached base pose.
 //
@@ -41,6 +41,7 @@
 #include <chrono>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <random>
 
 namespace ffsr {
@@ -167,15 +168,13 @@ inline bool project_to_manifold(const Model& model, Data& data, const CapturePro
   return r.norm() <= tol;
 }
 
-/// Joint-space distance with continuous joints compared modulo 2 pi.
+/// Joint-space distance (largest |a_k - b_k|) with continuous joints compared modulo 2 pi
+/// (configuration_error of null_space.hpp).
 inline double configuration_distance(const Model& model, const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
+  Eigen::VectorXd e;
+  detail::configuration_error(model, a, b, e);
   double d = 0;
-  for (int k = 0; k < model.n(); ++k) {
-    const Joint& j = model.joint(k);
-    double x = a(k) - b(k);
-    if (!std::isfinite(j.lower) && !std::isfinite(j.upper)) x = std::remainder(x, 2 * M_PI);
-    d = std::max(d, std::abs(x));
-  }
+  for (Eigen::Index k = 0; k < e.size(); ++k) d = std::max(d, std::abs(e(k)));
   return d;
 }
 
@@ -283,27 +282,16 @@ inline ManifoldSearchResult search_capture_manifold(const CaptureProblem& pb, co
   return detail::search_manifold(pb, task, s, base, so, extra_starts, so.starts);
 }
 
-inline ManifoldSearchResult detail::search_manifold(const CaptureProblem& pb, const CaptureTask& task,
-                                                    const CaptureSetup& s, const BasePose& base,
-                                                    const ManifoldSearchOptions& so,
-                                                    const std::vector<Eigen::VectorXd>& extra_starts,
-                                                    int random_starts) {
-  using detail::str;
-  const auto t0 = std::chrono::steady_clock::now();
-  const Model& model = *pb.model;
+namespace detail {
+
+/// The starts of the multistart: `extra` first, then `count` configurations drawn uniformly within
+/// the limits ([-pi, pi] for a continuous joint) by std::mt19937_64(seed) and unit_uniform.
+inline std::vector<Eigen::VectorXd> manifold_starts(const Model& model, std::uint64_t seed,
+                                                    const std::vector<Eigen::VectorXd>& extra, int count) {
   const int n = model.n();
-  Data data(model);
-  ManifoldSearchResult res;
-  const bool robust = so.objective == GlobalObjective::RobustForce;
-  if (robust && !so.robust)
-    throw InputError("search_capture_manifold: the robust-force objective needs its sample set");
-  res.method = so.objective == GlobalObjective::MultibodyForce
-                   ? "multistart NLopt SLSQP on M_ie, local optima ranked by the CVODE multibody peak"
-               : robust ? "multistart NLopt SLSQP on CVaR_95 of the exact F_max over the sample set"
-                        : "multistart NLopt SLSQP";
-  std::mt19937_64 rng(so.seed);
-  std::vector<Eigen::VectorXd> starts = extra_starts;
-  for (int i = 0; i < random_starts; ++i) {
+  std::mt19937_64 rng(seed);
+  std::vector<Eigen::VectorXd> starts = extra;
+  for (int i = 0; i < count; ++i) {
     Eigen::VectorXd q(n);
     for (int k = 0; k < n; ++k) {
       const Joint& j = model.joint(k);
@@ -313,12 +301,14 @@ inline ManifoldSearchResult detail::search_manifold(const CaptureProblem& pb, co
     }
     starts.push_back(std::move(q));
   }
-  res.starts = static_cast<int>(starts.size());
+  return starts;
+}
 
-  detail::SlsqpContext ctx{&model, &data, &pb, &task, &s, &base, robust ? so.robust.get() : nullptr,
-                           0,      {},    {},  {},    {}};
-  const int m = task.rows();
-  nlopt::opt local(nlopt::LD_SLSQP, static_cast<unsigned>(n));
+/// NLopt's SLSQP on the objective of `ctx` under the m equality constraints c = 0 (tolerance a
+/// tenth of the search's), within the joint limits, with the search's evaluation budget.
+inline void configure_slsqp(nlopt::opt& local, const Model& model, int m, SlsqpContext& ctx,
+                            const ManifoldSearchOptions& so) {
+  const int n = model.n();
   local.set_min_objective(detail::slsqp_objective, &ctx);
   local.add_equality_mconstraint(detail::slsqp_constraints, &ctx,
                                  std::vector<double>(static_cast<size_t>(m), so.constraint_tolerance * 0.1));
@@ -332,41 +322,117 @@ inline ManifoldSearchResult detail::search_manifold(const CaptureProblem& pb, co
   local.set_xtol_rel(1e-10);
   local.set_ftol_rel(1e-12);
   local.set_maxeval(so.max_local_evaluations);
+}
 
-  std::vector<ManifoldPoint> found;
-  for (Eigen::VectorXd q : starts) {
-    if (q.size() != n || !q.allFinite())
-      throw InputError("search_capture_manifold: an extra start has the wrong size or is not finite");
-    if (!detail::project_to_manifold(model, data, pb, task, s, base, q, so.constraint_tolerance)) continue;
-    if (!detail::within_limits(model, q)) continue;
-    ++res.projected_starts;
-    std::vector<double> x(q.data(), q.data() + n);
-    double f = 0;
-    try {
-      local.optimize(x, f);
-    } catch (const nlopt::roundoff_limited&) {  // x holds the best point found: checked below
-    } catch (const std::runtime_error&) {       // NLopt failure: keep the projected start
-      x.assign(q.data(), q.data() + n);
-    }
-    Eigen::VectorXd th = Eigen::Map<const Eigen::VectorXd>(x.data(), n);
-    // SLSQP satisfies c = 0 to its tolerance; a few Newton steps put the point back exactly on C
-    if (!detail::project_to_manifold(model, data, pb, task, s, base, th, so.constraint_tolerance, 20))
-      continue;
-    if (!detail::within_limits(model, th)) continue;
-    crba(model, data, base, th);
-    const double M = 1.0 / (inverse_effective_mass(model, data, pb.frame, s.u_cap) + s.target_inv_mass);
-    if (!std::isfinite(M)) continue;
-    // the value the local optima are compared by: M_ie, or CVaR_95 for robust-force
-    const double v =
-        robust ? so.robust->value(robot_inverse_inertia(model, data, base, th, pb.frame)).cvar95 : M;
-    bool duplicate = false;
-    for (ManifoldPoint& p : found)
-      if (detail::configuration_distance(model, p.theta, th) < 1e-3) {
-        duplicate = true;
-        if (v < p.objective) p = {th, M, v};
-      }
-    if (!duplicate) found.push_back({th, M, v});
+/// The local optimum from start q: projected on C(base), optimized by `local` (SLSQP), projected
+/// again (a few Newton steps put SLSQP's point exactly on C), within the limits, with a finite M_ie.
+/// Writes `out` (theta, M_ie, the value the optima are compared by: M_ie, or CVaR_95 for
+/// robust-force) and returns true; false when the start or the optimum is not usable. Counts a
+/// projected start in res.projected_starts.
+inline bool local_capture_optimum(const Model& model, Data& data, const CaptureProblem& pb,
+                                  const CaptureTask& task, const CaptureSetup& s, const BasePose& base,
+                                  const ManifoldSearchOptions& so, nlopt::opt& local, Eigen::VectorXd q,
+                                  ManifoldSearchResult& res, ManifoldPoint& out) {
+  const int n = model.n();
+  if (q.size() != n || !q.allFinite())
+    throw InputError("search_capture_manifold: an extra start has the wrong size or is not finite");
+  if (!detail::project_to_manifold(model, data, pb, task, s, base, q, so.constraint_tolerance)) return false;
+  if (!detail::within_limits(model, q)) return false;
+  ++res.projected_starts;
+  std::vector<double> x(q.data(), q.data() + n);
+  double f = 0;
+  try {
+    local.optimize(x, f);
+  } catch (const nlopt::roundoff_limited&) {  // x holds the best point found: checked below
+  } catch (const std::runtime_error&) {       // NLopt failure: keep the projected start
+    x.assign(q.data(), q.data() + n);
   }
+  Eigen::VectorXd th = Eigen::Map<const Eigen::VectorXd>(x.data(), n);
+  if (!detail::project_to_manifold(model, data, pb, task, s, base, th, so.constraint_tolerance, 20))
+    return false;
+  if (!detail::within_limits(model, th)) return false;
+  crba(model, data, base, th);
+  const double M = 1.0 / (inverse_effective_mass(model, data, pb.frame, s.u_cap) + s.target_inv_mass);
+  if (!std::isfinite(M)) return false;
+  const double v = so.objective == GlobalObjective::RobustForce
+                       ? so.robust->value(robot_inverse_inertia(model, data, base, th, pb.frame)).cvar95
+                       : M;
+  out = {th, M, v};
+  return true;
+}
+
+/// Adds p to the distinct optima: within 1e-3 rad (configuration_distance) of a kept one, it
+/// replaces that one if its objective is lower; else it is appended.
+inline void keep_distinct(const Model& model, std::vector<ManifoldPoint>& found, const ManifoldPoint& p) {
+  bool duplicate = false;
+  for (ManifoldPoint& f : found)
+    if (detail::configuration_distance(model, f.theta, p.theta) < 1e-3) {
+      duplicate = true;
+      if (p.objective < f.objective) f = p;
+    }
+  if (!duplicate) found.push_back(p);
+}
+
+/// Fills res.best and the objective of res.local_optima (sorted by the compared value): the CVODE
+/// peak at the best max_ranked optima for multibody-force (0 for those not ranked), CVaR_95 as
+/// compared for robust-force, M_ie or the exact F_max at it otherwise.
+inline void rank_local_optima(const CaptureProblem& pb, const CaptureSetup& s, const BasePose& base,
+                              const ManifoldSearchOptions& so, ManifoldSearchResult& res) {
+  std::vector<ManifoldPoint>& found = res.local_optima;
+  if (so.objective == GlobalObjective::MultibodyForce) {
+    // no gradient: evaluate the CVODE peak directly at the best local optima of M_ie
+    double best = std::numeric_limits<double>::infinity();
+    const size_t k = std::min(found.size(), static_cast<size_t>(so.max_ranked));
+    for (size_t i = 0; i < k; ++i) {
+      ManifoldPoint p = evaluate_capture(pb, s, base, found[i].theta, so.objective, so.multibody);
+      ++res.objective_evaluations;
+      found[i].objective = p.objective;
+      if (p.objective < best) {
+        best = p.objective;
+        res.best = p;
+      }
+    }
+    for (size_t i = k; i < found.size(); ++i) found[i].objective = 0;  // not evaluated
+  } else if (so.objective == GlobalObjective::RobustForce) {
+    res.best = found.front();  // sorted by CVaR_95, evaluated by local_capture_optimum
+  } else {
+    res.best = evaluate_capture(pb, s, base, found.front().theta, so.objective);
+    for (ManifoldPoint& p : found)
+      p.objective = so.objective == GlobalObjective::ExactForce ? max_force_exact(s.law, p.M_ie) : p.M_ie;
+  }
+}
+
+}  // namespace detail
+
+inline ManifoldSearchResult detail::search_manifold(const CaptureProblem& pb, const CaptureTask& task,
+                                                    const CaptureSetup& s, const BasePose& base,
+                                                    const ManifoldSearchOptions& so,
+                                                    const std::vector<Eigen::VectorXd>& extra_starts,
+                                                    int random_starts) {
+  using detail::str;
+  const auto t0 = std::chrono::steady_clock::now();
+  const Model& model = *pb.model;
+  Data data(model);
+  ManifoldSearchResult res;
+  const bool robust = so.objective == GlobalObjective::RobustForce;
+  if (robust && !so.robust)
+    throw InputError("search_capture_manifold: the robust-force objective needs its sample set");
+  res.method = so.objective == GlobalObjective::MultibodyForce
+                   ? "multistart NLopt SLSQP on M_ie, local optima ranked by the CVODE multibody peak"
+               : robust ? "multistart NLopt SLSQP on CVaR_95 of the exact F_max over the sample set"
+                        : "multistart NLopt SLSQP";
+  const std::vector<Eigen::VectorXd> starts = manifold_starts(model, so.seed, extra_starts, random_starts);
+  res.starts = static_cast<int>(starts.size());
+
+  detail::SlsqpContext ctx{&model, &data, &pb, &task, &s, &base, robust ? so.robust.get() : nullptr,
+                           0,      {},    {},  {},    {}};
+  nlopt::opt local(nlopt::LD_SLSQP, static_cast<unsigned>(model.n()));
+  configure_slsqp(local, model, task.rows(), ctx, so);
+  std::vector<ManifoldPoint> found;
+  ManifoldPoint p;
+  for (const Eigen::VectorXd& q : starts)
+    if (local_capture_optimum(model, data, pb, task, s, base, so, local, q, res, p))
+      keep_distinct(model, found, p);
   res.evaluations = ctx.evaluations;
   if (found.empty())
     throw InputError(
@@ -375,28 +441,8 @@ inline ManifoldSearchResult detail::search_manifold(const CaptureProblem& pb, co
             " starts); the capture point is out of reach"));
   std::sort(found.begin(), found.end(),
             [](const ManifoldPoint& a, const ManifoldPoint& b) { return a.objective < b.objective; });
-  res.local_optima = found;
-  if (so.objective == GlobalObjective::MultibodyForce) {
-    // no gradient: evaluate the CVODE peak directly at the best local optima of M_ie
-    double best = std::numeric_limits<double>::infinity();
-    const size_t k = std::min(found.size(), static_cast<size_t>(so.max_ranked));
-    for (size_t i = 0; i < k; ++i) {
-      ManifoldPoint p = evaluate_capture(pb, s, base, found[i].theta, so.objective, so.multibody);
-      ++res.objective_evaluations;
-      res.local_optima[i].objective = p.objective;
-      if (p.objective < best) {
-        best = p.objective;
-        res.best = p;
-      }
-    }
-    for (size_t i = k; i < res.local_optima.size(); ++i) res.local_optima[i].objective = 0;  // not evaluated
-  } else if (robust) {
-    res.best = found.front();  // sorted by CVaR_95, evaluated above
-  } else {
-    res.best = evaluate_capture(pb, s, base, found.front().theta, so.objective);
-    for (ManifoldPoint& p : res.local_optima)
-      p.objective = so.objective == GlobalObjective::ExactForce ? max_force_exact(s.law, p.M_ie) : p.M_ie;
-  }
+  res.local_optima = std::move(found);
+  rank_local_optima(pb, s, base, so, res);
   res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return res;
 }
@@ -426,6 +472,112 @@ struct GlobalCaptureResult {
   double search_seconds = 0;       ///< over every search
 };
 
+namespace detail {
+
+inline void check_global_options(const GlobalCaptureOptions& g, const char* where) {
+  if (g.max_iterations < 1) throw InputError(str(where, ": max_iterations must be >= 1"));
+  if (g.max_goals < 1) throw InputError(str(where, ": max_goals must be >= 1"));
+  if (!(g.gap_percent > 0)) throw InputError(str(where, ": gap_percent must be positive"));
+}
+
+/// Adds a search's evaluation counts and time to the planner's counters.
+inline void account(GlobalCaptureResult& res, const ManifoldSearchResult& sr) {
+  res.evaluations += sr.evaluations;
+  res.objective_evaluations += sr.objective_evaluations;
+  res.search_seconds += sr.seconds;
+}
+
+/// The goals of plan_capture_global at the base pose of the task-only run: the best max_goals local
+/// optima of a search from `extra` and random starts (multibody-force: the ranked ones), and the
+/// local optima next to each extra start (on the component of the self-motion manifold the arm is
+/// on, so reachable when the better ones are not), sorted by objective. Counts into res.
+inline std::vector<ManifoldPoint> capture_goals(const CaptureProblem& pb, const CaptureTask& task,
+                                                const CaptureSetup& setup, const BasePose& base,
+                                                const GlobalCaptureOptions& g,
+                                                const std::vector<Eigen::VectorXd>& extra,
+                                                GlobalCaptureResult& res) {
+  const ManifoldSearchResult first = search_capture_manifold(pb, task, setup, base, g.search, extra);
+  account(res, first);
+  std::vector<ManifoldPoint> goals;
+  for (const ManifoldPoint& p : first.local_optima)
+    if (p.objective > 0) goals.push_back(p);  // multibody-force: the ranked ones
+  auto by_objective = [](const ManifoldPoint& a, const ManifoldPoint& b) {
+    return a.objective < b.objective;
+  };
+  std::stable_sort(goals.begin(), goals.end(), by_objective);
+  if (goals.size() > static_cast<size_t>(g.max_goals)) goals.resize(static_cast<size_t>(g.max_goals));
+  for (const Eigen::VectorXd& x : extra) {
+    try {
+      const ManifoldSearchResult near = detail::search_manifold(pb, task, setup, base, g.search, {x}, 0);
+      account(res, near);
+      goals.push_back(near.best);
+    } catch (const InputError&) {
+    }
+  }
+  std::stable_sort(goals.begin(), goals.end(), by_objective);
+  return goals;
+}
+
+/// The shooting loop for one goal: reaching runs with ServoPolicy, the goal re-optimized locally at
+/// each reached base pose, until the reached objective is within gap_percent of that local optimum;
+/// then a full search at the reached base pose gives the gap. Returns that result (counters as of
+/// then), or nothing when the goal is given up: a joint limit on the way (goals_out_of_limits), the
+/// goal off the manifold at the reached base pose, the run ending on another component (more than
+/// 0.5 rad from the goal on some joint), or max_iterations spent. Counts into res.
+inline std::optional<GlobalCaptureResult> reach_goal(const CaptureProblem& pb, const CaptureTask& task,
+                                                     const CaptureOptions& run_opt, const CaptureSetup& setup,
+                                                     const GlobalCaptureOptions& g, Eigen::VectorXd goal,
+                                                     GlobalCaptureResult& res, const char* where) {
+  for (int it = 1; it <= g.max_iterations; ++it) {
+    ServoPolicy servo;
+    servo.theta_goal = goal;
+    ++res.shooting_iterations;
+    CaptureResult run;
+    try {
+      run = integrate_capture(pb, task, run_opt, setup, servo, where);
+    } catch (const JointLimitError&) {
+      ++res.goals_out_of_limits;
+      return std::nullopt;
+    }
+    const ManifoldPoint reached = evaluate_capture(pb, setup, run.base, run.theta, g.search.objective,
+                                                   g.search.multibody, g.search.robust.get());
+    if (g.search.objective == GlobalObjective::MultibodyForce) ++res.objective_evaluations;
+    ManifoldSearchResult local;  // the goal re-optimized locally at the reached base pose
+    try {
+      local = detail::search_manifold(pb, task, setup, run.base, g.search, {goal}, 0);
+    } catch (const InputError&) {
+      return std::nullopt;
+    }
+    account(res, local);
+    // the servo leaves ~e^-10 of the error; the rest is the move of the manifold with the base pose,
+    // small against the distance between components
+    if (detail::configuration_distance(*pb.model, run.theta, local.best.theta) > 0.5) return std::nullopt;
+    const double local_gap = 100.0 * (reached.objective - local.best.objective) / local.best.objective;
+    if (!std::isfinite(local_gap)) throw NumericalError(str(where, ": the optimality gap is not finite"));
+    if (local_gap > g.gap_percent) {
+      goal = local.best.theta;
+      continue;
+    }
+    std::vector<Eigen::VectorXd> ex = g.extra_starts;  // the goal is reached: the whole manifold
+    ex.push_back(goal);
+    ex.push_back(run.theta);
+    ManifoldSearchResult full = search_capture_manifold(pb, task, setup, run.base, g.search, ex);
+    account(res, full);
+    const double gap = 100.0 * (reached.objective - full.best.objective) / full.best.objective;
+    GlobalCaptureResult r = res;
+    r.run = std::move(run);
+    r.search = std::move(full);
+    r.objective = reached.objective;
+    r.manifold_optimum = r.search.best.objective;
+    r.optimality_gap_percent = gap;
+    r.reached_manifold_optimum = gap <= g.gap_percent;
+    return r;
+  }
+  return std::nullopt;
+}
+
+}  // namespace detail
+
 /// Global capture planning (see the top of this file). Goals are the local optima of the search at
 /// the base pose of the task-only run, best first. For each goal: plan the reaching run, re-optimize
 /// the goal locally at the reached base pose, repeat until the reached objective is within
@@ -445,10 +597,7 @@ inline GlobalCaptureResult plan_capture_global(const CaptureProblem& pb, const C
   o.gain = 0.0;
   o.progress = nullptr;
   const CaptureSetup setup = prepare_capture(pb, task, o, where);
-  if (g.max_iterations < 1) throw InputError(str(where, ": max_iterations must be >= 1"));
-  if (g.max_goals < 1) throw InputError(str(where, ": max_goals must be >= 1"));
-  if (!(g.gap_percent > 0)) throw InputError(str(where, ": gap_percent must be positive"));
-  const Model& model = *pb.model;
+  detail::check_global_options(g, where);
   CaptureOptions quiet = o;
   quiet.record_series = false;
 
@@ -459,95 +608,21 @@ inline GlobalCaptureResult plan_capture_global(const CaptureProblem& pb, const C
     throw InputError(str(where, ": max joint rate ", o.max_joint_rate * 180 / M_PI,
                          " deg/s is below what the task alone needs (", plain.max_joint_rate * 180 / M_PI,
                          " deg/s)"));
-
   GlobalCaptureResult res;
-  auto account = [&](const ManifoldSearchResult& sr) {
-    res.evaluations += sr.evaluations;
-    res.objective_evaluations += sr.objective_evaluations;
-    res.search_seconds += sr.seconds;
-  };
   std::vector<Eigen::VectorXd> extra = g.extra_starts;
   extra.push_back(plain.theta);
-  const ManifoldSearchResult first = search_capture_manifold(pb, task, setup, plain.base, g.search, extra);
-  account(first);
-  std::vector<ManifoldPoint> goals;
-  for (const ManifoldPoint& p : first.local_optima)
-    if (p.objective > 0) goals.push_back(p);  // multibody-force: the ranked ones
-  auto by_objective = [](const ManifoldPoint& a, const ManifoldPoint& b) {
-    return a.objective < b.objective;
-  };
-  std::stable_sort(goals.begin(), goals.end(), by_objective);
-  if (goals.size() > static_cast<size_t>(g.max_goals)) goals.resize(static_cast<size_t>(g.max_goals));
-  // and the local optima next to the extra starts and to the task-only run's configuration: on the
-  // component of the self-motion manifold the arm is on, so reachable when the better ones are not
-  for (const Eigen::VectorXd& x : extra) {
-    try {
-      const ManifoldSearchResult near =
-          detail::search_manifold(pb, task, setup, plain.base, g.search, {x}, 0);
-      account(near);
-      goals.push_back(near.best);
-    } catch (const InputError&) {
-    }
-  }
-  std::stable_sort(goals.begin(), goals.end(), by_objective);
+  const std::vector<ManifoldPoint> goals = detail::capture_goals(pb, task, setup, plain.base, g, extra, res);
 
+  CaptureOptions run_opt = quiet;
+  run_opt.record_series = opt.record_series;
   std::optional<GlobalCaptureResult> fallback;
-  double last_gap = std::numeric_limits<double>::infinity();
   for (const ManifoldPoint& target_goal : goals) {
     ++res.goals_tried;
-    Eigen::VectorXd goal = target_goal.theta;
-    for (int it = 1; it <= g.max_iterations; ++it) {
-      ServoPolicy servo;
-      servo.theta_goal = goal;
-      CaptureOptions run_opt = quiet;
-      run_opt.record_series = opt.record_series;
-      ++res.shooting_iterations;
-      CaptureResult run;
-      try {
-        run = integrate_capture(pb, task, run_opt, setup, servo, where);
-      } catch (const JointLimitError&) {
-        ++res.goals_out_of_limits;
-        break;  // the way to this goal crosses a joint limit: next goal
-      }
-      const ManifoldPoint reached = evaluate_capture(pb, setup, run.base, run.theta, g.search.objective,
-                                                     g.search.multibody, g.search.robust.get());
-      if (g.search.objective == GlobalObjective::MultibodyForce) ++res.objective_evaluations;
-      // the goal re-optimized locally at the reached base pose
-      ManifoldSearchResult local;
-      try {
-        local = detail::search_manifold(pb, task, setup, run.base, g.search, {goal}, 0);
-      } catch (const InputError&) {
-        break;  // the goal cannot be put on the manifold at this base pose
-      }
-      account(local);
-      // ended elsewhere: more than 0.5 rad from it on some joint (the servo leaves ~e^-10 of the error; the
-      // rest is the move of the manifold with the base pose, small against the distance between components)
-      if (detail::configuration_distance(model, run.theta, local.best.theta) > 0.5) break;
-      const double local_gap = 100.0 * (reached.objective - local.best.objective) / local.best.objective;
-      if (!std::isfinite(local_gap)) throw NumericalError(str(where, ": the optimality gap is not finite"));
-      if (local_gap > g.gap_percent) {
-        goal = local.best.theta;
-        continue;
-      }
-      // the goal is reached: compare with the whole manifold at the reached base pose
-      std::vector<Eigen::VectorXd> ex = g.extra_starts;
-      ex.push_back(goal);
-      ex.push_back(run.theta);
-      ManifoldSearchResult full = search_capture_manifold(pb, task, setup, run.base, g.search, ex);
-      account(full);
-      const double gap = 100.0 * (reached.objective - full.best.objective) / full.best.objective;
-      last_gap = std::min(last_gap, gap);
-      GlobalCaptureResult r = res;
-      r.run = std::move(run);
-      r.search = std::move(full);
-      r.objective = reached.objective;
-      r.manifold_optimum = r.search.best.objective;
-      r.optimality_gap_percent = gap;
-      r.reached_manifold_optimum = gap <= g.gap_percent;
-      if (r.reached_manifold_optimum) return r;
-      if (!fallback || r.objective < fallback->objective) fallback = std::move(r);
-      break;
-    }
+    std::optional<GlobalCaptureResult> r =
+        detail::reach_goal(pb, task, run_opt, setup, g, target_goal.theta, res, where);
+    if (!r) continue;
+    if (r->reached_manifold_optimum) return std::move(*r);
+    if (!fallback || r->objective < fallback->objective) fallback = std::move(r);
   }
   if (fallback) {
     // the counters of every goal tried, the run of the best reached one

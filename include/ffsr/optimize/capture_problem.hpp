@@ -1,0 +1,116 @@
+// ffsr/optimize/capture_problem.hpp -- what a capture run is given and what it returns (Section 4):
+// the task (which rows of J_f it constrains), the options of the rate law and the integration, the
+// problem (robot, end-effector, initial state, target, contact law), the setup that follows from
+// them (prepare_capture in capture.hpp), and the result with the monitors' record.
+#pragma once
+
+#include "ffsr/contact/contact_law.hpp"
+#include "ffsr/model/data.hpp"
+#include "ffsr/model/target.hpp"
+#include "ffsr/optimize/line_reference.hpp"
+
+#include <array>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace ffsr {
+
+/// What the end-effector must follow.
+struct CaptureTask {
+  enum class Kind { Position, Pose };
+  Kind kind = Kind::Position;
+  /// Position task: which inertial axes are constrained (x, y, z). The planar robot uses x and y.
+  std::array<bool, 3> axes{true, true, true};
+  /// Pose task: final end-effector orientation (inertial), reached by slerp; empty: hold the initial one.
+  std::optional<Matrix3> final_orientation;
+  /// Number of task rows.
+  int rows() const {
+    if (kind == Kind::Pose) return 6;
+    return int(axes[0]) + int(axes[1]) + int(axes[2]);
+  }
+};
+
+enum class CaptureObjective { IntegratedEffectiveMass, ExactMaxForce };
+
+struct CaptureOptions {
+  double duration = 180.0;              ///< T, s
+  double step = 0.1;                    ///< RK4 step, s
+  double gain = 0.0;                    ///< rho of Eq. 30 (< 0 lowers the objective; 0: plain tracking)
+  double feedback = 1.0;                ///< k_p, 1/s, on the position (m) and orientation (rad) error
+  double tolerance = 1e-3;              ///< required end-effector position error at T, m
+  double orientation_tolerance = 1e-2;  ///< pose task: required orientation error at T, rad
+  CaptureObjective objective = CaptureObjective::IntegratedEffectiveMass;
+  double singular_value_threshold = 1e-3;  ///< below it the pseudo-inverse is damped
+  double max_damping = 1e-2;               ///< largest damping (lambda) of the damped least squares
+  bool record_series = false;
+  int record_every = 1;                  ///< keep every k-th step in the series
+  std::function<void(double)> progress;  ///< called with the fraction done (0..1), optional
+  double max_joint_rate = 0;  ///< rad/s; the null-space term is scaled down to respect it (0: not limited)
+};
+
+/// The capture problem: robot, end-effector, initial state, target (its initial state at t = 0),
+/// contact law and approach speed at the capture.
+struct CaptureProblem {
+  const Model* model = nullptr;
+  int frame = -1;
+  BasePose base;
+  Eigen::VectorXd theta;
+  Target target;
+  ContactParams contact;
+  std::string law = "herbert-mcwhannell";
+  double approach_speed = 0.2;
+};
+
+struct CaptureSample {
+  double t = 0;
+  Eigen::VectorXd theta;
+  BasePose base;
+  Vector3 end_effector = Vector3::Zero();
+  double M_ie = 0;            ///< with the target at the capture time
+  double f_max_estimate = 0;  ///< closed-form F_max at that M_ie
+};
+
+struct CaptureResult {
+  Eigen::VectorXd theta;  ///< capture configuration (rad)
+  BasePose base;          ///< base pose at T
+  Vector3 end_effector = Vector3::Zero();
+  Vector3 capture_point = Vector3::Zero();
+  double tracking_error = 0;       ///< |p_e(T) - capture point| on the task's constrained axes, m
+  double capture_distance = 0;     ///< |p_e(T) - capture point| in 3-D (differs for a task on fewer axes), m
+  double orientation_error = 0;    ///< pose task: angle between the reached and desired orientation, rad
+  double base_position_drift = 0;  ///< |p_0(T) - p_0(0)|, m
+  double base_attitude_drift = 0;  ///< rotation angle between the base attitudes at 0 and T, rad
+  double M_ie = 0;
+  double approach_velocity = 0;  ///< delta_dot^- at the capture
+  double f_max_closed_form = 0;
+  double f_max_exact = 0;
+  double max_momentum = 0;          ///< largest |total momentum| along the run (checked each step)
+  double max_body_momentum = 0;     ///< largest |body momentum| along the run, for scale
+  double max_quaternion_error = 0;  ///< largest | |q| - 1 | before renormalization
+  double max_com_drift = 0;         ///< largest motion of the system centre of mass (zero momentum: ~0)
+  double max_tracking_error = 0;    ///< largest end-effector position error along the line, m
+  double min_singular_value = 0;    ///< smallest task singular value seen
+  long damped_steps = 0;            ///< evaluations where the pseudo-inverse was damped
+  double max_joint_rate = 0;        ///< largest |theta_dot_k| over every evaluation, rad/s
+  long steps = 0;
+  std::vector<CaptureSample> series;
+};
+
+/// Everything a capture run needs that follows from the problem: the target at T, the capture point
+/// and direction, the contact law at the capture's approach velocity, the line reference and the task
+/// rows. Made (and every input checked) by prepare_capture.
+struct CaptureSetup {
+  Target capture_target;             ///< the target at T
+  Vector3 x_cap = Vector3::Zero();   ///< capture point
+  Vector3 u_cap = Vector3::UnitX();  ///< inertial contact normal at T
+  double target_inv_mass = 0;        ///< the target's inverse mass along the normal (Eq. 14)
+  double v_in = 0;                   ///< delta_dot^- at the capture
+  AnyContactLaw law;
+  LineReference line;
+  Matrix3 R_end = Matrix3::Identity();  ///< pose task: the end-effector orientation at T
+  std::vector<int> rows;                ///< rows of J_f (and of the 6-D error) that the task constrains
+};
+
+}  // namespace ffsr
