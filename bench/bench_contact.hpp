@@ -3,7 +3,7 @@
 //   and one CVODE run of the single-body model Eq. 16 from first touch to separation.
 // Each reports the median over several batches of the time per call (std::chrono::steady_clock);
 // the results feed a volatile sink and the inputs vary per call so nothing is optimized away.
-// Targets (issue 3): closed form < 1 µs, exact < 20 µs.
+// Targets: closed form < 1 µs, exact < 20 µs.
 #pragma once
 
 #include <ffsr/contact/contact_law.hpp>
@@ -61,17 +61,13 @@ inline void bench_contact(std::ostream& os) {
   const double sim = bench::median_seconds_per_call(
       [&](int i) { return simulate_single_body(law, 5.0 + 1e-3 * i).f_max; }, 20, 11);
 
-  char line[160];
-  std::snprintf(line, sizeof line, "contact: closed-form F_max (Eq. 24)            %10.4f us/call\n",
-                closed * 1e6);
-  os << line;
-  std::snprintf(line, sizeof line, "contact: make_contact_law + closed-form F_max  %10.4f us/call\n",
-                closed_built * 1e6);
-  os << line;
-  std::snprintf(line, sizeof line, "contact: exact single-body F_max (Eq. 19)      %10.4f us/call\n",
-                exact * 1e6);
-  os << line;
-  std::snprintf(line, sizeof line, "contact: single-body CVODE run (Eq. 16)        %10.4f ms/run\n",
-                sim * 1e3);
-  os << line;
+  auto row = [&os](const char* what, double value, const char* unit) {
+    char line[160];
+    std::snprintf(line, sizeof line, "contact: %-38s%10.4f %s\n", what, value, unit);
+    os << line;
+  };
+  row("closed-form F_max (Eq. 24)", closed * 1e6, "us/call");
+  row("make_contact_law + closed-form F_max", closed_built * 1e6, "us/call");
+  row("exact single-body F_max (Eq. 19)", exact * 1e6, "us/call");
+  row("single-body CVODE run (Eq. 16)", sim * 1e3, "ms/run");
 }

@@ -10,7 +10,7 @@
 // analytic gradient, and rnea; one point of `ffsr-optimize map` (M_ie, F_max and its CSV row) in
 // points per second. Then the contact benchmarks (bench_contact.hpp), one multibody
 // CVODE contact run per robot, and the paper's capture scenarios (plan_capture, plain and
-// optimized). The targets of issues 2-4 are printed beside the figures.
+// optimized). The time targets are printed beside the figures.
 //
 // Allocations are counted by replacing the global operator new/delete and, on glibc, by
 // interposing malloc/calloc/realloc/free (Eigen allocates with malloc, not with operator new).
@@ -410,7 +410,7 @@ void bench_hot_paths(const Settings& s, const Robot& r, AllocCheck& check) {
 /// One point of `ffsr-optimize map` (src/cli/map.cpp): crba, the inverse effective mass, M_ie
 /// (Eq. 14), the closed-form F_max (Eq. 24) and the CSV row formatted with std::to_chars, on a grid
 /// walked in the map's order (last joint fastest, 2 deg steps). Reports points per second on one
-/// thread beside the target of issue 10 (5.83 million points in 10 s on 2 threads: 292k/s each).
+/// thread beside its target (5.83 million points in 10 s on 2 threads: 292k/s each).
 void bench_map(const Settings& s, const Robot& r, AllocCheck& check) {
   using namespace ffsr;
   const Model& model = r.model;
@@ -537,10 +537,9 @@ ffsr::CaptureTask pose_task() {
   return t;
 }
 
-/// Runs one plan_capture case (median of s.capture_runs runs) and prints it. Returns the median.
-double bench_capture_case(const Settings& s, const Robot& r, double duration, const CaptureCase& c) {
-  using namespace ffsr;
-  CaptureProblem pb;
+/// The paper's capture problem for robot r: its start configuration and target, the paper's contact.
+ffsr::CaptureProblem capture_problem(const Robot& r) {
+  ffsr::CaptureProblem pb;
   pb.model = &r.model;
   pb.frame = r.ee;
   pb.theta = r.theta_start;
@@ -548,6 +547,13 @@ double bench_capture_case(const Settings& s, const Robot& r, double duration, co
   pb.contact = kContact;
   pb.law = kLaw;
   pb.approach_speed = kApproachSpeed;
+  return pb;
+}
+
+/// Runs one plan_capture case (median of s.capture_runs runs) and prints it. Returns the median.
+double bench_capture_case(const Settings& s, const Robot& r, double duration, const CaptureCase& c) {
+  using namespace ffsr;
+  const CaptureProblem pb = capture_problem(r);
   CaptureOptions opt;
   opt.duration = duration;
   opt.step = 0.1;
@@ -584,20 +590,13 @@ void bench_scenarios(const Settings& s, const Robot& r3, const Robot& r7) {
 }
 
 #ifdef FFSR_HAVE_GLOBAL
-/// Global capture optimization (issue 9): the whole plan_capture_global (task-only run, search,
+/// Global capture optimization: the whole plan_capture_global (task-only run, search,
 /// reaching run, search at the reached base pose, ...) with the scenario files' 3 deg/s limit; and
 /// the multibody-force search (CVODE ranking of the local optima) at c_r = 0.3.
 void bench_global(const Settings& s, const Robot& r3, const Robot& r7) {
   using namespace ffsr;
   auto run = [&](const Robot& r, double T, const CaptureTask& task, const char* target, double limit) {
-    CaptureProblem pb;
-    pb.model = &r.model;
-    pb.frame = r.ee;
-    pb.theta = r.theta_start;
-    pb.target = r.target;
-    pb.contact = kContact;
-    pb.law = kLaw;
-    pb.approach_speed = kApproachSpeed;
+    CaptureProblem pb = capture_problem(r);
     CaptureOptions opt;
     opt.duration = T;
     opt.step = 0.1;
@@ -643,11 +642,9 @@ std::string robots_dir(const std::string& arg) {
   throw ffsr::InputError("ffsr-bench: no paper_3dof.urdf in '" + base + "' or '" + base + "/robots'");
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  Settings s;
-  std::string dir_arg;
+/// Reads the command line into s and dir; returns an exit code when the program should stop
+/// (after --help, or on an unknown option), else -1.
+int parse_arguments(int argc, char** argv, Settings& s, std::string& dir) {
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--quick") {
@@ -665,7 +662,7 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "ffsr-bench: error: unknown option '%s' (try --help)\n", a.c_str());
       return 2;
     } else {
-      dir_arg = a;
+      dir = a;
     }
   }
   if (s.quick) {
@@ -674,58 +671,72 @@ int main(int argc, char** argv) {
     s.contact_runs = 1;
     s.capture_runs = 1;
   }
-  try {
-    const std::string dir = robots_dir(dir_arg);
-    const Robot r3 = paper_3dof(dir);
-    const Robot r7 = paper_7dof(dir);
-    std::printf(
-        "ffsr-bench%s: %s; median and min over %d batches of the mean time per call (~%.1f ms a batch)\n",
-        s.quick ? " --quick" : "", dir.c_str(), s.batches, s.batch_seconds * 1e3);
-    std::printf("heap allocations per call after set-up counted by %s\n",
-                FFSR_BENCH_MALLOC_HOOK ? "interposed malloc/calloc/realloc and operator new"
-                                       : "replaced operator new (malloc not interposed on this platform)");
-    AllocCheck check;
-    print_header(
-        "hot paths (paper configurations: 3-DOF [0, 90, -90] deg, 7-DOF [0, 29, 54, 10, -10, 120, 32] deg, "
-        "16 nearby poses cycled)");
-    bench_hot_paths(s, r3, check);
-    bench_hot_paths(s, r7, check);
-    print_header("map (ffsr-optimize map, one thread; 3-DOF grid at 2 deg)");
-    bench_map(s, r3, check);
-    bench_map(s, r7, check);
-    print_header("inverse effective mass: dense against articulated-body recursion (serial chains)");
-    bench_crossover(s, check);
+  return -1;
+}
 
-    std::printf("\ncontact (bench_contact.hpp; targets: closed form < 1 us, exact < 20 us)\n");
-    std::fflush(stdout);
-    if (s.quick)
-      std::printf("  skipped with --quick\n");
-    else
-      bench_contact(std::cout);
-    std::cout.flush();
+/// Every benchmark in turn; returns the exit status (1 when a hot path allocates per call).
+int run_benchmarks(const Settings& s, const std::string& dir_arg) {
+  const std::string dir = robots_dir(dir_arg);
+  const Robot r3 = paper_3dof(dir);
+  const Robot r7 = paper_7dof(dir);
+  std::printf(
+      "ffsr-bench%s: %s; median and min over %d batches of the mean time per call (~%.1f ms a batch)\n",
+      s.quick ? " --quick" : "", dir.c_str(), s.batches, s.batch_seconds * 1e3);
+  std::printf("heap allocations per call after set-up counted by %s\n",
+              FFSR_BENCH_MALLOC_HOOK ? "interposed malloc/calloc/realloc and operator new"
+                                     : "replaced operator new (malloc not interposed on this platform)");
+  AllocCheck check;
+  print_header(
+      "hot paths (paper configurations: 3-DOF [0, 90, -90] deg, 7-DOF [0, 29, 54, 10, -10, 120, 32] deg, "
+      "16 nearby poses cycled)");
+  bench_hot_paths(s, r3, check);
+  bench_hot_paths(s, r7, check);
+  print_header("map (ffsr-optimize map, one thread; 3-DOF grid at 2 deg)");
+  bench_map(s, r3, check);
+  bench_map(s, r7, check);
+  print_header("inverse effective mass: dense against articulated-body recursion (serial chains)");
+  bench_crossover(s, check);
 
-    print_header(
-        "multibody contact: whole runs (K = 1e9, alpha = 1.5, c_r = 0.9, herbert-mcwhannell, 0.2 m/s)");
-    bench_multibody_contact(s, r3);
-    bench_multibody_contact(s, r7);
+  std::printf("\ncontact (bench_contact.hpp; targets: closed form < 1 us, exact < 20 us)\n");
+  std::fflush(stdout);
+  if (s.quick)
+    std::printf("  skipped with --quick\n");
+  else
+    bench_contact(std::cout);
+  std::cout.flush();
 
-    print_header(
-        "capture scenarios: whole plan_capture runs (RK4, step 0.1 s; 3-DOF T = 180 s, 7-DOF T = 157 s)");
-    bench_scenarios(s, r3, r7);
+  print_header(
+      "multibody contact: whole runs (K = 1e9, alpha = 1.5, c_r = 0.9, herbert-mcwhannell, 0.2 m/s)");
+  bench_multibody_contact(s, r3);
+  bench_multibody_contact(s, r7);
+
+  print_header(
+      "capture scenarios: whole plan_capture runs (RK4, step 0.1 s; 3-DOF T = 180 s, 7-DOF T = 157 s)");
+  bench_scenarios(s, r3, r7);
 #ifdef FFSR_HAVE_GLOBAL
-    print_header("global capture optimization (optimize/global.hpp; 3 deg/s joint-rate limit)");
-    bench_global(s, r3, r7);
+  print_header("global capture optimization (optimize/global.hpp; 3 deg/s joint-rate limit)");
+  bench_global(s, r3, r7);
 #endif
 
-    if (!check.failures.empty()) {
-      std::printf("\nFAIL: hot paths allocate per call:\n");
-      for (const auto& f : check.failures) std::printf("  %s\n", f.c_str());
-      return 1;
-    }
-    std::printf("\nallocation check: no hot path allocates per call\n");
+  if (!check.failures.empty()) {
+    std::printf("\nFAIL: hot paths allocate per call:\n");
+    for (const auto& f : check.failures) std::printf("  %s\n", f.c_str());
+    return 1;
+  }
+  std::printf("\nallocation check: no hot path allocates per call\n");
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Settings s;
+  std::string dir_arg;
+  if (const int stop = parse_arguments(argc, argv, s, dir_arg); stop >= 0) return stop;
+  try {
+    return run_benchmarks(s, dir_arg);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "ffsr-bench: error: %s\n", e.what());
     return 1;
   }
-  return 0;
 }

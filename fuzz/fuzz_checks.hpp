@@ -30,6 +30,19 @@ class Finding : public std::logic_error {
 
 [[noreturn]] inline void fail(const std::string& what) { throw Finding(what); }
 
+/// The body of a libFuzzer entry point: check(data, size); a Finding is printed as
+/// "<target>: FINDING: ..." and aborts (a crash libFuzzer records). Returns 0.
+template <class Check>
+int run_fuzz_input(const char* target, Check check, const std::uint8_t* data, std::size_t size) {
+  try {
+    check(data, size);
+  } catch (const Finding& f) {
+    std::fprintf(stderr, "%s: FINDING: %s\n", target, f.what());
+    std::abort();
+  }
+  return 0;
+}
+
 inline void require_finite(double x, const std::string& what) {
   if (!std::isfinite(x)) fail(what + " is not finite: " + std::to_string(x));
 }

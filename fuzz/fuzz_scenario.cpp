@@ -92,13 +92,10 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   std::filesystem::remove(dir + "/out.csv");
   std::vector<std::string> args{"ffsr-optimize"};
   for (const auto& a : ffsr_fuzz::scenario_arguments(dir)) args.push_back(a);
-  std::ostringstream out;
-  try {
+  auto check = [&](const uint8_t*, size_t) {
+    std::ostringstream out;
     const int code = run_main(args, out);
     ffsr_fuzz::check_scenario_outputs(dir, code, out.str());
-  } catch (const ffsr_fuzz::Finding& f) {
-    std::fprintf(stderr, "fuzz_scenario: FINDING: %s\n", f.what());
-    std::abort();
-  }
-  return 0;
+  };
+  return ffsr_fuzz::run_fuzz_input("fuzz_scenario", check, data, size);
 }

@@ -27,11 +27,37 @@ std::string fixed(double x, int digits) {
   return s.str();
 }
 
+/// An empty 2-D panel with its title and axis labels.
+Panel labelled(std::string title, std::string xlabel, std::string ylabel) {
+  Panel p;
+  p.title = std::move(title);
+  p.xlabel = std::move(xlabel);
+  p.ylabel = std::move(ylabel);
+  return p;
+}
+
 /// Points of one drawing in the inertial frame: polylines (each a list of 3-D points) and dots.
 struct Drawing {
   std::vector<std::vector<Vector3>> lines;
   std::vector<Vector3> dots;
 };
+
+/// Adds the outline of a box (centre c, axes the columns of R, half side h) to a drawing: the square
+/// in its x-y plane when `planar`, else the twelve edges of the cube.
+void add_box(Drawing& d, const Vector3& c, const Matrix3& R, double h, bool planar) {
+  auto corner = [&](double a, double b, double z) { return Vector3(c + R * Vector3(a * h, b * h, z * h)); };
+  auto square = [&](double z) {
+    return std::vector<Vector3>{corner(-1, -1, z), corner(1, -1, z), corner(1, 1, z), corner(-1, 1, z),
+                                corner(-1, -1, z)};
+  };
+  if (planar) {
+    d.lines.push_back(square(0));
+    return;
+  }
+  for (int z : {-1, 1}) d.lines.push_back(square(z));
+  for (int a : {-1, 1})
+    for (int b : {-1, 1}) d.lines.push_back({corner(a, b, -1), corner(a, b, 1)});
+}
 
 /// The robot at one recorded state: the base as a box around its frame origin (half side: the
 /// farthest joint mounted on it, so the mounts sit on the box), the links as segments between
@@ -42,21 +68,7 @@ Drawing robot_drawing(const Model& model, Data& data, int frame, const CaptureSa
   double half = 0.05;
   for (int i = 1; i < model.nb(); ++i)
     if (model.body(i).parent == 0) half = std::max(half, model.body(i).tree.p.cwiseAbs().maxCoeff());
-  const Matrix3& R0 = data.R[0];
-  const Vector3& p0 = data.p[0];
-  auto corner = [&](double a, double b, double c) {
-    return Vector3(p0 + R0 * Vector3(a * half, b * half, c * half));
-  };
-  if (planar) {
-    d.lines.push_back(
-        {corner(-1, -1, 0), corner(1, -1, 0), corner(1, 1, 0), corner(-1, 1, 0), corner(-1, -1, 0)});
-  } else {
-    for (int c : {-1, 1})
-      d.lines.push_back(
-          {corner(-1, -1, c), corner(1, -1, c), corner(1, 1, c), corner(-1, 1, c), corner(-1, -1, c)});
-    for (int a : {-1, 1})
-      for (int b : {-1, 1}) d.lines.push_back({corner(a, b, -1), corner(a, b, 1)});
-  }
+  add_box(d, data.p[0], data.R[0], half, planar);
   for (int i = 1; i < model.nb(); ++i) {
     const int parent = model.body(i).parent;
     if (parent > 0) d.lines.push_back({data.p[static_cast<size_t>(parent)], data.p[static_cast<size_t>(i)]});
@@ -73,20 +85,7 @@ Drawing robot_drawing(const Model& model, Data& data, int frame, const CaptureSa
 Drawing target_drawing(const Target& t, bool planar, double arrow) {
   Drawing d;
   const double h = std::max(0.1, t.contact_offset.cwiseAbs().maxCoeff());
-  const Matrix3 R = t.rotation();
-  auto corner = [&](double a, double b, double c) {
-    return Vector3(t.position + R * Vector3(a * h, b * h, c * h));
-  };
-  if (planar) {
-    d.lines.push_back(
-        {corner(-1, -1, 0), corner(1, -1, 0), corner(1, 1, 0), corner(-1, 1, 0), corner(-1, -1, 0)});
-  } else {
-    for (int c : {-1, 1})
-      d.lines.push_back(
-          {corner(-1, -1, c), corner(1, -1, c), corner(1, 1, c), corner(-1, 1, c), corner(-1, -1, c)});
-    for (int a : {-1, 1})
-      for (int b : {-1, 1}) d.lines.push_back({corner(a, b, -1), corner(a, b, 1)});
-  }
+  add_box(d, t.position, t.rotation(), h, planar);
   const Vector3 cp = t.contact_point(), u = t.normal_world();
   // the normal points from the end-effector into the target: draw it arriving at the contact point
   const Vector3 tail = cp - arrow * u;
@@ -110,67 +109,60 @@ std::vector<size_t> instants(size_t n) {
   return k;
 }
 
-/// Adds a drawing to a 2-D panel (axes a, b of the inertial frame) or a 3-D panel.
-void add(Panel& p, const Drawing& d, int a, int b, int color, double alpha, double width,
-         const std::string& label, const std::string& dot, double dot_scale) {
-  bool first = true;
+/// A drawing as curves: each line in `color`, `alpha` and `width`, then, when `dot` is set, the
+/// dots as one curve of that symbol. put(curve, point) appends a point in the panel's coordinates.
+template <class C, class Put>
+std::vector<C> drawing_curves(const Drawing& d, int color, double alpha, double width, const std::string& dot,
+                              double dot_scale, Put put) {
+  std::vector<C> out;
   for (const auto& l : d.lines) {
-    Curve c;
+    C c;
     c.color = color;
     c.alpha = alpha;
     c.width = width;
-    if (first && dot.empty()) c.label = label;
-    first = false;
-    for (const auto& v : l) {
-      c.x.push_back(v(a));
-      c.y.push_back(v(b));
-    }
-    p.curves.push_back(std::move(c));
+    for (const auto& v : l) put(c, v);
+    out.push_back(std::move(c));
   }
   if (!d.dots.empty() && !dot.empty()) {
-    Curve c;
+    C c;
     c.color = color;
     c.alpha = alpha;
     c.line_style = 0;
     c.symbol = dot;
     c.symbol_scale = dot_scale;
-    c.label = label;
-    for (const auto& v : d.dots) {
-      c.x.push_back(v(a));
-      c.y.push_back(v(b));
-    }
-    p.curves.push_back(std::move(c));
+    for (const auto& v : d.dots) put(c, v);
+    out.push_back(std::move(c));
   }
+  return out;
 }
 
+/// Adds a drawing to a 2-D panel (axes a, b of the inertial frame); `label` goes to the dots, or
+/// to the first line when there are none.
+void add(Panel& p, const Drawing& d, int a, int b, int color, double alpha, double width,
+         const std::string& label, const std::string& dot, double dot_scale) {
+  auto curves =
+      drawing_curves<Curve>(d, color, alpha, width, dot, dot_scale, [&](Curve& c, const Vector3& v) {
+        c.x.push_back(v(a));
+        c.y.push_back(v(b));
+      });
+  if (dot.empty()) {
+    if (!curves.empty()) curves.front().label = label;
+  } else if (!d.dots.empty()) {
+    curves.back().label = label;
+  }
+  for (auto& c : curves) p.curves.push_back(std::move(c));
+}
+
+/// Adds a drawing to a 3-D panel.
 void add(Panel3& p, const Drawing& d, int color, double alpha, double width, const std::string& dot,
          double dot_scale) {
-  for (const auto& l : d.lines) {
-    Curve3 c;
-    c.color = color;
-    c.alpha = alpha;
-    c.width = width;
-    for (const auto& v : l) {
-      c.x.push_back(v.x());
-      c.y.push_back(v.y());
-      c.z.push_back(v.z());
-    }
-    p.curves.push_back(std::move(c));
-  }
-  if (!d.dots.empty() && !dot.empty()) {
-    Curve3 c;
-    c.color = color;
-    c.alpha = alpha;
-    c.line_style = 0;
-    c.symbol = dot;
-    c.symbol_scale = dot_scale;
-    for (const auto& v : d.dots) {
-      c.x.push_back(v.x());
-      c.y.push_back(v.y());
-      c.z.push_back(v.z());
-    }
-    p.curves.push_back(std::move(c));
-  }
+  auto curves =
+      drawing_curves<Curve3>(d, color, alpha, width, dot, dot_scale, [](Curve3& c, const Vector3& v) {
+        c.x.push_back(v.x());
+        c.y.push_back(v.y());
+        c.z.push_back(v.z());
+      });
+  for (auto& c : curves) p.curves.push_back(std::move(c));
 }
 
 /// Smallest singular value of the task rows of J_f at a recorded state (as the planner computes it).
@@ -194,120 +186,117 @@ double angle_deg(const Quaternion& a, const Quaternion& b) {
   return Eigen::AngleAxisd(a.normalized().conjugate() * b.normalized()).angle() * 180.0 / M_PI;
 }
 
-}  // namespace
-
-std::vector<plot::Figure> capture(const Model& model, int frame, const Target& target_at_start,
-                                  double duration, const std::vector<CaptureRun>& runs) {
-  Data data(model);
-  const Target target = propagate_target(target_at_start, duration);
-  // planar: every joint, the end-effector and the contact point stay in one plane z = const
+/// True when every joint of every recorded state lies in the plane z = z0 (the contact point's).
+bool planar_motion(const Model& model, Data& data, double z0, const std::vector<CaptureRun>& runs) {
   bool planar = true;
-  const double z0 = target.contact_point().z();
   for (const auto& run : runs)
     for (const auto& s : run.result->series) {
       forward_kinematics(model, data, s.base, s.theta);
       for (int i = 0; i < model.nb() && planar; ++i)
         planar = std::abs(data.p[static_cast<size_t>(i)].z() - z0) < 1e-6;
     }
-  double reach = 0;
-  for (int i = 1; i < model.nb(); ++i) reach += model.body(i).tree.p.norm();
-  const double arrow = std::max(0.2, 0.12 * reach);
+  return planar;
+}
 
-  std::vector<plot::Figure> out;
-  for (size_t r = 0; r < runs.size(); ++r) {
-    const CaptureResult& res = *runs[r].result;
-    const int color = static_cast<int>(r);
-    const std::string title = str("Capture process, ", runs[r].label, " run: M_ie = ", fixed(res.M_ie, 3),
-                                  " kg, F#dmax#u = ", fixed(res.f_max_closed_form / 1e3, 2),
-                                  " kN at T = ", fixed(duration, 0), " s");
-    const auto idx = instants(res.series.size());
-    std::vector<Drawing> arms;
-    for (size_t k : idx) arms.push_back(robot_drawing(model, data, frame, res.series[k], planar));
-    const Drawing tgt = target_drawing(target, planar, arrow);
-    Drawing path;
-    path.lines.emplace_back();
-    for (const auto& s : res.series) path.lines.back().push_back(s.end_effector);
-    auto alpha = [&](size_t i) {
-      return arms.size() < 2 ? 1.0 : 0.2 + 0.8 * double(i) / double(arms.size() - 1);
-    };
-
-    plot::Figure fig;
-    fig.name = "capture_" + runs[r].label;
-    fig.title = title;
-    auto top_view = [&](Panel& p) {
-      p.equal_aspect = true;
-      p.legend_outside = true;
-      p.xlabel = "x (m)";
-      p.ylabel = "y (m)";
-      for (size_t i = 0; i < arms.size(); ++i) {
-        const bool last = i + 1 == arms.size();
-        const size_t first_curve = p.curves.size();
-        add(p, arms[i], 0, 1, color, alpha(i), 2.0,
-            i == 0 ? "arm at t = 0"
-            : last ? str("arm at T = ", fixed(duration, 0), " s")
-                   : "",
-            i == 0 ? "○" : "●", i == 0 ? 0.9 : 0.7);
-        if (i == 0)  // dashed, open joints: told from the arm at T, which has the same colour
-          for (size_t c = first_curve; c < p.curves.size(); ++c)
-            if (p.curves[c].line_style == 1) p.curves[c].line_style = 3;
-      }
-      add(p, path, 0, 1, kBlack, 1.0, 1.0, "end-effector path", "", 1.0);
-      p.curves.back().line_style = 2;
-      add(p, tgt, 0, 1, kTargetColor, 1.0, 1.5, "target at T, normal", "●", 0.9);
-    };
-    if (planar) {
-      Panel p;
-      p.title = str("the arm at ", arms.size(), " instants (faint: early, dark: late)");
-      top_view(p);
-      fig.panels.emplace_back(std::move(p));
-    } else {
-      fig.cols = 2;
-      Panel3 q;
-      q.title = str("oblique view, the arm at ", arms.size(), " instants (faint: early)");
-      q.xlabel = "x (m)";
-      q.ylabel = "y (m)";
-      q.zlabel = "z (m)";
-      for (size_t i = 0; i < arms.size(); ++i) add(q, arms[i], color, alpha(i), 2.0, "●", 0.6);
-      add(q, path, kBlack, 1.0, 1.0, "", 1.0);
-      q.curves.back().line_style = 2;
-      add(q, tgt, kTargetColor, 1.0, 1.5, "●", 0.8);
-      fig.panels.emplace_back(std::move(q));
-      Panel p;
-      p.title = "top view (x-y)";
-      top_view(p);
-      p.legend_outside = false;
-      fig.panels.emplace_back(std::move(p));
-    }
-    out.push_back(std::move(fig));
+/// The drawings of one run: the arm at the instants, the end-effector path, the target at T.
+struct RunDrawings {
+  std::vector<Drawing> arms;
+  Drawing path, target;
+  int color = 0;
+  double duration = 0;
+  bool planar = true;
+  /// Opacity of the i-th arm: faint early, dark late.
+  double alpha(size_t i) const {
+    return arms.size() < 2 ? 1.0 : 0.2 + 0.8 * double(i) / double(arms.size() - 1);
   }
+};
 
-  // --- time histories, all runs on shared axes -------------------------------------------------
+RunDrawings run_drawings(const Model& model, Data& data, int frame, const CaptureResult& res,
+                         const Drawing& target, bool planar) {
+  RunDrawings d;
+  for (size_t k : instants(res.series.size()))
+    d.arms.push_back(robot_drawing(model, data, frame, res.series[k], planar));
+  d.target = target;
+  d.planar = planar;
+  d.path.lines.emplace_back();
+  for (const auto& s : res.series) d.path.lines.back().push_back(s.end_effector);
+  return d;
+}
+
+/// The x-y view: the arms (the first dashed with open joints), the path, the target.
+void top_view(Panel& p, const RunDrawings& d) {
+  p.equal_aspect = true;
+  p.legend_outside = true;
+  p.xlabel = "x (m)";
+  p.ylabel = "y (m)";
+  for (size_t i = 0; i < d.arms.size(); ++i) {
+    const bool last = i + 1 == d.arms.size();
+    const size_t first_curve = p.curves.size();
+    add(p, d.arms[i], 0, 1, d.color, d.alpha(i), 2.0,
+        i == 0 ? "arm at t = 0"
+        : last ? str("arm at T = ", fixed(d.duration, 0), " s")
+               : "",
+        i == 0 ? "○" : "●", i == 0 ? 0.9 : 0.7);
+    if (i == 0)  // dashed, open joints: told from the arm at T, which has the same colour
+      for (size_t c = first_curve; c < p.curves.size(); ++c)
+        if (p.curves[c].line_style == 1) p.curves[c].line_style = 3;
+  }
+  add(p, d.path, 0, 1, kBlack, 1.0, 1.0, "end-effector path", "", 1.0);
+  p.curves.back().line_style = 2;
+  add(p, d.target, 0, 1, kTargetColor, 1.0, 1.5, "target at T, normal", "●", 0.9);
+}
+
+/// The oblique 3-D view of a spatial run.
+Panel3 oblique_view(const RunDrawings& d) {
+  Panel3 q;
+  q.title = str("oblique view, the arm at ", d.arms.size(), " instants (faint: early)");
+  q.xlabel = "x (m)";
+  q.ylabel = "y (m)";
+  q.zlabel = "z (m)";
+  for (size_t i = 0; i < d.arms.size(); ++i) add(q, d.arms[i], d.color, d.alpha(i), 2.0, "●", 0.6);
+  add(q, d.path, kBlack, 1.0, 1.0, "", 1.0);
+  q.curves.back().line_style = 2;
+  add(q, d.target, kTargetColor, 1.0, 1.5, "●", 0.8);
+  return q;
+}
+
+/// Figures 10, 11, 13-15 for one run: the top view alone (planar), or the oblique and top views.
+plot::Figure capture_figure(const std::string& label, const CaptureResult& res, const RunDrawings& d) {
+  plot::Figure fig;
+  fig.name = "capture_" + label;
+  fig.title = str("Capture process, ", label, " run: M_ie = ", fixed(res.M_ie, 3),
+                  " kg, F#dmax#u = ", fixed(res.f_max_closed_form / 1e3, 2),
+                  " kN at T = ", fixed(d.duration, 0), " s");
+  Panel p;
+  top_view(p, d);
+  if (d.planar) {
+    p.title = str("the arm at ", d.arms.size(), " instants (faint: early, dark: late)");
+  } else {
+    fig.cols = 2;
+    fig.panels.emplace_back(oblique_view(d));
+    p.title = "top view (x-y)";
+    p.legend_outside = false;
+  }
+  fig.panels.emplace_back(std::move(p));
+  return fig;
+}
+
+/// "histories": M_ie, closed-form F_max, base attitude drift and the task's smallest singular value
+/// against time, all runs on shared axes.
+plot::Figure histories(const Model& model, Data& data, int frame, const std::vector<CaptureRun>& runs) {
   plot::Figure h;
   h.name = "histories";
   h.title = "Capture process: time histories (target at T)";
   h.rows = 2;
   h.cols = 2;
-  Panel mie, fmax, drift, sigma;
-  mie.title = "integrated effective mass (Eq. 14)";
-  mie.ylabel = "M#die#u (kg)";
-  fmax.title = "closed-form maximum contact force (Eq. 24)";
-  fmax.ylabel = "F#dmax#u (kN)";
-  drift.title = "base attitude drift";
-  drift.ylabel = "rotation from t = 0 (deg)";
-  sigma.title = "smallest singular value of the task Jacobian";
   const bool any_pose = std::any_of(
       runs.begin(), runs.end(), [](const CaptureRun& r) { return r.task.kind == CaptureTask::Kind::Pose; });
-  sigma.ylabel = any_pose ? "σ#dmin#u of J#dt#u (m/rad, rad/rad)" : "σ#dmin#u of J#dt#u (m/rad)";
-  for (Panel* p : {&mie, &fmax, &drift, &sigma}) p->xlabel = "time t (s)";
-  plot::Figure joints;
-  joints.name = "joints";
-  joints.title = "Capture process: joint angles";
-  // side by side for one or two runs; stacked for more (three columns leave the last panel, which
-  // carries the legend outside, too narrow a viewport: PLplot aborts)
-  joints.cols = runs.size() <= 2 ? static_cast<int>(std::max<size_t>(1, runs.size())) : 1;
-  joints.rows = runs.size() <= 2 ? 1 : static_cast<int>(runs.size());
-  std::vector<Panel> joint_panels;
-  double jmin = 1e300, jmax = -1e300;
+  const std::string t = "time t (s)";
+  Panel mie = labelled("integrated effective mass (Eq. 14)", t, "M#die#u (kg)"),
+        fmax = labelled("closed-form maximum contact force (Eq. 24)", t, "F#dmax#u (kN)"),
+        drift = labelled("base attitude drift", t, "rotation from t = 0 (deg)"),
+        sigma = labelled("smallest singular value of the task Jacobian", t,
+                         any_pose ? "σ#dmin#u of J#dt#u (m/rad, rad/rad)" : "σ#dmin#u of J#dt#u (m/rad)");
   for (size_t r = 0; r < runs.size(); ++r) {
     const CaptureResult& res = *runs[r].result;
     Curve cm, cf, cd, cs;
@@ -327,27 +316,46 @@ std::vector<plot::Figure> capture(const Model& model, int frame, const Target& t
     fmax.curves.push_back(cf);
     drift.curves.push_back(cd);
     sigma.curves.push_back(cs);
-    Panel jp;
-    jp.title = runs[r].label + " run";
-    jp.xlabel = "time t (s)";
-    jp.ylabel = "joint angle (deg)";
-    jp.legend_outside = r + 1 == runs.size();
-    const auto names = model.joint_names();
-    for (int j = 0; j < model.n(); ++j) {
-      Curve c;
-      c.label = r + 1 == runs.size() ? names[static_cast<size_t>(j)] : "";
-      c.color = j;
-      c.line_style = j / plot::kPaletteSize + 1;
-      for (const auto& s : res.series) {
-        c.x.push_back(s.t);
-        c.y.push_back(s.theta(j) * 180.0 / M_PI);
-        jmin = std::min(jmin, c.y.back());
-        jmax = std::max(jmax, c.y.back());
-      }
-      jp.curves.push_back(std::move(c));
-    }
-    joint_panels.push_back(std::move(jp));
   }
+  for (Panel* p : {&mie, &fmax, &drift, &sigma}) h.panels.emplace_back(std::move(*p));
+  return h;
+}
+
+/// The joint angles of one run, deg; the legend (joint names) on the last run only. Widens
+/// [jmin, jmax] to the angles drawn.
+Panel joint_panel(const Model& model, const CaptureRun& run, bool last, double& jmin, double& jmax) {
+  Panel jp = labelled(run.label + " run", "time t (s)", "joint angle (deg)");
+  jp.legend_outside = last;
+  const auto names = model.joint_names();
+  for (int j = 0; j < model.n(); ++j) {
+    Curve c;
+    c.label = last ? names[static_cast<size_t>(j)] : "";
+    c.color = j;
+    c.line_style = j / plot::kPaletteSize + 1;
+    for (const auto& s : run.result->series) {
+      c.x.push_back(s.t);
+      c.y.push_back(s.theta(j) * 180.0 / M_PI);
+      jmin = std::min(jmin, c.y.back());
+      jmax = std::max(jmax, c.y.back());
+    }
+    jp.curves.push_back(std::move(c));
+  }
+  return jp;
+}
+
+/// "joints": the joint angles of each run on common angle limits.
+plot::Figure joints_figure(const Model& model, const std::vector<CaptureRun>& runs) {
+  plot::Figure joints;
+  joints.name = "joints";
+  joints.title = "Capture process: joint angles";
+  // side by side for one or two runs; stacked for more (three columns leave the last panel, which
+  // carries the legend outside, too narrow a viewport: PLplot aborts)
+  joints.cols = runs.size() <= 2 ? static_cast<int>(std::max<size_t>(1, runs.size())) : 1;
+  joints.rows = runs.size() <= 2 ? 1 : static_cast<int>(runs.size());
+  std::vector<Panel> joint_panels;
+  double jmin = 1e300, jmax = -1e300;
+  for (size_t r = 0; r < runs.size(); ++r)
+    joint_panels.push_back(joint_panel(model, runs[r], r + 1 == runs.size(), jmin, jmax));
   const double pad = 0.06 * std::max(1.0, jmax - jmin);
   for (auto& jp : joint_panels) {
     double tmax = 0;
@@ -356,9 +364,29 @@ std::vector<plot::Figure> capture(const Model& model, int frame, const Target& t
     jp.limits = {0.0, std::max(tmax, 1e-9), jmin - pad, jmax + pad};
     joints.panels.emplace_back(std::move(jp));
   }
-  for (Panel* p : {&mie, &fmax, &drift, &sigma}) h.panels.emplace_back(std::move(*p));
-  out.push_back(std::move(h));
-  out.push_back(std::move(joints));
+  return joints;
+}
+
+}  // namespace
+
+std::vector<plot::Figure> capture(const Model& model, int frame, const Target& target_at_start,
+                                  double duration, const std::vector<CaptureRun>& runs) {
+  Data data(model);
+  const Target target = propagate_target(target_at_start, duration);
+  const bool planar = planar_motion(model, data, target.contact_point().z(), runs);
+  double reach = 0;
+  for (int i = 1; i < model.nb(); ++i) reach += model.body(i).tree.p.norm();
+  const Drawing target_at_T = target_drawing(target, planar, std::max(0.2, 0.12 * reach));
+
+  std::vector<plot::Figure> out;
+  for (size_t r = 0; r < runs.size(); ++r) {
+    RunDrawings d = run_drawings(model, data, frame, *runs[r].result, target_at_T, planar);
+    d.color = static_cast<int>(r);
+    d.duration = duration;
+    out.push_back(capture_figure(runs[r].label, *runs[r].result, d));
+  }
+  out.push_back(histories(model, data, frame, runs));
+  out.push_back(joints_figure(model, runs));
   return out;
 }
 
@@ -368,13 +396,9 @@ plot::Figure contact(const std::vector<ContactCurve>& curves, double M_ie, doubl
   fig.title = str("Contact force (multibody run): M#die#u = ", fixed(M_ie, 3),
                   " kg, δ̇⁻ = ", fixed(approach_velocity, 3), " m/s");
   fig.cols = 2;
-  Panel loop, time;
-  loop.title = "F-δ hysteresis loop (Figure 3)";
-  loop.xlabel = "deformation δ (mm)";
-  loop.ylabel = "contact force F (kN)";
-  time.title = "force history (colours as on the left)";
-  time.xlabel = "time from first touch (ms)";
-  time.ylabel = "contact force F (kN)";
+  Panel loop = labelled("F-δ hysteresis loop (Figure 3)", "deformation δ (mm)", "contact force F (kN)"),
+        time = labelled("force history (colours as on the left)", "time from first touch (ms)",
+                        "contact force F (kN)");
   const bool one = curves.size() == 1;
   std::vector<Curve> markers;
   for (size_t k = 0; k < curves.size(); ++k) {

@@ -38,24 +38,30 @@ void require_available(const std::string& flag) {
                          "-DFFSR_WITH_PLOT=OFF); install libplplot-dev and plplot-driver-cairo and rebuild"));
 }
 
+namespace {
+/// Each format's file extension (as --plot-format spells it) and PLplot device.
+struct FormatNames {
+  Format format;
+  const char* extension;
+  const char* device;
+};
+constexpr FormatNames kFormats[] = {
+    {Format::Png, "png", "pngcairo"}, {Format::Svg, "svg", "svgcairo"}, {Format::Pdf, "pdf", "pdfcairo"}};
+
+const FormatNames& names_of(Format f) {
+  for (const auto& n : kFormats)
+    if (n.format == f) return n;
+  return kFormats[0];
+}
+}  // namespace
+
 Format parse_format(const std::string& text, const std::string& flag) {
-  if (text == "png") return Format::Png;
-  if (text == "svg") return Format::Svg;
-  if (text == "pdf") return Format::Pdf;
+  for (const auto& n : kFormats)
+    if (text == n.extension) return n.format;
   throw InputError(str(flag, ": unknown format '", text, "'; expected png, svg or pdf"));
 }
 
-const char* extension(Format f) {
-  switch (f) {
-    case Format::Png:
-      return "png";
-    case Format::Svg:
-      return "svg";
-    case Format::Pdf:
-      return "pdf";
-  }
-  return "png";
-}
+const char* extension(Format f) { return names_of(f).extension; }
 
 void check_folder(const std::string& dir, const std::string& flag) {
   std::error_code ec;
@@ -93,17 +99,7 @@ constexpr int kText = 1, kFirst = 2, kScratch = 10, kGrey = 11;
 // text size relative to PLplot's default: readable at 100 % on a 1000 x 700 page
 constexpr double kScale = 0.75;
 
-const char* device(Format f) {
-  switch (f) {
-    case Format::Png:
-      return "pngcairo";
-    case Format::Svg:
-      return "svgcairo";
-    case Format::Pdf:
-      return "pdfcairo";
-  }
-  return "pngcairo";
-}
+const char* device(Format f) { return names_of(f).device; }
 
 /// The data range of several arrays, with a relative margin; a flat range is widened.
 void range(const std::vector<const std::vector<double>*>& arrays, double margin, double& lo, double& hi) {
@@ -530,106 +526,139 @@ std::string read_text(const std::string& path) {
   return s.str();
 }
 
-}  // namespace
-
-std::vector<std::string> render(const std::vector<Figure>& figures, const std::string& dir, Format format) {
-  namespace fs = std::filesystem;
-  std::string tmpl = (fs::path(dir) / ".ffsr-plot-XXXXXX").string();
-  if (!::mkdtemp(tmpl.data())) throw InputError(str("--plot: cannot write into folder '", dir, "'"));
-  const fs::path tmp(tmpl);
-  auto cleanup = [&] {
+/// A fresh folder inside `dir` for the drawing process's files, removed with everything in it when
+/// this object goes (the finished figures are moved out first).
+class ScratchFolder {
+ public:
+  explicit ScratchFolder(const std::string& dir) {
+    std::string tmpl = (std::filesystem::path(dir) / ".ffsr-plot-XXXXXX").string();
+    if (!::mkdtemp(tmpl.data())) throw InputError(str("--plot: cannot write into folder '", dir, "'"));
+    path_ = tmpl;
+  }
+  ~ScratchFolder() {
     std::error_code ec;
-    fs::remove_all(tmp, ec);
-  };
-  const std::string log = (tmp / "plplot.log").string();
-  std::vector<std::string> names;
-  for (const auto& f : figures) names.push_back(f.name + "." + extension(format));
+    std::filesystem::remove_all(path_, ec);
+  }
+  ScratchFolder(const ScratchFolder&) = delete;
+  ScratchFolder& operator=(const ScratchFolder&) = delete;
+  const std::filesystem::path& path() const { return path_; }
 
+ private:
+  std::filesystem::path path_;
+};
+
+/// The drawing process: PLplot's chatter goes to `log`, never to our stdout (exit() from PLplot is
+/// fine here); before each figure "@@figure NAME", on an error of ours "@@error WHY". Never returns.
+[[noreturn]] void draw_in_child(const std::vector<Figure>& figures, const std::vector<std::string>& names,
+                                const std::filesystem::path& tmp, const std::string& log, Format format) {
+  const int null_fd = ::open("/dev/null", O_WRONLY);
+  const int log_fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
+  if (null_fd < 0 || log_fd < 0) ::_exit(4);
+  ::dup2(null_fd, 1);
+  ::dup2(log_fd, 2);
+  try {
+    if (!driver_present(device(format))) {
+      std::fprintf(stderr, "@@error PLplot has no '%s' driver (install plplot-driver-cairo)\n",
+                   device(format));
+      ::_exit(5);
+    }
+    for (size_t k = 0; k < figures.size(); ++k) {
+      const std::string path = (tmp / names[k]).string();
+      std::fprintf(stderr, "@@figure %s\n", names[k].c_str());
+      std::fflush(stderr);
+      render_one(figures[k], path, format);
+    }
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "@@error %s\n", e.what());
+    std::fflush(stderr);
+    ::_exit(6);
+  }
+  std::fflush(stderr);
+  ::_exit(0);
+}
+
+/// Runs draw_in_child in a forked process and returns its wait status.
+int draw_in_process(const std::vector<Figure>& figures, const std::vector<std::string>& names,
+                    const std::filesystem::path& tmp, const std::string& log, Format format) {
   std::cout.flush();
   std::cerr.flush();
   std::fflush(nullptr);
   const pid_t pid = ::fork();
-  if (pid < 0) {
-    cleanup();
-    throw InputError("--plot: cannot start the drawing process (fork failed)");
-  }
-  if (pid == 0) {
-    // child: PLplot's chatter goes to a log file, never to our stdout; exit() from PLplot is fine here
-    const int null_fd = ::open("/dev/null", O_WRONLY);
-    const int log_fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
-    if (null_fd < 0 || log_fd < 0) ::_exit(4);
-    ::dup2(null_fd, 1);
-    ::dup2(log_fd, 2);
-    try {
-      if (!driver_present(device(format))) {
-        std::fprintf(stderr, "@@error PLplot has no '%s' driver (install plplot-driver-cairo)\n",
-                     device(format));
-        ::_exit(5);
-      }
-      for (size_t k = 0; k < figures.size(); ++k) {
-        const std::string path = (tmp / names[k]).string();
-        std::fprintf(stderr, "@@figure %s\n", names[k].c_str());
-        std::fflush(stderr);
-        render_one(figures[k], path, format);
-      }
-    } catch (const std::exception& e) {
-      std::fprintf(stderr, "@@error %s\n", e.what());
-      std::fflush(stderr);
-      ::_exit(6);
-    }
-    std::fflush(stderr);
-    ::_exit(0);
-  }
+  if (pid < 0) throw InputError("--plot: cannot start the drawing process (fork failed)");
+  if (pid == 0) draw_in_child(figures, names, tmp, log, format);
   int status = 0;
   while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
   }
-  // what the child said: the figure it was drawing, an error of ours, PLplot's own messages
+  return status;
+}
+
+/// What the drawing process said in its log: the figure it was drawing, an error of ours, PLplot's
+/// own first message.
+struct ChildReport {
   std::string current, error, plplot_message;
-  {
-    std::istringstream in(read_text(log));
-    for (std::string line; std::getline(in, line);) {
-      if (line.rfind("@@figure ", 0) == 0)
-        current = line.substr(9);
-      else if (line.rfind("@@error ", 0) == 0)
-        error = line.substr(8);
-      else if (!line.empty() && line.find_first_not_of(" *") != std::string::npos && plplot_message.empty())
-        plplot_message = line;
-      if (line.find("PLPLOT ERROR") != std::string::npos || line.find("ABORTING") != std::string::npos) {
-        if (error.empty()) error = "PLplot: " + line;
-      }
+};
+
+ChildReport read_report(const std::string& log) {
+  ChildReport r;
+  std::istringstream in(read_text(log));
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind("@@figure ", 0) == 0)
+      r.current = line.substr(9);
+    else if (line.rfind("@@error ", 0) == 0)
+      r.error = line.substr(8);
+    else if (!line.empty() && line.find_first_not_of(" *") != std::string::npos && r.plplot_message.empty())
+      r.plplot_message = line;
+    if (line.find("PLPLOT ERROR") != std::string::npos || line.find("ABORTING") != std::string::npos) {
+      if (r.error.empty()) r.error = "PLplot: " + line;
     }
   }
-  const bool ok = WIFEXITED(status) && WEXITSTATUS(status) == 0 && error.empty();
-  if (!ok) {
-    cleanup();
-    const std::string file = current.empty() ? dir : (fs::path(dir) / current).string();
-    std::string why = !error.empty() ? error : !plplot_message.empty() ? "PLplot: " + plplot_message : "";
-    if (why.empty())
-      why = WIFSIGNALED(status) ? str("the drawing process died (signal ", WTERMSIG(status), ")")
-                                : str("the drawing process failed (exit ", WEXITSTATUS(status), ")");
-    throw InputError(str("--plot: cannot draw ", file, ": ", why));
+  return r;
+}
+
+/// InputError naming the figure being drawn and why, unless the process drew everything.
+void check_drawn(int status, const ChildReport& r, const std::string& dir) {
+  if (WIFEXITED(status) && WEXITSTATUS(status) == 0 && r.error.empty()) return;
+  const std::string file = r.current.empty() ? dir : (std::filesystem::path(dir) / r.current).string();
+  std::string why = !r.error.empty()            ? r.error
+                    : !r.plplot_message.empty() ? "PLplot: " + r.plplot_message
+                                                : "";
+  if (why.empty())
+    why = WIFSIGNALED(status) ? str("the drawing process died (signal ", WTERMSIG(status), ")")
+                              : str("the drawing process failed (exit ", WEXITSTATUS(status), ")");
+  throw InputError(str("--plot: cannot draw ", file, ": ", why));
+}
+
+/// Moves the figures from the scratch folder into `dir` once every one of them exists.
+std::vector<std::string> move_into(const std::string& dir, const std::filesystem::path& tmp,
+                                   const std::vector<std::string>& names) {
+  namespace fs = std::filesystem;
+  for (const auto& n : names) {
+    std::error_code ec;
+    const fs::path from = tmp / n;
+    if (!fs::is_regular_file(from, ec) || fs::file_size(from, ec) == 0)
+      throw InputError(str("--plot: cannot draw ", (fs::path(dir) / n).string(), ": PLplot wrote no file"));
   }
   std::vector<std::string> written;
   for (const auto& n : names) {
     std::error_code ec;
-    const fs::path from = tmp / n;
-    if (!fs::is_regular_file(from, ec) || fs::file_size(from, ec) == 0) {
-      cleanup();
-      throw InputError(str("--plot: cannot draw ", (fs::path(dir) / n).string(), ": PLplot wrote no file"));
-    }
-  }
-  for (const auto& n : names) {
-    std::error_code ec;
     const fs::path to = fs::path(dir) / n;
     fs::rename(tmp / n, to, ec);
-    if (ec) {
-      cleanup();
-      throw InputError(str("--plot: cannot write ", to.string(), ": ", ec.message()));
-    }
+    if (ec) throw InputError(str("--plot: cannot write ", to.string(), ": ", ec.message()));
     written.push_back(to.string());
   }
-  cleanup();
   return written;
+}
+
+}  // namespace
+
+std::vector<std::string> render(const std::vector<Figure>& figures, const std::string& dir, Format format) {
+  const ScratchFolder tmp(dir);
+  const std::string log = (tmp.path() / "plplot.log").string();
+  std::vector<std::string> names;
+  for (const auto& f : figures) names.push_back(f.name + "." + extension(format));
+  const int status = draw_in_process(figures, names, tmp.path(), log, format);
+  check_drawn(status, read_report(log), dir);
+  return move_into(dir, tmp.path(), names);
 }
 
 #else  // built without PLplot

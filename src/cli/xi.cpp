@@ -30,19 +30,39 @@ std::vector<double> spaced(double a, double b, int n, bool log) {
   return v;
 }
 
-int run_xi(const XiOptions& o) {
+/// The three studies of Figures 4-6, checked: the fixed contact parameters, the laws, and for each
+/// study the values of the varied parameter (xi still empty).
+struct XiSetup {
+  ContactParams base;
+  double approach_speed = 0;
+  plot::Format plot_format = plot::Format::Png;
+  std::vector<figures::XiStudy> studies;
+};
+
+/// The varied parameter of each study as the CSV names it; the study is xi_<column>.
+constexpr const char* kColumns[] = {"stiffness", "approach_speed", "restitution"};
+
+/// One study of `laws` against `x`.
+figures::XiStudy study(const char* column, std::string title, std::string xlabel, bool log_x,
+                       std::vector<double> x, const std::vector<std::string>& laws) {
+  return {std::string("xi_") + column, std::move(title), std::move(xlabel), log_x, std::move(x), laws, {}};
+}
+
+XiSetup parse(const XiOptions& o) {
   using detail::str;
   if (o.points < 2 || o.points > 100000)
     throw InputError(str("--points: expected 2 to 100000, got ", o.points));
-  const ContactParams base{o.stiffness, o.exponent, o.restitution};
+  XiSetup s;
+  s.base = {o.stiffness, o.exponent, o.restitution};
   try {
-    validate(base, "contact");
+    validate(s.base, "contact");
   } catch (const InputError& e) {
     throw InputError(str("--stiffness/--exponent/--restitution: ", e.what()));
   }
   if (!std::isfinite(o.approach_speed) || o.approach_speed <= 0)
     throw InputError(str("--approach-speed: must be positive and finite, got ", o.approach_speed));
-  const plot::Format plot_format = plot::check_request(o.plot, o.plot_format);
+  s.approach_speed = o.approach_speed;
+  s.plot_format = plot::check_request(o.plot, o.plot_format);
   std::vector<std::string> laws;
   for (auto n : contact_law_names()) laws.emplace_back(n);
   auto g = [](double x) {
@@ -53,56 +73,59 @@ int run_xi(const XiOptions& o) {
   const std::string fixed_k = "K = " + g(o.stiffness) + " N/m^" + g(o.exponent),
                     fixed_v = "δ̇⁻ = " + g(o.approach_speed) + " m/s",
                     fixed_c = "c#dr#u = " + g(o.restitution);
-  std::vector<figures::XiStudy> studies(3);
-  studies[0] = {"xi_stiffness",
-                "ξ against K (Figure 4): " + fixed_v + ", " + fixed_c,
-                "contact stiffness K (N/m^α)",
-                true,
-                spaced(1e7, 1e11, o.points, true),
-                laws,
-                {}};
-  studies[1] = {"xi_approach_speed",
-                "ξ against δ̇⁻ (Figure 5): " + fixed_k + ", " + fixed_c,
-                "initial relative contact velocity δ̇⁻ (m/s)",
-                true,
-                spaced(0.01, 1.0, o.points, true),
-                laws,
-                {}};
-  studies[2] = {"xi_restitution",
-                "ξ against c#dr#u (Figure 6): " + fixed_k + ", " + fixed_v,
-                "coefficient of restitution c#dr#u",
-                false,
-                spaced(0.1, 1.0, o.points, false),
-                laws,
-                {}};
-  std::ostringstream csv;
-  csv << std::setprecision(12) << "study,parameter,law,xi_percent\n";
-  const char* column[] = {"stiffness", "approach_speed", "restitution"};
-  for (size_t s = 0; s < studies.size(); ++s) {
-    auto& st = studies[s];
-    st.xi.assign(laws.size(), {});
-    for (size_t l = 0; l < laws.size(); ++l)
+  s.studies = {
+      study(kColumns[0], "ξ against K (Figure 4): " + fixed_v + ", " + fixed_c, "contact stiffness K (N/m^α)",
+            true, spaced(1e7, 1e11, o.points, true), laws),
+      study(kColumns[1], "ξ against δ̇⁻ (Figure 5): " + fixed_k + ", " + fixed_c,
+            "initial relative contact velocity δ̇⁻ (m/s)", true, spaced(0.01, 1.0, o.points, true), laws),
+      study(kColumns[2], "ξ against c#dr#u (Figure 6): " + fixed_k + ", " + fixed_v,
+            "coefficient of restitution c#dr#u", false, spaced(0.1, 1.0, o.points, false), laws)};
+  return s;
+}
+
+/// Fills xi[law][k] of each study: study 0 varies K, study 1 delta_dot^-, study 2 c_r.
+void compute(XiSetup& s) {
+  for (size_t k = 0; k < s.studies.size(); ++k) {
+    auto& st = s.studies[k];
+    st.xi.assign(st.laws.size(), {});
+    for (size_t l = 0; l < st.laws.size(); ++l)
       for (double x : st.x) {
-        ContactParams p = base;
-        double v = o.approach_speed;
-        if (s == 0) p.K = x;
-        if (s == 1) v = x;
-        if (s == 2) p.c_r = x;
-        const double xi = relative_error(make_contact_law(laws[l], p, v));
-        st.xi[l].push_back(xi);
-        csv << column[s] << "," << x << "," << laws[l] << "," << xi << "\n";
+        ContactParams p = s.base;
+        double v = s.approach_speed;
+        if (k == 0) p.K = x;
+        if (k == 1) v = x;
+        if (k == 2) p.c_r = x;
+        st.xi[l].push_back(relative_error(make_contact_law(st.laws[l], p, v)));
       }
   }
+}
+
+/// The figures (when asked), then the CSV study,parameter,law,xi_percent to its file or stdout.
+int report(const XiOptions& o, const XiSetup& s) {
   if (!o.plot.empty()) {
     std::vector<plot::Figure> figs;
-    for (const auto& st : studies) figs.push_back(figures::xi(st));
-    plot::render(figs, o.plot, plot_format);
+    for (const auto& st : s.studies) figs.push_back(figures::xi(st));
+    plot::render(figs, o.plot, s.plot_format);
+  }
+  std::ostringstream csv;
+  csv << std::setprecision(12) << "study,parameter,law,xi_percent\n";
+  for (size_t k = 0; k < s.studies.size(); ++k) {
+    const auto& st = s.studies[k];
+    for (size_t l = 0; l < st.laws.size(); ++l)
+      for (size_t i = 0; i < st.x.size(); ++i)
+        csv << kColumns[k] << "," << st.x[i] << "," << st.laws[l] << "," << st.xi[l][i] << "\n";
   }
   if (o.csv.empty())
     std::cout << csv.str();
   else
     write_file_atomic(o.csv, csv.str());
   return 0;
+}
+
+int run_xi(const XiOptions& o) {
+  XiSetup s = parse(o);
+  compute(s);
+  return report(o, s);
 }
 
 }  // namespace

@@ -1,10 +1,10 @@
 // ffsr/uncertainty/detail/sampling.hxx -- bodies of ffsr/uncertainty/sampling.hpp.
 #pragma once
 
-#include <exception>
+#include "ffsr/detail/parallel.hpp"
+
 #include <iomanip>
 #include <sstream>
-#include <mutex>
 
 namespace ffsr {
 
@@ -566,44 +566,11 @@ inline void parallel_for(std::uint64_t begin, std::uint64_t end, int threads,
                          const std::function<void(std::uint64_t)>& f,
                          const std::function<void(std::uint64_t)>& progress) {
   if (end <= begin) return;
-  std::atomic<std::uint64_t> next{begin}, done{0};
-  std::atomic<bool> stop{false};
-  std::mutex mutex;
-  std::exception_ptr error;
-  std::uint64_t error_index = end;
-  auto work = [&] {
-    for (;;) {
-      const std::uint64_t i = next.fetch_add(1);
-      if (i >= end || stop.load()) return;
-      try {
-        f(i);
-      } catch (...) {
-        std::lock_guard<std::mutex> lock(mutex);
-        if (i < error_index) {
-          error_index = i;
-          error = std::current_exception();
-        }
-        stop = true;
-      }
-      done.fetch_add(1);
-    }
-  };
-  const int nt = std::max(1, threads);
-  if (nt == 1 && !progress) {
-    work();
-  } else {
-    std::vector<std::thread> pool;
-    for (int k = 0; k < nt; ++k) pool.emplace_back(work);
-    if (progress) {
-      while (done.load() < end - begin && !stop.load()) {
-        std::this_thread::sleep_for(std::chrono::milliseconds(50));
-        progress(done.load());
-      }
-    }
-    for (auto& t : pool) t.join();
-    if (progress && !error) progress(done.load());
-  }
-  if (error) std::rethrow_exception(error);
+  detail::ParallelOptions options;  // one index per chunk: the first error by index is rethrown
+  options.progress = progress;
+  detail::parallel_for(
+      end - begin, static_cast<unsigned>(std::max(1, threads)), [&](std::uint64_t i) { f(begin + i); },
+      options);
 }
 
 inline double robust_force_p95(const Model& model, Data& data, const BasePose& base,
