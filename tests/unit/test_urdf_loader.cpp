@@ -1,8 +1,11 @@
 // tests/unit/test_urdf_loader.cpp -- the named steps of the URDF loader and of ModelBuilder, each
 // alone: link merging (composite inertia), mimic resolution, locked values through mimic chains,
-// inertia repairs (each one reported), the document checks. Expected values come from identities
+// inertia repairs (each one reported), the document checks; and the steps of the contact
+// simulations (scaled right-hand side, Hertz time, running maxima). Expected values come from identities
 // and from sums computed here independently, never from the code under test.
 #include "ffsr/io/urdf.hpp"
+#include "ffsr/simulate/multibody.hpp"
+#include "ffsr/simulate/single_body.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -190,4 +193,36 @@ TEST_CASE("the document checks: two parents, and the bus options", "[urdf_loader
   bus.mass = 10;
   bus.inertia = Vector3(1, 1, 1).asDiagonal();
   CHECK_NOTHROW(detail::validate_bus(bus));
+}
+
+TEST_CASE("single-body steps: the scaled right-hand side is Eq. 16 in SI units", "[urdf_loader][simulate]") {
+  const HertzDamped<HuntCrossley> law({1e9, 1.5, 0.5}, 0.2);
+  const double M_ie = 40.0;
+  const auto s = detail::single_body_scaling(law, M_ie);
+  CHECK(s.delta_ref == law.max_deformation(M_ie));
+  CHECK(s.v0 == 0.2);
+  const cvode::Rhs rhs = detail::single_body_rhs(s);
+  for (const auto& [x, v] : {std::pair{0.0, 1.0}, std::pair{0.5, 0.7}, std::pair{0.9, -0.3}}) {
+    Eigen::Vector2d y(x, v), ydot;
+    rhs(0.0, y, ydot);
+    CHECK(ydot[0] == v);
+    // Back in SI units: δ̈ = ydot[1] v0^2 / δ_ref, and M_ie δ̈ = -F(δ, δ̇) (Eq. 16); relative 1e-12.
+    const double F = law.force(s.delta_ref * x, s.v0 * v);
+    CHECK(M_ie * ydot[1] * s.v0 * s.v0 / s.delta_ref == Approx(-F).epsilon(1e-12).margin(1e-9));
+  }
+}
+
+TEST_CASE("multibody steps: Hertz time and running maxima", "[urdf_loader][simulate]") {
+  // A linear spring (alpha = 1): the time scale is sqrt(M/K), whatever the speed.
+  for (double vin : {0.01, 0.3, 2.0})
+    CHECK(detail::hertz_time({4e6, 1.0, 1.0}, 25.0, vin) == Approx(std::sqrt(25.0 / 4e6)).epsilon(1e-14));
+  MultibodyContactResult res;
+  detail::record_contact_sample(res, 0.1, 5.0, 1e-5, true);
+  detail::record_contact_sample(res, 0.2, 9.0, 2e-5, true);
+  detail::record_contact_sample(res, 0.3, 7.0, 3e-5, false);
+  CHECK(res.f_max == 9.0);
+  CHECK(res.t_at_f_max == 0.2);
+  CHECK(res.delta_at_f_max == 2e-5);
+  CHECK(res.delta_max == 3e-5);
+  CHECK(res.series.size() == 2);
 }
