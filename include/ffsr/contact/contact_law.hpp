@@ -437,41 +437,50 @@ inline AnyContactLaw make_contact_law(std::string_view name, const ContactParams
   return detail::make_contact_law_impl(name, p, approach_velocity);
 }
 
+namespace detail {
+/// Evaluates `quantity` (a generic lambda taking the law) on the law the variant holds: the one
+/// dispatch behind the run-time functions below, each the law's member of the same name.
+template <class Quantity>
+decltype(auto) visit_law(const AnyContactLaw& law, Quantity&& quantity) {
+  return std::visit(std::forward<Quantity>(quantity), law);
+}
+}  // namespace detail
+
 inline std::string_view contact_law_name(const AnyContactLaw& law) {
-  return std::visit([](const auto& l) { return l.name; }, law);
+  return detail::visit_law(law, [](const auto& l) { return l.name; });
 }
 inline double force(const AnyContactLaw& law, double delta, double delta_dot) {
-  return std::visit([&](const auto& l) { return l.force(delta, delta_dot); }, law);
+  return detail::visit_law(law, [&](const auto& l) { return l.force(delta, delta_dot); });
 }
 inline double damping_factor(const AnyContactLaw& law) {
-  return std::visit([](const auto& l) { return l.f(); }, law);
+  return detail::visit_law(law, [](const auto& l) { return l.f(); });
 }
 inline double lambda(const AnyContactLaw& law) {
-  return std::visit([](const auto& l) { return l.lambda(); }, law);
+  return detail::visit_law(law, [](const auto& l) { return l.lambda(); });
 }
 inline double approach_velocity(const AnyContactLaw& law) {
-  return std::visit([](const auto& l) { return l.approach_velocity(); }, law);
+  return detail::visit_law(law, [](const auto& l) { return l.approach_velocity(); });
 }
 inline double max_deformation(const AnyContactLaw& law, double M_ie) {
-  return std::visit([&](const auto& l) { return l.max_deformation(M_ie); }, law);
+  return detail::visit_law(law, [&](const auto& l) { return l.max_deformation(M_ie); });
 }
 inline double max_force_estimate(const AnyContactLaw& law, double M_ie) {
-  return std::visit([&](const auto& l) { return l.max_force_estimate(M_ie); }, law);
+  return detail::visit_law(law, [&](const auto& l) { return l.max_force_estimate(M_ie); });
 }
 inline double zeta(const AnyContactLaw& law) {
-  return std::visit([](const auto& l) { return l.zeta(); }, law);
+  return detail::visit_law(law, [](const auto& l) { return l.zeta(); });
 }
 inline double max_force_closed_form(const AnyContactLaw& law, double M_ie) {
-  return std::visit([&](const auto& l) { return l.max_force_closed_form(M_ie); }, law);
+  return detail::visit_law(law, [&](const auto& l) { return l.max_force_closed_form(M_ie); });
 }
 inline ForcePeak exact_peak(const AnyContactLaw& law, double M_ie) {
-  return std::visit([&](const auto& l) { return l.exact_peak(M_ie); }, law);
+  return detail::visit_law(law, [&](const auto& l) { return l.exact_peak(M_ie); });
 }
 inline double max_force_exact(const AnyContactLaw& law, double M_ie) {
-  return std::visit([&](const auto& l) { return l.max_force_exact(M_ie); }, law);
+  return detail::visit_law(law, [&](const auto& l) { return l.max_force_exact(M_ie); });
 }
 inline double relative_error(const AnyContactLaw& law) {
-  return std::visit([](const auto& l) { return l.relative_error(); }, law);
+  return detail::visit_law(law, [](const auto& l) { return l.relative_error(); });
 }
 
 inline double approach_velocity(const Eigen::Vector3d& u, const Eigen::Vector3d& v_e,

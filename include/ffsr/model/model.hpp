@@ -110,6 +110,31 @@ inline void validate_inertia(const Inertia& in, const std::string& what, bool re
         str(what, ": principal moments (", e(0), ", ", e(1), ", ", e(2), ") break the triangle inequality"));
 }
 
+namespace detail {
+
+/// The inertia `in` of a link expressed in the frame where the link frame has pose `pose`: the
+/// centre of mass moved and the rotational inertia (about it) rotated, I' = R I R^T.
+inline Inertia inertia_in_frame(const Inertia& in, const Pose& pose) {
+  return {in.mass, pose.p + pose.R * in.com, pose.R * in.I * pose.R.transpose()};
+}
+
+/// The composite inertia of two bodies given in the same frame (the link merging of a fixed
+/// joint): masses add, the centre of mass is the mass-weighted mean c, and each rotational
+/// inertia moves to c by the parallel-axis theorem, I_c = I + m (|d|^2 1 - d d^T), d = com - c
+/// (RBDA 2.12). Two massless bodies give zero mass and the sum of their inertias.
+inline Inertia merged_inertia(const Inertia& a, const Inertia& b) {
+  const double m = a.mass + b.mass;
+  if (m <= 0) return {0.0, Vector3::Zero(), a.I + b.I};
+  const Vector3 c = (a.mass * a.com + b.mass * b.com) / m;
+  auto about_c = [&](const Inertia& x) {
+    const Vector3 d = x.com - c;
+    return Matrix3(x.I + x.mass * (d.squaredNorm() * Matrix3::Identity() - d * d.transpose()));
+  };
+  return {m, c, about_c(a) + about_c(b)};
+}
+
+}  // namespace detail
+
 class ModelBuilder;
 
 /// A free-floating multibody tree. Constant after it is built (see ModelBuilder).
@@ -218,7 +243,7 @@ class ModelBuilder {
     validate_inertia(inertia, "link '" + child + "'", false);
     const Pose pose = pf.pose * origin;
     Inertia& target = model_.bodies_[static_cast<size_t>(pf.body)].inertia;
-    target = merge(target, transformed(inertia, pose));
+    target = detail::merged_inertia(target, detail::inertia_in_frame(inertia, pose));
     frame_parent_.push_back(frame_position(parent));
     model_.frames_.push_back({child, pf.body, pose});
     return *this;
@@ -310,19 +335,6 @@ class ModelBuilder {
   static void check_pose(const Pose& p, const std::string& what) {
     if (!p.p.allFinite() || !p.R.allFinite()) throw ModelError(what + ": values must be finite");
   }
-  static Inertia transformed(const Inertia& in, const Pose& pose) {
-    return {in.mass, pose.p + pose.R * in.com, pose.R * in.I * pose.R.transpose()};
-  }
-  static Inertia merge(const Inertia& a, const Inertia& b) {
-    const double m = a.mass + b.mass;
-    if (m <= 0) return {0.0, Vector3::Zero(), a.I + b.I};
-    const Vector3 c = (a.mass * a.com + b.mass * b.com) / m;
-    auto about_c = [&](const Inertia& x) {
-      const Vector3 d = x.com - c;
-      return Matrix3(x.I + x.mass * (d.squaredNorm() * Matrix3::Identity() - d * d.transpose()));
-    };
-    return {m, c, about_c(a) + about_c(b)};
-  }
   std::vector<std::string> leaf_frames(const Model& m) const {
     // A leaf is a link frame that is no other link's parent (fixed children count as children).
     std::vector<char> is_parent(m.frames_.size(), 0);
@@ -338,46 +350,52 @@ class ModelBuilder {
       if (model_.frames_[i].name == name) return static_cast<int>(i);
     return -1;
   }
-  /// Resolves the mimic chains to independent joints and numbers the coordinates: every joint that
-  /// mimics no other is a coordinate, in body order; a follower takes its resolved leader's
-  /// coordinate with the composed multiplier and offset. O(bodies * chain length).
-  void resolve_mimics(Model& m) const {
-    using detail::str;
-    auto body_of = [&m](const std::string& joint) {
-      for (int i = 1; i < m.nb(); ++i)
-        if (m.bodies_[static_cast<size_t>(i)].joint.name == joint) return i;
-      return -1;
-    };
-    auto spec_of = [this](const std::string& joint) -> const MimicSpec* {
-      for (const auto& s : mimic_)
-        if (s.follower == joint) return &s;
-      return nullptr;
-    };
+  struct MimicSpec {
+    std::string follower, leader;
+    double multiplier, offset;
+  };
+  /// The body whose moving joint is named `joint`, or -1.
+  static int body_of_joint(const Model& m, const std::string& joint) {
+    for (int i = 1; i < m.nb(); ++i)
+      if (m.bodies_[static_cast<size_t>(i)].joint.name == joint) return i;
+    return -1;
+  }
+  /// The <mimic> of the follower `joint`, or null.
+  const MimicSpec* mimic_of(const std::string& joint) const {
     for (const auto& s : mimic_)
-      if (body_of(s.follower) < 0)
-        throw ModelError(str("mimic joint '", s.follower, "': not a moving joint of the model"));
-    for (int i = 1; i < m.nb(); ++i) {
-      Body& b = m.bodies_[static_cast<size_t>(i)];
-      std::vector<std::string> chain{b.joint.name};
-      double mult = 1.0, off = 0.0;
-      for (const MimicSpec* s = spec_of(b.joint.name); s; s = spec_of(chain.back())) {
-        if (body_of(s->leader) < 0)
-          throw ModelError(str("mimic joint '", s->follower, "': its leader '", s->leader,
-                               "' is not a moving joint of the model"));
-        off += mult * s->offset;  // q_f = mult * (m q_l + o) + off
-        mult *= s->multiplier;
-        for (const auto& c : chain)
-          if (c == s->leader) {
-            std::string loop;
-            for (const auto& x : chain) loop += "'" + x + "' -> ";
-            throw ModelError(str("mimic joints form a loop: ", loop, "'", s->leader, "'"));
-          }
-        chain.push_back(s->leader);
-      }
-      b.multiplier = mult;
-      b.offset = off;
-      b.leader = chain.size() > 1 ? chain.back() : std::string();
+      if (s.follower == joint) return &s;
+    return nullptr;
+  }
+  /// Follows the mimic chain of body i's joint to its independent leader and writes the body's
+  /// leader (empty for an independent joint) and the composed multiplier and offset:
+  /// q_f = mult * (m q_l + o) + off at each link of the chain. Throws ModelError for a leader that
+  /// is no moving joint, or a loop. Reads mimic_. Writes m.bodies_[i].leader, multiplier, offset.
+  void resolve_mimic_chain(Model& m, int i) const {
+    using detail::str;
+    Body& b = m.bodies_[static_cast<size_t>(i)];
+    std::vector<std::string> chain{b.joint.name};
+    double mult = 1.0, off = 0.0;
+    for (const MimicSpec* s = mimic_of(b.joint.name); s; s = mimic_of(chain.back())) {
+      if (body_of_joint(m, s->leader) < 0)
+        throw ModelError(str("mimic joint '", s->follower, "': its leader '", s->leader,
+                             "' is not a moving joint of the model"));
+      off += mult * s->offset;  // q_f = mult * (m q_l + o) + off
+      mult *= s->multiplier;
+      for (const auto& c : chain)
+        if (c == s->leader) {
+          std::string loop;
+          for (const auto& x : chain) loop += "'" + x + "' -> ";
+          throw ModelError(str("mimic joints form a loop: ", loop, "'", s->leader, "'"));
+        }
+      chain.push_back(s->leader);
     }
+    b.multiplier = mult;
+    b.offset = off;
+    b.leader = chain.size() > 1 ? chain.back() : std::string();
+  }
+  /// Numbers the coordinates: every joint without a leader is one, in body order; a follower
+  /// takes its leader's. Reads m.bodies_[i].leader. Writes m.bodies_[i].coord, m.coord_body_.
+  static void number_coordinates(Model& m) {
     m.coord_body_.clear();
     for (int i = 1; i < m.nb(); ++i) {
       Body& b = m.bodies_[static_cast<size_t>(i)];
@@ -388,13 +406,19 @@ class ModelBuilder {
     }
     for (int i = 1; i < m.nb(); ++i) {
       Body& b = m.bodies_[static_cast<size_t>(i)];
-      if (!b.leader.empty()) b.coord = m.bodies_[static_cast<size_t>(body_of(b.leader))].coord;
+      if (!b.leader.empty()) b.coord = m.bodies_[static_cast<size_t>(body_of_joint(m, b.leader))].coord;
     }
   }
-  struct MimicSpec {
-    std::string follower, leader;
-    double multiplier, offset;
-  };
+  /// Resolves the mimic chains to independent joints and numbers the coordinates: every joint that
+  /// mimics no other is a coordinate, in body order; a follower takes its resolved leader's
+  /// coordinate with the composed multiplier and offset. O(bodies * chain length).
+  void resolve_mimics(Model& m) const {
+    for (const auto& s : mimic_)
+      if (body_of_joint(m, s.follower) < 0)
+        throw ModelError(detail::str("mimic joint '", s.follower, "': not a moving joint of the model"));
+    for (int i = 1; i < m.nb(); ++i) resolve_mimic_chain(m, i);
+    number_coordinates(m);
+  }
   std::vector<MimicSpec> mimic_;
   Vector3 ee_offset_ = Vector3::Zero();
   bool has_ee_offset_ = false;

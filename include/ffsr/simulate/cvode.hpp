@@ -113,6 +113,7 @@ class Integrator {
 
  private:
   Status finish(int flag, double tret, bool one_step);
+  Status run(double t_stop, bool one_step, const char* where);
   void check_target(double t_target, const char* where) const;
   std::unique_ptr<detail::State> s_;
 };
@@ -258,6 +259,15 @@ inline void validate(const Options& o, Eigen::Index n) {
     throw InputError(str(w, ": max_order must be in 1..5 (BDF), got ", o.max_order));
 }
 
+/// One statistic of the integrator: `get` (CVodeGetNumSteps, CVodeGetLastStep...) writes it into
+/// a T; its flag is checked (IntegrationError naming `call`).
+template <class T, class Getter>
+T statistic(State& s, Getter get, const char* call) {
+  T v = 0;
+  s.check(get(s.mem.get(), &v), call);
+  return v;
+}
+
 }  // namespace detail
 
 inline Integrator::Integrator(Rhs f, const Eigen::VectorXd& y0, double t0, const Options& opt, int n_roots,
@@ -340,22 +350,23 @@ inline Integrator::Status Integrator::finish(int flag, double tret, bool one_ste
   return one_step ? Status::Step : Status::Reached;
 }
 
-inline Integrator::Status Integrator::step(double t_stop) {
-  check_target(t_stop, "cvode::Integrator::step");
+/// Integrates towards t_stop (never past it): one internal step (CV_ONE_STEP) or up to t_stop or
+/// the next root (CV_NORMAL). Reads and writes the CVODE memory and s_->t, s_->y (finish).
+inline Integrator::Status Integrator::run(double t_stop, bool one_step, const char* where) {
+  check_target(t_stop, where);
   if (t_stop == s_->t) return Status::Reached;
   s_->check(CVodeSetStopTime(s_->mem.get(), t_stop), "CVodeSetStopTime");
   sunrealtype tret = s_->t;
-  const int flag = CVode(s_->mem.get(), t_stop, s_->y_nv.get(), &tret, CV_ONE_STEP);
-  return finish(flag, tret, true);
+  const int flag = CVode(s_->mem.get(), t_stop, s_->y_nv.get(), &tret, one_step ? CV_ONE_STEP : CV_NORMAL);
+  return finish(flag, tret, one_step);
+}
+
+inline Integrator::Status Integrator::step(double t_stop) {
+  return run(t_stop, true, "cvode::Integrator::step");
 }
 
 inline Integrator::Status Integrator::advance(double tout) {
-  check_target(tout, "cvode::Integrator::advance");
-  if (tout == s_->t) return Status::Reached;
-  s_->check(CVodeSetStopTime(s_->mem.get(), tout), "CVodeSetStopTime");
-  sunrealtype tret = s_->t;
-  const int flag = CVode(s_->mem.get(), tout, s_->y_nv.get(), &tret, CV_NORMAL);
-  return finish(flag, tret, false);
+  return run(tout, false, "cvode::Integrator::advance");
 }
 
 inline void Integrator::reinit(double t0, const Eigen::VectorXd& y0) {
@@ -387,29 +398,19 @@ inline std::vector<int> Integrator::roots_found() const {
 }
 
 inline long Integrator::num_steps() const {
-  long v = 0;
-  s_->check(CVodeGetNumSteps(s_->mem.get(), &v), "CVodeGetNumSteps");
-  return v;
+  return detail::statistic<long>(*s_, CVodeGetNumSteps, "CVodeGetNumSteps");
 }
 inline long Integrator::num_rhs_evals() const {
-  long v = 0;
-  s_->check(CVodeGetNumRhsEvals(s_->mem.get(), &v), "CVodeGetNumRhsEvals");
-  return v;
+  return detail::statistic<long>(*s_, CVodeGetNumRhsEvals, "CVodeGetNumRhsEvals");
 }
 inline long Integrator::num_root_evals() const {
-  long v = 0;
-  s_->check(CVodeGetNumGEvals(s_->mem.get(), &v), "CVodeGetNumGEvals");
-  return v;
+  return detail::statistic<long>(*s_, CVodeGetNumGEvals, "CVodeGetNumGEvals");
 }
 inline double Integrator::current_time() const {
-  sunrealtype tc = 0;
-  s_->check(CVodeGetCurrentTime(s_->mem.get(), &tc), "CVodeGetCurrentTime");
-  return tc;
+  return detail::statistic<sunrealtype>(*s_, CVodeGetCurrentTime, "CVodeGetCurrentTime");
 }
 inline double Integrator::last_step() const {
-  sunrealtype h = 0;
-  s_->check(CVodeGetLastStep(s_->mem.get(), &h), "CVodeGetLastStep");
-  return h;
+  return detail::statistic<sunrealtype>(*s_, CVodeGetLastStep, "CVodeGetLastStep");
 }
 
 }  // namespace ffsr::cvode

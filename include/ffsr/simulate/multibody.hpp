@@ -226,23 +226,31 @@ inline Eigen::VectorXd approach_joint_rates(const Model& model, Data& data, cons
   return cod.solve(Vector3(approach_speed * u));
 }
 
-/// The full multibody contact simulation (see the top of this file). `theta` is the capture
-/// configuration; the target is placed so that its contact point touches the end-effector
-/// (its `position` is ignored). Throws InputError for bad arguments or receding bodies,
-/// IntegrationError for a CVODE failure, NumericalError if the bodies do not separate.
-inline MultibodyContactResult simulate_contact(const Model& model, const BasePose& base,
-                                               const Eigen::Ref<const Eigen::VectorXd>& theta, int frame,
-                                               Target target, double approach_speed,
-                                               const ContactParams& params, std::string_view law_name,
-                                               const MultibodyContactOptions& options = {}) {
-  using detail::str;
-  target.validate("simulate_contact: target");
-  validate(params, "simulate_contact");
-  detail::require_finite(approach_speed, "simulate_contact", "approach speed");
-  Data data(model);
-  const Vector3& rho = options.robot_contact_offset;
-  detail::require_finite_all(rho, "simulate_contact", "robot contact offset");
-  // place the target at the first touch
+namespace detail {
+
+/// The contact force of a law chosen at run time. One instantiation for all laws: the simulation
+/// needs only F(delta, delta_dot), and a visit per force evaluation costs nothing beside the
+/// dynamics (templating the whole run on the law would compile it eight times).
+struct AnyLawForce {
+  const AnyContactLaw& any;
+  double force(double d, double dd) const { return ffsr::force(any, d, dd); }
+};
+
+/// The robot's approach at the first touch: the integrated effective mass along u (Eq. 14, with
+/// the contact point at rho from the end-effector origin), the joint rates and base velocity.
+struct ApproachState {
+  double M_ie;
+  Eigen::VectorXd qd;
+  Vector6 xb;
+};
+
+/// Places `target` so that its contact point touches the robot's contact point (writes
+/// target.position) and returns the approach state: M_ie = 1 / (s^T M^-1 s + target's inverse mass
+/// along u), s = [u; rho x u]; theta_dot from approach_joint_rates; the base velocity from zero total
+/// momentum. Runs crba. Writes data.
+inline ApproachState approach_at_first_touch(const Model& model, Data& data, const BasePose& base,
+                                             const Eigen::Ref<const Eigen::VectorXd>& theta, int frame,
+                                             Target& target, double approach_speed, const Vector3& rho) {
   crba(model, data, base, theta);
   const Vector3 pe = frame_pose(model, data, frame).p + rho;
   const Vector3 u = target.normal_world();
@@ -258,84 +266,144 @@ inline MultibodyContactResult simulate_contact(const Model& model, const BasePos
   const double M_ie = 1.0 / (inv_me + target.inverse_mass_along_normal());
   const Eigen::VectorXd qd = approach_joint_rates(model, data, base, theta, frame, u, approach_speed, rho);
   const Vector6 xb = base_velocity_from_momentum(model, data, qd);
+  return {M_ie, qd, xb};
+}
 
-  detail::ContactSystem sys(model, base, Eigen::VectorXd(theta), frame, target, rho);
-  const Eigen::Index N = sys.size();
-  Eigen::VectorXd y0 = Eigen::VectorXd::Zero(N);
-  y0.segment<6>(sys.iv()) = xb;
-  y0.segment(sys.iv() + 6, model.n()) = qd;
+/// The state vector of `sys` at the first touch: zero displacements, the robot's base velocity
+/// `xb` and joint rates `qd`, the target's velocity and spin.
+inline Eigen::VectorXd contact_initial_state(const ContactSystem& sys, const ApproachState& start,
+                                             const Target& target) {
+  Eigen::VectorXd y0 = Eigen::VectorXd::Zero(sys.size());
+  y0.segment<6>(sys.iv()) = start.xb;
+  y0.segment(sys.iv() + 6, sys.n) = start.qd;
   y0.segment<3>(sys.it() + 6) = target.velocity;
   y0.segment<3>(sys.it() + 9) = target.angular_velocity_world();
-  const auto k0 = sys.kinematics(y0);
-  const double vin = k0.delta_dot;
+  return y0;
+}
+
+/// Hertz time scale of the contact, (M/K)^(1/(alpha+1)) v^((1-alpha)/(alpha+1)): a contact lasts
+/// a few of it.
+inline double hertz_time(const ContactParams& params, double M_ie, double vin) {
+  const double a1 = params.alpha + 1;
+  return std::pow(M_ie / params.K, 1.0 / a1) * std::pow(vin, (1.0 - params.alpha) / a1);
+}
+
+/// CVODE settings of the contact simulation: position tolerances on the displacements (robot and
+/// target), velocity tolerances on the rest, steps bounded by fractions of the Hertz time.
+inline cvode::Options contact_cvode_options(const MultibodyContactOptions& options, const ContactSystem& sys,
+                                            double t_hertz) {
+  cvode::Options co;
+  co.rtol = options.rtol;
+  co.max_num_steps = options.max_num_steps;
+  co.atol_vector = Eigen::VectorXd::Constant(sys.size(), options.atol_velocity);
+  co.atol_vector.segment(0, 6 + sys.n).setConstant(options.atol_position);
+  co.atol_vector.segment<6>(sys.it()).setConstant(options.atol_position);
+  co.initial_step = 1e-3 * t_hertz;
+  co.max_step = 0.05 * t_hertz;
+  return co;
+}
+
+/// The root functions of the contact simulation at state y. Root 0: delta (separation,
+/// decreasing); root 1: dF/dt (peak, decreasing), by a central difference of F with step h along
+/// the exact state derivative. The peak root is armed only in compression with a positive force,
+/// where the peak lies (at delta_dot = 0, dF/dt = lambda delta^alpha delta_ddot < 0): in restitution
+/// a strongly damped contact hovers at the clamp, where dF/dt vanishes on an interval, which CVODE's
+/// root finder must not see. `yd`, `yp` are scratch of the state's size.
+template <class Law>
+void contact_roots(ContactSystem& sys, const Law& law, double h, const Eigen::Ref<const Eigen::VectorXd>& y,
+                   Eigen::Ref<Eigen::VectorXd> g, Eigen::VectorXd& yd, Eigen::VectorXd& yp) {
+  const auto k = sys.kinematics(y);
+  g(0) = k.delta;
+  if (!(sys.force(law, k) > 0.0) || !(k.delta_dot > 0.0)) {
+    g(1) = -1.0;
+    return;
+  }
+  sys.rhs(law, y, yd);
+  yp = y + h * yd;
+  const double Fp = sys.force(law, sys.kinematics(yp));
+  yp = y - h * yd;
+  const double Fm = sys.force(law, sys.kinematics(yp));
+  g(1) = (Fp - Fm) / (2 * h);
+}
+
+/// Updates the running maxima of `res` (delta_max, f_max and where it occurred) with the sample
+/// (t, F, delta) and appends it to the series when `record_series`.
+inline void record_contact_sample(MultibodyContactResult& res, double t, double F, double delta,
+                                  bool record_series) {
+  res.delta_max = std::max(res.delta_max, delta);
+  if (F > res.f_max) {
+    res.f_max = F;
+    res.t_at_f_max = t;
+    res.delta_at_f_max = delta;
+  }
+  if (record_series) res.series.push_back({t, F, delta});
+}
+
+/// Writes the separation into `res`: the time, delta_dot (and restitution against `vin`), the
+/// momentum and energy of the state `y`, the number of CVODE steps.
+inline void record_separation(MultibodyContactResult& res, ContactSystem& sys, const cvode::Integrator& integ,
+                              double delta_dot, double vin) {
+  res.contact_duration = integ.t();
+  res.separation_velocity = delta_dot;
+  res.restitution = -delta_dot / vin;
+  res.momentum_end = sys.total_momentum(integ.y());
+  res.energy_end = sys.total_energy(integ.y());
+  res.steps = integ.num_steps();
+}
+
+}  // namespace detail
+
+/// The full multibody contact simulation (see the top of this file). `theta` is the capture
+/// configuration; the target is placed so that its contact point touches the end-effector
+/// (its `position` is ignored). Throws InputError for bad arguments or receding bodies,
+/// IntegrationError for a CVODE failure, NumericalError if the bodies do not separate.
+/// The steps: detail::approach_at_first_touch, contact_initial_state, contact_cvode_options,
+/// the right-hand side ContactSystem::rhs with contact_roots, then record_contact_sample at each
+/// step until the separation root (record_separation).
+inline MultibodyContactResult simulate_contact(const Model& model, const BasePose& base,
+                                               const Eigen::Ref<const Eigen::VectorXd>& theta, int frame,
+                                               Target target, double approach_speed,
+                                               const ContactParams& params, std::string_view law_name,
+                                               const MultibodyContactOptions& options = {}) {
+  using detail::str;
+  target.validate("simulate_contact: target");
+  validate(params, "simulate_contact");
+  detail::require_finite(approach_speed, "simulate_contact", "approach speed");
+  Data data(model);
+  const Vector3& rho = options.robot_contact_offset;
+  detail::require_finite_all(rho, "simulate_contact", "robot contact offset");
+  const detail::ApproachState start =
+      detail::approach_at_first_touch(model, data, base, theta, frame, target, approach_speed, rho);
+
+  detail::ContactSystem sys(model, base, Eigen::VectorXd(theta), frame, target, rho);
+  const Eigen::VectorXd y0 = detail::contact_initial_state(sys, start, target);
+  const double vin = sys.kinematics(y0).delta_dot;
   if (!(vin > 0))
     throw InputError(str("simulate_contact: the bodies do not approach (delta_dot^- = ", vin,
                          " m/s); increase the approach speed"));
   const AnyContactLaw any_law = make_contact_law(law_name, params, vin);
-
-  // One instantiation for all laws: the simulation needs only F(delta, delta_dot), and a visit per
-  // force evaluation costs nothing beside the dynamics (templating the whole run on the law would
-  // compile it eight times).
-  struct LawForce {
-    const AnyContactLaw& any;
-    double force(double d, double dd) const { return ffsr::force(any, d, dd); }
-  };
-  const LawForce law{any_law};
+  const detail::AnyLawForce law{any_law};
   MultibodyContactResult res;
   res.model = std::string(law_name);
   res.approach_velocity = vin;
-  res.integrated_effective_mass = M_ie;
-  // Hertz time scale of the contact, (M/K)^(1/(alpha+1)) v^((1-alpha)/(alpha+1)): a few of it
-  const double a1 = params.alpha + 1;
-  const double t_hertz = std::pow(M_ie / params.K, 1.0 / a1) * std::pow(vin, (1.0 - params.alpha) / a1);
+  res.integrated_effective_mass = start.M_ie;
+  const double t_hertz = detail::hertz_time(params, start.M_ie, vin);
   const double t_max = options.max_duration > 0 ? options.max_duration : 100.0 * t_hertz;
-
-  cvode::Options co;
-  co.rtol = options.rtol;
-  co.max_num_steps = options.max_num_steps;
-  co.atol_vector = Eigen::VectorXd::Constant(N, options.atol_velocity);
-  co.atol_vector.segment(0, 6 + model.n()).setConstant(options.atol_position);
-  co.atol_vector.segment<6>(sys.it()).setConstant(options.atol_position);
-  co.initial_step = 1e-3 * t_hertz;
-  co.max_step = 0.05 * t_hertz;
 
   auto rhs = [&](double, const Eigen::Ref<const Eigen::VectorXd>& y, Eigen::Ref<Eigen::VectorXd> yd) {
     sys.rhs(law, y, yd);
   };
-  // root 0: delta (separation, decreasing); root 1: dF/dt (peak, decreasing), by a central
-  // difference of F along the exact state derivative. The peak root is armed only in
-  // compression with a positive force, where the peak lies (at delta_dot = 0, dF/dt =
-  // lambda delta^alpha delta_ddot < 0): in restitution a strongly damped contact hovers at the
-  // clamp, where dF/dt vanishes on an interval, which CVODE's root finder must not see.
-  Eigen::VectorXd yd(N), yp(N);
+  Eigen::VectorXd yd(sys.size()), yp(sys.size());
   auto roots = [&](double, const Eigen::Ref<const Eigen::VectorXd>& y, Eigen::Ref<Eigen::VectorXd> g) {
-    const auto k = sys.kinematics(y);
-    g(0) = k.delta;
-    if (!(sys.force(law, k) > 0.0) || !(k.delta_dot > 0.0)) {
-      g(1) = -1.0;
-      return;
-    }
-    sys.rhs(law, y, yd);
-    const double h = 1e-6 * t_hertz;
-    yp = y + h * yd;
-    const double Fp = sys.force(law, sys.kinematics(yp));
-    yp = y - h * yd;
-    const double Fm = sys.force(law, sys.kinematics(yp));
-    g(1) = (Fp - Fm) / (2 * h);
+    detail::contact_roots(sys, law, 1e-6 * t_hertz, y, g, yd, yp);
   };
-  cvode::Integrator integ(rhs, y0, 0.0, co, 2, roots, {-1, -1});
+  cvode::Integrator integ(rhs, y0, 0.0, detail::contact_cvode_options(options, sys, t_hertz), 2, roots,
+                          {-1, -1});
   res.momentum_start = sys.total_momentum(y0);
   res.energy_start = sys.total_energy(y0);
   auto record = [&](double t, const Eigen::VectorXd& y) {
     const auto k = sys.kinematics(y);
-    const double F = sys.force(law, k);
-    res.delta_max = std::max(res.delta_max, k.delta);
-    if (F > res.f_max) {
-      res.f_max = F;
-      res.t_at_f_max = t;
-      res.delta_at_f_max = k.delta;
-    }
-    if (options.record_series) res.series.push_back({t, F, k.delta});
+    detail::record_contact_sample(res, t, sys.force(law, k), k.delta, options.record_series);
     return k;
   };
   record(0.0, y0);
@@ -343,12 +411,7 @@ inline MultibodyContactResult simulate_contact(const Model& model, const BasePos
     const auto status = integ.step(t_max);
     const auto k = record(integ.t(), integ.y());
     if (status == cvode::Integrator::Status::Root && integ.roots_found()[0] != 0 && integ.t() > 0) {
-      res.contact_duration = integ.t();
-      res.separation_velocity = k.delta_dot;
-      res.restitution = -k.delta_dot / vin;
-      res.momentum_end = sys.total_momentum(integ.y());
-      res.energy_end = sys.total_energy(integ.y());
-      res.steps = integ.num_steps();
+      detail::record_separation(res, sys, integ, k.delta_dot, vin);
       return res;
     }
     if (status == cvode::Integrator::Status::Reached) break;

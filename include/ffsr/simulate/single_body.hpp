@@ -80,91 +80,132 @@ inline SingleBodyResult simulate_single_body(const AnyContactLaw& law, double M_
 // Implementation
 // ============================================================================================
 
+namespace detail {
+
+/// The natural units of a single-body contact (file comment) and the law in them: length
+/// delta_ref = δ_max (Eq. 20), velocity v0 = δ̇⁻, time T = delta_ref / v0; the scaled acceleration
+/// is -F * accel_scale.
+template <class Damping>
+struct SingleBodyScaling {
+  const HertzDamped<Damping>* law;
+  double delta_ref, v0, T, accel_scale, f, alpha;
+  /// F [N] at the scaled state (x, v) = (δ/delta_ref, δ̇/v0).
+  double force(double x, double v) const { return law->force(delta_ref * x, v0 * v); }
+};
+
+/// The scaling of `law` with M_ie (validates M_ie through HertzDamped::max_deformation).
+template <class Damping>
+SingleBodyScaling<Damping> single_body_scaling(const HertzDamped<Damping>& law, double M_ie) {
+  const double delta_ref = law.max_deformation(M_ie);  // validates M_ie
+  const double v0 = law.approach_velocity();
+  return {&law, delta_ref, v0, delta_ref / v0, delta_ref / (M_ie * v0 * v0), law.f(), law.params().alpha};
+}
+
+/// The right-hand side of Eq. 16 in the scaled state y = (x, v): ẋ = v, v̇ = -F(x, v) accel_scale.
+template <class Damping>
+cvode::Rhs single_body_rhs(const SingleBodyScaling<Damping>& s) {
+  return [s](double, const Eigen::Ref<const Eigen::VectorXd>& y, Eigen::Ref<Eigen::VectorXd> ydot) {
+    ydot[0] = y[1];
+    ydot[1] = -s.force(y[0], y[1]) * s.accel_scale;
+  };
+}
+
+/// The event functions (file comment): g0 = (dF/dt) / (δ^(α-1) K δ̇⁻) = α v (1 + f v) + f x a,
+/// armed in compression only; g1 = v; g2 = x.
+template <class Damping>
+cvode::Roots single_body_roots(const SingleBodyScaling<Damping>& s) {
+  return [s](double, const Eigen::Ref<const Eigen::VectorXd>& y, Eigen::Ref<Eigen::VectorXd> g) {
+    const double x = y[0], v = y[1];
+    const double a = -s.force(x, v) * s.accel_scale;
+    // Armed only in compression (v > 0), where the peak lies (at v = 0, dF/dt = λ δ^α δ̈ < 0): in
+    // restitution a strongly damped contact hovers at the clamp 1 + f v = 0, where this expression
+    // vanishes on an interval and CVODE's root finder would stop (CV_ILL_INPUT).
+    g[0] = v > 0.0 ? s.alpha * v * (1.0 + s.f * v) + s.f * x * a : -1.0;
+    g[1] = v;
+    g[2] = x;
+  };
+}
+
+/// Appends the integrator's current state to `series`, in SI units.
+template <class Damping>
+void record_single_body_sample(const SingleBodyScaling<Damping>& s, const cvode::Integrator& integ,
+                               SingleBodySeries& series) {
+  const double x = integ.y()[0], v = integ.y()[1];
+  series.t.push_back(integ.t() * s.T);
+  series.force.push_back(s.force(x, v));
+  series.delta.push_back(x * s.delta_ref);
+  series.delta_dot.push_back(v * s.v0);
+}
+
+/// Which events of a single-body contact have been seen.
+struct SingleBodyEvents {
+  bool peak = false, compressed = false;
+};
+
+/// Records the events at which CVODE stopped (roots 0: force peak, the largest kept; 1: maximum
+/// deformation, the first kept; 2: separation) into `r`. Returns true at the separation, after
+/// writing the duration, separation velocity, restitution and step count; a separation before
+/// the peak and the maximum deformation is a NumericalError.
+template <class Damping>
+bool record_single_body_events(const SingleBodyScaling<Damping>& s, const cvode::Integrator& integ,
+                               SingleBodyEvents& seen, SingleBodyResult& r) {
+  const std::vector<int> info = integ.roots_found();
+  const double x = integ.y()[0], v = integ.y()[1];
+  if (info[0] != 0) {
+    const double F = s.force(x, v);
+    if (!seen.peak || F > r.f_max) {
+      r.f_max = F;
+      r.t_at_f_max = integ.t() * s.T;
+      r.delta_at_f_max = x * s.delta_ref;
+      r.delta_dot_at_f_max = v * s.v0;
+    }
+    seen.peak = true;
+  }
+  if (info[1] != 0 && !seen.compressed) {
+    r.delta_max = x * s.delta_ref;
+    r.t_at_delta_max = integ.t() * s.T;
+    seen.compressed = true;
+  }
+  if (info[2] == 0) return false;
+  if (!seen.peak || !seen.compressed)
+    throw NumericalError(str("simulate_single_body: separation at t = ", integ.t() * s.T,
+                             " s before the force peak or the maximum deformation was found"));
+  r.contact_duration = integ.t() * s.T;
+  r.separation_velocity = v * s.v0;
+  r.restitution = -v;
+  r.num_steps = integ.num_steps();
+  return true;
+}
+
+}  // namespace detail
+
+/// The steps: detail::single_body_scaling, single_body_rhs and single_body_roots for CVODE, then
+/// record_single_body_events at each event until the separation.
 template <class Damping>
 SingleBodyResult simulate_single_body(const HertzDamped<Damping>& law, double M_ie,
                                       const SingleBodyOptions& opt) {
   using detail::str;
   constexpr const char* where = "simulate_single_body";
-  const double delta_ref = law.max_deformation(M_ie);  // validates M_ie
+  const detail::SingleBodyScaling<Damping> s = detail::single_body_scaling(law, M_ie);
   if (!(opt.max_scaled_duration > 0.0) || !std::isfinite(opt.max_scaled_duration))
     throw InputError(
         str(where, ": max_scaled_duration must be positive and finite, got ", opt.max_scaled_duration));
-  const double v0 = law.approach_velocity();
-  const double T = delta_ref / v0;                          // time unit [s]
-  const double accel_scale = delta_ref / (M_ie * v0 * v0);  // scaled accel = -F * accel_scale
-  const double f = law.f();
-  const double alpha = law.params().alpha;
-
-  auto scaled_force = [&law, delta_ref, v0](double x, double v) { return law.force(delta_ref * x, v0 * v); };
-  cvode::Rhs rhs = [scaled_force, accel_scale](double, const Eigen::Ref<const Eigen::VectorXd>& y,
-                                               Eigen::Ref<Eigen::VectorXd> ydot) {
-    ydot[0] = y[1];
-    ydot[1] = -scaled_force(y[0], y[1]) * accel_scale;
-  };
-  // g0 = (dF/dt) / (δ^(α-1) K δ̇⁻) = α v (1 + f v) + f x a; g1 = v; g2 = x.
-  cvode::Roots roots = [scaled_force, accel_scale, alpha, f](double,
-                                                             const Eigen::Ref<const Eigen::VectorXd>& y,
-                                                             Eigen::Ref<Eigen::VectorXd> g) {
-    const double x = y[0], v = y[1];
-    const double a = -scaled_force(x, v) * accel_scale;
-    // Armed only in compression (v > 0), where the peak lies (at v = 0, dF/dt = λ δ^α δ̈ < 0): in
-    // restitution a strongly damped contact hovers at the clamp 1 + f v = 0, where this expression
-    // vanishes on an interval and CVODE's root finder would stop (CV_ILL_INPUT).
-    g[0] = v > 0.0 ? alpha * v * (1.0 + f * v) + f * x * a : -1.0;
-    g[1] = v;
-    g[2] = x;
-  };
-
-  cvode::Integrator integ(rhs, Eigen::Vector2d(0.0, 1.0), 0.0, opt.cvode, 3, roots, {-1, -1, -1});
-
+  cvode::Integrator integ(detail::single_body_rhs(s), Eigen::Vector2d(0.0, 1.0), 0.0, opt.cvode, 3,
+                          detail::single_body_roots(s), {-1, -1, -1});
   SingleBodyResult r;
-  auto record = [&] {
-    const double x = integ.y()[0], v = integ.y()[1];
-    r.series.t.push_back(integ.t() * T);
-    r.series.force.push_back(scaled_force(x, v));
-    r.series.delta.push_back(x * delta_ref);
-    r.series.delta_dot.push_back(v * v0);
-  };
-  if (opt.record_series) record();
-
-  bool peak = false, compressed = false;
+  if (opt.record_series) detail::record_single_body_sample(s, integ, r.series);
+  detail::SingleBodyEvents seen;
   // advance() returns only at events (three expected) or at the end; step() once per step.
   const long max_calls = opt.record_series ? opt.cvode.max_num_steps : 64;
   for (long call = 0; call < max_calls; ++call) {
     const auto status =
         opt.record_series ? integ.step(opt.max_scaled_duration) : integ.advance(opt.max_scaled_duration);
-    if (opt.record_series) record();
+    if (opt.record_series) detail::record_single_body_sample(s, integ, r.series);
     if (status == cvode::Integrator::Status::Reached)
-      throw NumericalError(str(where, ": no separation within ", opt.max_scaled_duration * T, " s (",
+      throw NumericalError(str(where, ": no separation within ", opt.max_scaled_duration * s.T, " s (",
                                opt.max_scaled_duration, " time units delta_max/v0)"));
-    if (status != cvode::Integrator::Status::Root) continue;
-    const std::vector<int> info = integ.roots_found();
-    const double x = integ.y()[0], v = integ.y()[1];
-    if (info[0] != 0) {
-      const double F = scaled_force(x, v);
-      if (!peak || F > r.f_max) {
-        r.f_max = F;
-        r.t_at_f_max = integ.t() * T;
-        r.delta_at_f_max = x * delta_ref;
-        r.delta_dot_at_f_max = v * v0;
-      }
-      peak = true;
-    }
-    if (info[1] != 0 && !compressed) {
-      r.delta_max = x * delta_ref;
-      r.t_at_delta_max = integ.t() * T;
-      compressed = true;
-    }
-    if (info[2] != 0) {
-      if (!peak || !compressed)
-        throw NumericalError(str(where, ": separation at t = ", integ.t() * T,
-                                 " s before the force peak or the maximum deformation was found"));
-      r.contact_duration = integ.t() * T;
-      r.separation_velocity = v * v0;
-      r.restitution = -v;
-      r.num_steps = integ.num_steps();
+    if (status == cvode::Integrator::Status::Root && detail::record_single_body_events(s, integ, seen, r))
       return r;
-    }
   }
   throw IntegrationError(str(where, ": no separation after ", max_calls,
                              " calls of CVODE (max_num_steps = ", opt.cvode.max_num_steps, ")"));
