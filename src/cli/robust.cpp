@@ -512,8 +512,7 @@ struct RobustRun {
 
 /// The flags and the scenario file: the keys, the [uncertainty] table (samples and seed overridden
 /// by the flags), the force model and the shard.
-RobustRun parse_robust(const RobustOptions& o) {
-  ScenarioKeys keys = read_scenario_file(o.config);
+RobustRun parse_robust(const RobustOptions& o, ScenarioKeys keys) {
   std::optional<std::uint64_t> samples_flag, seed_flag;
   if (!o.samples.empty()) samples_flag = parse_count(o.samples, "--samples");
   if (!o.seed.empty()) seed_flag = parse_count(o.seed, "--seed");
@@ -707,14 +706,39 @@ int report_robust(const RobustRun& run, const RobustOptions& o, Outputs& outputs
   return 0;
 }
 
-int run_robust(const RobustOptions& o) {
-  if (!o.merge.empty()) return run_merge(o);
-  if (o.config.empty()) throw InputError("robust: --config SCENARIO.toml is required (or --merge FILES)");
+/// robust's own keys, also allowed in a scenario file (a flag overrides the file).
+const std::set<std::string> kRobustKeys = {"force-model", "samples", "shard",       "threads", "json",
+                                           "csv",         "plot",    "plot-format", "quiet"};
+
+/// The flags, completed by the file's robust keys that no flag overrides.
+RobustOptions with_file_keys(const RobustOptions& flags, const ScenarioKeys& keys, const CLI::App& app) {
+  RobustOptions o = flags;
+  for (const auto& [name, text] : keys.extra) {
+    const std::string flag = "--" + name;
+    if (app.get_option(flag)->count() > 0) continue;
+    if (name == "force-model") o.force_model = text;
+    if (name == "samples") o.samples = text;
+    if (name == "shard") o.shard = text;
+    if (name == "threads") o.threads = static_cast<int>(detail::integer_from_text(text, flag));
+    if (name == "json") o.json = text;
+    if (name == "csv") o.csv = text;
+    if (name == "plot") o.plot = text;
+    if (name == "plot-format") o.plot_format = text;
+    if (name == "quiet") o.quiet = detail::boolean_from_text(text, flag);
+  }
+  return o;
+}
+
+int run_robust(const RobustOptions& flags, const CLI::App& app) {
+  if (!flags.merge.empty()) return run_merge(flags);
+  if (flags.config.empty()) throw InputError("robust: --config SCENARIO.toml is required (or --merge FILES)");
+  ScenarioKeys keys = read_scenario_file(flags.config, kRobustKeys);
+  const RobustOptions o = with_file_keys(flags, keys, app);
   Outputs outputs;  // checked first (two outputs on standard output); the table goes to standard error then
   outputs.add("--json", o.json);
   outputs.add("--csv", o.csv);
   const plot::Format plot_format = plot::check_request(o.plot, o.plot_format);
-  RobustRun run = parse_robust(o);
+  RobustRun run = parse_robust(o, std::move(keys));
   run.configs = o.capture_joints_deg.empty()
                     ? planned_configurations(run.sc, o.quiet)
                     : std::vector<Configuration>{given_configuration(o, *run.sc.model)};
@@ -765,7 +789,7 @@ void register_robust(CLI::App& app, Action& action) {
       "Draw the CDF and the histogram of F_max per configuration into this (existing) folder (robust.png)");
   sub->add_option("--plot-format", o->plot_format, "Figure format: png, svg or pdf")->capture_default_str();
   sub->add_flag("--quiet", o->quiet, "No progress line");
-  sub->callback([o, &action] { action = [o] { return run_robust(*o); }; });
+  sub->callback([o, sub, &action] { action = [o, sub] { return run_robust(*o, *sub); }; });
 }
 
 }  // namespace ffsr::cli
