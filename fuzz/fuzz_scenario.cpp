@@ -46,7 +46,7 @@ int run_main(std::vector<std::string> args, std::ostringstream& out) {
   register_inspect(app, action);
   register_contact(app, action);
   register_robust(app, action);
-  register_run(app, action, argc, argv.data());
+  register_run(app, action);
   app.require_subcommand(0, 1);
   try {
     app.parse(argc, argv.data());

@@ -60,6 +60,23 @@ Vector3 parse_vec3(const std::string& text, const std::string& flag) {
   return {v[0], v[1], v[2]};
 }
 
+std::uint64_t parse_count(const std::string& text, const std::string& flag) {
+  if (text.empty() || text.size() > 19 || text.find_first_not_of("0123456789") != std::string::npos)
+    throw InputError(str(flag, ": expected a non-negative integer, got '", text, "'"));
+  return std::stoull(text);
+}
+
+Shard parse_shard(const std::string& text) {
+  const size_t slash = text.find('/');
+  if (slash == std::string::npos) throw InputError(str("--shard: expected K/N, got '", text, "'"));
+  Shard s;
+  s.k = parse_count(text.substr(0, slash), "--shard");
+  s.n = parse_count(text.substr(slash + 1), "--shard");
+  if (s.n < 1) throw InputError("--shard: N must be at least 1");
+  if (s.k >= s.n) throw InputError(str("--shard: K must be less than N (K counts from 0), got ", text));
+  return s;
+}
+
 double deg2rad(double deg) { return deg * M_PI / 180.0; }
 double rad2deg(double rad) { return rad * 180.0 / M_PI; }
 

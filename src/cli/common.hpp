@@ -27,6 +27,14 @@ constexpr int kExitRegression = 4;
 std::vector<double> parse_list(const std::string& text, const std::string& flag,
                                std::vector<size_t> counts = {});
 Vector3 parse_vec3(const std::string& text, const std::string& flag);
+/// A non-negative integer written in decimal digits (no sign, no exponent), or InputError naming `flag`.
+std::uint64_t parse_count(const std::string& text, const std::string& flag);
+/// --shard K/N: part K (counting from 0) of N.
+struct Shard {
+  std::uint64_t k = 0, n = 1;
+};
+/// Parses K/N (0 <= K < N); InputError naming --shard.
+Shard parse_shard(const std::string& text);
 double deg2rad(double deg);
 double rad2deg(double rad);
 

@@ -69,77 +69,63 @@ nlohmann::json row_json(const Row& r) {
           {"restitution_realized", r.restitution}};
 }
 
-int run_contact(const ContactOptions& o) {
-  Outputs outputs;  // --series '-' and --json both print on standard output: one of them only
-  if (o.json) outputs.claim_stdout("--json");
-  outputs.add("--series", o.series);
-  const Robot r = load_robot(o.robot);
-  Target target = o.target.build();
-  o.law.set_target_motion(target);
-  if (!std::isfinite(o.law.approach_speed)) throw InputError("--approach-speed: must be finite");
-  const ContactParams params = o.law.params();
-  const plot::Format plot_format = plot::check_request(o.plot, o.plot_format);
+/// The laws to evaluate: every law for --model all, else the one named (an unknown name lists them).
+std::vector<std::string> contact_laws(const ContactOptions& o, const ContactParams& params) {
   std::vector<std::string> names;
   if (o.law.model == "all") {
     for (auto n : contact_law_names()) names.emplace_back(n);
-  } else {
-    try {
-      make_contact_law(o.law.model, params, 1.0);  // unknown name: lists the laws
-    } catch (const InputError& e) {
-      throw InputError(std::string("--model: ") + e.what());
-    }
-    names.push_back(o.law.model);
+    return names;
   }
-  std::vector<Row> rows;
-  for (const auto& n : names) rows.push_back(evaluate(r, target, o, n));
+  try {
+    make_contact_law(o.law.model, params, 1.0);  // unknown name: lists the laws
+  } catch (const InputError& e) {
+    throw InputError(std::string("--model: ") + e.what());
+  }
+  names.push_back(o.law.model);
+  return names;
+}
 
-  if (!o.plot.empty()) {  // Figure 3 from the same rows; the marked points from the multibody run
-    std::vector<figures::ContactCurve> curves;
-    for (const auto& row : rows) {
-      figures::ContactCurve c;
-      c.law = row.model;
-      for (const auto& s : row.series) {
-        c.t.push_back(s.t);
-        c.delta.push_back(s.delta);
-        c.force.push_back(s.force);
-      }
-      const AnyContactLaw law = make_contact_law(row.model, params, row.v_in);
-      c.delta_max = row.mb_delta_max;
-      c.force_at_delta_max = force(law, row.mb_delta_max, 0.0);  // delta_dot = 0 at the largest deformation
-      c.delta_at_f_max = row.mb_delta_at_f_max;
-      c.f_max = row.f_multibody;
-      curves.push_back(std::move(c));
+/// Figure 3 from the same rows; the marked points from the multibody run.
+void plot_contact(const std::vector<Row>& rows, const ContactParams& params, const ContactOptions& o,
+                  plot::Format plot_format) {
+  std::vector<figures::ContactCurve> curves;
+  for (const auto& row : rows) {
+    figures::ContactCurve c;
+    c.law = row.model;
+    for (const auto& s : row.series) {
+      c.t.push_back(s.t);
+      c.delta.push_back(s.delta);
+      c.force.push_back(s.force);
     }
-    plot::render({figures::contact(curves, rows.front().M_ie, rows.front().v_in)}, o.plot, plot_format);
+    const AnyContactLaw law = make_contact_law(row.model, params, row.v_in);
+    c.delta_max = row.mb_delta_max;
+    c.force_at_delta_max = force(law, row.mb_delta_max, 0.0);  // delta_dot = 0 at the largest deformation
+    c.delta_at_f_max = row.mb_delta_at_f_max;
+    c.f_max = row.f_multibody;
+    curves.push_back(std::move(c));
   }
-  if (!o.series.empty()) {
-    std::ostringstream csv;
-    csv << std::setprecision(12) << "model,t_s,force_N,delta_m\n";
-    for (const auto& row : rows)
-      for (const auto& s : row.series)
-        csv << row.model << "," << s.t << "," << s.force << "," << s.delta << "\n";
-    outputs.set("--series", csv.str());
-    outputs.write();
+  plot::render({figures::contact(curves, rows.front().M_ie, rows.front().v_in)}, o.plot, plot_format);
+}
+
+nlohmann::json contact_json(const std::vector<Row>& rows, const ContactOptions& o) {
+  nlohmann::json j = o.law.model == "all" ? nlohmann::json::object() : row_json(rows.front());
+  if (o.law.model == "all") {
+    j["integrated_effective_mass"] = rows.front().M_ie;
+    j["approach_velocity"] = rows.front().v_in;
+    j["laws"] = nlohmann::json::array();
+    for (const auto& row : rows) j["laws"].push_back(row_json(row));
   }
-  if (o.json) {
-    nlohmann::json j = o.law.model == "all" ? nlohmann::json::object() : row_json(rows.front());
-    if (o.law.model == "all") {
-      j["integrated_effective_mass"] = rows.front().M_ie;
-      j["approach_velocity"] = rows.front().v_in;
-      j["laws"] = nlohmann::json::array();
-      for (const auto& row : rows) j["laws"].push_back(row_json(row));
-    }
-    j["parameters"] = {{"stiffness", o.law.stiffness},
-                       {"exponent", o.law.exponent},
-                       {"restitution", o.law.restitution},
-                       {"approach_speed", o.law.approach_speed},
-                       {"urdf", o.robot.urdf},
-                       {"joints_deg", o.robot.joints_deg}};
-    j["version"] = FFSR_VERSION;
-    std::cout << j.dump(2) << "\n";
-    return 0;
-  }
-  std::ostream& out = outputs.table();  // standard error when --series is '-'
+  j["parameters"] = {{"stiffness", o.law.stiffness},
+                     {"exponent", o.law.exponent},
+                     {"restitution", o.law.restitution},
+                     {"approach_speed", o.law.approach_speed},
+                     {"urdf", o.robot.urdf},
+                     {"joints_deg", o.robot.joints_deg}};
+  j["version"] = FFSR_VERSION;
+  return j;
+}
+
+void print_contact_table(std::ostream& out, const std::vector<Row>& rows) {
   out << std::setprecision(6) << "integrated effective mass M_ie = " << rows.front().M_ie << " kg (Eq. 14)\n"
       << "approach velocity delta_dot^-  = " << rows.front().v_in << " m/s (Eq. 10-12)\n\n";
   out << std::left << std::setw(20) << "model" << std::right << std::setw(13) << "closed (N)" << std::setw(13)
@@ -154,6 +140,36 @@ int run_contact(const ContactOptions& o) {
   out << "\nclosed: Eq. 24 (F at the maximum deformation); exact: peak of the single-body model Eq. 16;\n"
          "multibody: CVODE integration of robot + target (Figure 2); accuracy: Eq. 32, closed vs "
          "multibody.\n";
+}
+
+int run_contact(const ContactOptions& o) {
+  Outputs outputs;  // --series '-' and --json both print on standard output: one of them only
+  if (o.json) outputs.claim_stdout("--json");
+  outputs.add("--series", o.series);
+  const Robot r = load_robot(o.robot);
+  Target target = o.target.build();
+  o.law.set_target_motion(target);
+  if (!std::isfinite(o.law.approach_speed)) throw InputError("--approach-speed: must be finite");
+  const ContactParams params = o.law.params();
+  const plot::Format plot_format = plot::check_request(o.plot, o.plot_format);
+  std::vector<Row> rows;
+  for (const auto& n : contact_laws(o, params)) rows.push_back(evaluate(r, target, o, n));
+
+  if (!o.plot.empty()) plot_contact(rows, params, o, plot_format);
+  if (!o.series.empty()) {
+    std::ostringstream csv;
+    csv << std::setprecision(12) << "model,t_s,force_N,delta_m\n";
+    for (const auto& row : rows)
+      for (const auto& s : row.series)
+        csv << row.model << "," << s.t << "," << s.force << "," << s.delta << "\n";
+    outputs.set("--series", csv.str());
+    outputs.write();
+  }
+  if (o.json) {
+    std::cout << contact_json(rows, o).dump(2) << "\n";
+    return 0;
+  }
+  print_contact_table(outputs.table(), rows);  // standard error when --series is '-'
   return 0;
 }
 

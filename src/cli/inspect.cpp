@@ -15,7 +15,7 @@ struct InspectOptions {
   bool json = false;
 };
 
-/// What the loader did to the file (issue 11): merged links, mimic and locked joints, repairs.
+/// What the loader did to the file: merged links, mimic and locked joints, repairs.
 void print_load_report(const UrdfReport& rep) {
   auto line = [](const char* label, const std::vector<std::string>& items) {
     if (items.empty()) return;

@@ -8,6 +8,30 @@
 #include <csignal>
 #include <iostream>
 
+namespace {
+
+/// The exit code of the exception in flight (in a catch block), after its one error line. Bad input
+/// (a parse error, InputError, ModelError) is 2; another ffsr::Error (numerical, integration) is 3.
+int exit_code_of_current_exception(bool parsing) {
+  try {
+    throw;
+  } catch (const ffsr::InputError& e) {
+    std::cerr << "ffsr-optimize: error: " << e.what() << "\n";
+    return ffsr::cli::kExitInput;
+  } catch (const ffsr::ModelError& e) {
+    std::cerr << "ffsr-optimize: error: " << e.what() << "\n";
+    return ffsr::cli::kExitInput;
+  } catch (const ffsr::Error& e) {
+    std::cerr << "ffsr-optimize: error: " << e.what() << "\n";
+    return parsing ? ffsr::cli::kExitInput : ffsr::cli::kExitNumerical;
+  } catch (const std::exception& e) {
+    std::cerr << "ffsr-optimize: error: " << e.what() << "\n";
+    return 1;
+  }
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
   using namespace ffsr::cli;
   // A reader that closes the pipe early (`ffsr-optimize --json - | head -c 10`) makes a write fail
@@ -25,38 +49,23 @@ int main(int argc, char** argv) {
   register_xi(app, action);
   register_map(app, action);
   register_robust(app, action);
-  register_run(app, action, argc, argv);
+  register_run(app, action);
   app.require_subcommand(0, 1);
   try {
     app.parse(argc, argv);
-  } catch (const CLI::CallForHelp& e) {
-    return app.exit(e);
-  } catch (const CLI::CallForAllHelp& e) {
-    return app.exit(e);
-  } catch (const CLI::CallForVersion& e) {
+  } catch (const CLI::Success& e) {  // --help, --help-all, --version
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
     std::cerr << "ffsr-optimize: error: " << e.what() << "\n";
     return kExitInput;
-  } catch (const ffsr::Error& e) {
-    std::cerr << "ffsr-optimize: error: " << e.what() << "\n";
-    return kExitInput;
+  } catch (...) {
+    return exit_code_of_current_exception(true);
   }
   try {
     const int code = action();
     flush_stdout();  // a table or JSON printed on a closed pipe or a full disk is an error too
     return code;
-  } catch (const ffsr::InputError& e) {
-    std::cerr << "ffsr-optimize: error: " << e.what() << "\n";
-    return kExitInput;
-  } catch (const ffsr::ModelError& e) {
-    std::cerr << "ffsr-optimize: error: " << e.what() << "\n";
-    return kExitInput;
-  } catch (const ffsr::Error& e) {
-    std::cerr << "ffsr-optimize: error: " << e.what() << "\n";
-    return kExitNumerical;
-  } catch (const std::exception& e) {
-    std::cerr << "ffsr-optimize: error: " << e.what() << "\n";
-    return 1;
+  } catch (...) {
+    return exit_code_of_current_exception(false);
   }
 }

@@ -118,30 +118,10 @@ Grid parse_grid(const MapOptions& o, int n_joints) {
   return g;
 }
 
-struct Shard {
-  std::uint64_t k = 0, n = 1;
-  /// The first point of part j of a grid of `size` points.
-  std::uint64_t begin(std::uint64_t size, std::uint64_t j) const {
-    return j * (size / n) + std::min(j, size % n);
-  }
-};
-
-Shard parse_shard(const std::string& text) {
-  auto fail = [&]() -> Shard {
-    throw InputError(
-        str("--shard: expected K/N with integers 0 <= K < N (for example 0/4), got '", text, "'"));
-  };
-  const size_t slash = text.find('/');
-  if (slash == std::string::npos) return fail();
-  Shard s;
-  const std::string a = text.substr(0, slash), b = text.substr(slash + 1);
-  for (const auto* part : {&a, &b})
-    if (part->empty() || part->size() > 18 || part->find_first_not_of("0123456789") != std::string::npos)
-      return fail();
-  s.k = std::stoull(a);
-  s.n = std::stoull(b);
-  if (s.n < 1 || s.k >= s.n) return fail();
-  return s;
+/// The first point of part j of N of a grid of `size` points (the first size mod N parts hold one
+/// point more).
+std::uint64_t shard_begin(const Shard& s, std::uint64_t size, std::uint64_t j) {
+  return j * (size / s.n) + std::min(j, size % s.n);
 }
 
 /// The CSV output: a temporary file next to `path`, renamed onto it by commit(); removed if the
@@ -324,12 +304,9 @@ std::vector<plot::Figure> map_figures(const Grid& grid, const std::vector<std::s
           figures::map_cloud(g, "map_cloud", "M_ie over " + joints + " (Figure 8)")};
 }
 
-int run_map(const MapOptions& o) {
-  const Robot r = load_robot(o.robot);
-  Target target = o.target.build();
-  o.law.set_target_motion(target);
-  if (!std::isfinite(o.law.approach_speed)) throw InputError("--approach-speed: must be finite");
-  const ContactParams params = o.law.params();
+/// The contact law at the approach velocity of the flags (Eq. 10-12); InputError when the end-effector
+/// does not approach the target or the law is unknown.
+AnyContactLaw map_law(const MapOptions& o, const Target& target, const ContactParams& params) {
   if (o.law.model == "all")
     throw InputError("--model: map evaluates one law; 'all' is for the contact subcommand");
   const Vector3 u = target.normal_world();
@@ -338,69 +315,49 @@ int run_map(const MapOptions& o) {
   if (!(v_in > 0))
     throw InputError(str("--approach-speed: the end-effector does not approach the target (delta_dot^- = ",
                          v_in, " m/s); increase the approach speed"));
-  const AnyContactLaw law = [&] {
-    try {
-      return make_contact_law(o.law.model, params, v_in);
-    } catch (const InputError& e) {
-      throw InputError(std::string("--model: ") + e.what());
-    }
-  }();
-  const Grid grid = parse_grid(o, r.model.n());
-  const Shard shard = parse_shard(o.shard);
-  const std::uint64_t first = shard.begin(grid.size, shard.k), last = shard.begin(grid.size, shard.k + 1);
-  const std::uint64_t count = last - first;
+  try {
+    return make_contact_law(o.law.model, params, v_in);
+  } catch (const InputError& e) {
+    throw InputError(std::string("--model: ") + e.what());
+  }
+}
 
-  // the pictures' arguments, checked before the grid is evaluated
-  const bool plotting = !o.plot.empty();
-  const plot::Format plot_format = plot::parse_format(o.plot_format, "--plot-format");
+/// The pictures' arguments, checked before the grid is evaluated; returns the slices (deg).
+std::vector<double> check_map_plot(const MapOptions& o, const Grid& grid, const Shard& shard) {
   std::vector<double> slice_deg(grid.axes.size(), 0.0);
   if (!o.slice_deg.empty()) {
     slice_deg = parse_list(o.slice_deg, "--slice-deg", {grid.axes.size()});
     if (grid.axes.size() != 3) throw InputError("--slice-deg: slices are drawn for three varied joints only");
   }
-  if (plotting) {
-    plot::require_available("--plot");
-    plot::check_folder(o.plot, "--plot");
-    if (grid.axes.size() > 3)
-      throw InputError(str("--plot: pictures are drawn for 1 to 3 varied joints, got ", grid.axes.size(),
-                           " (the CSV holds every point)"));
-    if (shard.n > 1)
-      throw InputError(
-          "--plot: a shard holds part of the grid only; run the whole grid (--shard 0/1) to plot it");
-    if (grid.size > kMaxPlotPoints)
-      throw InputError(str("--plot: the grid has ", grid.size, " points; pictures are drawn for at most ",
-                           kMaxPlotPoints, " (use a coarser --step-deg)"));
-  }
-  std::vector<double> values(plotting ? count : 0);
+  if (o.plot.empty()) return slice_deg;
+  plot::require_available("--plot");
+  plot::check_folder(o.plot, "--plot");
+  if (grid.axes.size() > 3)
+    throw InputError(str("--plot: pictures are drawn for 1 to 3 varied joints, got ", grid.axes.size(),
+                         " (the CSV holds every point)"));
+  if (shard.n > 1)
+    throw InputError(
+        "--plot: a shard holds part of the grid only; run the whole grid (--shard 0/1) to plot it");
+  if (grid.size > kMaxPlotPoints)
+    throw InputError(str("--plot: the grid has ", grid.size, " points; pictures are drawn for at most ",
+                         kMaxPlotPoints, " (use a coarser --step-deg)"));
+  return slice_deg;
+}
 
-  CsvOutput out(o.csv);
-  if (shard.k == 0) {
-    std::string header;
-    const auto names = r.model.joint_names();
-    for (const Axis& a : grid.axes) header += names[static_cast<size_t>(a.joint)] + "_deg,";
-    header += "M_ie_kg,F_max_N\n";
-    out.write(header.data(), header.size());
-  }
-
-  // blocks of points claimed in order; each is written once all blocks before it are
-  constexpr std::uint64_t kBlock = 2048;
-  const std::uint64_t blocks = (count + kBlock - 1) / kBlock;
-  unsigned threads = o.threads ? o.threads : std::max(1U, std::thread::hardware_concurrency());
-  threads = static_cast<unsigned>(std::max<std::uint64_t>(1, std::min<std::uint64_t>(threads, blocks)));
-  const double target_inverse_mass = target.inverse_mass_along_normal();
+/// The points [first, last) of the grid on a pool of workers: blocks of points claimed in order,
+/// each written to `out` once all blocks before it are.
+struct GridRun {
   std::vector<std::unique_ptr<Worker>> workers;
-  for (unsigned t = 0; t < threads; ++t)
-    workers.push_back(std::make_unique<Worker>(r.model, grid, law, r, u, target_inverse_mass, kBlock));
-  for (auto& w : workers) {
-    w->values = plotting ? values.data() : nullptr;
-    w->first_point = first;
-  }
+  unsigned threads = 1;
+};
 
+void run_workers(GridRun& g, CsvOutput& out, std::uint64_t first, std::uint64_t last, std::uint64_t blocks,
+                 std::uint64_t block, bool quiet) {
   std::atomic<std::uint64_t> next_block{0}, done{0};
   std::mutex m;
   std::condition_variable cv;
   std::uint64_t next_write = 0;
-  unsigned running = threads;
+  unsigned running = g.threads;
   bool failed = false;
   std::exception_ptr error;
   auto work = [&](Worker& w) {
@@ -408,7 +365,7 @@ int run_map(const MapOptions& o) {
       for (;;) {
         const std::uint64_t b = next_block.fetch_add(1);
         if (b >= blocks) break;
-        const std::uint64_t lo = first + b * kBlock, hi = std::min(last, lo + kBlock);
+        const std::uint64_t lo = first + b * block, hi = std::min(last, lo + block);
         const size_t bytes = w.run(lo, hi);
         std::unique_lock<std::mutex> lock(m);
         cv.wait(lock, [&] { return next_write == b || failed; });
@@ -427,35 +384,29 @@ int run_map(const MapOptions& o) {
     --running;
     cv.notify_all();
   };
-  const auto t0 = std::chrono::steady_clock::now();
-  Progress progress("map", o.quiet);
+  Progress progress("map", quiet);
   std::vector<std::thread> pool;
-  for (unsigned t = 0; t < threads; ++t) pool.emplace_back(work, std::ref(*workers[t]));
+  for (unsigned t = 0; t < g.threads; ++t) pool.emplace_back(work, std::ref(*g.workers[t]));
   {
     std::unique_lock<std::mutex> lock(m);
     while (running > 0) {
       cv.wait_for(lock, std::chrono::milliseconds(200), [&] { return running == 0; });
-      if (!failed) progress(done.load(), count);
+      if (!failed) progress(done.load(), last - first);
     }
   }
   for (auto& t : pool) t.join();
   if (error) std::rethrow_exception(error);
-  // the pictures before the CSV is committed: a failed drawing leaves no CSV behind
-  std::vector<std::string> drawn;
-  if (plotting)
-    drawn = plot::render(map_figures(grid, r.model.joint_names(), std::move(values), slice_deg), o.plot,
-                         plot_format);
-  out.commit();
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
 
-  std::ostream& os = o.csv == "-" ? std::cerr : std::cout;
+void print_map_summary(std::ostream& os, const MapOptions& o, const Grid& grid, const Shard& shard,
+                       const GridRun& g, std::uint64_t count, double seconds) {
   os << "map: " << count << " of " << grid.size << " points (shard " << shard.k << "/" << shard.n << ") in "
      << seconds << " s, " << (seconds > 0 ? static_cast<double>(count) / seconds : 0.0) << " points/s on "
-     << threads << " thread" << (threads > 1 ? "s" : "") << "\n";
+     << g.threads << " thread" << (g.threads > 1 ? "s" : "") << "\n";
   if (count > 0) {
-    const Worker* hi = workers[0].get();
-    const Worker* lo = workers[0].get();
-    for (const auto& w : workers) {
+    const Worker* hi = g.workers[0].get();
+    const Worker* lo = g.workers[0].get();
+    for (const auto& w : g.workers) {
       if (w->max_M > hi->max_M || (w->max_M == hi->max_M && w->argmax < hi->argmax)) hi = w.get();
       if (w->min_M < lo->min_M || (w->min_M == lo->min_M && w->argmin < lo->argmin)) lo = w.get();
     }
@@ -463,6 +414,55 @@ int run_map(const MapOptions& o) {
        << " deg; min M_ie = " << lo->min_M << " kg at " << point_deg(grid, lo->argmin) << " deg\n";
   }
   if (o.csv != "-") os << "wrote " << o.csv << "\n";
+}
+
+int run_map(const MapOptions& o) {
+  const Robot r = load_robot(o.robot);
+  Target target = o.target.build();
+  o.law.set_target_motion(target);
+  if (!std::isfinite(o.law.approach_speed)) throw InputError("--approach-speed: must be finite");
+  const AnyContactLaw law = map_law(o, target, o.law.params());
+  const Grid grid = parse_grid(o, r.model.n());
+  const Shard shard = parse_shard(o.shard);
+  const std::uint64_t first = shard_begin(shard, grid.size, shard.k),
+                      last = shard_begin(shard, grid.size, shard.k + 1);
+  const std::uint64_t count = last - first;
+  const bool plotting = !o.plot.empty();
+  const plot::Format plot_format = plot::parse_format(o.plot_format, "--plot-format");
+  const std::vector<double> slice_deg = check_map_plot(o, grid, shard);
+  std::vector<double> values(plotting ? count : 0);
+
+  CsvOutput out(o.csv);
+  if (shard.k == 0) {
+    std::string header;
+    const auto names = r.model.joint_names();
+    for (const Axis& a : grid.axes) header += names[static_cast<size_t>(a.joint)] + "_deg,";
+    header += "M_ie_kg,F_max_N\n";
+    out.write(header.data(), header.size());
+  }
+  constexpr std::uint64_t kBlock = 2048;
+  const std::uint64_t blocks = (count + kBlock - 1) / kBlock;
+  GridRun g;
+  g.threads = o.threads ? o.threads : std::max(1U, std::thread::hardware_concurrency());
+  g.threads = static_cast<unsigned>(std::max<std::uint64_t>(1, std::min<std::uint64_t>(g.threads, blocks)));
+  const Vector3 u = target.normal_world();
+  const double target_inverse_mass = target.inverse_mass_along_normal();
+  for (unsigned t = 0; t < g.threads; ++t) {
+    g.workers.push_back(std::make_unique<Worker>(r.model, grid, law, r, u, target_inverse_mass, kBlock));
+    g.workers.back()->values = plotting ? values.data() : nullptr;
+    g.workers.back()->first_point = first;
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  run_workers(g, out, first, last, blocks, kBlock, o.quiet);
+  // the pictures before the CSV is committed: a failed drawing leaves no CSV behind
+  std::vector<std::string> drawn;
+  if (plotting)
+    drawn = plot::render(map_figures(grid, r.model.joint_names(), std::move(values), slice_deg), o.plot,
+                         plot_format);
+  out.commit();
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  std::ostream& os = o.csv == "-" ? std::cerr : std::cout;
+  print_map_summary(os, o, grid, shard, g, count, seconds);
   for (const std::string& f : drawn) os << "wrote " << f << "\n";
   return 0;
 }

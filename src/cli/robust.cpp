@@ -6,8 +6,8 @@
 // (seed, index) only, so --shard K/N runs can be merged exactly (--merge): a shard's JSON keeps every
 // sample's F_max, the merge concatenates them by index and recomputes the summary.
 //
-// The [uncertainty] table is read with toml++ (CLI11 2.1's reader does not parse its inline tables);
-// the other keys of the file go to the same options as the flags, and a flag overrides the file.
+// The scenario file (its keys and its [uncertainty] table) is read by the library's one reader
+// (ffsr/io/scenario.hpp); a flag overrides a key of the file.
 #include "common.hpp"
 #include "plot.hpp"
 #include "scenario.hpp"
@@ -16,8 +16,6 @@
 #include "ffsr/uncertainty/multibody.hpp"
 #include "ffsr/uncertainty/sampling.hpp"
 
-#include <toml++/toml.h>
-
 #include <algorithm>
 #include <fstream>
 #include <iomanip>
@@ -25,6 +23,7 @@
 #include <iterator>
 #include <map>
 #include <memory>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <thread>
@@ -38,7 +37,7 @@ using detail::str;
 constexpr std::size_t kTail = 5;
 
 struct RobustOptions {
-  RunOptions scenario;
+  ScenarioFlags flags;  ///< the scenario keys as flags (a flag overrides the file)
   std::string config;
   std::string force_model = "exact";
   std::string samples, seed, shard = "0/1";
@@ -48,161 +47,6 @@ struct RobustOptions {
   std::string json, csv, plot, plot_format = "png";
   bool quiet = false;
 };
-
-/// A non-negative integer written in decimal digits (no sign, no exponent), or InputError naming `key`.
-std::uint64_t parse_count(const std::string& text, const std::string& key) {
-  if (text.empty() || text.size() > 19 || text.find_first_not_of("0123456789") != std::string::npos)
-    throw InputError(str(key, ": expected a non-negative integer, got '", text, "'"));
-  return std::stoull(text);
-}
-
-// --- the [uncertainty] table --------------------------------------------------------------------
-
-double number(const toml::node& n, const std::string& key) {
-  if (auto i = n.value_exact<int64_t>()) return static_cast<double>(*i);
-  if (auto d = n.value_exact<double>()) {
-    if (!std::isfinite(*d)) throw InputError(str(key, ": must be finite, got ", *d));
-    return *d;
-  }
-  throw InputError(str(key, ": expected a number"));
-}
-
-Spread parse_spread(Quantity q, const toml::table& t, const std::string& key) {
-  static const std::set<std::string> known{"law", "std", "relative-std", "half-width", "relative",
-                                           "min", "max", "sigma",        "angle-deg",  "axes-deg"};
-  for (const auto& [k, v] : t)
-    if (!known.count(std::string(k.str())))
-      throw InputError(str(key, ".", k.str(),
-                           ": unknown parameter; expected law, std, relative-std, half-width, ",
-                           "relative, min, max, sigma, angle-deg or axes-deg"));
-  const auto law = t["law"].value<std::string>();
-  if (!law) throw InputError(str(key, ": missing law (normal, uniform, log-normal or cone)"));
-  auto get = [&](const char* name) -> std::optional<double> {
-    if (const toml::node* n = t.get(name)) return number(*n, str(key, ".", name));
-    return std::nullopt;
-  };
-  Spread sp;
-  const auto sd = get("std"), rsd = get("relative-std"), hw = get("half-width"), rel = get("relative"),
-             lo = get("min"), hi = get("max"), sigma = get("sigma"), angle = get("angle-deg"),
-             axes = get("axes-deg");
-  for (const auto& [name, v] : {std::pair{"std", sd},
-                                {"relative-std", rsd},
-                                {"half-width", hw},
-                                {"relative", rel},
-                                {"sigma", sigma},
-                                {"angle-deg", angle},
-                                {"axes-deg", axes}})
-    if (v && *v < 0)
-      throw InputError(
-          str(key, ".", name, ": a spread must be non-negative, got ", detail::short_number(*v)));
-  // spin is given in deg/s, the library takes rad/s
-  const double unit = q == Quantity::Spin ? M_PI / 180.0 : 1.0;
-  auto one_of = [&](std::initializer_list<std::pair<const char*, std::optional<double>>> opts) {
-    int count = 0;
-    std::string names;
-    for (const auto& [n, v] : opts) {
-      count += v.has_value();
-      names += (names.empty() ? "" : " or ") + std::string(n);
-    }
-    if (count != 1) throw InputError(str(key, ": the ", *law, " law takes exactly one of ", names));
-  };
-  if (*law == "normal") {
-    sp.law = Spread::Law::Normal;
-    one_of({{"std", sd}, {"relative-std", rsd}});
-    sp.relative = rsd.has_value();
-    sp.scale = sd ? *sd * unit : *rsd;
-  } else if (*law == "uniform") {
-    sp.law = Spread::Law::Uniform;
-    const bool range = lo.has_value() && hi.has_value() && !hw && !rel;
-    if (!range) one_of({{"half-width", hw}, {"relative", rel}});
-    sp.has_range = range;
-    sp.relative = rel.has_value();
-    sp.scale = hw ? *hw * unit : rel ? *rel : 0.0;
-  } else if (*law == "log-normal") {
-    sp.law = Spread::Law::LogNormal;
-    if (!sigma) throw InputError(str(key, ": the log-normal law needs sigma (standard deviation of ln x)"));
-    sp.scale = *sigma;
-  } else if (*law == "cone") {
-    sp.law = Spread::Law::Cone;
-    if (!angle) throw InputError(str(key, ": the cone law needs angle-deg (half-angle)"));
-    sp.scale = *angle * M_PI / 180.0;
-  } else {
-    throw InputError(
-        str(key, ".law: unknown law '", *law, "'; expected normal, uniform, log-normal or cone"));
-  }
-  if (q == Quantity::TargetInertia && sp.law != Spread::Law::Cone && !sp.relative)
-    throw InputError(str(key, ": the inertia takes a relative spread (relative-std or relative)"));
-  if (lo) sp.min = *lo * unit;
-  if (hi) sp.max = *hi * unit;
-  if (axes) sp.axes = *axes * M_PI / 180.0;
-  if (axes && q != Quantity::TargetInertia)
-    throw InputError(str(key, ".axes-deg: only the inertia takes it"));
-  return sp;
-}
-
-/// Reads the [uncertainty] table of the scenario file into `spec` (samples and seed only if the
-/// flags did not set them).
-void parse_uncertainty(const toml::table& root, UncertaintySpec& spec, bool samples_set, bool seed_set,
-                       const std::string& where) {
-  const toml::node* node = root.get("uncertainty");
-  if (!node) throw InputError(str(where, ": no [uncertainty] table"));
-  const toml::table* u = node->as_table();
-  if (!u) throw InputError(str(where, ": 'uncertainty' must be a table"));
-  for (const auto& [k, v] : *u) {
-    const std::string name(k.str());
-    const std::string key = "uncertainty." + name;
-    if (name == "samples" || name == "seed") {
-      const auto i = v.value_exact<int64_t>();
-      if (!i) throw InputError(str(key, ": must be an integer"));
-      if (name == "samples" && *i < 1) throw InputError(str(key, ": must be at least 1, got ", *i));
-      if (name == "seed" && *i < 0) throw InputError(str(key, ": must be a non-negative integer, got ", *i));
-      if (name == "samples" && !samples_set) spec.samples = static_cast<std::uint64_t>(*i);
-      if (name == "seed" && !seed_set) spec.seed = static_cast<std::uint64_t>(*i);
-      continue;
-    }
-    const auto it = std::find(kQuantityNames.begin(), kQuantityNames.end(), name);
-    if (it == kQuantityNames.end()) {
-      std::string names;
-      for (auto n : kQuantityNames) names += (names.empty() ? "" : ", ") + std::string(n);
-      throw InputError(str(key, ": unknown uncertain quantity; expected one of ", names, ", samples, seed"));
-    }
-    const toml::table* t = v.as_table();
-    if (!t) throw InputError(str(key, ": expected a table such as { law = \"normal\", std = 0.01 }"));
-    const Quantity q = static_cast<Quantity>(it - kQuantityNames.begin());
-    spec[q] = parse_spread(q, *t, key);
-  }
-  validate(spec);
-}
-
-/// The file's other keys go to the options of `app` that the command line did not set.
-void apply_scenario_keys(const toml::table& root, CLI::App& app, const std::string& where) {
-  auto text = [&](const toml::node& n, const std::string& key) -> std::string {
-    if (auto s = n.value_exact<std::string>()) return *s;
-    if (auto i = n.value_exact<int64_t>()) return std::to_string(*i);
-    if (auto d = n.value_exact<double>()) {
-      std::ostringstream os;
-      os << std::setprecision(17) << *d;
-      return os.str();
-    }
-    if (auto b = n.value_exact<bool>()) return *b ? "true" : "false";
-    throw InputError(str(where, ": key '", key, "' has a value of an unsupported type"));
-  };
-  for (const auto& [k, v] : root) {
-    const std::string key(k.str());
-    if (key == "uncertainty") continue;
-    CLI::Option* opt = key == "config" || key == "help" ? nullptr : app.get_option_no_throw("--" + key);
-    if (!opt) throw InputError(str(where, ": unknown key '", key, "'"));
-    if (opt->count() > 0) continue;  // the flag overrides the file
-    std::vector<std::string> inputs;
-    if (const toml::array* a = v.as_array()) {
-      for (const auto& e : *a) inputs.push_back(text(e, key));
-    } else {
-      inputs.push_back(text(v, key));
-    }
-    opt->add_result(inputs);
-    opt->run_callback();
-  }
-}
 
 // --- evaluation ---------------------------------------------------------------------------------
 
@@ -584,186 +428,227 @@ int run_merge(const RobustOptions& o) {
   return 0;
 }
 
-int run_robust(RobustOptions& o, CLI::App& app) {  // by reference: the file's keys land in o.scenario
-  if (!o.merge.empty()) return run_merge(o);
-  if (o.config.empty()) throw InputError("robust: --config SCENARIO.toml is required (or --merge FILES)");
-  Outputs outputs;  // checked first (two outputs on standard output); the table goes to standard error then
-  outputs.add("--json", o.json);
-  outputs.add("--csv", o.csv);
-  const plot::Format plot_format = plot::check_request(o.plot, o.plot_format);
-  // --- the scenario file: toml++ for the whole file, the keys into the scenario options ----------
-  const std::string where = "scenario " + o.config;
-  const bool urdf_cli = app.get_option("--urdf")->count() > 0;
-  toml::table root;
-  try {
-    root = toml::parse_file(o.config);
-  } catch (const toml::parse_error& e) {
-    throw InputError(str(where, ":", e.source().begin.line, ": ", e.description()));
-  }
-  UncertaintySpec spec;
-  if (!o.samples.empty()) spec.samples = parse_count(o.samples, "--samples");
-  if (!o.seed.empty()) spec.seed = parse_count(o.seed, "--seed");
-  if (!o.samples.empty() && spec.samples < 1) throw InputError("--samples: must be at least 1, got 0");
-  parse_uncertainty(root, spec, !o.samples.empty(), !o.seed.empty(), where);
-  apply_scenario_keys(root, app, where);
+/// The scenario of the run: the file's keys, the flags as overrides. A top-level `seed` key of the file
+/// is not the global search's seed here (--seed is the Monte Carlo seed): the global runs use seed 1.
+Scenario robust_scenario(ScenarioKeys keys, const RobustOptions& o) {
+  o.flags.apply(keys);
+  keys.seed = "1";
+  keys.given.erase("seed");
+  return command_scenario(std::move(keys));
+}
 
-  ForceModel force_model;
-  if (o.force_model == "closed")
-    force_model = ForceModel::Closed;
-  else if (o.force_model == "exact")
-    force_model = ForceModel::Exact;
-  else if (o.force_model == "multibody")
-    force_model = ForceModel::Multibody;
-  else
-    throw InputError(
-        str("--force-model: unknown model '", o.force_model, "'; expected closed, exact or multibody"));
-  std::uint64_t shard_k = 0, shard_n = 1;
-  {
-    const size_t slash = o.shard.find('/');
-    if (slash == std::string::npos) throw InputError(str("--shard: expected K/N, got '", o.shard, "'"));
-    shard_k = parse_count(o.shard.substr(0, slash), "--shard");
-    shard_n = parse_count(o.shard.substr(slash + 1), "--shard");
-    if (shard_n < 1) throw InputError("--shard: N must be at least 1");
-    if (shard_k >= shard_n)
-      throw InputError(str("--shard: K must be less than N (K counts from 0), got ", o.shard));
+ForceModel robust_force_model(const std::string& name) {
+  if (name == "closed") return ForceModel::Closed;
+  if (name == "exact") return ForceModel::Exact;
+  if (name == "multibody") return ForceModel::Multibody;
+  throw InputError(str("--force-model: unknown model '", name, "'; expected closed, exact or multibody"));
+}
+
+/// The capture configuration given with --capture-joints-deg.
+Configuration given_configuration(const RobustOptions& o, const Model& model) {
+  if (static_cast<int>(o.capture_joints_deg.size()) != model.n())
+    throw InputError(str("--capture-joints-deg: got ", o.capture_joints_deg.size(), " angles, the robot has ",
+                         model.n(), " joints"));
+  Configuration c;
+  c.name = "given";
+  c.theta = Eigen::Map<const Eigen::VectorXd>(o.capture_joints_deg.data(), model.n()) * (M_PI / 180.0);
+  for (double x : o.capture_joints_deg)
+    if (!std::isfinite(x)) throw InputError("--capture-joints-deg: values must be finite");
+  if (o.capture_base_position.size() != 3) throw InputError("--capture-base-position: expected 3 numbers");
+  if (o.capture_base_rpy_deg.size() != 3) throw InputError("--capture-base-rpy-deg: expected 3 numbers");
+  c.base.position =
+      Vector3(o.capture_base_position[0], o.capture_base_position[1], o.capture_base_position[2]);
+  const Vector3 rpy(o.capture_base_rpy_deg[0], o.capture_base_rpy_deg[1], o.capture_base_rpy_deg[2]);
+  if (!c.base.position.allFinite() || !rpy.allFinite())
+    throw InputError("--capture-base-position/--capture-base-rpy-deg: values must be finite");
+  c.base.orientation = Quaternion(rotation_from_rpy(rpy * (M_PI / 180.0)));
+  return c;
+}
+
+/// The planned configurations: plain, optimized and (unless global = false) global -- for
+/// robust-force the nominal global run (mass) beside the robust one, on the same samples: the price
+/// and the gain of robustness side by side.
+std::vector<Configuration> planned_configurations(const Scenario& sc, bool quiet) {
+  std::vector<Configuration> configs;
+  auto add = [&](const char* name, const CaptureResult& r) {
+    Configuration c;
+    c.name = name;
+    c.theta = r.theta;
+    c.base = r.base;
+    configs.push_back(std::move(c));
+  };
+  Progress p1{"plain"}, p2{"optimized"};
+  ScenarioRunOptions run;
+  if (!quiet) {
+    run.plain_progress = std::ref(p1);
+    run.optimized_progress = std::ref(p2);
   }
+  const auto [plain, optimized] = plan_plain_and_optimized(sc, run);
+  add("plain", plain);
+  add("optimized", optimized);
+  if (!sc.keys.global) return configs;
+  if (sc.objective == GlobalObjective::RobustForce) {
+    add("global", run_global(sc, optimized, GlobalObjective::Mass, nullptr, true).result.run);
+    const auto set = scenario_robust_objective(sc, uncertainty_spec(sc.keys));
+    add("robust", run_global(sc, optimized, sc.objective, set).result.run);
+  } else {
+    add("global", run_global(sc, optimized, sc.objective).result.run);
+  }
+  return configs;
+}
+
+/// A run of `robust`: what is evaluated (the scenario, the configurations, this shard's samples) and
+/// what came out (the F_max per configuration and sample).
+struct RobustRun {
+  Scenario sc;
+  UncertaintySpec spec;
+  ForceModel force_model = ForceModel::Exact;
+  std::uint64_t shard_k = 0, shard_n = 1, first = 0, end = 0;
+  std::vector<Configuration> configs;
+  std::vector<UncertainSample> samples;  // this shard's, shard-local index
+  UncertainNominal nominal;
+  std::uint64_t redraws = 0;
+};
+
+/// The flags and the scenario file: the keys, the [uncertainty] table (samples and seed overridden
+/// by the flags), the force model and the shard.
+RobustRun parse_robust(const RobustOptions& o, ScenarioKeys keys) {
+  std::optional<std::uint64_t> samples_flag, seed_flag;
+  if (!o.samples.empty()) samples_flag = parse_count(o.samples, "--samples");
+  if (!o.seed.empty()) seed_flag = parse_count(o.seed, "--seed");
+  if (samples_flag && *samples_flag < 1) throw InputError("--samples: must be at least 1, got 0");
+  RobustRun run;
+  run.spec = uncertainty_spec(keys, samples_flag, seed_flag);
+  run.force_model = robust_force_model(o.force_model);
+  const Shard shard = parse_shard(o.shard);
+  run.shard_k = shard.k;
+  run.shard_n = shard.n;
   if (o.threads < 1 || o.threads > 1024)
     throw InputError(str("--threads: must be in [1, 1024], got ", o.threads));
+  run.sc = robust_scenario(std::move(keys), o);
+  run.first = run.spec.samples * run.shard_k / run.shard_n;
+  run.end = run.spec.samples * (run.shard_k + 1) / run.shard_n;
+  return run;
+}
 
-  o.scenario.config = o.config;
-  const Scenario sc = prepare_scenario(o.scenario, app, urdf_cli);
-  const Model& model = *sc.model;
-  const CaptureProblem& pb = sc.problem;
-  const RunOptions& so = sc.options;
-
-  // --- the configurations ---------------------------------------------------------------------
-  std::vector<Configuration> configs;
-  if (!o.capture_joints_deg.empty()) {
-    if (static_cast<int>(o.capture_joints_deg.size()) != model.n())
-      throw InputError(str("--capture-joints-deg: got ", o.capture_joints_deg.size(),
-                           " angles, the robot has ", model.n(), " joints"));
-    Configuration c;
-    c.name = "given";
-    c.theta = Eigen::Map<const Eigen::VectorXd>(o.capture_joints_deg.data(), model.n()) * (M_PI / 180.0);
-    for (double x : o.capture_joints_deg)
-      if (!std::isfinite(x)) throw InputError("--capture-joints-deg: values must be finite");
-    if (o.capture_base_position.size() != 3) throw InputError("--capture-base-position: expected 3 numbers");
-    if (o.capture_base_rpy_deg.size() != 3) throw InputError("--capture-base-rpy-deg: expected 3 numbers");
-    c.base.position =
-        Vector3(o.capture_base_position[0], o.capture_base_position[1], o.capture_base_position[2]);
-    const Vector3 rpy(o.capture_base_rpy_deg[0], o.capture_base_rpy_deg[1], o.capture_base_rpy_deg[2]);
-    if (!c.base.position.allFinite() || !rpy.allFinite())
-      throw InputError("--capture-base-position/--capture-base-rpy-deg: values must be finite");
-    c.base.orientation = Quaternion(rotation_from_rpy(rpy * (M_PI / 180.0)));
-    configs.push_back(std::move(c));
-  } else {
-    const auto [plain, optimized] = plan_plain_and_optimized(sc, o.quiet);
-    auto add = [&](const char* name, const CaptureResult& r) {
-      Configuration c;
-      c.name = name;
-      c.theta = r.theta;
-      c.base = r.base;
-      configs.push_back(std::move(c));
-    };
-    add("plain", plain);
-    add("optimized", optimized);
-    if (so.global) {
-      // the global run with the scenario's objective; for robust-force, the nominal global run (mass)
-      // beside the robust one, on the same samples: the price and the gain of robustness side by side
-      const GlobalObjective objective = global_objective(so.objective);
-      if (objective == GlobalObjective::RobustForce) {
-        add("global", run_global(sc, optimized, GlobalObjective::Mass, nullptr, true).result.run);
-        const auto set = scenario_robust_objective(sc, read_uncertainty_table(o.config, where));
-        add("robust", run_global(sc, optimized, objective, set).result.run);
-      } else {
-        add("global", run_global(sc, optimized, objective).result.run);
-      }
-    }
-  }
-
-  // --- the samples of this shard (common to all configurations) --------------------------------
-  UncertainNominal nominal;
-  nominal.target = propagate_target(pb.target, sc.capture.duration);
-  nominal.contact = pb.contact;
-  nominal.approach_speed = pb.approach_speed;
-  const std::uint64_t first = spec.samples * shard_k / shard_n, end = spec.samples * (shard_k + 1) / shard_n;
-  const std::uint64_t count = end - first;
-  std::vector<UncertainSample> samples(count);
+/// Draws this shard's samples (common to all configurations) and evaluates F_max of every
+/// configuration on each, on o.threads threads.
+void evaluate_samples(RobustRun& run, const RobustOptions& o) {
+  const Model& model = *run.sc.model;
+  const CaptureProblem& pb = run.sc.problem;
+  run.nominal.target = propagate_target(pb.target, run.sc.capture.duration);
+  run.nominal.contact = pb.contact;
+  run.nominal.approach_speed = pb.approach_speed;
+  const std::uint64_t count = run.end - run.first;
+  run.samples.resize(count);
   Progress progress("robust", o.quiet, "evaluations");
-  const std::uint64_t total_work = count * (1 + configs.size());
+  const std::uint64_t total_work = count * (1 + run.configs.size());
   std::atomic<std::uint64_t> work_done{0};
   auto report = [&](std::uint64_t) { progress(work_done.load(), total_work); };
-  parallel_for(
-      0, count, o.threads,
-      [&](std::uint64_t i) {
-        samples[i] = draw_sample(spec, nominal, first + i);
-        work_done.fetch_add(1);
-      },
-      report);
+  auto each = [&](const std::function<void(std::uint64_t)>& f) {
+    parallel_for(
+        0, count, o.threads,
+        [&](std::uint64_t i) {
+          f(i);
+          work_done.fetch_add(1);
+        },
+        report);
+  };
+  each([&](std::uint64_t i) { run.samples[i] = draw_sample(run.spec, run.nominal, run.first + i); });
   Data data(model);
   UncertaintySpec fixed;  // the nominal sample: no spread
-  fixed.seed = spec.seed;
-  const UncertainSample nominal_sample = draw_sample(fixed, nominal, 0);
-  for (auto& c : configs) {
+  fixed.seed = run.spec.seed;
+  const UncertainSample nominal_sample = draw_sample(fixed, run.nominal, 0);
+  for (auto& c : run.configs) {
     c.forces.resize(count);
-    const Matrix6 G = robot_inverse_inertia(model, data, c.base, c.theta, pb.frame);
-    if (force_model == ForceModel::Multibody) {
-      c.nominal = sample_force_multibody(model, c.base, c.theta, pb.frame, nominal_sample, pb.law);
-      parallel_for(
-          0, count, o.threads,
-          [&](std::uint64_t i) {
-            c.forces[i] = sample_force_multibody(model, c.base, c.theta, pb.frame, samples[i], pb.law);
-            work_done.fetch_add(1);
-          },
-          report);
+    if (run.force_model == ForceModel::Multibody) {
+      auto force = [&](const UncertainSample& s) {
+        return sample_force_multibody(model, c.base, c.theta, pb.frame, s, pb.law);
+      };
+      c.nominal = force(nominal_sample);
+      each([&](std::uint64_t i) { c.forces[i] = force(run.samples[i]); });
     } else {
-      c.nominal = sample_force(G, nominal_sample, pb.law, force_model);
-      parallel_for(
-          0, count, o.threads,
-          [&](std::uint64_t i) {
-            c.forces[i] = sample_force(G, samples[i], pb.law, force_model);
-            work_done.fetch_add(1);
-          },
-          report);
+      const Matrix6 G = robot_inverse_inertia(model, data, c.base, c.theta, pb.frame);
+      c.nominal = sample_force(G, nominal_sample, pb.law, run.force_model);
+      each([&](std::uint64_t i) { c.forces[i] = sample_force(G, run.samples[i], pb.law, run.force_model); });
     }
   }
   progress(total_work, total_work);  // ends the line if one was shown
+  for (const auto& smp : run.samples) run.redraws += static_cast<std::uint64_t>(smp.redraws);
+}
 
-  // --- outputs: built first, then written all or nothing ---------------------------------------
+/// The [uncertainty] table as drawn (an absent bound is left out: the JSON has no null).
+nlohmann::json uncertainty_json(const UncertaintySpec& spec) {
+  nlohmann::json u = nlohmann::json::object();
+  for (std::size_t q = 0; q < kNumQuantities; ++q) {
+    const Spread& sp = spec.spread[q];
+    if (sp.law == Spread::Law::Fixed) continue;
+    nlohmann::json e = {{"law", kLawNames[static_cast<int>(sp.law)]},
+                        {"scale", sp.scale},
+                        {"relative", sp.relative},
+                        {"range", sp.has_range},
+                        {"axes", sp.axes}};
+    if (std::isfinite(sp.min)) e["min"] = sp.min;
+    if (std::isfinite(sp.max)) e["max"] = sp.max;
+    u[quantity_label(q)] = e;
+  }
+  return u;
+}
+
+/// One configuration: its pose, the nominal force, every sample's F_max and the largest kTail.
+nlohmann::json configuration_json(const RobustRun& run, const Configuration& c) {
+  const std::uint64_t count = run.end - run.first;
+  nlohmann::json cj;
+  cj["name"] = c.name;
+  cj["joints_deg"] = to_json(Eigen::VectorXd(c.theta * (180.0 / M_PI)));
+  cj["base_position"] = to_json(Eigen::VectorXd(c.base.position));
+  const Eigen::Vector4d q = c.base.orientation.coeffs();
+  cj["base_quaternion_wxyz"] = {q(3), q(0), q(1), q(2)};
+  cj["nominal"] = {{"M_ie", c.nominal.M_ie},
+                   {"approach_velocity", c.nominal.approach_velocity},
+                   {"f_max", c.nominal.f_max}};
+  std::vector<double> f(count);
+  for (std::uint64_t i = 0; i < count; ++i) f[i] = c.forces[i].f_max;
+  cj["f_max"] = f;
+  std::vector<std::uint64_t> order(count);
+  for (std::uint64_t i = 0; i < count; ++i) order[i] = i;
+  const std::size_t k = std::min<std::size_t>(kTail, count);
+  std::partial_sort(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(k), order.end(),
+                    [&](std::uint64_t a, std::uint64_t b) { return f[a] != f[b] ? f[a] > f[b] : a < b; });
+  cj["tail"] = nlohmann::json::array();
+  for (std::size_t t = 0; t < k; ++t) {
+    const auto i = order[t];
+    cj["tail"].push_back({{"index", run.first + i},
+                          {"f_max", f[i]},
+                          {"M_ie", c.forces[i].M_ie},
+                          {"approach_velocity", c.forces[i].approach_velocity},
+                          {"extreme", extremes(run.samples[i], run.spec)},
+                          {"parameters", sample_json(run.samples[i])}});
+  }
+  return cj;
+}
+
+/// The shard's summary (every sample's F_max, for merging).
+nlohmann::json robust_json(const RobustRun& run, const RobustOptions& o) {
+  const ScenarioKeys& so = run.sc.keys;
   nlohmann::json j;
   j["kind"] = "ffsr-robust";
   j["version"] = FFSR_VERSION;
   j["scenario"] = {{"source", o.config}, {"urdf", so.urdf}, {"model", so.model}, {"duration", so.duration}};
   j["force_model"] = o.force_model;
-  j["law"] = pb.law;
-  j["seed"] = spec.seed;
-  j["samples"] = spec.samples;
-  j["shard"] = {{"k", shard_k}, {"n", shard_n}, {"first", first}, {"end", end}};
-  {
-    nlohmann::json u = nlohmann::json::object();
-    for (std::size_t q = 0; q < kNumQuantities; ++q) {
-      const Spread& sp = spec.spread[q];
-      if (sp.law == Spread::Law::Fixed) continue;
-      // an absent bound is left out (the JSON has no null)
-      nlohmann::json e = {{"law", kLawNames[static_cast<int>(sp.law)]},
-                          {"scale", sp.scale},
-                          {"relative", sp.relative},
-                          {"range", sp.has_range},
-                          {"axes", sp.axes}};
-      if (std::isfinite(sp.min)) e["min"] = sp.min;
-      if (std::isfinite(sp.max)) e["max"] = sp.max;
-      u[quantity_label(q)] = e;
-    }
-    j["uncertainty"] = u;
-  }
+  j["law"] = run.sc.problem.law;
+  j["seed"] = run.spec.seed;
+  j["samples"] = run.spec.samples;
+  j["shard"] = {{"k", run.shard_k}, {"n", run.shard_n}, {"first", run.first}, {"end", run.end}};
+  j["uncertainty"] = uncertainty_json(run.spec);
   // the percentiles: conditional on the stiffness where F_max scales exactly with it (sampling.hpp)
-  if (stiffness_conditional_applies(force_model, spec[Quantity::Stiffness])) {
+  if (stiffness_conditional_applies(run.force_model, run.spec[Quantity::Stiffness])) {
     j["estimator"] = "stiffness-conditional";
-    j["stiffness_nominal"] = nominal.contact.K;
-    std::vector<double> K(count), alpha(count);
-    for (std::uint64_t i = 0; i < count; ++i) {
-      K[i] = samples[i].contact.K;
-      alpha[i] = samples[i].contact.alpha;
+    j["stiffness_nominal"] = run.nominal.contact.K;
+    std::vector<double> K, alpha;
+    for (const auto& smp : run.samples) {
+      K.push_back(smp.contact.K);
+      alpha.push_back(smp.contact.alpha);
     }
     j["stiffness"] = K;
     j["exponent"] = alpha;
@@ -771,112 +656,97 @@ int run_robust(RobustOptions& o, CLI::App& app) {  // by reference: the file's k
     j["estimator"] = "order-statistics";
   }
   j["configurations"] = nlohmann::json::array();
-  std::uint64_t redraws = 0;
-  for (const auto& s : samples) redraws += static_cast<std::uint64_t>(s.redraws);
-  j["redraws"] = redraws;
-  for (const auto& c : configs) {
-    nlohmann::json cj;
-    cj["name"] = c.name;
-    cj["joints_deg"] = to_json(Eigen::VectorXd(c.theta * (180.0 / M_PI)));
-    cj["base_position"] = to_json(Eigen::VectorXd(c.base.position));
-    const Eigen::Vector4d q = c.base.orientation.coeffs();
-    cj["base_quaternion_wxyz"] = {q(3), q(0), q(1), q(2)};
-    cj["nominal"] = {{"M_ie", c.nominal.M_ie},
-                     {"approach_velocity", c.nominal.approach_velocity},
-                     {"f_max", c.nominal.f_max}};
-    std::vector<double> f(count);
-    for (std::uint64_t i = 0; i < count; ++i) f[i] = c.forces[i].f_max;
-    cj["f_max"] = f;
-    std::vector<std::uint64_t> order(count);
-    for (std::uint64_t i = 0; i < count; ++i) order[i] = i;
-    const std::size_t k = std::min<std::size_t>(kTail, count);
-    std::partial_sort(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(k), order.end(),
-                      [&](std::uint64_t a, std::uint64_t b) { return f[a] != f[b] ? f[a] > f[b] : a < b; });
-    cj["tail"] = nlohmann::json::array();
-    for (std::size_t t = 0; t < k; ++t) {
-      const auto i = order[t];
-      cj["tail"].push_back({{"index", first + i},
-                            {"f_max", f[i]},
-                            {"M_ie", c.forces[i].M_ie},
-                            {"approach_velocity", c.forces[i].approach_velocity},
-                            {"extreme", extremes(samples[i], spec)},
-                            {"parameters", sample_json(samples[i])}});
-    }
-    j["configurations"].push_back(std::move(cj));
-  }
+  j["redraws"] = run.redraws;
+  for (const auto& c : run.configs) j["configurations"].push_back(configuration_json(run, c));
   finish_summary(j);
+  return j;
+}
 
+/// One row per sample and configuration.
+std::string robust_csv(const RobustRun& run) {
+  std::ostringstream c;
+  c << std::setprecision(12)
+    << "configuration,sample,target_mass,Ixx,Iyy,Izz,Ixy,Ixz,Iyz,offset_x,offset_y,offset_z,normal_x,"
+       "normal_y,"
+       "normal_z,spin_x_deg,spin_y_deg,spin_z_deg,velocity_x,velocity_y,velocity_z,approach_speed,"
+       "stiffness,"
+       "exponent,restitution,robot_offset_x,robot_offset_y,robot_offset_z,M_ie,delta_dot,F_max\n";
+  for (const auto& cf : run.configs)
+    for (std::uint64_t i = 0; i < run.samples.size(); ++i) {
+      const UncertainSample& s = run.samples[i];
+      const Matrix3& I = s.target.inertia;
+      const Vector3 w = s.target.angular_velocity * (180.0 / M_PI);
+      c << cf.name << "," << run.first + i << "," << s.target.mass << "," << I(0, 0) << "," << I(1, 1) << ","
+        << I(2, 2) << "," << I(0, 1) << "," << I(0, 2) << "," << I(1, 2);
+      for (const Vector3* v : {&s.target.contact_offset, &s.target.normal, &w, &s.target.velocity})
+        c << "," << (*v)(0) << "," << (*v)(1) << "," << (*v)(2);
+      c << "," << s.approach_speed << "," << s.contact.K << "," << s.contact.alpha << "," << s.contact.c_r
+        << "," << s.robot_offset(0) << "," << s.robot_offset(1) << "," << s.robot_offset(2) << ","
+        << cf.forces[i].M_ie << "," << cf.forces[i].approach_velocity << "," << cf.forces[i].f_max << "\n";
+    }
+  return c.str();
+}
+
+/// JSON, CSV and the figure (the picture first: a failed drawing leaves no output file), then the table.
+int report_robust(const RobustRun& run, const RobustOptions& o, Outputs& outputs, plot::Format plot_format) {
+  const nlohmann::json j = robust_json(run, o);
   if (!o.json.empty()) outputs.set("--json", j.dump(1) + "\n");
-  if (!o.csv.empty()) {
-    std::ostringstream c;
-    c << std::setprecision(12)
-      << "configuration,sample,target_mass,Ixx,Iyy,Izz,Ixy,Ixz,Iyz,offset_x,offset_y,offset_z,normal_x,"
-         "normal_y,"
-         "normal_z,spin_x_deg,spin_y_deg,spin_z_deg,velocity_x,velocity_y,velocity_z,approach_speed,"
-         "stiffness,"
-         "exponent,restitution,robot_offset_x,robot_offset_y,robot_offset_z,M_ie,delta_dot,F_max\n";
-    for (const auto& cf : configs)
-      for (std::uint64_t i = 0; i < count; ++i) {
-        const UncertainSample& s = samples[i];
-        const Matrix3& I = s.target.inertia;
-        const Vector3 w = s.target.angular_velocity * (180.0 / M_PI);
-        c << cf.name << "," << first + i << "," << s.target.mass << "," << I(0, 0) << "," << I(1, 1) << ","
-          << I(2, 2) << "," << I(0, 1) << "," << I(0, 2) << "," << I(1, 2);
-        for (const Vector3* v : {&s.target.contact_offset, &s.target.normal, &w, &s.target.velocity})
-          c << "," << (*v)(0) << "," << (*v)(1) << "," << (*v)(2);
-        c << "," << s.approach_speed << "," << s.contact.K << "," << s.contact.alpha << "," << s.contact.c_r
-          << "," << s.robot_offset(0) << "," << s.robot_offset(1) << "," << s.robot_offset(2) << ","
-          << cf.forces[i].M_ie << "," << cf.forces[i].approach_velocity << "," << cf.forces[i].f_max << "\n";
-      }
-    outputs.set("--csv", c.str());
-  }
-  std::vector<std::string> drawn;  // the picture first: a failed drawing leaves no output file
+  if (!o.csv.empty()) outputs.set("--csv", robust_csv(run));
+  std::vector<std::string> drawn;
   if (!o.plot.empty()) drawn = plot::render({robust_figure(j)}, o.plot, plot_format);
   outputs.write();
-
   std::ostream& out = outputs.table();
-  out << "ffsr-optimize " << FFSR_VERSION << " robust: " << where << " (" << model.n() << " joints, "
-      << pb.law << ", " << o.force_model << " F_max)\n"
-      << spec.samples << " samples, seed " << spec.seed << "; this run: samples " << first << " to " << end
-      << " (shard " << shard_k << "/" << shard_n << "), " << redraws << " redraws by the physical rules\n\n";
+  out << "ffsr-optimize " << FFSR_VERSION << " robust: " << run.sc.where << " (" << run.sc.model->n()
+      << " joints, " << run.sc.problem.law << ", " << o.force_model << " F_max)\n"
+      << run.spec.samples << " samples, seed " << run.spec.seed << "; this run: samples " << run.first
+      << " to " << run.end << " (shard " << run.shard_k << "/" << run.shard_n << "), " << run.redraws
+      << " redraws by the physical rules\n\n";
   print_summary(j, out);
   for (const std::string& f : drawn) out << "wrote " << f << "\n";
   return 0;
 }
 
+/// robust's own keys, also allowed in a scenario file (a flag overrides the file).
+const std::set<std::string> kRobustKeys = {"force-model", "samples", "shard",       "threads", "json",
+                                           "csv",         "plot",    "plot-format", "quiet"};
+
+/// The flags, completed by the file's robust keys that no flag overrides.
+RobustOptions with_file_keys(const RobustOptions& flags, const ScenarioKeys& keys, const CLI::App& app) {
+  RobustOptions o = flags;
+  for (const auto& [name, text] : keys.extra) {
+    const std::string flag = "--" + name;
+    if (app.get_option(flag)->count() > 0) continue;
+    if (name == "force-model") o.force_model = text;
+    if (name == "samples") o.samples = text;
+    if (name == "shard") o.shard = text;
+    if (name == "threads") o.threads = static_cast<int>(detail::integer_from_text(text, flag));
+    if (name == "json") o.json = text;
+    if (name == "csv") o.csv = text;
+    if (name == "plot") o.plot = text;
+    if (name == "plot-format") o.plot_format = text;
+    if (name == "quiet") o.quiet = detail::boolean_from_text(text, flag);
+  }
+  return o;
+}
+
+int run_robust(const RobustOptions& flags, const CLI::App& app) {
+  if (!flags.merge.empty()) return run_merge(flags);
+  if (flags.config.empty()) throw InputError("robust: --config SCENARIO.toml is required (or --merge FILES)");
+  ScenarioKeys keys = read_scenario_file(flags.config, kRobustKeys);
+  const RobustOptions o = with_file_keys(flags, keys, app);
+  Outputs outputs;  // checked first (two outputs on standard output); the table goes to standard error then
+  outputs.add("--json", o.json);
+  outputs.add("--csv", o.csv);
+  const plot::Format plot_format = plot::check_request(o.plot, o.plot_format);
+  RobustRun run = parse_robust(o, std::move(keys));
+  run.configs = o.capture_joints_deg.empty()
+                    ? planned_configurations(run.sc, o.quiet)
+                    : std::vector<Configuration>{given_configuration(o, *run.sc.model)};
+  evaluate_samples(run, o);
+  return report_robust(run, o, outputs, plot_format);
+}
+
 }  // namespace
-
-UncertaintySpec read_uncertainty_table(const std::string& config, const std::string& where) {
-  toml::table root;
-  try {
-    root = toml::parse_file(config);
-  } catch (const toml::parse_error& e) {
-    throw InputError(str(where, ":", e.source().begin.line, ": ", e.description()));
-  }
-  UncertaintySpec spec;
-  try {
-    parse_uncertainty(root, spec, false, false, where);
-  } catch (const InputError& e) {
-    if (!root.get("uncertainty"))
-      throw InputError(str("--objective: robust-force needs an [uncertainty] table in ", where));
-    throw;
-  }
-  return spec;
-}
-
-std::shared_ptr<RobustForceObjective> scenario_robust_objective(const Scenario& sc,
-                                                                const UncertaintySpec& spec) {
-  UncertainNominal nominal;
-  nominal.target = propagate_target(sc.problem.target, sc.capture.duration);
-  nominal.contact = sc.problem.contact;
-  nominal.approach_speed = sc.problem.approach_speed;
-  UncertaintySpec s = spec;
-  s.seed = robust_objective_seed(spec);
-  std::vector<UncertainSample> samples(s.samples);
-  const int threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  parallel_for(0, s.samples, threads, [&](std::uint64_t i) { samples[i] = draw_sample(s, nominal, i); });
-  return std::make_shared<RobustForceObjective>(std::move(samples), sc.problem.law);
-}
 
 void register_robust(CLI::App& app, Action& action) {
   auto o = std::make_shared<RobustOptions>();
@@ -885,10 +755,10 @@ void register_robust(CLI::App& app, Action& action) {
       "Monte Carlo of F_max over the scenario's [uncertainty] table, for the planned capture configurations");
   sub->add_option("--config", o->config, "Scenario file (TOML) with an [uncertainty] table")
       ->check(CLI::ExistingFile);
-  // before the scenario's keys: here --seed (and a scenario's `seed`) is the Monte Carlo seed, not the
-  // global search's (add_scenario_options leaves an existing --seed alone)
+  // before the scenario's keys: here --seed is the Monte Carlo seed, not the global search's
+  // (ScenarioFlags leaves an existing --seed alone; robust_scenario sets the global search's to 1)
   sub->add_option("--seed", o->seed, "Seed, a non-negative integer (overrides uncertainty.seed)");
-  add_scenario_options(*sub, o->scenario);
+  o->flags.add_to(*sub);
   sub->add_option("--force-model", o->force_model,
                   "F_max per sample: closed (Eq. 24), exact (Eq. 16) or multibody (CVODE)")
       ->capture_default_str();

@@ -15,10 +15,9 @@ void register_contact(CLI::App& app, Action& action);
 /// xi: the relative error of the closed-form maximum force against K, delta_dot^- and c_r.
 void register_xi(CLI::App& app, Action& action);
 void register_map(CLI::App& app, Action& action);
-/// `robust`: Monte Carlo of F_max over the scenario's [uncertainty] table (issue 12).
+/// `robust`: Monte Carlo of F_max over the scenario's [uncertainty] table.
 void register_robust(CLI::App& app, Action& action);
-/// The main job (no subcommand): run a capture scenario. `argv` lets it tell which keys came from
-/// the command line (they override the scenario file and are not resolved against its folder).
-void register_run(CLI::App& app, Action& action, int argc, char** argv);
+/// The main job (no subcommand): run a capture scenario; a flag overrides the scenario file's key.
+void register_run(CLI::App& app, Action& action);
 
 }  // namespace ffsr::cli

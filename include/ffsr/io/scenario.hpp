@@ -1,0 +1,147 @@
+// ffsr/io/scenario.hpp -- a capture scenario as a value: its keys, one TOML reader (toml++, the
+// [uncertainty] table included), overrides given as text (a command line), one validation, and the
+// problem it describes. Component ffsr::scenario (urdfdom, SUNDIALS, NLopt, toml++, nlohmann/json).
+//
+// A scenario file is a flat TOML table: every key of `scenario_keys()` (robot, start state, target,
+// contact, tasks, planner, global run) and an optional [uncertainty] table. Messages name the file
+// ("scenario FILE: missing key 'duration'") or the key ("--duration: must be positive, got -1"): the
+// keys are spelled as the command's flags, so a message reads the same for a file and a flag.
+//
+//   ffsr::Scenario sc = ffsr::load_scenario("robots/paper_7dof_position.toml");
+//   ffsr::ScenarioResult r = ffsr::run_scenario(sc);          // scenario_run.hpp
+//   nlohmann::json j = ffsr::scenario_json(sc, r, "0.1.0");   // what `ffsr-optimize --json` writes
+#pragma once
+
+#include "ffsr/errors.hpp"
+#include "ffsr/io/urdf.hpp"
+#include "ffsr/optimize/capture.hpp"
+#include "ffsr/optimize/global.hpp"
+#include "ffsr/uncertainty/sampling.hpp"
+
+#include <nlohmann/json.hpp>
+#include <toml++/toml.h>
+
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <memory>
+#include <optional>
+#include <set>
+#include <string>
+#include <vector>
+
+namespace ffsr {
+
+/// How a URDF becomes a model: the bus it is mounted on, locked joints, inertia repairs, the contact
+/// point at the gripper (the keys bus-mass ... end-effector-offset).
+struct ModelLoadKeys {
+  double bus_mass = 0.0;
+  std::vector<double> bus_inertia, bus_com, mount_xyz, mount_rpy_deg, end_effector_offset;
+  std::vector<std::string> lock_joints;
+  std::string inertia_repair = "none";
+  double min_mass = 0.0, min_inertia = 0.0;
+  std::set<std::string> given;  ///< the keys that were set (bus-mass, the mount keys, ...)
+  /// The loader options; InputError naming the key on a bad value.
+  UrdfOptions build(const std::string& end_effector) const;
+  /// The keys as given (the resolved scenario of the JSON result).
+  nlohmann::json to_json() const;
+};
+
+/// The keys of a scenario, as read (units of the file: degrees where the key says so).
+struct ScenarioKeys {
+  std::string urdf, end_effector;
+  ModelLoadKeys load;
+  std::vector<double> joints_deg, base_position{0, 0, 0}, base_rpy_deg{0, 0, 0};
+  double target_mass = 0;
+  std::vector<double> target_inertia, target_position, target_rpy_deg{0, 0, 0}, target_angular_velocity_deg,
+      target_velocity{0, 0, 0}, contact_offset, normal;
+  std::string model;
+  double stiffness = 0, exponent = 0, restitution = 0, approach_speed = 0;
+  std::string task, task_axes = "xyz", baseline_task;
+  std::vector<double> final_rpy_deg;
+  double duration = 0, step = 0, gain = 0, feedback = 1.0, tolerance = 0, orientation_tolerance_deg = 0.5;
+  std::string objective = "mass";
+  bool global = true;             ///< also run the global capture optimization
+  std::string seed = "1";         ///< the global search's seed (text: a bad value names the key)
+  double max_joint_rate_deg = 0;  ///< 0: not set
+  int global_starts = 32;
+
+  std::string file;                  ///< the scenario file; empty: a built-in scenario
+  std::string where;                 ///< "scenario FILE" or "built-in scenario", for messages
+  std::set<std::string> given;       ///< keys set by the file or an override
+  std::set<std::string> overridden;  ///< keys set by an override (paths not resolved against the file)
+  std::map<std::string, std::string> extra;     ///< keys of the caller (read_scenario_file), as text
+  std::shared_ptr<const toml::table> document;  ///< the file as read (its [uncertainty] table)
+};
+
+/// The kind of a key's value: one parser each, from a TOML node and from text.
+enum class KeyKind { Text, Texts, Number, Numbers, Integer, Boolean };
+
+/// One key of a scenario: its name (as in the file; the flag is "--" + name), kind, help text and
+/// how it is set. Both setters throw InputError naming the key ("--name: ...").
+struct ScenarioKey {
+  std::string name;
+  KeyKind kind;
+  std::string help;
+  std::string default_text;  ///< shown in a command's help; empty: none shown
+  std::function<void(ScenarioKeys&, const toml::node&)> from_toml;
+  std::function<void(ScenarioKeys&, const std::string&)> from_text;  ///< lists: comma-separated
+};
+
+/// Every key, in the order a command lists them.
+const std::vector<ScenarioKey>& scenario_keys();
+/// The key named `name`, or null.
+const ScenarioKey* find_scenario_key(const std::string& name);
+
+/// Keys a scenario file must name (the others have defaults).
+const std::vector<std::string>& required_scenario_keys();
+
+/// Reads a scenario file: every key and the [uncertainty] table (kept, parsed by uncertainty_spec).
+/// `extra_keys`: further keys the caller allows (a command's output keys), kept as text in
+/// ScenarioKeys::extra (a list joined with commas). InputError "scenario FILE: unknown key 'k'",
+/// "scenario FILE:LINE: <TOML error>", or naming the key.
+ScenarioKeys read_scenario_file(const std::string& path, const std::set<std::string>& extra_keys = {});
+/// The same from text (`where` names it in messages; `file` is empty: a built-in scenario).
+ScenarioKeys read_scenario_text(const std::string& text, const std::string& where,
+                                const std::string& file = "", const std::set<std::string>& extra_keys = {});
+/// Sets key `name` from text, as an override (a flag overrides the file). InputError naming the key.
+void override_scenario_key(ScenarioKeys& keys, const std::string& name, const std::string& text);
+
+/// A validated scenario: the robot, the capture problem, the tasks of the optimized and the plain
+/// run, the optimized run's options (the plain run uses gain 0) and the global run's settings.
+struct Scenario {
+  ScenarioKeys keys;  ///< as resolved (the URDF path relative to the scenario file)
+  std::string where;  ///< "scenario FILE" or "built-in scenario"
+  bool builtin = false;
+  std::unique_ptr<Model> model;
+  CaptureProblem problem;  ///< problem.model points to *model
+  CaptureTask task, baseline_task;
+  CaptureOptions capture;
+  UrdfReport report;                                  ///< what the loader did to the file
+  GlobalObjective objective = GlobalObjective::Mass;  ///< the global run's objective
+  std::uint64_t seed = 1;                             ///< the global search's seed
+};
+
+/// A URDF given as text for a built-in scenario whose `urdf` key names it (not read from disk).
+struct EmbeddedUrdf {
+  std::string name;    ///< the value of the urdf key it stands for ("paper_3dof.urdf")
+  std::string source;  ///< how messages name it
+  std::string xml;
+};
+
+/// Checks the keys (a file must name required_scenario_keys()) and builds the problem; a URDF path
+/// of the file is relative to the file. InputError naming the file or the key; ModelError from the
+/// loader.
+Scenario build_scenario(ScenarioKeys keys, const EmbeddedUrdf* embedded = nullptr);
+/// read_scenario_file + build_scenario.
+Scenario load_scenario(const std::string& path);
+
+/// The [uncertainty] table of the scenario (read with the file). InputError naming the key
+/// ("uncertainty.spin.std: ...") or "WHERE: no [uncertainty] table". `samples`, `seed`: overrides
+/// (the table's values are still checked).
+UncertaintySpec uncertainty_spec(const ScenarioKeys& keys, std::optional<std::uint64_t> samples = {},
+                                 std::optional<std::uint64_t> seed = {});
+
+}  // namespace ffsr
+
+#include "ffsr/io/detail/scenario.hxx"

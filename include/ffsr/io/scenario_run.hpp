@@ -1,0 +1,78 @@
+// ffsr/io/scenario_run.hpp -- the main job of a scenario (ffsr/io/scenario.hpp): the plain run
+// (rho = 0, the baseline task), the paper's method (the optimized run, Eq. 29-31) and the global run,
+// as one result struct, and that result as JSON (the keys and values of `ffsr-optimize --json`).
+// Component ffsr::scenario. Never prints; progress goes to the callbacks of ScenarioRunOptions.
+#pragma once
+
+#include "ffsr/io/scenario.hpp"
+#include "ffsr/uncertainty/robust_objective.hpp"
+
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <thread>
+#include <utility>
+#include <vector>
+
+namespace ffsr {
+
+/// The global run and what the outputs need beside it.
+struct GlobalRun {
+  GlobalCaptureResult result;
+  double paper_objective = 0;  ///< the objective at the paper's-method run's capture configuration
+};
+
+/// The tail measure of one row over the robust-force objective's sample set, N.
+struct RobustRow {
+  std::string name;  ///< baseline, optimized, global
+  double cvar95 = 0, p95 = 0;
+};
+
+struct ScenarioResult {
+  CaptureResult plain, optimized;
+  std::optional<GlobalRun> global;  ///< unless the scenario's global = false
+  /// objective = robust-force: the search's sample set, its table and each row's tail measure
+  std::shared_ptr<RobustForceObjective> robust;
+  UncertaintySpec robust_spec;
+  std::vector<RobustRow> robust_rows;
+};
+
+struct ScenarioRunOptions {
+  bool record_series = false;  ///< keep the time series of every run (CaptureResult::series)
+  std::function<void(double)> plain_progress, optimized_progress;  ///< fraction done, optional
+};
+
+/// The plain and the optimized run. A NumericalError names the run ("plain run: ...").
+std::pair<CaptureResult, CaptureResult> plan_plain_and_optimized(const Scenario& sc,
+                                                                 const ScenarioRunOptions& options = {});
+
+/// The seed of the robust-force objective's sample set: the table's seed + 1, so that the search's
+/// samples are independent of the ones `robust` evaluates with the same table (an out-of-sample check).
+inline std::uint64_t robust_objective_seed(const UncertaintySpec& spec) { return spec.seed + 1; }
+/// The robust-force objective of a scenario: spec.samples samples (seed robust_objective_seed)
+/// around the nominal target at T, the scenario's contact and law.
+std::shared_ptr<RobustForceObjective> scenario_robust_objective(const Scenario& sc,
+                                                                const UncertaintySpec& spec);
+
+/// Plans the global run: the optimized run's task, no gain, the joint-rate limit, the paper's-method
+/// capture configuration as an extra start (so the global row is never worse than it). `robust`:
+/// the sample set of the robust-force objective (null otherwise). The reaching runs stop within
+/// 1 % of the manifold optimum, 0.01 % for robust-force or with `tight_reaching`. Errors name the run.
+GlobalRun run_global(const Scenario& sc, const CaptureResult& paper_run, GlobalObjective objective,
+                     std::shared_ptr<RobustForceObjective> robust = nullptr, bool tight_reaching = false);
+
+/// The main job: plain, optimized and (unless global = false) global runs; robust-force reads the
+/// scenario's [uncertainty] table.
+ScenarioResult run_scenario(const Scenario& sc, const ScenarioRunOptions& options = {});
+
+/// The result as JSON: the resolved scenario, the model as loaded, each run, the reductions, the
+/// global and the robust rows (`version` is recorded as given).
+nlohmann::json scenario_json(const Scenario& sc, const ScenarioResult& r, const std::string& version);
+
+/// Reduction of `after` against `before`, percent: 100 (before - after) / before.
+inline double reduction_percent(double before, double after) { return 100.0 * (before - after) / before; }
+
+}  // namespace ffsr
+
+#include "ffsr/io/detail/scenario_run.hxx"

@@ -1,0 +1,160 @@
+// Scenarios through the library (ffsr/io/scenario.hpp, ffsr/io/scenario_run.hpp): a scenario file
+// gives the same result as `ffsr-optimize --json`, every shipped scenario loads, bad keys are named.
+#include "ffsr/io/scenario.hpp"
+#include "ffsr/io/scenario_run.hpp"
+
+#include "support/run_command.hpp"
+
+#include <catch2/catch.hpp>
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+const std::string kSource = FFSR_SOURCE_DIR;
+
+/// Every number of `a` and `b` at the same place agrees within rtol 1e-9 (the same code runs in
+/// both: only the last bits of a sum may differ), except wall-clock keys named `seconds`; every key
+/// of one is a key of the other.
+void check_same_numbers(const json& a, const json& b, const std::string& path) {
+  INFO("at " << path);
+  REQUIRE(a.is_number() ==
+          b.is_number());  // an integer may be stored signed on one side, unsigned on the other
+  if (!a.is_number()) REQUIRE(a.type() == b.type());
+  if (a.is_object()) {
+    REQUIRE(a.size() == b.size());
+    for (const auto& [key, value] : a.items()) {
+      REQUIRE(b.contains(key));
+      if (key == "seconds") continue;
+      check_same_numbers(value, b[key], path + "." + key);
+    }
+  } else if (a.is_array()) {
+    REQUIRE(a.size() == b.size());
+    for (std::size_t i = 0; i < a.size(); ++i)
+      check_same_numbers(a[i], b[i], path + "[" + std::to_string(i) + "]");
+  } else if (a.is_number()) {
+    const double x = a.get<double>(), y = b.get<double>();
+    CHECK(std::abs(x - y) <= 1e-9 * std::max(std::abs(x), std::abs(y)) + 1e-12);
+  } else {
+    CHECK(a == b);
+  }
+}
+
+struct TempDir {
+  fs::path path;
+  TempDir() {
+    std::string pattern = (fs::temp_directory_path() / "ffsr_scenario_XXXXXX").string();
+    path = mkdtemp(pattern.data());
+  }
+  ~TempDir() {
+    std::error_code ec;
+    fs::remove_all(path, ec);
+  }
+};
+
+/// A scenario file written from `text` (paths in it relative to robots/).
+std::string write_scenario(const TempDir& dir, const std::string& name, const std::string& text) {
+  const fs::path p = dir.path / name;
+  std::ofstream(p) << text;
+  return p.string();
+}
+
+std::string read_text(const std::string& path) {
+  std::ifstream in(path);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const ffsr::InputError& e) {
+    return e.what();
+  }
+  return "(no InputError)";
+}
+
+}  // namespace
+
+TEST_CASE("scenario: robots/paper_7dof_position.toml through the library gives the command's --json numbers",
+          "[scenario]") {
+  const std::string file = kSource + "/robots/paper_7dof_position.toml";
+  const ffsr::Scenario sc = ffsr::load_scenario(file);
+  const ffsr::ScenarioResult result = ffsr::run_scenario(sc);
+  json lib = ffsr::scenario_json(sc, result, "library");
+
+  TempDir tmp;
+  const std::string out = (tmp.path / "out.json").string();
+  const auto r = ffsr::test::run_command({FFSR_CLI, "--config", file, "--quiet", "--json", out});
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  json cmd = json::parse(read_text(out));
+  // the version is the command's; everything else, the resolved scenario included, is the same
+  lib.erase("version");
+  cmd.erase("version");
+  check_same_numbers(lib, cmd, "result");
+  CHECK(lib["optimized"]["integrated_effective_mass"].get<double>() <
+        lib["baseline"]["integrated_effective_mass"].get<double>());
+}
+
+TEST_CASE("scenario: every robots/*.toml loads through the library", "[scenario]") {
+  int count = 0;
+  for (const auto& e : fs::directory_iterator(kSource + "/robots")) {
+    if (e.path().extension() != ".toml") continue;
+    INFO(e.path().string());
+    const ffsr::Scenario sc = ffsr::load_scenario(e.path().string());
+    CHECK(sc.model->n() > 0);
+    CHECK(sc.problem.model == sc.model.get());
+    CHECK(sc.where == "scenario " + e.path().string());
+    ++count;
+  }
+  CHECK(count >= 5);
+  // the uncertain scenario's [uncertainty] table is read by the same reader
+  const auto keys = ffsr::read_scenario_file(kSource + "/robots/paper_7dof_position_uncertain.toml");
+  CHECK(ffsr::uncertainty_spec(keys).samples >= 1);
+}
+
+TEST_CASE("scenario: bad keys and values name the file or the key", "[scenario]") {
+  TempDir tmp;
+  const std::string base = read_text(kSource + "/robots/paper_3dof.toml");
+  const std::string urdf = kSource + "/robots/paper_3dof.urdf";
+  auto with = [&](const std::string& extra) {
+    return write_scenario(
+        tmp, "s.toml", "urdf = \"" + urdf + "\"\n" + extra + "\n" + [&] {
+          std::string s = base;  // the same file without its urdf line
+          const auto at = s.find("urdf =");
+          return s.erase(at, s.find('\n', at) - at);
+        }());
+  };
+  CHECK(error_of([&] { ffsr::load_scenario(with("colour = \"red\"")); }).find("unknown key 'colour'") !=
+        std::string::npos);
+  CHECK(error_of([&] {
+          ffsr::read_scenario_file(with("orientation-tolerance-deg = \"fast\""));
+        }).find("--orientation-tolerance-deg: 'fast' is not a number") != std::string::npos);
+  CHECK(error_of([&] {
+          ffsr::read_scenario_file(with("global-starts = \"many\""));
+        }).find("--global-starts") != std::string::npos);
+
+  ffsr::ScenarioKeys keys = ffsr::read_scenario_file(with(""));
+  ffsr::override_scenario_key(keys, "duration", "-1");
+  CHECK(error_of([&] { ffsr::build_scenario(keys); }) == "--duration: must be positive, got -1");
+  keys = ffsr::read_scenario_file(with(""));
+  keys.given.erase("step");
+  CHECK(error_of([&] { ffsr::build_scenario(keys); }) ==
+        "scenario " + tmp.path.string() + "/s.toml: missing key 'step'");
+  keys = ffsr::read_scenario_file(with(""));
+  ffsr::override_scenario_key(keys, "joints-deg", "1,2");
+  CHECK(error_of([&] { ffsr::build_scenario(keys); }).rfind("--joints-deg: got 2 angles", 0) == 0);
+  CHECK(error_of([&] { ffsr::override_scenario_key(keys, "target-inertia", "1,abc,3"); }) ==
+        "--target-inertia: 'abc' is not a number (in '1,abc,3')");
+  CHECK(error_of([&] {
+          ffsr::read_scenario_text("duration = [", "scenario x.toml");
+        }).rfind("scenario x.toml:1: ", 0) == 0);
+}
