@@ -26,17 +26,15 @@
 #include "figures.hpp"
 #include "subcommands.hpp"
 
-#include <atomic>
+#include "ffsr/detail/parallel.hpp"
+
 #include <charconv>
-#include <condition_variable>
 #include <cstdint>
 #include <cstdio>
-#include <exception>
 #include <filesystem>
 #include <iostream>
 #include <limits>
 #include <memory>
-#include <mutex>
 #include <random>
 #include <sstream>
 #include <thread>
@@ -344,58 +342,32 @@ std::vector<double> check_map_plot(const MapOptions& o, const Grid& grid, const 
   return slice_deg;
 }
 
-/// The points [first, last) of the grid on a pool of workers: blocks of points claimed in order,
-/// each written to `out` once all blocks before it are.
+/// The per-thread workers of a grid run (detail::parallel_chunks hands each thread its own).
 struct GridRun {
   std::vector<std::unique_ptr<Worker>> workers;
   unsigned threads = 1;
 };
 
-void run_workers(GridRun& g, CsvOutput& out, std::uint64_t first, std::uint64_t last, std::uint64_t blocks,
-                 std::uint64_t block, bool quiet) {
-  std::atomic<std::uint64_t> next_block{0}, done{0};
-  std::mutex m;
-  std::condition_variable cv;
-  std::uint64_t next_write = 0;
-  unsigned running = g.threads;
-  bool failed = false;
-  std::exception_ptr error;
-  auto work = [&](Worker& w) {
-    try {
-      for (;;) {
-        const std::uint64_t b = next_block.fetch_add(1);
-        if (b >= blocks) break;
-        const std::uint64_t lo = first + b * block, hi = std::min(last, lo + block);
-        const size_t bytes = w.run(lo, hi);
-        std::unique_lock<std::mutex> lock(m);
-        cv.wait(lock, [&] { return next_write == b || failed; });
-        if (failed) break;
-        out.write(w.text.data(), bytes);
-        ++next_write;
-        done += hi - lo;
-        cv.notify_all();
-      }
-    } catch (...) {
-      std::lock_guard<std::mutex> lock(m);
-      if (!error) error = std::current_exception();
-      failed = true;
-    }
-    std::lock_guard<std::mutex> lock(m);
-    --running;
-    cv.notify_all();
-  };
+/// The points [first, last) of the grid in blocks of `block` points on the shared thread pool
+/// (ffsr/detail/parallel.hpp): each block is formatted by a worker and written to `out` once all
+/// blocks before it are, so the CSV does not depend on the thread count.
+void run_workers(GridRun& g, CsvOutput& out, std::uint64_t first, std::uint64_t last, std::uint64_t block,
+                 bool quiet) {
   Progress progress("map", quiet);
-  std::vector<std::thread> pool;
-  for (unsigned t = 0; t < g.threads; ++t) pool.emplace_back(work, std::ref(*g.workers[t]));
-  {
-    std::unique_lock<std::mutex> lock(m);
-    while (running > 0) {
-      cv.wait_for(lock, std::chrono::milliseconds(200), [&] { return running == 0; });
-      if (!failed) progress(done.load(), last - first);
-    }
-  }
-  for (auto& t : pool) t.join();
-  if (error) std::rethrow_exception(error);
+  std::vector<size_t> bytes(g.threads, 0);
+  ffsr::detail::ParallelOptions opt;
+  opt.chunk = block;
+  opt.commit = [&](unsigned t, std::uint64_t, std::uint64_t) {
+    out.write(g.workers[t]->text.data(), bytes[t]);
+  };
+  opt.progress = [&](std::uint64_t done) { progress(done, last - first); };
+  opt.progress_every = std::chrono::milliseconds(200);
+  ffsr::detail::parallel_chunks(
+      last - first, g.threads,
+      [&](unsigned t, std::uint64_t lo, std::uint64_t hi) {
+        bytes[t] = g.workers[t]->run(first + lo, first + hi);
+      },
+      opt);
 }
 
 void print_map_summary(std::ostream& os, const MapOptions& o, const Grid& grid, const Shard& shard,
@@ -453,7 +425,7 @@ int run_map(const MapOptions& o) {
     g.workers.back()->first_point = first;
   }
   const auto t0 = std::chrono::steady_clock::now();
-  run_workers(g, out, first, last, blocks, kBlock, o.quiet);
+  run_workers(g, out, first, last, kBlock, o.quiet);
   // the pictures before the CSV is committed: a failed drawing leaves no CSV behind
   std::vector<std::string> drawn;
   if (plotting)
