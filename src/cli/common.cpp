@@ -115,15 +115,7 @@ void TargetOptions::add_to(CLI::App& app) {
 }
 
 Matrix3 parse_inertia(const std::string& text, const std::string& flag) {
-  const auto v = parse_list(text, flag, {3, 6});
-  Matrix3 I = Matrix3::Zero();
-  I.diagonal() << v[0], v[1], v[2];
-  if (v.size() == 6) {
-    I(0, 1) = I(1, 0) = v[3];
-    I(0, 2) = I(2, 0) = v[4];
-    I(1, 2) = I(2, 1) = v[5];
-  }
-  return I;
+  return ffsr::detail::inertia_from_components(parse_list(text, flag, {3, 6}));
 }
 
 Target TargetOptions::build() const {
@@ -135,14 +127,7 @@ Target TargetOptions::build() const {
   const Vector3 rpy = parse_vec3(rpy_deg, "--target-rpy-deg") * (M_PI / 180.0);
   t.attitude = Quaternion(rotation_from_rpy(rpy));
   t.contact_offset = parse_vec3(contact_offset, "--contact-offset");
-  const Vector3 n = parse_vec3(normal, "--normal");
-  if (n.norm() < 1e-12) throw InputError("--normal: the contact normal must be a non-zero vector");
-  t.normal = n.normalized();
-  try {
-    t.validate("target");
-  } catch (const InputError& e) {
-    throw InputError(str("--target-inertia/--target-mass: ", e.what()));
-  }
+  ffsr::detail::finish_target(t, parse_vec3(normal, "--normal"), "--target-inertia/--target-mass");
   return t;
 }
 

@@ -169,4 +169,15 @@ struct Progress {
 nlohmann::json to_json(const Eigen::MatrixXd& m);
 nlohmann::json to_json(const Eigen::VectorXd& v);
 
+/// Calls set(name, text, flag) for every command key the scenario file holds (ScenarioKeys::extra:
+/// json, csv, plot, ...) whose flag was not given on the command line: a flag overrides the file.
+template <class Set>
+void for_each_file_key(const ScenarioKeys& keys, const CLI::App& app, Set&& set) {
+  for (const auto& [name, text] : keys.extra) {
+    const std::string flag = "--" + name;
+    if (app.get_option(flag)->count() > 0) continue;
+    set(name, text, flag);
+  }
+}
+
 }  // namespace ffsr::cli

@@ -713,19 +713,19 @@ const std::set<std::string> kRobustKeys = {"force-model", "samples", "shard",   
 /// The flags, completed by the file's robust keys that no flag overrides.
 RobustOptions with_file_keys(const RobustOptions& flags, const ScenarioKeys& keys, const CLI::App& app) {
   RobustOptions o = flags;
-  for (const auto& [name, text] : keys.extra) {
-    const std::string flag = "--" + name;
-    if (app.get_option(flag)->count() > 0) continue;
-    if (name == "force-model") o.force_model = text;
-    if (name == "samples") o.samples = text;
-    if (name == "shard") o.shard = text;
-    if (name == "threads") o.threads = static_cast<int>(detail::integer_from_text(text, flag));
-    if (name == "json") o.json = text;
-    if (name == "csv") o.csv = text;
-    if (name == "plot") o.plot = text;
-    if (name == "plot-format") o.plot_format = text;
-    if (name == "quiet") o.quiet = detail::boolean_from_text(text, flag);
-  }
+  for_each_file_key(keys, app,
+                    [&](const std::string& name, const std::string& text, const std::string& flag) {
+                      if (name == "force-model") o.force_model = text;
+                      if (name == "samples") o.samples = text;
+                      if (name == "shard") o.shard = text;
+                      if (name == "threads")
+                        o.threads = static_cast<int>(detail::integer_from_text(text, flag));
+                      if (name == "json") o.json = text;
+                      if (name == "csv") o.csv = text;
+                      if (name == "plot") o.plot = text;
+                      if (name == "plot-format") o.plot_format = text;
+                      if (name == "quiet") o.quiet = detail::boolean_from_text(text, flag);
+                    });
   return o;
 }
 

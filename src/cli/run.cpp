@@ -61,23 +61,22 @@ struct RunOptions {
 /// The settings of the flags, completed by the file's command keys that no flag overrides.
 RunSettings settings_of(const RunSettings& flags, const ScenarioKeys& keys, const CLI::App& app) {
   RunSettings s = flags;
-  for (const auto& [name, text] : keys.extra) {
-    const std::string flag = "--" + name;
-    if (app.get_option(flag)->count() > 0) continue;
-    if (name == "json") s.json = text;
-    if (name == "csv") s.csv = text;
-    if (name == "plot") s.plot = text;
-    if (name == "plot-format") s.plot_format = text;
-    if (name == "rtol") s.rtol = detail::number_from_text(text, flag);
-    if (name == "atol") s.atol = detail::number_from_text(text, flag);
-    if (name == "quiet") s.quiet = detail::boolean_from_text(text, flag);
-    if (name == "expect") {  // relative to the scenario file
-      const size_t slash = keys.file.find_last_of('/');
-      s.expect = text.empty() || text.front() == '/' || slash == std::string::npos
-                     ? text
-                     : keys.file.substr(0, slash + 1) + text;
-    }
-  }
+  for_each_file_key(keys, app,
+                    [&](const std::string& name, const std::string& text, const std::string& flag) {
+                      if (name == "json") s.json = text;
+                      if (name == "csv") s.csv = text;
+                      if (name == "plot") s.plot = text;
+                      if (name == "plot-format") s.plot_format = text;
+                      if (name == "rtol") s.rtol = detail::number_from_text(text, flag);
+                      if (name == "atol") s.atol = detail::number_from_text(text, flag);
+                      if (name == "quiet") s.quiet = detail::boolean_from_text(text, flag);
+                      if (name == "expect") {  // relative to the scenario file
+                        const size_t slash = keys.file.find_last_of('/');
+                        s.expect = text.empty() || text.front() == '/' || slash == std::string::npos
+                                       ? text
+                                       : keys.file.substr(0, slash + 1) + text;
+                      }
+                    });
   return s;
 }
 

@@ -350,6 +350,31 @@ inline void override_scenario_key(ScenarioKeys& keys, const std::string& name, c
 
 namespace detail {
 
+/// The symmetric inertia matrix of Ixx,Iyy,Izz or Ixx,Iyy,Izz,Ixy,Ixz,Iyz (the order of the
+/// inertia keys; 3 or 6 values, checked by the caller).
+inline Matrix3 inertia_from_components(const std::vector<double>& I) {
+  Matrix3 m = Matrix3::Zero();
+  m.diagonal() << I[0], I[1], I[2];
+  if (I.size() == 6) {
+    m(0, 1) = m(1, 0) = I[3];
+    m(0, 2) = m(2, 0) = I[4];
+    m(1, 2) = m(2, 1) = I[5];
+  }
+  return m;
+}
+
+/// The contact normal of a target (normalized; a zero vector is refused under `--normal`) and the
+/// target's own checks, whose message is prefixed with `label` (the keys the checks speak of).
+inline void finish_target(Target& t, const Vector3& normal, const char* label) {
+  if (normal.norm() < 1e-12) throw InputError("--normal: the contact normal must be a non-zero vector");
+  t.normal = normal.normalized();
+  try {
+    t.validate("target");
+  } catch (const InputError& e) {
+    throw InputError(str(label, ": ", e.what()));
+  }
+}
+
 inline Vector3 vec3_or_zero(const std::vector<double>& v, const char* key) {
   if (v.empty()) return Vector3::Zero();
   if (v.size() != 3) throw InputError(str(key, ": expected 3 numbers, got ", v.size()));
@@ -368,13 +393,7 @@ inline Bus bus_of(const ModelLoadKeys& k) {
   bus.mass = k.bus_mass;
   for (double x : k.bus_inertia)
     if (!std::isfinite(x)) throw InputError(str("--bus-inertia: values must be finite, got ", x));
-  const auto& I = k.bus_inertia;
-  bus.inertia.diagonal() << I[0], I[1], I[2];
-  if (I.size() == 6) {
-    bus.inertia(0, 1) = bus.inertia(1, 0) = I[3];
-    bus.inertia(0, 2) = bus.inertia(2, 0) = I[4];
-    bus.inertia(1, 2) = bus.inertia(2, 1) = I[5];
-  }
+  bus.inertia = inertia_from_components(k.bus_inertia);
   bus.com = vec3_or_zero(k.bus_com, "--bus-com");
   bus.mount = Pose::from_xyz_rpy(vec3_or_zero(k.mount_xyz, "--mount-xyz"),
                                  vec3_or_zero(k.mount_rpy_deg, "--mount-rpy-deg") * (M_PI / 180.0));
@@ -524,26 +543,13 @@ inline Target target_of(const ScenarioKeys& k) {
     throw InputError(str("--target-inertia: expected 3 or 6 numbers, got ", I.size()));
   for (double x : I)
     if (!std::isfinite(x)) throw InputError(str("--target-inertia: values must be finite, got ", x));
-  t.inertia = Matrix3::Zero();
-  t.inertia.diagonal() << I[0], I[1], I[2];
-  if (I.size() == 6) {
-    t.inertia(0, 1) = t.inertia(1, 0) = I[3];
-    t.inertia(0, 2) = t.inertia(2, 0) = I[4];
-    t.inertia(1, 2) = t.inertia(2, 1) = I[5];
-  }
+  t.inertia = inertia_from_components(I);
   t.position = vec3(k.target_position, "target-position");
   t.attitude = Quaternion(rpy_deg(k.target_rpy_deg, "target-rpy-deg"));
   t.angular_velocity = vec3(k.target_angular_velocity_deg, "target-angular-velocity-deg") * (M_PI / 180.0);
   t.velocity = vec3(k.target_velocity, "target-velocity");
   t.contact_offset = vec3(k.contact_offset, "contact-offset");
-  const Vector3 nrm = vec3(k.normal, "normal");
-  if (nrm.norm() < 1e-12) throw InputError("--normal: the contact normal must be a non-zero vector");
-  t.normal = nrm.normalized();
-  try {
-    t.validate("target");
-  } catch (const InputError& e) {
-    throw InputError(str("--target-mass/--target-inertia: ", e.what()));
-  }
+  finish_target(t, vec3(k.normal, "normal"), "--target-mass/--target-inertia");
   return t;
 }
 
