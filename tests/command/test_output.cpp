@@ -391,7 +391,7 @@ TEST_CASE("expect: a result compared with itself passes, a moved value gives exi
   };
   const double m = base.at("optimized").at("integrated_effective_mass").get<double>();
 
-  SECTION("one value moved by 0.1 %") {
+  {  // one value moved by 0.1 %
     json moved = base;
     moved["optimized"]["integrated_effective_mass"] = m * 1.001;
     const auto r = expect_with(moved);
@@ -404,7 +404,7 @@ TEST_CASE("expect: a result compared with itself passes, a moved value gives exi
     CHECK(contains(r.err, kErrorPrefix + " --expect stored.json: 1 value differs"));
     CHECK(r.out.find("With optimization") != std::string::npos);  // the table is still printed
   }
-  SECTION("within --rtol passes; a tighter --rtol fails") {
+  {  // within --rtol passes; a tighter --rtol fails
     json moved = base;
     moved["optimized"]["integrated_effective_mass"] = m * (1 + 1e-8);
     CHECK(expect_with(moved).exit_code == 0);  // default rtol 1e-6
@@ -412,7 +412,7 @@ TEST_CASE("expect: a result compared with itself passes, a moved value gives exi
     CHECK(tight.exit_code == 4);
     CHECK(moved_lines(tight.err).size() == 1);
   }
-  SECTION("array entries, missing and extra keys, strings are differences too") {
+  {  // array entries, missing and extra keys, strings are differences too
     json moved = base;
     moved["baseline"]["capture_configuration_deg"][1] =
         base.at("baseline").at("capture_configuration_deg")[1].get<double>() + 0.5;
@@ -432,13 +432,13 @@ TEST_CASE("expect: a result compared with itself passes, a moved value gives exi
     CHECK(contains(all, "optimized.capture_point: stored 2 entries, now 3"));
     CHECK(contains(all, "5 values differ"));
   }
-  SECTION("the version and the resolved scenario are inputs: not compared") {
+  {  // the version and the resolved scenario are inputs: not compared
     json other = base;
     other["version"] = "0.0.0";
     other["scenario"]["urdf"] = "/elsewhere/paper_3dof.urdf";
     CHECK(expect_with(other).exit_code == 0);
   }
-  SECTION("wall-clock times and the optimizers' work counters are not results: not compared") {
+  {  // wall-clock times and the optimizers' work counters are not results: not compared
     json other = base;
     REQUIRE(other["optimized"].contains("damped_evaluations"));
     other["optimized"]["damped_evaluations"] = other["optimized"]["damped_evaluations"].get<long>() + 7;
@@ -449,7 +449,7 @@ TEST_CASE("expect: a result compared with itself passes, a moved value gives exi
     CHECK(r.exit_code == 4);
     CHECK(moved_lines(r.err).size() == 1);
   }
-  SECTION("--atol: the floor for values near zero") {
+  {  // --atol: the floor for values near zero
     json moved = base;
     // tracking_error is ~1e-11 m (round-off of the tracking): 1e-10 differs by a factor of ten
     // but by less than the default atol of 1e-9

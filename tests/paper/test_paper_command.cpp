@@ -172,7 +172,7 @@ TEST_CASE("run: --config robots/paper_3dof.toml from another directory finds its
   CHECK(fs::equivalent(j.at("scenario").at("urdf").get<std::string>(), kUrdf3));
   check_series_csv(tmp / "out.csv", 3);
 
-  SECTION("the scenario and the built-in default give the same result") {
+  {  // the scenario and the built-in default give the same result
     const auto d = cli({"--json", "default.json", "--quiet"}, tmp.str());
     REQUIRE(d.exit_code == 0);
     const json jd = read_json_file(tmp / "default.json");
@@ -181,7 +181,7 @@ TEST_CASE("run: --config robots/paper_3dof.toml from another directory finds its
     CHECK(jd.at("optimized").at("integrated_effective_mass").get<double>() ==
           Approx(j.at("optimized").at("integrated_effective_mass").get<double>()).epsilon(1e-12));
   }
-  SECTION("a relative --config path is resolved against the working directory, the URDF against the file") {
+  {  // a relative --config path is resolved against the working directory, the URDF against the file
     const auto rel = cli({"--config", "robots/paper_3dof.toml", "--quiet"}, kSource);
     INFO(rel.err);
     CHECK(rel.exit_code == 0);
