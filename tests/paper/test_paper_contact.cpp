@@ -26,10 +26,7 @@
 namespace test_paper_contact {
 
 using namespace ffsr;
-using ffsr::test::deg;
-using ffsr::test::kPaperContact;
-using ffsr::test::kRobots;
-using ffsr::test::paper_target;
+using ffsr::test::deg, ffsr::test::kPaperContact, ffsr::test::kRobots, ffsr::test::paper_target;
 
 namespace {
 

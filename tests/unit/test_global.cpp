@@ -20,10 +20,7 @@
 namespace test_global {
 
 using namespace ffsr;
-using ffsr::test::deg;
-using ffsr::test::kRobots;
-using ffsr::test::problem_3dof;
-using ffsr::test::problem_7dof;
+using ffsr::test::deg, ffsr::test::kRobots, ffsr::test::problem_3dof, ffsr::test::problem_7dof;
 using namespace ffsr::test::global_capture;
 
 namespace {

@@ -14,10 +14,7 @@
 namespace test_simulate {
 
 using namespace ffsr;
-using ffsr::test::deg;
-using ffsr::test::kPaperContact;
-using ffsr::test::kRobots;
-using ffsr::test::paper_target;
+using ffsr::test::deg, ffsr::test::kPaperContact, ffsr::test::kRobots, ffsr::test::paper_target;
 
 TEST_CASE("Multibody contact conserves momentum, and energy without damping", "[simulate]") {
   const Model m = model_from_urdf_file(kRobots + "paper_7dof.urdf");
