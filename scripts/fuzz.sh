@@ -21,7 +21,8 @@
 # Installs clang-14 and libclang-rt-14-dev with apt-get when they are missing (as root, or with sudo -n);
 # if clang cannot be had, it says so on one line and exits 0. A failing input is saved as
 # BUILD_DIR/artifacts/<target>/crash-* (or timeout-*, oom-*, leak-*); replay it with BUILD_DIR/<target> FILE.
-# The targets run one after the other (one core each); set FFSR_FUZZ_TARGETS to run only some of them.
+# The targets run side by side (one core each; FFSR_FUZZ_JOBS at a time, default all); set
+# FFSR_FUZZ_TARGETS to run only some of them.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 src=$(pwd)
@@ -73,9 +74,10 @@ if [ "$mode" = ci ]; then
   fi
 fi
 
-failed=()
-summary=()
-for t in $targets; do
+# One target: replay and fixed-seed mutation (ci) or a timed run (explore). Its messages go to
+# stdout; its summary line to BUILD_DIR/<target>.summary, and BUILD_DIR/<target>.failed when it failed.
+fuzz_one() {
+  local t=$1
   mkdir -p "$build/artifacts/$t"
   common=(-timeout=60 -rss_limit_mb=2048 -print_final_stats=1 -artifact_prefix="$build/artifacts/$t/")
   [ -f "fuzz/$t.dict" ] && common+=(-dict="fuzz/$t.dict")
@@ -92,11 +94,11 @@ for t in $targets; do
     echo "fuzz.sh: $t: replaying ${#inputs[@]} seed and regression inputs"
     "$build/$t" "${common[@]}" "${inputs[@]}" >"$log.replay" 2>&1 || rc=$?
     if [ "$rc" -ne 0 ]; then
-      failed+=("$t (replay)")
+      echo "$t (replay)" >"$build/$t.failed"
       echo "fuzz.sh: $t FAILED on a seed or regression input (exit $rc); the end of its log:"
       grep -v '^#[0-9]' "$log.replay" | tail -40
-      summary+=("$t: replay failed")
-      continue
+      echo "$t: replay failed" >"$build/$t.summary"
+      return 0
     fi
     # 2. fixed-seed mutation from an empty scratch corpus plus the seeds and regressions
     scratch="$build/ci-corpus/$t"
@@ -113,13 +115,31 @@ for t in $targets; do
   fi
   execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)
   cov=$(grep -o 'cov: [0-9]*' "$log" | tail -1 || true)
-  summary+=("$t: ${execs:-?} executions, ${cov:-cov: ?}, exit $rc")
+  echo "$t: ${execs:-?} executions, ${cov:-cov: ?}, exit $rc" >"$build/$t.summary"
   if [ "$rc" -ne 0 ]; then
-    failed+=("$t")
+    echo "$t" >"$build/$t.failed"
     echo "fuzz.sh: $t FAILED (exit $rc); the end of its log:"
     grep -v '^#[0-9]' "$log" | tail -40
     ls "$build/artifacts/$t"
   fi
+}
+
+# The targets run side by side (each is one process on one core; libFuzzer's result for a fixed seed and
+# run count does not depend on what else runs), FFSR_FUZZ_JOBS at a time (default: all of them); their
+# messages are printed target by target once all have finished.
+max_jobs=${FFSR_FUZZ_JOBS:-$(wc -w <<<"$targets")}
+for t in $targets; do
+  rm -f "$build/$t.summary" "$build/$t.failed"
+  while [ "$(jobs -rp | wc -l)" -ge "$max_jobs" ]; do wait -n || true; done
+  fuzz_one "$t" >"$build/$t.out" 2>&1 &
+done
+wait
+failed=()
+summary=()
+for t in $targets; do
+  cat "$build/$t.out"
+  summary+=("$(cat "$build/$t.summary" 2>/dev/null || echo "$t: no summary (the script stopped early)")")
+  if [ -f "$build/$t.failed" ] || [ ! -f "$build/$t.summary" ]; then failed+=("$(cat "$build/$t.failed" 2>/dev/null || echo "$t")"); fi
 done
 printf 'fuzz.sh: %s\n' "${summary[@]}"
 if [ ${#failed[@]} -gt 0 ]; then

@@ -17,6 +17,8 @@
 #include <string>
 #include <vector>
 
+namespace test_fuzz_regressions {
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -38,26 +40,26 @@ std::string bytes_of(const std::string& path) { return ffsr_fuzz::read_text(path
 
 const uint8_t* data_of(const std::string& s) { return reinterpret_cast<const uint8_t*>(s.data()); }
 
-}  // namespace
-
-TEST_CASE("fuzz_urdf: every regression and seed input keeps the contract", "[fuzz]") {
-  const auto files = inputs("fuzz_urdf");
+/// Every regression and seed input of `target` through `check` (the target's contract): none throws.
+template <class Check>
+void replay(const std::string& target, Check check) {
+  const auto files = inputs(target);
   REQUIRE(files.size() >= 2);
   for (const auto& f : files) {
     INFO(f);
     const std::string b = bytes_of(f);
-    CHECK_NOTHROW(ffsr_fuzz::check_urdf_input(data_of(b), b.size()));
+    CHECK_NOTHROW(check(data_of(b), b.size()));
   }
 }
 
+}  // namespace
+
+TEST_CASE("fuzz_urdf: every regression and seed input keeps the contract", "[fuzz]") {
+  replay("fuzz_urdf", [](const uint8_t* data, size_t size) { ffsr_fuzz::check_urdf_input(data, size); });
+}
+
 TEST_CASE("fuzz_numeric: every regression and seed input keeps the contract", "[fuzz]") {
-  const auto files = inputs("fuzz_numeric");
-  REQUIRE(files.size() >= 2);
-  for (const auto& f : files) {
-    INFO(f);
-    const std::string b = bytes_of(f);
-    CHECK_NOTHROW(ffsr_fuzz::check_numeric_input(data_of(b), b.size()));
-  }
+  replay("fuzz_numeric", [](const uint8_t* data, size_t size) { ffsr_fuzz::check_numeric_input(data, size); });
 }
 
 TEST_CASE("fuzz_scenario: ffsr-optimize on every regression and seed scenario keeps the contract", "[fuzz]") {
@@ -77,3 +79,5 @@ TEST_CASE("fuzz_scenario: ffsr-optimize on every regression and seed scenario ke
     CHECK_NOTHROW(ffsr_fuzz::check_scenario_outputs(tmp.str(), r.exit_code, r.out));
   }
 }
+
+}  // namespace test_fuzz_regressions

@@ -3,7 +3,7 @@
 // contact law, evaluated here from the angles the CSV reports; the maximum of the 3-DOF map at the
 // stretched arm is the paper's Section 5.1 finding; shards put together must equal the whole map
 // byte for byte; bad inputs give one error line naming the flag and leave no file behind.
-#include "support/run_command.hpp"
+#include "support/command.hpp"
 
 #include <ffsr/contact/contact_law.hpp>
 #include <ffsr/ffsr.hpp>
@@ -20,55 +20,13 @@
 #include <string>
 #include <vector>
 
+namespace test_map {
+
+using namespace ffsr::test;
+
 namespace {
 
-using ffsr::test::CommandResult;
-using ffsr::test::run_command;
-using ffsr::test::TempDir;
-using Args = std::vector<std::string>;
-
-const std::string kCli = FFSR_CLI;
-const std::string kUrdf3 = std::string(FFSR_SOURCE_DIR) + "/robots/paper_3dof.urdf";
-const std::string kUrdf7 = std::string(FFSR_SOURCE_DIR) + "/robots/paper_7dof.urdf";
-
-CommandResult map_cli(const Args& args, const std::string& cwd) {
-  Args full{kCli, "map"};
-  full.insert(full.end(), args.begin(), args.end());
-  return run_command(full, cwd);
-}
-
-std::string read_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  REQUIRE(in.good());
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-struct Csv {
-  std::string header;
-  std::vector<std::vector<double>> rows;
-};
-
-Csv parse_csv(const std::string& text) {
-  Csv c;
-  std::istringstream in(text);
-  std::getline(in, c.header);
-  std::string line;
-  while (std::getline(in, line)) {
-    std::vector<double> row;
-    const char* p = line.c_str();
-    for (;;) {
-      char* end = nullptr;
-      row.push_back(std::strtod(p, &end));
-      if (end == p) FAIL("not a number in the CSV line '" << line << "'");
-      if (*end != ',') break;
-      p = end + 1;
-    }
-    c.rows.push_back(std::move(row));
-  }
-  return c;
-}
+CommandResult map_cli(const Args& args, const std::string& cwd) { return cli_sub("map", args, cwd); }
 
 /// M_ie and F_max from the library for the CLI's default target and contact flags (the paper's
 /// target, Herbert-McWhannell, K = 1e9, alpha = 1.5, c_r = 0.9, 0.2 m/s, spin 2 deg/s about z).
@@ -109,7 +67,7 @@ TEST_CASE("map: the 3-DOF map over the full grid at 6 deg peaks at the stretched
   INFO(r.err);
   REQUIRE(r.exit_code == 0);
   CHECK(r.err.empty());  // stderr is a file here, not a terminal: no progress line
-  const Csv csv = parse_csv(read_file(dir.str() + "/m.csv"));
+  const NumericCsv csv = parse_numeric_csv(read_existing_file(dir.str() + "/m.csv"));
   CHECK(csv.header == "joint1_deg,joint2_deg,joint3_deg,M_ie_kg,F_max_N");
   REQUIRE(csv.rows.size() == 60u * 60u * 60u);  // [-180, 180) in steps of 6: 60 angles per joint
 
@@ -153,30 +111,6 @@ TEST_CASE("map: the 3-DOF map over the full grid at 6 deg peaks at the stretched
   }
 }
 
-TEST_CASE("map: over the paper's ranges (Figure 8) the maximum is the stretched arm alone", "[map][cli]") {
-  TempDir dir;
-  const CommandResult r =
-      map_cli({"--urdf", kUrdf3, "--joints-deg", "0,0,0", "--vary", "1,2,3", "--range-deg",
-               "-90,90,-120,120,-120,120", "--step-deg", "6", "--csv", "m.csv"},
-              dir.str());
-  INFO(r.err);
-  REQUIRE(r.exit_code == 0);
-  const Csv csv = parse_csv(read_file(dir.str() + "/m.csv"));
-  REQUIRE(csv.rows.size() == 30u * 40u * 40u);
-  size_t best = 0;
-  for (size_t k = 1; k < csv.rows.size(); ++k)
-    if (csv.rows[k][3] > csv.rows[best][3]) best = k;
-  CHECK(csv.rows[best][0] == 0.0);
-  CHECK(csv.rows[best][1] == 0.0);
-  CHECK(csv.rows[best][2] == 0.0);
-  size_t near_max = 0;  // other points within 1e-6 of the maximum
-  for (size_t k = 0; k < csv.rows.size(); ++k)
-    near_max += k != best && csv.rows[k][3] >= csv.rows[best][3] * (1 - 1e-6);
-  CHECK(near_max == 0u);
-  CHECK_THAT(r.out,
-             Catch::Matchers::Contains("max M_ie = ") && Catch::Matchers::Contains("at [0, 0, 0] deg"));
-}
-
 TEST_CASE("map: per-joint ranges and steps, the joints not varied held at --joints-deg", "[map][cli]") {
   TempDir dir;
   const CommandResult r =
@@ -185,7 +119,7 @@ TEST_CASE("map: per-joint ranges and steps, the joints not varied held at --join
               dir.str());
   INFO(r.err);
   REQUIRE(r.exit_code == 0);
-  const Csv csv = parse_csv(read_file(dir.str() + "/m.csv"));
+  const NumericCsv csv = parse_numeric_csv(read_existing_file(dir.str() + "/m.csv"));
   REQUIRE(csv.rows.size() == 2u * 4u);  // {0, 5} x {-20, -17.5, -15, -12.5}
   Reference ref(kUrdf7);
   for (size_t k = 0; k < csv.rows.size(); ++k) {
@@ -215,10 +149,10 @@ TEST_CASE("map: three shards concatenated equal the whole map byte for byte", "[
     const CommandResult s = map_cli(part, dir.str());
     INFO(s.err);
     REQUIRE(s.exit_code == 0);
-    joined += read_file(dir.str() + "/" + name);
+    joined += read_existing_file(dir.str() + "/" + name);
   }
-  const std::string all = read_file(dir.str() + "/all.csv");
-  CHECK(parse_csv(all).rows.size() == 140608u);
+  const std::string all = read_existing_file(dir.str() + "/all.csv");
+  CHECK(parse_numeric_csv(all).rows.size() == 140608u);
   CHECK(joined == all);
 }
 
@@ -270,3 +204,5 @@ TEST_CASE("map: bad inputs give one error line naming the flag and no output fil
                                    dir.str());
   CHECK(ok.exit_code == 0);
 }
+
+}  // namespace test_map

@@ -10,7 +10,7 @@
 //
 // Every child process runs with a timeout (tests/support/run_command.hpp, or the helpers below), so
 // a FIFO nobody reads or a blocked pipe fails a test instead of hanging the suite.
-#include "support/run_command.hpp"
+#include "support/command.hpp"
 
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
@@ -35,37 +35,23 @@
 #include <thread>
 #include <vector>
 
-namespace {
+namespace test_output {
 
 namespace fs = std::filesystem;
-using ffsr::test::CommandResult;
-using ffsr::test::run_command;
-using ffsr::test::TempDir;
-using Args = std::vector<std::string>;
+using namespace ffsr::test;
 using nlohmann::json;
 
-const std::string kCli = FFSR_CLI;
-const std::string kSource = FFSR_SOURCE_DIR;
-const std::string kUrdf3 = kSource + "/robots/paper_3dof.urdf";
-const std::string kScenario3 = kSource + "/robots/paper_3dof.toml";
-const std::string kErrorPrefix = "ffsr-optimize: error:";
+namespace {
 
+/// The command in `cwd`; the main job without the global search: these tests are about the output
+/// files, and the search costs minutes at -O0 with ASan (its own tests are in test_global)
 CommandResult cli(const Args& args, const std::string& cwd) {
-  Args full{kCli};
-  // the main job without the global search: these tests are about the output files, and the search
-  // costs minutes at -O0 with ASan (its own tests are in test_global)
+  Args full;
   const bool main_job = args.empty() || (args[0] != "inspect" && args[0] != "contact" && args[0] != "map" &&
                                          args[0] != "robust" && args[0] != "xi");
   if (main_job) full.insert(full.end(), {"--global", "false"});
   full.insert(full.end(), args.begin(), args.end());
-  return run_command(full, cwd, 60.0);
-}
-
-std::string read_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
+  return ffsr::test::cli(full, cwd, 60.0);
 }
 
 void write_text(const std::string& path, const std::string& text) {
@@ -130,23 +116,7 @@ CommandResult run_with_closed_stdout(const Args& args, double timeout_s = 60.0) 
     ::_exit(127);
   }
   ::close(fds[1]);
-  CommandResult r;
-  int status = 0;
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
-  while (::waitpid(pid, &status, WNOHANG) != pid) {
-    if (std::chrono::steady_clock::now() > deadline) {
-      ::kill(pid, SIGKILL);
-      ::waitpid(pid, &status, 0);
-      r.timed_out = true;
-      break;
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(2));
-  }
-  if (WIFEXITED(status)) r.exit_code = WEXITSTATUS(status);
-  if (WIFSIGNALED(status)) {
-    r.signaled = true;
-    r.exit_code = 128 + WTERMSIG(status);
-  }
+  CommandResult r = ffsr::test::detail::wait_for(pid, timeout_s);
   r.err = ffsr::test::detail::read_all(err_fd);
   ::close(err_fd);
   return r;
@@ -421,7 +391,7 @@ TEST_CASE("expect: a result compared with itself passes, a moved value gives exi
   };
   const double m = base.at("optimized").at("integrated_effective_mass").get<double>();
 
-  SECTION("one value moved by 0.1 %") {
+  {  // one value moved by 0.1 %
     json moved = base;
     moved["optimized"]["integrated_effective_mass"] = m * 1.001;
     const auto r = expect_with(moved);
@@ -434,7 +404,7 @@ TEST_CASE("expect: a result compared with itself passes, a moved value gives exi
     CHECK(contains(r.err, kErrorPrefix + " --expect stored.json: 1 value differs"));
     CHECK(r.out.find("With optimization") != std::string::npos);  // the table is still printed
   }
-  SECTION("within --rtol passes; a tighter --rtol fails") {
+  {  // within --rtol passes; a tighter --rtol fails
     json moved = base;
     moved["optimized"]["integrated_effective_mass"] = m * (1 + 1e-8);
     CHECK(expect_with(moved).exit_code == 0);  // default rtol 1e-6
@@ -442,7 +412,7 @@ TEST_CASE("expect: a result compared with itself passes, a moved value gives exi
     CHECK(tight.exit_code == 4);
     CHECK(moved_lines(tight.err).size() == 1);
   }
-  SECTION("array entries, missing and extra keys, strings are differences too") {
+  {  // array entries, missing and extra keys, strings are differences too
     json moved = base;
     moved["baseline"]["capture_configuration_deg"][1] =
         base.at("baseline").at("capture_configuration_deg")[1].get<double>() + 0.5;
@@ -462,13 +432,13 @@ TEST_CASE("expect: a result compared with itself passes, a moved value gives exi
     CHECK(contains(all, "optimized.capture_point: stored 2 entries, now 3"));
     CHECK(contains(all, "5 values differ"));
   }
-  SECTION("the version and the resolved scenario are inputs: not compared") {
+  {  // the version and the resolved scenario are inputs: not compared
     json other = base;
     other["version"] = "0.0.0";
     other["scenario"]["urdf"] = "/elsewhere/paper_3dof.urdf";
     CHECK(expect_with(other).exit_code == 0);
   }
-  SECTION("wall-clock times and the optimizers' work counters are not results: not compared") {
+  {  // wall-clock times and the optimizers' work counters are not results: not compared
     json other = base;
     REQUIRE(other["optimized"].contains("damped_evaluations"));
     other["optimized"]["damped_evaluations"] = other["optimized"]["damped_evaluations"].get<long>() + 7;
@@ -479,7 +449,7 @@ TEST_CASE("expect: a result compared with itself passes, a moved value gives exi
     CHECK(r.exit_code == 4);
     CHECK(moved_lines(r.err).size() == 1);
   }
-  SECTION("--atol: the floor for values near zero") {
+  {  // --atol: the floor for values near zero
     json moved = base;
     // tracking_error is ~1e-11 m (round-off of the tracking): 1e-10 differs by a factor of ten
     // but by less than the default atol of 1e-9
@@ -540,3 +510,5 @@ TEST_CASE("expect: expect and rtol as scenario keys, expect relative to the scen
   CHECK(cli({"--config", "s/scenario.toml", "--quiet", "--rtol", "1e-6"}, tmp.str()).exit_code ==
         0);  // flag wins
 }
+
+}  // namespace test_output

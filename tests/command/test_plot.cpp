@@ -1,4 +1,4 @@
-// Figures (issue 10): the plotting module and the pictures of the command. Every picture made here
+// Figures (--plot): the plotting module and the pictures of the command. Every picture made here
 // is decoded (PNG: size from IHDR, more than one colour, the long dark lines of the axes box) or
 // parsed (SVG as XML). The drawings are checked against independent computations: the arm drawn at
 // T ends where the planner's end-effector is, the attitude-drift curve ends at the planner's drift,
@@ -17,6 +17,8 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+
+namespace test_plot {
 
 namespace {
 
@@ -369,3 +371,5 @@ TEST_CASE("plot bad inputs: a missing folder or an unknown format give one error
   }
   CHECK(dir.entries().empty());  // nothing written, no temporary folder left
 }
+
+}  // namespace test_plot

@@ -6,6 +6,8 @@
 
 #include <catch2/catch.hpp>
 
+namespace test_plot_stub {
+
 TEST_CASE("plot stub: --plot in a build without plotting is a one-line InputError", "[plot]") {
   using namespace ffsr::cli;
   CHECK_FALSE(plot::available());
@@ -24,3 +26,5 @@ TEST_CASE("plot stub: --plot in a build without plotting is a one-line InputErro
   CHECK_THROWS_WITH(plot::parse_format("tiff", "--plot-format"),
                     Catch::StartsWith("--plot-format: unknown format"));
 }
+
+}  // namespace test_plot_stub

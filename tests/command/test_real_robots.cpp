@@ -1,4 +1,4 @@
-// tests/test_real_robots.cpp -- issue 11: URDFs of real arms as the community ships them (Panda, UR5,
+// tests/test_real_robots.cpp -- URDFs of real arms as the community ships them (Panda, UR5,
 // Kinova Jaco2 in ../shared/urdf-samples), mounted on a spacecraft bus, with mimic and locked joints,
 // inertia repairs and the contact point at the gripper.
 //
@@ -19,6 +19,8 @@
 #include <fstream>
 #include <limits>
 #include <sstream>
+
+namespace test_real_robots {
 
 using namespace ffsr;
 using namespace ffsr_test;
@@ -92,14 +94,12 @@ TestRobot load(const std::string& name, const std::string& xml, const UrdfOption
   return r;
 }
 
-Config random_config(const Model& m, Rng& rng) { return {rng.base_pose(), rng.vec(m.n(), 1.0)}; }
-
-/// The identities of issue 11, each to 1e-9 relative (rel_err: relative to max(1, |reference|)).
+/// The dynamics identities, each to 1e-9 relative (rel_err: relative to max(1, |reference|)).
 void check_identities(const TestRobot& r, unsigned seed) {
   Rng rng(seed);
   Data d(r.model);
   for (int k = 0; k < 2; ++k) {
-    const Config q = random_config(r.model, rng);
+    const Config q = random_config(r.model, rng, 1.0);
     VectorXd v(r.model.nv());
     v << rng.vec3(0.4), rng.vec3(0.3), rng.vec(r.model.n(), 1.0);
     INFO(r.name << " config " << k);
@@ -238,7 +238,7 @@ TEST_CASE("mimic reduction: H, C, J_bm, M_ie gradient against the full model", "
     return t;
   }();
   for (int k = 0; k < 2; ++k) {
-    const Config q = random_config(red.model, rng);
+    const Config q = random_config(red.model, rng, 1.0);
     const VectorXd qf = T * q.theta + c;
     VectorXd v(14);
     v << rng.vec3(0.4), rng.vec3(0.3), rng.vec(8, 1.0);
@@ -607,3 +607,5 @@ TEST_CASE("ffsr-optimize inspect: what was done to the file, and bad keys", "[cl
     std::cout << "  " << joined << "\n    -> " << r.err;
   }
 }
+
+}  // namespace test_real_robots

@@ -1,11 +1,11 @@
-// End-to-end tests of `ffsr-optimize robust` (issue 12) on robots/paper_7dof_position_uncertain.toml:
+// End-to-end tests of `ffsr-optimize robust` on robots/paper_7dof_position_uncertain.toml:
 // shards merged reproduce the unsharded summary exactly, sample i does not depend on the sample
 // count, the 95th percentile of 1e3 samples against 2e4, the CSV, flags over the file, and the bad
 // inputs (one error line naming the key, exit 2, no output file).
 //
 // To stay fast, the runs evaluate one given capture configuration (--capture-joints-deg) with the
 // exact single-body F_max instead of planning.
-#include "support/run_command.hpp"
+#include "support/command.hpp"
 
 #include <catch2/catch.hpp>
 #include "ffsr/uncertainty/sampling.hpp"
@@ -19,29 +19,22 @@
 #include <string>
 #include <vector>
 
-namespace {
+namespace test_robust {
 
-using ffsr::test::CommandResult;
-using ffsr::test::run_command;
-using ffsr::test::TempDir;
-using Args = std::vector<std::string>;
+using namespace ffsr::test;
 using nlohmann::json;
 
-const std::string kCli = FFSR_CLI;
-const std::string kSource = FFSR_SOURCE_DIR;
+namespace {
+
 const std::string kScenario = kSource + "/robots/paper_7dof_position_uncertain.toml";
 const Args kGiven{"--capture-joints-deg", "5,80,95,-85,92,88,3", "--quiet"};
 
-CommandResult robust(Args args, const std::string& cwd) {
-  Args full{kCli, "robust"};
-  full.insert(full.end(), args.begin(), args.end());
-  return run_command(full, cwd);
-}
+CommandResult robust(const Args& args, const std::string& cwd) { return cli_sub("robust", args, cwd); }
 
-json read_json(const std::string& path) {
-  std::ifstream in(path);
-  REQUIRE(in.good());
-  return json::parse(in);
+/// Merges shard0..3.json of `dir` with shard 1 replaced by `shard1` (written to dir/name).
+CommandResult merge_with_shard1(const TempDir& dir, const std::string& name, const json& shard1) {
+  std::ofstream(dir / name) << shard1.dump();
+  return robust({"--merge", dir / "shard0.json", dir / name, dir / "shard2.json", dir / "shard3.json"}, dir.str());
 }
 
 /// The example scenario with its URDF path made absolute and without its [uncertainty] table.
@@ -97,7 +90,7 @@ TEST_CASE("robust: 4 shards merged equal the unsharded run to the last digit", "
   const CommandResult m = robust(merge, dir.str());
   INFO(m.err);
   REQUIRE(m.exit_code == 0);
-  const json a = read_json(dir / "whole.json"), b = read_json(dir / "merged.json");
+  const json a = read_json_file(dir / "whole.json"), b = read_json_file(dir / "merged.json");
   REQUIRE(a["configurations"].size() == 1);
   const json& ca = a["configurations"][0];
   const json& cb = b["configurations"][0];
@@ -116,24 +109,18 @@ TEST_CASE("robust: 4 shards merged equal the unsharded run to the last digit", "
   CHECK(gap.exit_code == 2);
   CHECK(gap.err.find("--merge") != std::string::npos);
   // a shard of another estimator (multibody: order statistics) is refused by name
-  json other = read_json(dir / "shard1.json");
+  json other = read_json_file(dir / "shard1.json");
   other["estimator"] = "order-statistics";
   other.erase("stiffness");
   other.erase("exponent");
   other.erase("stiffness_nominal");
-  std::ofstream(dir / "other1.json") << other.dump();
-  const CommandResult mixed =
-      robust({"--merge", dir / "shard0.json", dir / "other1.json", dir / "shard2.json", dir / "shard3.json"},
-             dir.str());
+  const CommandResult mixed = merge_with_shard1(dir, "other1.json", other);
   CHECK(mixed.exit_code == 2);
   CHECK(mixed.err.find("differ in 'estimator'") != std::string::npos);
   // a shard whose per-sample stiffness list lost a value
-  json cut = read_json(dir / "shard1.json");
+  json cut = read_json_file(dir / "shard1.json");
   cut["stiffness"].erase(cut["stiffness"].size() - 1);
-  std::ofstream(dir / "cut1.json") << cut.dump();
-  const CommandResult lost =
-      robust({"--merge", dir / "shard0.json", dir / "cut1.json", dir / "shard2.json", dir / "shard3.json"},
-             dir.str());
+  const CommandResult lost = merge_with_shard1(dir, "cut1.json", cut);
   CHECK(lost.exit_code == 2);
   CHECK(lost.err.find("'stiffness' lists do not hold one value per sample") != std::string::npos);
   CHECK(std::count(lost.err.begin(), lost.err.end(), '\n') == 1);
@@ -151,7 +138,7 @@ TEST_CASE("robust: sample i depends on (seed, i) only -- p95 of 1e3 against 2e4 
   b.insert(b.end(), kGiven.begin(), kGiven.end());
   const CommandResult small = robust(b, dir.str());
   REQUIRE(small.exit_code == 0);
-  const json jb = read_json(dir / "big.json"), js = read_json(dir / "small.json");
+  const json jb = read_json_file(dir / "big.json"), js = read_json_file(dir / "small.json");
   const auto fb = jb["configurations"][0]["f_max"].get<std::vector<double>>();
   const auto fs = js["configurations"][0]["f_max"].get<std::vector<double>>();
   REQUIRE(fb.size() == 20000);
@@ -202,7 +189,7 @@ TEST_CASE("robust: sample i depends on (seed, i) only -- p95 of 1e3 against 2e4 
   CHECK(big.out.find("nan") == std::string::npos);
 }
 
-TEST_CASE("robust: the 95th percentile from 1e3 and from 1e5 samples within 1 % (exact model, issue 12)",
+TEST_CASE("robust: the 95th percentile from 1e3 and from 1e5 samples within 1 % (exact model)",
           "[robust]") {
   TempDir dir;
   Args a{"--config", kScenario, "--samples", "100000", "--json", dir / "big.json"};
@@ -210,7 +197,7 @@ TEST_CASE("robust: the 95th percentile from 1e3 and from 1e5 samples within 1 % 
   const CommandResult big = robust(a, dir.str());
   INFO(big.err);
   REQUIRE(big.exit_code == 0);
-  const json jb = read_json(dir / "big.json");
+  const json jb = read_json_file(dir / "big.json");
   const json sb = jb["configurations"][0]["summary"];
   REQUIRE(sb["n"] == 100000);
   // the first 1000 samples of the 1e5 run are the 1e3 run's (sample i depends on (seed, i) only);
@@ -239,7 +226,7 @@ TEST_CASE("robust: the 95th percentile from 1e3 and from 1e5 samples within 1 % 
   Args s{"--config", kScenario, "--json", dir / "small.json"};  // samples = 1000 from the file
   s.insert(s.end(), kGiven.begin(), kGiven.end());
   REQUIRE(robust(s, dir.str()).exit_code == 0);
-  const json ss = read_json(dir / "small.json")["configurations"][0]["summary"];
+  const json ss = read_json_file(dir / "small.json")["configurations"][0]["summary"];
   CHECK(std::abs(ss["p95"].get<double>() / sb["p95"].get<double>() - 1) < 0.01);
   // the conditional and the order-statistics estimates of the same law agree: the 1e5 conditional p95
   // lies within the distribution-free interval of the 1e5 order statistics
@@ -318,7 +305,7 @@ TEST_CASE("robust: bad inputs give one error line naming the key, exit 2, no out
   const CommandResult rf = robust(f, dir.str());
   INFO(rf.err);
   REQUIRE(rf.exit_code == 0);
-  const json j = read_json(dir / "ok.json");
+  const json j = read_json_file(dir / "ok.json");
   CHECK(j["samples"] == 7);
   CHECK(j["seed"] == 4);
   CHECK(j["configurations"][0]["tail"][0]["parameters"]["stiffness"] == 2e9);  // no spread: the flag's value
@@ -341,7 +328,7 @@ TEST_CASE(
       run_command({kCli, "--config", kScenario, "--json", dir / "main.json", "--quiet"}, dir.str());
   INFO(m.err);
   REQUIRE(m.exit_code == 0);
-  const json j = read_json(dir / "main.json");
+  const json j = read_json_file(dir / "main.json");
   CHECK(j["global"]["objective"] == "robust-force");
   const json& r = j["robust"];
   CHECK(r["samples"] == 1000);
@@ -363,7 +350,7 @@ TEST_CASE(
       {"--config", kScenario, "--samples", "10000", "--json", dir / "robust.json", "--quiet"}, dir.str());
   INFO(rb.err);
   REQUIRE(rb.exit_code == 0);
-  const json k = read_json(dir / "robust.json");
+  const json k = read_json_file(dir / "robust.json");
   std::vector<std::string> names;
   for (const auto& c : k["configurations"]) names.push_back(c["name"]);
   CHECK(names == std::vector<std::string>{"plain", "optimized", "global", "robust"});
@@ -371,7 +358,7 @@ TEST_CASE(
   const auto& rc = k["configurations"][3];
   CHECK(rc["nominal"]["M_ie"].get<double>() ==
         Approx(j["global"]["integrated_effective_mass"].get<double>()).epsilon(1e-12));
-  // issue 12: on the example (the contact point known to +-5 cm) the robust configuration's 95th
+  // on the example (the contact point known to +-5 cm) the robust configuration's 95th
   // percentile is below the nominal global configuration's on the evaluation samples (seed 2022, not
   // the search's 2023), the whole paired 95 % interval of the ratio below 1, and it pays for it with
   // a higher nominal M_ie: the price of robustness
@@ -419,7 +406,7 @@ TEST_CASE("robust --json -: the JSON alone on standard output, the table on stan
   const CommandResult rk = robust(k, dir.str());
   INFO(rk.err);
   REQUIRE(rk.exit_code == 0);
-  const json jk = read_json(dir / "known_k.json");
+  const json jk = read_json_file(dir / "known_k.json");
   CHECK(jk["estimator"] == "order-statistics");
   CHECK_FALSE(jk.contains("stiffness"));
   const json sk = jk["configurations"][0]["summary"];
@@ -474,3 +461,5 @@ TEST_CASE("robust --plot: the CDF and histogram per configuration, from a run an
   CHECK(std::count(bad.err.begin(), bad.err.end(), '\n') == 1);
   CHECK(empty.entries().empty());
 }
+
+}  // namespace test_robust

@@ -113,6 +113,11 @@ struct Config {
   VectorXd theta;
 };
 
+/// A random configuration: a random base pose (Rng::base_pose) and joint angles in [-range, range].
+inline Config random_config(const ffsr::Model& m, Rng& rng, double range = M_PI) {
+  return {rng.base_pose(), rng.vec(m.n(), range)};
+}
+
 /// A chart: the configuration reached from `q` after time h along generalized velocity v, in some
 /// choice of velocity coordinates.
 using Chart = std::function<Config(const Config& q, const VectorXd& v, double h)>;

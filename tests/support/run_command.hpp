@@ -59,6 +59,33 @@ inline std::string read_all(int fd) {
   return s;
 }
 
+/// Waits for the child `pid` to exit, killing it (SIGKILL) after `timeout_s`; its exit code, or 128 +
+/// the signal number when a signal ended it.
+inline CommandResult wait_for(pid_t pid, double timeout_s) {
+  CommandResult r;
+  int status = 0;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+  for (;;) {
+    const pid_t w = ::waitpid(pid, &status, WNOHANG);
+    if (w == pid) break;
+    if (w < 0 && errno != EINTR) throw std::system_error(errno, std::generic_category(), "waitpid");
+    if (std::chrono::steady_clock::now() > deadline) {
+      ::kill(pid, SIGKILL);
+      ::waitpid(pid, &status, 0);
+      r.timed_out = true;
+      break;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  if (WIFEXITED(status)) {
+    r.exit_code = WEXITSTATUS(status);
+  } else if (WIFSIGNALED(status)) {
+    r.signaled = true;
+    r.exit_code = 128 + WTERMSIG(status);
+  }
+  return r;
+}
+
 }  // namespace detail
 
 /// Runs args[0] (a path, not looked up in PATH) with args[1..] in `cwd` (empty: the current
@@ -91,32 +118,12 @@ inline CommandResult run_command(const std::vector<std::string>& args, const std
     ::_exit(127);
   }
 
-  CommandResult r;
-  int status = 0;
 #if defined(FFSR_SANITIZED) && defined(__OPTIMIZE__)
   timeout_s *= 4.0;  // ASan + UBSan at -O1 (.ci/run) run the command a few times slower than Release
 #elif defined(FFSR_SANITIZED)
   timeout_s *= 10.0;  // at -O0 with ASan + UBSan, an order of magnitude slower
 #endif
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
-  for (;;) {
-    const pid_t w = ::waitpid(pid, &status, WNOHANG);
-    if (w == pid) break;
-    if (w < 0 && errno != EINTR) throw std::system_error(errno, std::generic_category(), "waitpid");
-    if (std::chrono::steady_clock::now() > deadline) {
-      ::kill(pid, SIGKILL);
-      ::waitpid(pid, &status, 0);
-      r.timed_out = true;
-      break;
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(2));
-  }
-  if (WIFEXITED(status)) {
-    r.exit_code = WEXITSTATUS(status);
-  } else if (WIFSIGNALED(status)) {
-    r.signaled = true;
-    r.exit_code = 128 + WTERMSIG(status);
-  }
+  CommandResult r = detail::wait_for(pid, timeout_s);
   r.out = detail::read_all(out_fd);
   r.err = detail::read_all(err_fd);
   ::close(out_fd);

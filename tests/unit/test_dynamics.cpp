@@ -22,6 +22,8 @@
 #include <random>
 #include <utility>
 
+namespace test_dynamics {
+
 using namespace ffsr;
 using namespace ffsr_test;
 
@@ -70,7 +72,22 @@ std::vector<TestRobot> robots_under_test() {
   return {paper_robot("paper_3dof.urdf"), paper_robot("paper_7dof.urdf"), random_tree(7)};
 }
 
-Config random_config(const Model& m, Rng& rng) { return {rng.base_pose(), rng.vec(m.n(), M_PI)}; }
+
+/// The common loop of the identity checks: for every robot under test, `samples` random
+/// configurations drawn from one generator seeded with `seed`, each handed to
+/// body(robot, its Data, the generator, configuration, sample index); the body draws whatever else
+/// it needs from the same generator, so the sequence is fixed by the seed.
+template <class Body>
+void for_each_config(unsigned seed, int samples, Body body) {
+  Rng rng(seed);
+  for (const auto& r : robots_under_test()) {
+    Data d(r.model);
+    for (int k = 0; k < samples; ++k) {
+      const Config q = random_config(r.model, rng);
+      body(r, d, rng, q, k);
+    }
+  }
+}
 
 VectorXd random_velocity(const Model& m, Rng& rng) {
   VectorXd v(m.nv());
@@ -97,24 +114,19 @@ TEST_CASE("random tree: the builder made the intended tree", "[dynamics]") {
 }
 
 TEST_CASE("H is symmetric positive definite", "[dynamics]") {
-  Rng rng(11);
-  for (const auto& r : robots_under_test()) {
-    Data d(r.model);
-    for (int k = 0; k < 5; ++k) {
-      const Config q = random_config(r.model, rng);
-      const MatrixXd H = crba(r.model, d, q.base, q.theta);
-      INFO(r.name << " config " << k);
-      // symmetry: 1e-13 relative to the largest entry (CRBA writes both triangles from one value;
-      // only the rotated link inertias R I R^T may round differently)
-      CHECK((H - H.transpose()).cwiseAbs().maxCoeff() <= 1e-13 * H.cwiseAbs().maxCoeff());
-      Eigen::SelfAdjointEigenSolver<MatrixXd> es(H);
-      // positive definite: every moving body has mass, so the smallest eigenvalue must be clearly
-      // above the rounding level, 1e-12 of the largest (the light 7-DOF wrist brings it down to
-      // ~1e-5 of the largest in some configurations: physical, not a defect)
-      CHECK(es.eigenvalues().minCoeff() > 1e-12 * es.eigenvalues().maxCoeff());
-      CHECK(H.llt().info() == Eigen::Success);
-    }
-  }
+  for_each_config(11, 5, [&](const TestRobot& r, Data& d, Rng& /*rng*/, const Config& q, int k) {
+    const MatrixXd H = crba(r.model, d, q.base, q.theta);
+    INFO(r.name << " config " << k);
+    // symmetry: 1e-13 relative to the largest entry (CRBA writes both triangles from one value;
+    // only the rotated link inertias R I R^T may round differently)
+    CHECK((H - H.transpose()).cwiseAbs().maxCoeff() <= 1e-13 * H.cwiseAbs().maxCoeff());
+    Eigen::SelfAdjointEigenSolver<MatrixXd> es(H);
+    // positive definite: every moving body has mass, so the smallest eigenvalue must be clearly
+    // above the rounding level, 1e-12 of the largest (the light 7-DOF wrist brings it down to
+    // ~1e-5 of the largest in some configurations: physical, not a defect)
+    CHECK(es.eigenvalues().minCoeff() > 1e-12 * es.eigenvalues().maxCoeff());
+    CHECK(H.llt().info() == Eigen::Success);
+  });
 }
 
 TEST_CASE("H columns equal RNEA with unit accelerations", "[dynamics]") {
@@ -151,154 +163,124 @@ TEST_CASE("H columns equal RNEA with unit accelerations", "[dynamics]") {
 }
 
 TEST_CASE("RNEA is H a + C, and bias_forces is RNEA at zero acceleration", "[dynamics]") {
-  Rng rng(13);
-  for (const auto& r : robots_under_test()) {
-    Data d(r.model);
-    for (int k = 0; k < 3; ++k) {
-      const Config q = random_config(r.model, rng);
-      const VectorXd v = random_velocity(r.model, rng), a = rng.vec(r.model.nv(), 2.0);
-      const MatrixXd H = crba(r.model, d, q.base, q.theta);
-      const VectorXd C = bias_forces(r.model, d, q.base, q.theta, v);
-      const VectorXd C0 = rnea(r.model, d, q.base, q.theta, v, VectorXd::Zero(r.model.nv()));
-      const VectorXd tau = rnea(r.model, d, q.base, q.theta, v, a);
-      INFO(r.name << " config " << k);
-      CHECK(rel_err(C, C0) == 0.0);                      // the same computation
-      CHECK(rel_err(tau, VectorXd(H * a + C)) < 1e-11);  // Eq. 1, rounding only
-    }
-  }
+  for_each_config(13, 3, [&](const TestRobot& r, Data& d, Rng& rng, const Config& q, int k) {
+    const VectorXd v = random_velocity(r.model, rng), a = rng.vec(r.model.nv(), 2.0);
+    const MatrixXd H = crba(r.model, d, q.base, q.theta);
+    const VectorXd C = bias_forces(r.model, d, q.base, q.theta, v);
+    const VectorXd C0 = rnea(r.model, d, q.base, q.theta, v, VectorXd::Zero(r.model.nv()));
+    const VectorXd tau = rnea(r.model, d, q.base, q.theta, v, a);
+    INFO(r.name << " config " << k);
+    CHECK(rel_err(C, C0) == 0.0);                      // the same computation
+    CHECK(rel_err(tau, VectorXd(H * a + C)) < 1e-11);  // Eq. 1, rounding only
+  });
 }
 
 TEST_CASE("kinetic energy and H from finite differences of forward kinematics", "[dynamics]") {
-  Rng rng(14);
-  for (const auto& r : robots_under_test()) {
-    Data d(r.model);
-    for (int k = 0; k < 3; ++k) {
-      const Config q = random_config(r.model, rng);
-      const VectorXd v = random_velocity(r.model, rng);
-      const MatrixXd H = crba(r.model, d, q.base, q.theta);
-      const double T_fd = fd_kinetic_energy(r, fd_link_velocities(r, q, v, library_chart));
-      INFO(r.name << " config " << k);
-      // FD truncation O(h^2) with h = 1e-5: 1e-8 relative
-      CHECK(0.5 * v.dot(H * v) == Approx(T_fd).epsilon(1e-8));
-      CHECK(kinetic_energy(r.model, d, v) == Approx(T_fd).epsilon(1e-8));
-      // the whole matrix: sum over bodies of m Jv^T Jv + Jw^T I Jw with FD Jacobians
-      CHECK(rel_err(H, fd_inertia_matrix(r, q, library_chart)) < 1e-8);
-    }
-  }
+  for_each_config(14, 3, [&](const TestRobot& r, Data& d, Rng& rng, const Config& q, int k) {
+    const VectorXd v = random_velocity(r.model, rng);
+    const MatrixXd H = crba(r.model, d, q.base, q.theta);
+    const double T_fd = fd_kinetic_energy(r, fd_link_velocities(r, q, v, library_chart));
+    INFO(r.name << " config " << k);
+    // FD truncation O(h^2) with h = 1e-5: 1e-8 relative
+    CHECK(0.5 * v.dot(H * v) == Approx(T_fd).epsilon(1e-8));
+    CHECK(kinetic_energy(r.model, d, v) == Approx(T_fd).epsilon(1e-8));
+    // the whole matrix: sum over bodies of m Jv^T Jv + Jw^T I Jw with FD Jacobians
+    CHECK(rel_err(H, fd_inertia_matrix(r, q, library_chart)) < 1e-8);
+  });
 }
 
 TEST_CASE("first six rows of H v are the total momentum", "[dynamics]") {
-  Rng rng(15);
-  for (const auto& r : robots_under_test()) {
-    Data d(r.model);
-    for (int k = 0; k < 3; ++k) {
-      const Config q = random_config(r.model, rng);
-      const VectorXd v = random_velocity(r.model, rng);
-      const MatrixXd H = crba(r.model, d, q.base, q.theta);
-      const Vector6 Hv = (H * v).head<6>();
-      const Vector6 h_fd = fd_momentum(r, fd_link_velocities(r, q, v, library_chart), q.base.position);
-      INFO(r.name << " config " << k);
-      CHECK(rel_err(momentum(r.model, d, v), Hv) < 1e-12);  // two library routes: rounding only
-      CHECK(rel_err(Hv, h_fd) < 1e-8);                      // FD body sum, truncation O(h^2)
-    }
-  }
+  for_each_config(15, 3, [&](const TestRobot& r, Data& d, Rng& rng, const Config& q, int k) {
+    const VectorXd v = random_velocity(r.model, rng);
+    const MatrixXd H = crba(r.model, d, q.base, q.theta);
+    const Vector6 Hv = (H * v).head<6>();
+    const Vector6 h_fd = fd_momentum(r, fd_link_velocities(r, q, v, library_chart), q.base.position);
+    INFO(r.name << " config " << k);
+    CHECK(rel_err(momentum(r.model, d, v), Hv) < 1e-12);  // two library routes: rounding only
+    CHECK(rel_err(Hv, h_fd) < 1e-8);                      // FD body sum, truncation O(h^2)
+  });
 }
 
 TEST_CASE("frame_jacobian against finite differences of forward kinematics", "[dynamics]") {
-  Rng rng(16);
-  for (const auto& r : robots_under_test()) {
-    Data d(r.model);
+  for_each_config(16, 3, [&](const TestRobot& r, Data& d, Rng& /*rng*/, const Config& q, int k) {
     std::vector<int> frames{r.ee, 0};
     if (r.name == "random tree")
       frames = {r.ee, r.model.frame_index("tool"), r.model.frame_index("c2"), r.model.frame_index("b3"), 0};
-    for (int k = 0; k < 3; ++k) {
-      const Config q = random_config(r.model, rng);
-      forward_kinematics(r.model, d, q.base, q.theta);
-      for (int f : frames) {
-        const MatrixXd J = frame_jacobian(r.model, d, f);
-        INFO(r.name << " config " << k << " frame " << r.model.frame(f).name);
-        CHECK(rel_err(J, fd_frame_jacobian(r, q, f, library_chart)) < 1e-8);  // FD, O(h^2)
-      }
+    forward_kinematics(r.model, d, q.base, q.theta);
+    for (int f : frames) {
+      const MatrixXd J = frame_jacobian(r.model, d, f);
+      INFO(r.name << " config " << k << " frame " << r.model.frame(f).name);
+      CHECK(rel_err(J, fd_frame_jacobian(r, q, f, library_chart)) < 1e-8);  // FD, O(h^2)
     }
-  }
+  });
 }
 
 TEST_CASE("J_f is the end-effector velocity under zero momentum", "[dynamics]") {
-  Rng rng(17);
-  for (const auto& r : robots_under_test()) {
-    Data d(r.model);
-    for (int k = 0; k < 3; ++k) {
-      const Config q = random_config(r.model, rng);
-      const VectorXd theta_dot = rng.vec(r.model.n(), 1.0);
-      const MatrixXd Jf = generalized_jacobian(r.model, d, q.base, q.theta, r.ee);
-      const MatrixXd J = d.J;
-      const Vector6 xb = base_velocity_from_momentum(r.model, d, theta_dot);
-      VectorXd v(r.model.nv());
-      v << xb, theta_dot;
-      INFO(r.name << " config " << k);
-      const Vector6 xe = Jf * theta_dot;
-      CHECK(rel_err(Vector6(J * v), xe) < 1e-12);  // Eq. 29 algebra, rounding only
-      // independent: the end-effector velocity by FD of forward kinematics along v, O(h^2)
-      CHECK(rel_err(Vector6(fd_frame_jacobian(r, q, r.ee, library_chart) * v), xe) < 1e-8);
-      // the motion carries no momentum (FD body sum): compare with the momentum the joint motion
-      // alone would carry on a clamped base, 1e-8 of it
-      VectorXd v_clamped = VectorXd::Zero(r.model.nv());
-      v_clamped.tail(r.model.n()) = theta_dot;
-      const double scale =
-          fd_momentum(r, fd_link_velocities(r, q, v_clamped, library_chart), q.base.position).norm();
-      CHECK(fd_momentum(r, fd_link_velocities(r, q, v, library_chart), q.base.position).norm() <
-            1e-8 * scale);
-      CHECK(momentum(r.model, d, v).norm() < 1e-12 * scale);
-      // and with a given momentum the base velocity reproduces it (library momentum, rounding)
-      const Vector6 h = Vector6(rng.vec(6, 50.0));
-      v.head<6>() = base_velocity_from_momentum(r.model, d, theta_dot, h);
-      CHECK(rel_err(momentum(r.model, d, v), h) < 1e-12);
-    }
-  }
+  for_each_config(17, 3, [&](const TestRobot& r, Data& d, Rng& rng, const Config& q, int k) {
+    const VectorXd theta_dot = rng.vec(r.model.n(), 1.0);
+    const MatrixXd Jf = generalized_jacobian(r.model, d, q.base, q.theta, r.ee);
+    const MatrixXd J = d.J;
+    const Vector6 xb = base_velocity_from_momentum(r.model, d, theta_dot);
+    VectorXd v(r.model.nv());
+    v << xb, theta_dot;
+    INFO(r.name << " config " << k);
+    const Vector6 xe = Jf * theta_dot;
+    CHECK(rel_err(Vector6(J * v), xe) < 1e-12);  // Eq. 29 algebra, rounding only
+    // independent: the end-effector velocity by FD of forward kinematics along v, O(h^2)
+    CHECK(rel_err(Vector6(fd_frame_jacobian(r, q, r.ee, library_chart) * v), xe) < 1e-8);
+    // the motion carries no momentum (FD body sum): compare with the momentum the joint motion
+    // alone would carry on a clamped base, 1e-8 of it
+    VectorXd v_clamped = VectorXd::Zero(r.model.nv());
+    v_clamped.tail(r.model.n()) = theta_dot;
+    const double scale =
+        fd_momentum(r, fd_link_velocities(r, q, v_clamped, library_chart), q.base.position).norm();
+    CHECK(fd_momentum(r, fd_link_velocities(r, q, v, library_chart), q.base.position).norm() <
+          1e-8 * scale);
+    CHECK(momentum(r.model, d, v).norm() < 1e-12 * scale);
+    // and with a given momentum the base velocity reproduces it (library momentum, rounding)
+    const Vector6 h = Vector6(rng.vec(6, 50.0));
+    v.head<6>() = base_velocity_from_momentum(r.model, d, theta_dot, h);
+    CHECK(rel_err(momentum(r.model, d, v), h) < 1e-12);
+  });
 }
 
 TEST_CASE("effective mass does not depend on the base-velocity coordinates", "[dynamics]") {
-  Rng rng(18);
-  for (const auto& r : robots_under_test()) {
-    Data d(r.model);
-    for (int k = 0; k < 2; ++k) {
-      const Config q = random_config(r.model, rng);
-      const Vector3 u = rng.unit();
-      const double me = effective_mass(r.model, d, q.base, q.theta, r.ee, u);
-      const MatrixXd H = d.H;
-      INFO(r.name << " config " << k);
-      // m_e = 1 / (u^T J_v H^-1 J_v^T u) with H and J_v of another chart, both from FD of forward
-      // kinematics (the kinetic-energy body sum), never from the library's H or J.
-      auto me_in = [&](const Chart& chart, MatrixXd* Hc) {
-        const MatrixXd Hx = fd_inertia_matrix(r, q, chart);
-        const MatrixXd Jv = fd_frame_jacobian(r, q, r.ee, chart).topRows(3);
-        if (Hc) *Hc = Hx;
-        const Eigen::VectorXd w = Jv.transpose() * u;
-        return 1.0 / w.dot(Hx.ldlt().solve(w));
-      };
-      MatrixXd H_body, H_com;
-      const Chart body_chart = advance_base_body_frame;
-      const Chart com_chart = advance_com_chart(r);
-      // FD errors O(h^2) propagate through the solve: 1e-7 relative
-      CHECK(me_in(library_chart, nullptr) == Approx(me).epsilon(1e-7));
-      CHECK(me_in(body_chart, &H_body) == Approx(me).epsilon(1e-7));
-      CHECK(me_in(com_chart, &H_com) == Approx(me).epsilon(1e-7));
-      // the charts are genuinely different coordinates: their inertia matrices differ from H ...
-      CHECK(rel_err(H_body, H) > 1e-3);
-      CHECK(rel_err(H_com, H) > 1e-3);
-      // ... and they are what theory says. Body frame: H' = T^T H T with v = T v',
-      // T = diag(R0, R0, 1). Centre-of-mass velocity: linear momentum M v_g decouples,
-      // H'_gg = M E and H'_g* = 0 (closed form).
-      const Matrix3 R0 = q.base.orientation.normalized().toRotationMatrix();
-      MatrixXd T = MatrixXd::Identity(r.model.nv(), r.model.nv());
-      T.block<3, 3>(0, 0) = R0;
-      T.block<3, 3>(3, 3) = R0;
-      CHECK(rel_err(H_body, MatrixXd(T.transpose() * H * T)) < 1e-8);
-      CHECK(rel_err(MatrixXd(H_com.topLeftCorner(3, 3)),
-                    MatrixXd(r.model.total_mass() * Matrix3::Identity())) < 1e-8);
-      CHECK(H_com.block(0, 3, 3, r.model.nv() - 3).cwiseAbs().maxCoeff() < 1e-8 * H.cwiseAbs().maxCoeff());
-    }
-  }
+  for_each_config(18, 2, [&](const TestRobot& r, Data& d, Rng& rng, const Config& q, int k) {
+    const Vector3 u = rng.unit();
+    const double me = effective_mass(r.model, d, q.base, q.theta, r.ee, u);
+    const MatrixXd H = d.H;
+    INFO(r.name << " config " << k);
+    // m_e = 1 / (u^T J_v H^-1 J_v^T u) with H and J_v of another chart, both from FD of forward
+    // kinematics (the kinetic-energy body sum), never from the library's H or J.
+    auto me_in = [&](const Chart& chart, MatrixXd* Hc) {
+      const MatrixXd Hx = fd_inertia_matrix(r, q, chart);
+      const MatrixXd Jv = fd_frame_jacobian(r, q, r.ee, chart).topRows(3);
+      if (Hc) *Hc = Hx;
+      const Eigen::VectorXd w = Jv.transpose() * u;
+      return 1.0 / w.dot(Hx.ldlt().solve(w));
+    };
+    MatrixXd H_body, H_com;
+    const Chart body_chart = advance_base_body_frame;
+    const Chart com_chart = advance_com_chart(r);
+    // FD errors O(h^2) propagate through the solve: 1e-7 relative
+    CHECK(me_in(library_chart, nullptr) == Approx(me).epsilon(1e-7));
+    CHECK(me_in(body_chart, &H_body) == Approx(me).epsilon(1e-7));
+    CHECK(me_in(com_chart, &H_com) == Approx(me).epsilon(1e-7));
+    // the charts are genuinely different coordinates: their inertia matrices differ from H ...
+    CHECK(rel_err(H_body, H) > 1e-3);
+    CHECK(rel_err(H_com, H) > 1e-3);
+    // ... and they are what theory says. Body frame: H' = T^T H T with v = T v',
+    // T = diag(R0, R0, 1). Centre-of-mass velocity: linear momentum M v_g decouples,
+    // H'_gg = M E and H'_g* = 0 (closed form).
+    const Matrix3 R0 = q.base.orientation.normalized().toRotationMatrix();
+    MatrixXd T = MatrixXd::Identity(r.model.nv(), r.model.nv());
+    T.block<3, 3>(0, 0) = R0;
+    T.block<3, 3>(3, 3) = R0;
+    CHECK(rel_err(H_body, MatrixXd(T.transpose() * H * T)) < 1e-8);
+    CHECK(rel_err(MatrixXd(H_com.topLeftCorner(3, 3)),
+                  MatrixXd(r.model.total_mass() * Matrix3::Identity())) < 1e-8);
+    CHECK(H_com.block(0, 3, 3, r.model.nv() - 3).cwiseAbs().maxCoeff() < 1e-8 * H.cwiseAbs().maxCoeff());
+  });
 }
 
 TEST_CASE("momentum and energy are conserved along a free-floating motion", "[dynamics]") {
@@ -417,169 +399,9 @@ TEST_CASE("effective mass invariances", "[dynamics]") {
 // ------------------------------------------------------------------------------------------------
 // Forward kinematics of the paper robots, closed forms.
 
-TEST_CASE("3-DOF forward kinematics: closed form of Figure 7", "[dynamics][paper]") {
-  const TestRobot r = paper_robot("paper_3dof.urdf");
-  Data d(r.model);
-  Rng rng(21);
-  for (int k = 0; k < 5; ++k) {
-    const Config q = random_config(r.model, rng);
-    forward_kinematics(r.model, d, q.base, q.theta);
-    const double t1 = q.theta(0), t12 = t1 + q.theta(1), t123 = t12 + q.theta(2);
-    // a = 0.6, b = 1.4, c = 1.6, d = 0.5 m; all joints about the base z axis (Section 5.1)
-    const Vector3 local(0.6 + 1.4 * std::cos(t1) + 1.6 * std::cos(t12) + 0.5 * std::cos(t123),
-                        1.4 * std::sin(t1) + 1.6 * std::sin(t12) + 0.5 * std::sin(t123), 0.0);
-    const Vector3 expected = q.base.position + q.base.orientation.toRotationMatrix() * local;
-    CHECK((frame_pose(r.model, d, r.ee).p - expected).norm() < 1e-12);  // rounding only
-  }
-  // stretched along +x at zero angles, base at the origin: ee at a + b + c + d = 4.1 m
-  forward_kinematics(r.model, d, BasePose{}, Eigen::Vector3d::Zero());
-  CHECK((frame_pose(r.model, d, r.ee).p - Vector3(4.1, 0, 0)).norm() < 1e-12);
-}
-
-TEST_CASE("7-DOF end-effector at the initial configuration", "[dynamics][paper]") {
-  // Issue 2: at [0, 90, 90, -90, 90, 90, 0] deg the end-effector is at about (1.8, -0.6, 1.8) m.
-  // Working the joint layout by hand gives exactly that point, so the tolerance is rounding, 1e-12 m.
-  const TestRobot r = paper_robot("paper_7dof.urdf");
-  Data d(r.model);
-  Eigen::VectorXd theta(7);
-  theta << 0, 90, 90, -90, 90, 90, 0;
-  forward_kinematics(r.model, d, BasePose{}, theta * M_PI / 180);
-  CHECK((frame_pose(r.model, d, r.ee).p - Vector3(1.8, -0.6, 1.8)).norm() < 1e-12);
-}
-
 // ------------------------------------------------------------------------------------------------
 // The paper's tables.
 
-namespace {
-
-Target paper_target(const Vector3& r_tp) {
-  Target t;
-  t.mass = 200;                           // Tables 2 and 5
-  t.inertia = 100 * Matrix3::Identity();  // Tables 2 and 5
-  t.attitude = Quaternion::Identity();    // "Euler angle [0, 0, 0] deg"
-  t.contact_offset = r_tp;                // Sections 5.1 and 5.2
-  t.normal = Vector3::UnitX();            // u_n = [1, 0, 0]
-  t.validate();
-  return t;
-}
-
-struct Row {
-  std::vector<double> deg;
-  double paper;
-};
-
-struct RowResult {
-  double at_listed, lo, hi;
-};
-
-/// M_ie at the listed angles and its min/max over the given offsets (degrees) of every joint.
-RowResult evaluate_row(const TestRobot& r, Data& d, const Target& t, const Row& row,
-                       const std::vector<std::vector<double>>& offsets) {
-  const long n = r.model.n();
-  Eigen::VectorXd theta(n);
-  for (long i = 0; i < n; ++i) theta(i) = deg(row.deg[static_cast<size_t>(i)]);
-  RowResult out{integrated_effective_mass(r.model, d, BasePose{}, theta, r.ee, t), 1e300, -1e300};
-  for (const auto& off : offsets) {
-    Eigen::VectorXd th(n);
-    for (long i = 0; i < n; ++i) th(i) = deg(row.deg[static_cast<size_t>(i)] + off[static_cast<size_t>(i)]);
-    const double M = integrated_effective_mass(r.model, d, BasePose{}, th, r.ee, t);
-    out.lo = std::min(out.lo, M);
-    out.hi = std::max(out.hi, M);
-  }
-  return out;
-}
-
-/// All combinations of the given per-joint offsets.
-std::vector<std::vector<double>> grid(int n, const std::vector<double>& values) {
-  std::vector<std::vector<double>> g{{}};
-  for (int i = 0; i < n; ++i) {
-    std::vector<std::vector<double>> next;
-    for (const auto& p : g)
-      for (double v : values) {
-        auto q = p;
-        q.push_back(v);
-        next.push_back(q);
-      }
-    g = next;
-  }
-  return g;
-}
-
-void print_table(const char* title, const std::vector<Row>& rows, const std::vector<RowResult>& res) {
-  std::printf("\n%s\n%-36s %9s %9s %9s %9s %9s %s\n", title, "configuration (deg)", "paper", "ours",
-              "box min", "box max", "rel.err", "in box(+-0.1%)");
-  for (size_t i = 0; i < rows.size(); ++i) {
-    std::string cfg = "[";
-    for (size_t j = 0; j < rows[i].deg.size(); ++j)
-      cfg += (j ? ", " : "") + std::to_string(static_cast<int>(rows[i].deg[j]));
-    cfg += "]";
-    const bool in = rows[i].paper >= res[i].lo * 0.999 && rows[i].paper <= res[i].hi * 1.001;
-    std::printf("%-36s %9.4f %9.4f %9.4f %9.4f %+8.3f%% %s\n", cfg.c_str(), rows[i].paper, res[i].at_listed,
-                res[i].lo, res[i].hi, 100 * (res[i].at_listed - rows[i].paper) / rows[i].paper,
-                in ? "yes" : "NO");
-  }
-  std::fflush(stdout);
-}
-
-}  // namespace
-
-TEST_CASE("Table 3: integrated effective mass of the 3-DOF robot", "[paper]") {
-  const TestRobot r = paper_robot("paper_3dof.urdf");
-  Data d(r.model);
-  const Target t = paper_target(Vector3(-0.25, 0.15, 0.0));
-  // Table 3, column "Integrated Effective Mass (kg)"
-  const std::vector<Row> rows{{{36, 30, -4}, 1.555},  {{85, -41, 11}, 1.648},  {{-75, 30, 12}, 3.679},
-                              {{10, 86, -76}, 4.299}, {{0, 90, -90}, 5.817},   {{30, 21, -56}, 5.926},
-                              {{54, -30, -5}, 7.446}, {{-10, -18, 30}, 9.635}, {{46, -45, 0}, 13.74},
-                              {{-6, 20, -7}, 21.093}};
-  // [0, 90, -90] is exact in degrees: 0.1 % (the paper prints four digits)
-  Eigen::Vector3d exact(0, deg(90), deg(-90));
-  CHECK(integrated_effective_mass(r.model, d, BasePose{}, exact, r.ee, t) == Approx(5.817).epsilon(1e-3));
-  // the other rows are rounded to whole degrees: the paper's value must lie in the range of M_ie
-  // over the 3x3x3 grid at -0.5, 0, +0.5 deg around the listed angles, widened 0.1 % each side
-  const auto g = grid(3, {-0.5, 0.0, 0.5});
-  std::vector<RowResult> res;
-  for (const auto& row : rows) res.push_back(evaluate_row(r, d, t, row, g));
-  print_table("Table 3 (3-DOF), M_ie in kg; box = 3x3x3 grid of +-0.5 deg", rows, res);
-  for (size_t i = 0; i < rows.size(); ++i) {
-    INFO("row " << i << ": paper " << rows[i].paper << ", ours " << res[i].at_listed << ", box [" << res[i].lo
-                << ", " << res[i].hi << "]");
-    CHECK(rows[i].paper >= res[i].lo * (1 - 1e-3));
-    CHECK(rows[i].paper <= res[i].hi * (1 + 1e-3));
-  }
-}
-
-TEST_CASE("Table 6: integrated effective mass of the 7-DOF robot", "[paper]") {
-  const TestRobot r = paper_robot("paper_7dof.urdf");
-  Data d(r.model);
-  const Target t = paper_target(Vector3(-0.25, 0.15, 0.1));
-  // Table 6, column "Integrated Effective Mass (kg)"
-  const std::vector<Row> rows{
-      {{0, 29, 54, 10, -10, 120, 32}, 4.875},   {{10, -2, 160, 0, 33, -5, 80}, 7.876},
-      {{55, -22, 45, 11, 36, -10, 160}, 2.848}, {{-10, 30, 60, -45, 0, 22, 4}, 3.061},
-      {{23, 33, -64, 145, 34, 88, 60}, 3.167},  {{74, -20, 2, 19, 112, 75, -10}, 5.003},
-      {{5, 100, 26, -69, 20, 108, -66}, 2.513}, {{100, 23, 126, -6, 34, 34, -1}, 1.658},
-      {{1, 110, -90, 90, 14, 150, 45}, 2.677},  {{-36, 88, 46, 123, -110, 15, 0}, 1.495}};
-  // the box: the 2^7 corners at +-0.5 deg (the centre is the listed configuration itself)
-  const auto corners = grid(7, {-0.5, 0.5});
-  std::vector<RowResult> res;
-  int in_box = 0;
-  for (const auto& row : rows) {
-    res.push_back(evaluate_row(r, d, t, row, corners));
-    RowResult& x = res.back();
-    x.lo = std::min(x.lo, x.at_listed);
-    x.hi = std::max(x.hi, x.at_listed);
-    if (row.paper >= x.lo * (1 - 1e-3) && row.paper <= x.hi * (1 + 1e-3)) ++in_box;
-  }
-  print_table("Table 6 (7-DOF), M_ie in kg; box = 2^7 corners of +-0.5 deg and the centre", rows, res);
-  for (size_t i = 0; i < rows.size(); ++i) {
-    INFO("row " << i << ": paper " << rows[i].paper << ", ours " << res[i].at_listed);
-    // the layout is reconstructed (Figure 12 missing): within 5 % of the paper (issue 2)
-    CHECK(std::abs(res[i].at_listed - rows[i].paper) <= 0.05 * rows[i].paper);
-  }
-  // at least 9 of the 10 rows inside the +-0.5 deg box widened 0.1 % (issue 2)
-  CHECK(in_box >= 9);
-}
 
 namespace {
 
@@ -684,54 +506,51 @@ TEST_CASE(
   // s = [u; rho x u] equals the effective mass of the end-effector frame, a different point of the
   // same body (rho = p_ee - p_body from forward kinematics); and the analytic gradient of a form
   // s^T Lambda^-1 s (any 6-vector s) equals central differences.
-  Rng rng(47);
-  for (const auto& r : robots_under_test()) {
-    Data d(r.model);
+  for_each_config(47, 3, [&](const TestRobot& r, Data& d, Rng& rng, const Config& q, int k) {
     const int body = r.model.frame(r.ee).body;
     const int origin = r.model.frame_index(r.model.body(body).name);
     REQUIRE(r.model.frame(origin).body == body);
-    for (int k = 0; k < 3; ++k) {
-      const Config q = random_config(r.model, rng);
-      INFO(r.name << " config " << k);
-      crba(r.model, d, q.base, q.theta);
-      const Matrix6 L = inverse_inertia_matrix(r.model, d, origin);
-      CHECK((L - L.transpose()).cwiseAbs().maxCoeff() == 0.0);
-      CHECK(Eigen::SelfAdjointEigenSolver<Matrix6>(L).eigenvalues().minCoeff() > -1e-12 * L.norm());
-      const MatrixXd H = fd_inertia_matrix(r, q, library_chart);
-      const MatrixXd J = fd_frame_jacobian(r, q, origin, library_chart);
-      const MatrixXd Lfd = J * H.ldlt().solve(J.transpose());
-      CHECK(rel_err(MatrixXd(L), Lfd) < 1e-6);
+    INFO(r.name << " config " << k);
+    crba(r.model, d, q.base, q.theta);
+    const Matrix6 L = inverse_inertia_matrix(r.model, d, origin);
+    CHECK((L - L.transpose()).cwiseAbs().maxCoeff() == 0.0);
+    CHECK(Eigen::SelfAdjointEigenSolver<Matrix6>(L).eigenvalues().minCoeff() > -1e-12 * L.norm());
+    const MatrixXd H = fd_inertia_matrix(r, q, library_chart);
+    const MatrixXd J = fd_frame_jacobian(r, q, origin, library_chart);
+    const MatrixXd Lfd = J * H.ldlt().solve(J.transpose());
+    CHECK(rel_err(MatrixXd(L), Lfd) < 1e-6);
 
-      forward_kinematics(r.model, d, q.base, q.theta);
-      const Vector3 rho = frame_pose(r.model, d, r.ee).p - frame_pose(r.model, d, origin).p;
-      CHECK(rho.norm() > 0.05);  // a genuinely different point
-      crba(r.model, d, q.base, q.theta);
-      for (int j = 0; j < 3; ++j) {
-        const Vector3 u = rng.unit();
-        Vector6 s;
-        s << u, rho.cross(u);
-        const double at_point = s.dot(L * s);
-        CHECK(std::abs(at_point - inverse_effective_mass(r.model, d, r.ee, u)) < 1e-10 * at_point);
-      }
-
+    forward_kinematics(r.model, d, q.base, q.theta);
+    const Vector3 rho = frame_pose(r.model, d, r.ee).p - frame_pose(r.model, d, origin).p;
+    CHECK(rho.norm() > 0.05);  // a genuinely different point
+    crba(r.model, d, q.base, q.theta);
+    for (int j = 0; j < 3; ++j) {
+      const Vector3 u = rng.unit();
       Vector6 s;
-      s << rng.vec3(1.0), rng.vec3(0.5);  // not a force at a point in general (s_f . s_m != 0)
-      VectorXd g(r.model.n());
-      crba(r.model, d, q.base, q.theta);
-      const double qs = inverse_inertia_form_gradient(r.model, d, origin, s, g);
-      CHECK(qs == Approx(s.dot(L * s)).epsilon(1e-12));
-      for (int c = 0; c < r.model.n(); ++c) {
-        const double h = 1e-6;
-        VectorXd tp = q.theta, tm = q.theta;
-        tp(c) += h;
-        tm(c) -= h;
-        crba(r.model, d, q.base, tp);
-        const double fp = s.dot(inverse_inertia_matrix(r.model, d, origin) * s);
-        crba(r.model, d, q.base, tm);
-        const double fm = s.dot(inverse_inertia_matrix(r.model, d, origin) * s);
-        INFO("coordinate " << c);
-        CHECK(g(c) == Approx((fp - fm) / (2 * h)).epsilon(1e-6).margin(1e-8 * qs));
-      }
+      s << u, rho.cross(u);
+      const double at_point = s.dot(L * s);
+      CHECK(std::abs(at_point - inverse_effective_mass(r.model, d, r.ee, u)) < 1e-10 * at_point);
     }
-  }
+
+    Vector6 s;
+    s << rng.vec3(1.0), rng.vec3(0.5);  // not a force at a point in general (s_f . s_m != 0)
+    VectorXd g(r.model.n());
+    crba(r.model, d, q.base, q.theta);
+    const double qs = inverse_inertia_form_gradient(r.model, d, origin, s, g);
+    CHECK(qs == Approx(s.dot(L * s)).epsilon(1e-12));
+    for (int c = 0; c < r.model.n(); ++c) {
+      const double h = 1e-6;
+      VectorXd tp = q.theta, tm = q.theta;
+      tp(c) += h;
+      tm(c) -= h;
+      crba(r.model, d, q.base, tp);
+      const double fp = s.dot(inverse_inertia_matrix(r.model, d, origin) * s);
+      crba(r.model, d, q.base, tm);
+      const double fm = s.dot(inverse_inertia_matrix(r.model, d, origin) * s);
+      INFO("coordinate " << c);
+      CHECK(g(c) == Approx((fp - fm) / (2 * h)).epsilon(1e-6).margin(1e-8 * qs));
+    }
+  });
 }
+
+}  // namespace test_dynamics

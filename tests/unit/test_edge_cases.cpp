@@ -1,4 +1,4 @@
-// Numerical edge cases (issue 5): each ends in a correct answer or in a typed error with a message;
+// Numerical edge cases: each ends in a correct answer or in a typed error with a message;
 // none hangs and none answers NaN. The README's "Edge cases" table points here.
 #include <catch2/catch.hpp>
 
@@ -11,6 +11,8 @@
 #include "ffsr/simulate/single_body.hpp"
 
 #include <string>
+
+namespace test_edge_cases {
 
 using namespace ffsr;
 using ffsr::test::deg;
@@ -309,3 +311,5 @@ TEST_CASE("Edge: CVODE asked for impossible tolerances", "[edge]") {
                                    {1e9, 1.5, 0.9}, "hunt-crossley", o),
                   InputError);
 }
+
+}  // namespace test_edge_cases

@@ -1,8 +1,9 @@
-// Global capture optimization (optimize/global.hpp, issue 9): the capture-manifold search, the
+// Global capture optimization (optimize/global.hpp): the capture-manifold search, the
 // reaching planner, an optimality check that does not use the search, and the failure modes.
 // The expensive runs (one global plan per robot) are made once and shared by the checks.
 #include <catch2/catch.hpp>
 
+#include "support/global_capture.hpp"
 #include "support/paper.hpp"
 #include "support/run_command.hpp"
 
@@ -16,126 +17,13 @@
 #include <nlohmann/json.hpp>
 #include <random>
 
+namespace test_global {
+
 using namespace ffsr;
-using ffsr::test::deg;
-using ffsr::test::kRobots;
+using ffsr::test::deg, ffsr::test::kRobots, ffsr::test::problem_3dof, ffsr::test::problem_7dof;
+using namespace ffsr::test::global_capture;
 
 namespace {
-
-constexpr double kRate = 3.0 * M_PI / 180.0;  // max-joint-rate-deg = 3 of the paper scenario files
-
-/// robots/paper_3dof.toml
-CaptureProblem problem_3dof(const Model& m) {
-  CaptureProblem pb;
-  pb.model = &m;
-  pb.frame = m.end_effector();
-  pb.theta = deg({0, 150, -100});
-  pb.target.position = Vector3(2.75, 1.45, 0);
-  pb.target.angular_velocity = Vector3(0, 0, 2) * (M_PI / 180);
-  return pb;
-}
-
-/// robots/paper_7dof_position.toml (and _pose.toml: the same robot and target)
-CaptureProblem problem_7dof(const Model& m) {
-  CaptureProblem pb;
-  pb.model = &m;
-  pb.frame = m.end_effector();
-  pb.theta = deg({0, 90, 90, -90, 90, 90, 0});
-  pb.target.position = Vector3(2.3, -0.8, 2);
-  pb.target.angular_velocity = Vector3(1, -0.5, 2) * (M_PI / 180);
-  pb.target.contact_offset = Vector3(-0.25, 0.15, 0.1);
-  return pb;
-}
-
-CaptureOptions options(double T) {
-  CaptureOptions o;
-  o.duration = T;
-  o.step = 0.1;
-  o.tolerance = 1e-3;
-  o.max_joint_rate = kRate;
-  return o;
-}
-
-CaptureTask position_task(bool planar) {
-  CaptureTask t;
-  if (planar) t.axes = {true, true, false};
-  return t;
-}
-
-struct Shared {
-  Model model;
-  CaptureProblem pb;
-  CaptureTask task;
-  CaptureOptions opt;
-  CaptureResult paper;  ///< the paper's method (rho of the scenario file)
-  GlobalCaptureResult global;
-};
-
-const Shared& shared_3dof() {
-  static const Shared s = [] {
-    Shared r{
-        model_from_urdf_file(kRobots + "paper_3dof.urdf"), {}, position_task(true), options(180), {}, {}};
-    r.pb = problem_3dof(r.model);
-    CaptureOptions paper = r.opt;
-    paper.gain = -0.01;
-    paper.max_joint_rate = 0;
-    r.paper = plan_capture(r.pb, r.task, paper);
-    GlobalCaptureOptions g;
-    g.extra_starts = {r.paper.theta};
-    r.global = plan_capture_global(r.pb, r.task, r.opt, g);
-    return r;
-  }();
-  return s;
-}
-
-const Shared& shared_7dof_position() {
-  static const Shared s = [] {
-    Shared r{
-        model_from_urdf_file(kRobots + "paper_7dof.urdf"), {}, position_task(false), options(157), {}, {}};
-    r.pb = problem_7dof(r.model);
-    CaptureOptions paper = r.opt;
-    paper.gain = -0.01;
-    paper.max_joint_rate = 0;
-    r.paper = plan_capture(r.pb, r.task, paper);
-    GlobalCaptureOptions g;
-    g.extra_starts = {r.paper.theta};
-    r.global = plan_capture_global(r.pb, r.task, r.opt, g);
-    return r;
-  }();
-  return s;
-}
-
-/// The checks every global run must pass, against the run's own records and the paper's method.
-void check_run(const Shared& s, double bound_M_ie) {
-  const GlobalCaptureResult& g = s.global;
-  INFO("global M_ie " << g.run.M_ie << " paper's method " << s.paper.M_ie << " optimum " << g.manifold_optimum
-                      << " gap " << g.optimality_gap_percent << " % iterations " << g.shooting_iterations);
-  CHECK(g.run.M_ie <= bound_M_ie);
-  CHECK(g.run.M_ie <= s.paper.M_ie);  // never worse than the paper's method
-  CHECK(g.reached_manifold_optimum);
-  CHECK(g.optimality_gap_percent <= 1.0);
-  CHECK(g.optimality_gap_percent >=
-        -1e-6);  // the optimum is the best the search knows, the reached point among the starts
-  CHECK(g.shooting_iterations >= 1);
-  CHECK(g.shooting_iterations <= 8 * g.goals_tried);
-  CHECK(g.run.tracking_error <= s.opt.tolerance);
-  CHECK(g.run.max_joint_rate <= kRate * (1 + 1e-9));  // the limit of the scenario
-  // zero total momentum along the run (relative to the bodies' own momenta) and a still centre of mass
-  CHECK(g.run.max_momentum <= 1e-9 * g.run.max_body_momentum);
-  CHECK(g.run.max_com_drift <= 1e-6);
-  // the objective reported is M_ie at the reached configuration and base pose (independent recomputation)
-  Data d(s.model);
-  const Target cap = propagate_target(s.pb.target, s.opt.duration);
-  CHECK(
-      g.objective ==
-      Approx(integrated_effective_mass(s.model, d, g.run.base, g.run.theta, s.pb.frame, cap)).epsilon(1e-9));
-  std::printf(
-      "\nglobal %d-DOF: M_ie %.3f kg (paper's method %.3f), F_max %.3f kN (%.3f), rate %.3f deg/s (%.3f), "
-      "gap %.3f %%, %d iterations, %ld SLSQP evaluations, search %.3f s\n",
-      s.model.n(), g.run.M_ie, s.paper.M_ie, g.run.f_max_closed_form / 1e3, s.paper.f_max_closed_form / 1e3,
-      g.run.max_joint_rate * 180 / M_PI, s.paper.max_joint_rate * 180 / M_PI, g.optimality_gap_percent,
-      g.shooting_iterations, g.evaluations, g.search_seconds);
-}
 
 /// A damped-Newton projection onto the capture manifold written here, apart from the library's
 /// (position rows only; plain Gauss-Newton with a fixed damping and no line search).
@@ -164,16 +52,6 @@ bool test_projection(const Model& m, Data& d, int frame, const BasePose& base, c
 }
 
 }  // namespace
-
-TEST_CASE("Global capture, 3-DOF (robots/paper_3dof.toml)", "[global][paper]") {
-  check_run(shared_3dof(), 1.26);  // issue 9: <= 1.26 kg (paper's method 1.22 in the paper, 1.31 here)
-}
-
-TEST_CASE("Global capture, 7-DOF position (robots/paper_7dof_position.toml)", "[global][paper]") {
-  const Shared& s = shared_7dof_position();
-  check_run(s, 1.35);                              // issue 9: <= 1.35 kg (paper 2.70 kg)
-  CHECK(s.global.run.f_max_closed_form <= 800.0);  // issue 9: <= 0.80 kN (paper 1.17 kN)
-}
 
 TEST_CASE("Global optimum: no projected random configuration is more than 1 % lower", "[global]") {
   // Independent of the search: 1000 random configurations (fixed seed) put on the capture manifold at
@@ -284,48 +162,6 @@ ffsr::test::CommandResult cli(std::vector<std::string> args) {
 
 }  // namespace
 
-TEST_CASE("ffsr-optimize: the global row and its JSON keys (7-DOF pose scenario)", "[global][cli][paper]") {
-#if defined(FFSR_SANITIZED) && !defined(__OPTIMIZE__)
-  // the full 7-DOF pose run with its global search takes many minutes at -O0 with ASan: skipped there
-  // (.ci/run builds its sanitizer stage with -O1, where it runs); the library cases above run the global
-  // search under the sanitizers at any optimization level
-  WARN("skipped in an unoptimized sanitizer build (runs at -O1 and in Release)");
-  return;
-#endif
-  ffsr::test::TempDir tmp;
-  const std::string out = tmp.str() + "/r.json";
-  const auto r = cli({"--quiet", "--config", kRobots + "paper_7dof_pose.toml", "--json", out});
-  INFO(r.out << r.err);
-  REQUIRE(r.exit_code == 0);
-  CHECK(r.out.find("Global") != std::string::npos);
-  CHECK(r.out.find("Reduction (global)") != std::string::npos);
-  std::ifstream in(out);
-  const nlohmann::json j = nlohmann::json::parse(in);
-  const auto& g = j["global"];
-  for (const char* key :
-       {"capture_configuration_deg", "integrated_effective_mass", "f_max_closed_form", "f_max_exact",
-        "tracking_error", "max_total_momentum", "max_center_of_mass_drift", "manifold_optimum",
-        "optimality_gap_percent", "shooting_iterations", "max_joint_rate_deg", "search"})
-    CHECK(g.contains(key));
-  for (const char* key : {"method", "starts", "evaluations", "seconds"}) CHECK(g["search"].contains(key));
-  CHECK(j["baseline"].contains("max_joint_rate_deg"));
-  CHECK(j["optimized"].contains("max_joint_rate_deg"));
-  // issue 9: the pose task (one null-space direction) at most 15.70 kg, never worse than the paper's method
-  const double M = g["integrated_effective_mass"].get<double>();
-  std::printf("\n7-DOF pose: global M_ie %.3f kg (paper's method %.3f kg), gap %.3f %%, rate %.3f deg/s\n", M,
-              j["optimized"]["integrated_effective_mass"].get<double>(),
-              g["optimality_gap_percent"].get<double>(), g["max_joint_rate_deg"].get<double>());
-  CHECK(M <= 15.70);
-  CHECK(M <= j["optimized"]["integrated_effective_mass"].get<double>());
-  CHECK(g["tracking_error"].get<double>() <= 1e-3);
-  CHECK(g["orientation_error_deg"].get<double>() <= 0.5);
-  CHECK(g["max_joint_rate_deg"].get<double>() <= 3.0 + 1e-9);
-  // on the 1-D self-motion manifold of the pose task the optimum may lie on a component the arm cannot
-  // reach; the result says so, and the gap is then the honest distance to it
-  if (g["reached_manifold_optimum"].get<bool>()) CHECK(g["optimality_gap_percent"].get<double>() <= 1.0);
-  CHECK(g["optimality_gap_percent"].get<double>() >= -1e-6);
-}
-
 TEST_CASE("ffsr-optimize: bad global inputs give one error line naming the key", "[global][cli]") {
   const std::string sc = kRobots + "paper_3dof.toml";
   const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
@@ -348,3 +184,5 @@ TEST_CASE("ffsr-optimize: bad global inputs give one error line naming the key",
     CHECK(std::count(r.err.begin(), r.err.end(), '\n') == 1);
   }
 }
+
+}  // namespace test_global

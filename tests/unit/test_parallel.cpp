@@ -13,6 +13,8 @@
 #include <thread>
 #include <vector>
 
+namespace test_parallel {
+
 using ffsr::detail::parallel_chunks;
 using ffsr::detail::parallel_for;
 using ffsr::detail::ParallelOptions;
@@ -133,3 +135,5 @@ TEST_CASE("parallel_for: progress ends with the count, on the calling thread", "
   CHECK(std::is_sorted(reports.begin(), reports.end()));
   CHECK(on_caller);
 }
+
+}  // namespace test_parallel

@@ -24,6 +24,8 @@
 #include <random>
 #include <sstream>
 
+namespace test_planner {
+
 using namespace ffsr;
 using ffsr::test::kRobots;
 
@@ -363,3 +365,5 @@ TEST_CASE("Each run monitor trips on its violation", "[planner]") {
     CHECK(r.max_quaternion_error == 2e-9);
   }
 }
+
+}  // namespace test_planner

@@ -14,6 +14,8 @@
 #include <string>
 #include <vector>
 
+namespace test_scenario {
+
 namespace fs = std::filesystem;
 using nlohmann::json;
 
@@ -158,3 +160,5 @@ TEST_CASE("scenario: bad keys and values name the file or the key", "[scenario]"
           ffsr::read_scenario_text("duration = [", "scenario x.toml");
         }).rfind("scenario x.toml:1: ", 0) == 0);
 }
+
+}  // namespace test_scenario

@@ -1,4 +1,4 @@
-// Uncertain targets (issue 12): the reproducible sampler, the laws and their physical redraw rules,
+// Uncertain targets (uncertainty/): the reproducible sampler, the laws and their physical redraw rules,
 // the per-sample M_ie / F_max against the library's direct computations, the summary statistics,
 // and the multibody force of a sample against simulate_contact.
 #include <catch2/catch.hpp>
@@ -15,6 +15,8 @@
 #include <cmath>
 #include <random>
 #include <vector>
+
+namespace test_uncertainty {
 
 using namespace ffsr;
 using ffsr::test::deg;
@@ -757,3 +759,5 @@ TEST_CASE("stiffness-conditional percentiles: bad inputs", "[uncertainty][robust
   CHECK_FALSE(stiffness_conditional_applies(ForceModel::Exact, law(Spread::Law::LogNormal, 0.0)));
   CHECK(stiffness_conditional_applies(ForceModel::Closed, ln));
 }
+
+}  // namespace test_uncertainty

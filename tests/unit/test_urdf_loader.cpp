@@ -12,6 +12,8 @@
 #include <cmath>
 #include <string>
 
+namespace test_urdf_loader {
+
 using namespace ffsr;
 
 namespace {
@@ -226,3 +228,5 @@ TEST_CASE("multibody steps: Hertz time and running maxima", "[urdf_loader][simul
   CHECK(res.delta_max == 3e-5);
   CHECK(res.series.size() == 2);
 }
+
+}  // namespace test_urdf_loader
