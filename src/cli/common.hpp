@@ -169,6 +169,30 @@ struct Progress {
 nlohmann::json to_json(const Eigen::MatrixXd& m);
 nlohmann::json to_json(const Eigen::VectorXd& v);
 
+/// The output keys of the subcommands that run a scenario (the main job, robust): where the JSON,
+/// the CSV and the figures go, and whether progress is shown. A flag or the scenario file sets them.
+struct OutputKeys {
+  std::string json, csv, plot, plot_format = "png";
+  bool quiet = false;
+  /// Sets output key `name` from the scenario file's text (`flag` names it in errors); false when
+  /// `name` is not an output key.
+  bool set_from_file(const std::string& name, const std::string& text, const std::string& flag) {
+    if (name == "json")
+      json = text;
+    else if (name == "csv")
+      csv = text;
+    else if (name == "plot")
+      plot = text;
+    else if (name == "plot-format")
+      plot_format = text;
+    else if (name == "quiet")
+      quiet = ffsr::detail::boolean_from_text(text, flag);
+    else
+      return false;
+    return true;
+  }
+};
+
 /// Calls set(name, text, flag) for every command key the scenario file holds (ScenarioKeys::extra:
 /// json, csv, plot, ...) whose flag was not given on the command line: a flag overrides the file.
 template <class Set>

@@ -36,7 +36,7 @@ using detail::str;
 /// Tail samples kept per configuration (the largest F_max), in the summary and across a merge.
 constexpr std::size_t kTail = 5;
 
-struct RobustOptions {
+struct RobustOptions : OutputKeys {
   ScenarioFlags flags;  ///< the scenario keys as flags (a flag overrides the file)
   std::string config;
   std::string force_model = "exact";
@@ -44,8 +44,6 @@ struct RobustOptions {
   int threads = std::max(1u, std::thread::hardware_concurrency());
   std::vector<double> capture_joints_deg, capture_base_position{0, 0, 0}, capture_base_rpy_deg{0, 0, 0};
   std::vector<std::string> merge;
-  std::string json, csv, plot, plot_format = "png";
-  bool quiet = false;
 };
 
 // --- evaluation ---------------------------------------------------------------------------------
@@ -715,16 +713,12 @@ RobustOptions with_file_keys(const RobustOptions& flags, const ScenarioKeys& key
   RobustOptions o = flags;
   for_each_file_key(keys, app,
                     [&](const std::string& name, const std::string& text, const std::string& flag) {
+                      if (o.set_from_file(name, text, flag)) return;
                       if (name == "force-model") o.force_model = text;
                       if (name == "samples") o.samples = text;
                       if (name == "shard") o.shard = text;
                       if (name == "threads")
                         o.threads = static_cast<int>(detail::integer_from_text(text, flag));
-                      if (name == "json") o.json = text;
-                      if (name == "csv") o.csv = text;
-                      if (name == "plot") o.plot = text;
-                      if (name == "plot-format") o.plot_format = text;
-                      if (name == "quiet") o.quiet = detail::boolean_from_text(text, flag);
                     });
   return o;
 }

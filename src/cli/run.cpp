@@ -41,8 +41,7 @@ using detail::str;
 
 /// The main job's outputs: flags, and keys of a scenario file too (kCommandKeys; a flag overrides the
 /// file, and --expect of the file is relative to it).
-struct RunSettings {
-  std::string json, csv, plot, plot_format = "png";
+struct RunSettings : OutputKeys {
   std::string expect;  ///< a stored result to compare with (regression run)
   double rtol = 1e-6, atol = 1e-9;
   bool quiet = false;
@@ -63,13 +62,9 @@ RunSettings settings_of(const RunSettings& flags, const ScenarioKeys& keys, cons
   RunSettings s = flags;
   for_each_file_key(keys, app,
                     [&](const std::string& name, const std::string& text, const std::string& flag) {
-                      if (name == "json") s.json = text;
-                      if (name == "csv") s.csv = text;
-                      if (name == "plot") s.plot = text;
-                      if (name == "plot-format") s.plot_format = text;
+                      if (s.set_from_file(name, text, flag)) return;
                       if (name == "rtol") s.rtol = detail::number_from_text(text, flag);
                       if (name == "atol") s.atol = detail::number_from_text(text, flag);
-                      if (name == "quiet") s.quiet = detail::boolean_from_text(text, flag);
                       if (name == "expect") {  // relative to the scenario file
                         const size_t slash = keys.file.find_last_of('/');
                         s.expect = text.empty() || text.front() == '/' || slash == std::string::npos
