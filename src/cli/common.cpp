@@ -253,6 +253,38 @@ int write_all(int fd, const std::string& content) {
   return 0;
 }
 
+/// Creates a temporary file next to `final_path` (with the mode of the file it will replace) and
+/// returns its descriptor, its name in `tmp`; -1 with errno set (and `tmp` empty) on failure.
+int open_temporary(const std::string& final_path, std::string& tmp) {
+  static thread_local std::random_device rd;
+  int fd = -1;
+  for (int attempt = 0; fd < 0 && attempt < 100; ++attempt) {
+    tmp = final_path + ".tmp-" + std::to_string(rd());
+    fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+    if (fd < 0 && errno != EEXIST) break;
+  }
+  if (fd < 0) {
+    const int err = errno;
+    tmp.clear();
+    errno = err;
+    return -1;
+  }
+  struct stat st {};
+  if (::stat(final_path.c_str(), &st) == 0) (void)::fchmod(fd, st.st_mode & 07777);  // keep the mode
+  return fd;
+}
+
+/// Opens a direct output (a FIFO, a device; standard output is descriptor 1, flushed first).
+/// Returns the descriptor or -1 with errno set.
+int open_direct(OutputKind kind, const std::string& final_path) {
+  if (kind == OutputKind::Stdout) {
+    std::cout.flush();
+    std::fflush(stdout);
+    return 1;
+  }
+  return ::open(final_path.c_str(), O_WRONLY | O_NOCTTY | O_CLOEXEC);
+}
+
 /// The writer behind Outputs, write_file_atomic and write_files_atomic. Reads the file system.
 /// Writes: regular files via temporary files and rename (all or nothing), the others directly.
 void write_outputs(const std::vector<OutputSpec>& outputs) {
@@ -274,23 +306,14 @@ void write_outputs(const std::vector<OutputSpec>& outputs) {
     for (const auto& t : tmps)
       if (!t.empty()) ::unlink(t.c_str());
   };
-  std::random_device rd;
   for (size_t i = 0; i < outputs.size(); ++i) {
     if (kinds[i] != OutputKind::Regular) continue;
-    int fd = -1;
-    for (int attempt = 0; fd < 0 && attempt < 100; ++attempt) {
-      tmps[i] = finals[i] + ".tmp-" + std::to_string(rd());
-      fd = ::open(tmps[i].c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-      if (fd < 0 && errno != EEXIST) break;
-    }
+    const int fd = open_temporary(finals[i], tmps[i]);
     if (fd < 0) {
       const int err = errno;
-      tmps[i].clear();
       remove_tmps();
       throw_write_error(output_name(outputs[i]), err);
     }
-    struct stat st {};
-    if (::stat(finals[i].c_str(), &st) == 0) (void)::fchmod(fd, st.st_mode & 07777);  // keep the mode
     int err = write_all(fd, *outputs[i].content);
     if (::close(fd) != 0 && err == 0) err = errno;
     if (err != 0) {
@@ -301,14 +324,8 @@ void write_outputs(const std::vector<OutputSpec>& outputs) {
   // 3. standard output, FIFOs, devices: written directly, never replaced
   for (size_t i = 0; i < outputs.size(); ++i) {
     if (kinds[i] == OutputKind::Regular) continue;
-    int fd = 1, err = 0;
-    if (kinds[i] == OutputKind::Stdout) {
-      std::cout.flush();
-      std::fflush(stdout);
-    } else {
-      fd = ::open(finals[i].c_str(), O_WRONLY | O_NOCTTY | O_CLOEXEC);
-      if (fd < 0) err = errno;
-    }
+    const int fd = open_direct(kinds[i], finals[i]);
+    int err = fd < 0 ? errno : 0;
     if (err == 0) err = write_all(fd, *outputs[i].content);
     if (fd != 1 && fd >= 0 && ::close(fd) != 0 && err == 0) err = errno;
     if (err != 0) {
@@ -367,6 +384,41 @@ void Outputs::write() const {
   for (const auto& it : items_)
     if (it.has_content) specs.push_back({it.flag, it.path, &it.content});
   write_outputs(specs);
+}
+
+StreamingOutput::StreamingOutput(const std::string& flag, const std::string& path)
+    : name_(output_name({flag, path, nullptr})) {
+  const OutputKind kind = resolve_output(path, name_, final_);
+  fd_ = kind == OutputKind::Regular ? open_temporary(final_, tmp_) : open_direct(kind, final_);
+  if (fd_ < 0) throw_write_error(name_, errno);
+  buffer_.reserve(kBuffer);
+}
+
+StreamingOutput::~StreamingOutput() {
+  if (fd_ > 1) ::close(fd_);
+  if (!tmp_.empty()) ::unlink(tmp_.c_str());
+}
+
+void StreamingOutput::write(const char* data, size_t n) {
+  if (err_ != 0) return;  // reported by commit()
+  buffer_.append(data, n);
+  if (buffer_.size() >= kBuffer) flush_buffer();
+}
+
+void StreamingOutput::flush_buffer() {
+  if (err_ == 0) err_ = write_all(fd_, buffer_);
+  buffer_.clear();
+}
+
+void StreamingOutput::commit() {
+  flush_buffer();
+  if (fd_ > 1 && ::close(fd_) != 0 && err_ == 0) err_ = errno;
+  fd_ = -1;
+  if (err_ != 0) throw_write_error(name_, err_);
+  if (tmp_.empty()) return;  // written in place: standard output, a FIFO, a device
+  if (::rename(tmp_.c_str(), final_.c_str()) != 0)
+    throw_write_error(name_, errno, "cannot write the output file (rename failed)");
+  tmp_.clear();
 }
 
 void write_file_atomic(const std::string& path, const std::string& content) {

@@ -145,6 +145,29 @@ void write_file_atomic(const std::string& path, const std::string& content);
 /// removes the temporary files and throws InputError naming the path, so no regular output file of
 /// the run is left behind.
 void write_files_atomic(const std::vector<std::pair<std::string, std::string>>& files);
+/// An output written as it is produced (a large CSV), with the rules of Outputs: a regular file (or
+/// a symbolic link's target) goes to a temporary file next to it, renamed into place by commit();
+/// standard output, FIFOs and devices are written directly. Destroyed without commit() (the run
+/// failed), it removes the temporary file: no partial regular file is left behind. Errors name the
+/// flag and the file (InputError), from the constructor or from commit().
+class StreamingOutput {
+ public:
+  StreamingOutput(const std::string& flag, const std::string& path);
+  ~StreamingOutput();
+  StreamingOutput(const StreamingOutput&) = delete;
+  StreamingOutput& operator=(const StreamingOutput&) = delete;
+  /// Appends `n` bytes (buffered; a write error is reported by commit()).
+  void write(const char* data, size_t n);
+  /// Flushes, closes and renames the temporary file into place.
+  void commit();
+
+ private:
+  static constexpr size_t kBuffer = 1 << 16;
+  void flush_buffer();
+  std::string name_, final_, tmp_, buffer_;
+  int fd_ = -1;
+  int err_ = 0;
+};
 /// Flushes standard output and throws InputError ("standard output: cannot write ...") when a write to
 /// it failed (a closed pipe, a full disk). main calls it after every successful action.
 void flush_stdout();

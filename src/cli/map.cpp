@@ -15,7 +15,8 @@
 // Speed. Each thread has its own Data and buffers (no heap allocation per point); blocks of points
 // are claimed in order, formatted with std::to_chars (the shortest text that reads back as the same
 // double) and appended to the output in order, so the output never has to fit in memory. The file
-// is written to a temporary next to the destination and renamed at the end: all or nothing.
+// is written like every output of the command (StreamingOutput: a temporary next to the
+// destination, renamed at the end: all or nothing).
 //
 // Pictures (--plot DIR): one varied joint gives M_ie against the angle; two a heat map with contour
 // lines and a colour bar (Figure 9); three the orthogonal slices through --slice-deg (Figure 9's
@@ -31,11 +32,9 @@
 #include <charconv>
 #include <cstdint>
 #include <cstdio>
-#include <filesystem>
 #include <iostream>
 #include <limits>
 #include <memory>
-#include <random>
 #include <sstream>
 #include <thread>
 
@@ -121,61 +120,6 @@ Grid parse_grid(const MapOptions& o, int n_joints) {
 std::uint64_t shard_begin(const Shard& s, std::uint64_t size, std::uint64_t j) {
   return j * (size / s.n) + std::min(j, size % s.n);
 }
-
-/// The CSV output: a temporary file next to `path`, renamed onto it by commit(); removed if the
-/// run fails. "-" writes to stdout; an existing device or FIFO is written in place.
-class CsvOutput {
- public:
-  explicit CsvOutput(const std::string& path) : path_(path) {
-    if (path == "-") {
-      file_ = stdout;
-      return;
-    }
-    namespace fs = std::filesystem;
-    std::error_code ec;
-    const fs::path parent = fs::path(path).parent_path();
-    if (!parent.empty() && !fs::is_directory(parent, ec))
-      throw InputError(str("--csv: the folder '", parent.string(), "' of ", path, " does not exist"));
-    const fs::file_status st = fs::status(path, ec);
-    if (fs::is_directory(st)) throw InputError(str("--csv: ", path, " is a directory"));
-    if (fs::exists(st) && !fs::is_regular_file(st)) {
-      // a device or FIFO (/dev/null, a named pipe): write to it directly; renaming a temporary file
-      // onto it would replace the device with a regular file
-      file_ = std::fopen(path.c_str(), "wb");
-      if (!file_) throw InputError(str("--csv: cannot write the output file ", path));
-      return;
-    }
-    tmp_ = path + ".tmp-" + std::to_string(std::random_device{}());
-    file_ = std::fopen(tmp_.c_str(), "wb");
-    if (!file_) throw InputError(str("--csv: cannot write the output file ", path));
-  }
-  CsvOutput(const CsvOutput&) = delete;
-  CsvOutput& operator=(const CsvOutput&) = delete;
-  ~CsvOutput() {
-    if (file_ && file_ != stdout) std::fclose(file_);
-    if (!tmp_.empty() && !committed_) std::remove(tmp_.c_str());
-  }
-  void write(const char* data, size_t n) {
-    if (n && std::fwrite(data, 1, n, file_) != n) failed_ = true;
-  }
-  void commit() {
-    if (std::fflush(file_) != 0 || std::ferror(file_) || failed_)
-      throw InputError(str("--csv: cannot write the output file ", path_, " (disk full?)"));
-    if (file_ == stdout) return;
-    const int rc = std::fclose(file_);
-    file_ = nullptr;
-    if (rc != 0) throw InputError(str("--csv: cannot write the output file ", path_));
-    if (tmp_.empty()) return;  // written in place (a device or FIFO)
-    if (std::rename(tmp_.c_str(), path_.c_str()) != 0)
-      throw InputError(str("--csv: cannot write the output file ", path_, " (rename failed)"));
-    committed_ = true;
-  }
-
- private:
-  std::string path_, tmp_;
-  std::FILE* file_ = nullptr;
-  bool failed_ = false, committed_ = false;
-};
 
 /// Appends the shortest round-trip text of x and a separator.
 inline char* put(char* p, char* end, double x, char sep) {
@@ -351,8 +295,8 @@ struct GridRun {
 /// The points [first, last) of the grid in blocks of `block` points on the shared thread pool
 /// (ffsr/detail/parallel.hpp): each block is formatted by a worker and written to `out` once all
 /// blocks before it are, so the CSV does not depend on the thread count.
-void run_workers(GridRun& g, CsvOutput& out, std::uint64_t first, std::uint64_t last, std::uint64_t block,
-                 bool quiet) {
+void run_workers(GridRun& g, StreamingOutput& out, std::uint64_t first, std::uint64_t last,
+                 std::uint64_t block, bool quiet) {
   Progress progress("map", quiet);
   std::vector<size_t> bytes(g.threads, 0);
   ffsr::detail::ParallelOptions opt;
@@ -404,7 +348,7 @@ int run_map(const MapOptions& o) {
   const std::vector<double> slice_deg = check_map_plot(o, grid, shard);
   std::vector<double> values(plotting ? count : 0);
 
-  CsvOutput out(o.csv);
+  StreamingOutput out("--csv", o.csv);
   if (shard.k == 0) {
     std::string header;
     const auto names = r.model.joint_names();
