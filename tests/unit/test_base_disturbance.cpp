@@ -21,7 +21,8 @@ using ffsr::test::deg, ffsr::test::kPaperContact, ffsr::test::kRobots, ffsr::tes
 TEST_CASE("Single-body restitution: the root of G(-e) = 0 against the CVODE single-body run",
           "[base_disturbance]") {
   CHECK(single_body_restitution(0.0) == 1.0);
-  for (const char* name : {"hunt-crossley", "herbert-mcwhannell", "lankarani-nikravesh", "flores", "gonthier"})
+  for (const char* name :
+       {"hunt-crossley", "herbert-mcwhannell", "lankarani-nikravesh", "flores", "gonthier"})
     for (double c_r : {0.3, 0.7, 0.9, 0.99}) {
       const ContactParams p{1e9, 1.5, c_r};
       const AnyContactLaw law = make_contact_law(name, p, 0.2);
@@ -96,8 +97,8 @@ TEST_CASE("Predicted base velocity jump against the CVODE multibody run after se
     crba(m, d, base, c.theta);
     const Vector3 u = t.normal_world();
     t.position = frame_pose(m, d, m.end_effector()).p - t.offset_world();
-    const double vin = approach_velocity(u, Vector3(0.2 * u), t.velocity, t.angular_velocity_world(),
-                                         t.offset_world());
+    const double vin =
+        approach_velocity(u, Vector3(0.2 * u), t.velocity, t.angular_velocity_world(), t.offset_world());
     const AnyContactLaw law = make_contact_law("herbert-mcwhannell", kPaperContact, vin);
     const BaseDisturbance p = base_disturbance(m, d, base, c.theta, m.end_effector(), t, law);
     const Vector6 measured = mb.base_velocity_end - mb.base_velocity_start;

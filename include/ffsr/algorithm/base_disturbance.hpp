@@ -29,12 +29,12 @@ namespace ffsr {
 
 /// The impact disturbance of the base at a capture configuration (single-body impulse).
 struct BaseDisturbance {
-  double M_ie = 0;                   ///< integrated effective mass (Eq. 14), kg
-  double approach_velocity = 0;      ///< delta_dot^-, m/s
-  double restitution = 0;            ///< e of the single-body model (realized by the law)
-  double impulse = 0;                ///< P = M_ie delta_dot^- (1 + e), N s
-  Vector3 linear = Vector3::Zero();  ///< jump of the base origin's velocity, m/s (inertial frame)
-  Vector3 angular = Vector3::Zero(); ///< jump of the base's angular velocity, rad/s (inertial frame)
+  double M_ie = 0;                    ///< integrated effective mass (Eq. 14), kg
+  double approach_velocity = 0;       ///< delta_dot^-, m/s
+  double restitution = 0;             ///< e of the single-body model (realized by the law)
+  double impulse = 0;                 ///< P = M_ie delta_dot^- (1 + e), N s
+  Vector3 linear = Vector3::Zero();   ///< jump of the base origin's velocity, m/s (inertial frame)
+  Vector3 angular = Vector3::Zero();  ///< jump of the base's angular velocity, rad/s (inertial frame)
   /// |Delta w_0|, rad/s
   double angular_rate() const { return angular.norm(); }
 };
@@ -81,7 +81,8 @@ inline BaseDisturbance base_disturbance(const Model& model, Data& data, const Ba
 
 inline double single_body_restitution(double f) {
   if (!std::isfinite(f) || f < 0.0)
-    throw InputError(detail::str("single_body_restitution: the damping factor must be >= 0 and finite, got ", f));
+    throw InputError(
+        detail::str("single_body_restitution: the damping factor must be >= 0 and finite, got ", f));
   if (f == 0.0) return 1.0;
   // G is increasing in s on s < 0 (dG/ds = -s/(1 + f s)), positive at 0, <= 0 at -1 and -> -inf at
   // -1/f: the root lies in (max(-1, -1/f), 0).
