@@ -14,7 +14,10 @@
 //  3. for `levels` values eps between the two ends' rates: SLSQP minimizing M_ie under
 //     (|Delta w_0| / eps)^2 <= 1 and c = 0, started from the previous level's point and from the
 //     M_ie end (the better feasible result kept);
-//  4. the non-dominated set of every point found, sorted by M_ie.
+//  4. the non-dominated set of every point found, sorted by M_ie, rates within 1e-9 of the M_ie end's
+//     counted as equal (the arm can turn the impulse's line through the point that leaves the base's
+//     rotation alone: the least rate is then zero to rounding, reached on a whole set of
+//     configurations, and the rate end is the one of least M_ie among them).
 // The gradient of M_ie is analytic (effective_mass.hpp); that of |Delta w_0|^2 a central difference
 // (step 1e-6 rad), 2n evaluations of crba and one back substitution each.
 //
@@ -167,14 +170,16 @@ inline std::optional<ParetoPoint> pareto_local(ParetoContext& ctx, const Capture
   return p;
 }
 
-/// The non-dominated subset of `all`, M_ie increasing.
-inline std::vector<ParetoPoint> non_dominated(std::vector<ParetoPoint> all) {
+/// The non-dominated subset of `all`, M_ie increasing; rates within `floor` of each other count as
+/// equal (the one of least M_ie kept), so that rates at rounding level (a configuration whose impulse
+/// turns no base) do not make a tail of noise.
+inline std::vector<ParetoPoint> non_dominated(std::vector<ParetoPoint> all, double floor) {
   std::sort(all.begin(), all.end(), [](const ParetoPoint& a, const ParetoPoint& b) {
     return a.M_ie < b.M_ie || (a.M_ie == b.M_ie && a.base_rate < b.base_rate);
   });
   std::vector<ParetoPoint> front;
   for (const ParetoPoint& p : all)
-    if (front.empty() || p.base_rate < front.back().base_rate * (1 - 1e-9)) front.push_back(p);
+    if (front.empty() || p.base_rate < front.back().base_rate * (1 - 1e-9) - floor) front.push_back(p);
   return front;
 }
 
@@ -220,8 +225,14 @@ inline ParetoFront pareto_front(const CaptureProblem& pb, const CaptureTask& tas
   ParetoFront f;
   f.evaluations = mass.evaluations;
   Data data(model);
-  detail::ParetoContext ctx{
-      {&model, &data, &pb, &task, &s, &base}, single_body_restitution(s.law), 1, 0, {}, {}};
+  detail::ParetoContext ctx{};
+  ctx.manifold.model = &model;
+  ctx.manifold.data = &data;
+  ctx.manifold.pb = &pb;
+  ctx.manifold.task = &task;
+  ctx.manifold.setup = &s;
+  ctx.manifold.base = &base;
+  ctx.restitution = single_body_restitution(s.law);
   std::vector<ParetoPoint> all;
   for (const ManifoldPoint& m : mass.local_optima)
     all.push_back(detail::pareto_point(model, data, pb, s, base, m.theta, ctx.restitution));
@@ -252,7 +263,10 @@ inline ParetoFront pareto_front(const CaptureProblem& pb, const CaptureTask& tas
   }
   all.push_back(f.min_mass);
   all.push_back(f.min_rate);
-  f.points = detail::non_dominated(std::move(all));
+  // the ends as the front's: the rate end is the least M_ie among the least rates (within the floor)
+  f.points = detail::non_dominated(std::move(all), 1e-9 * f.min_mass.base_rate);
+  f.min_mass = f.points.front();
+  f.min_rate = f.points.back();
   detail::pareto_measures(f);
   f.evaluations += ctx.evaluations + ctx.manifold.evaluations;
   f.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

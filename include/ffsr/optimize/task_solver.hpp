@@ -82,10 +82,11 @@ class TaskSolver {
   TaskSolver(int n, std::vector<int> rows, double singular_value_threshold, double max_damping)
       : TaskSolver(n, std::move(rows), 0, singular_value_threshold, max_damping) {}
 
-  /// The same with `extra_rows` (>= 0) further constraint rows stacked below the task rows and held
-  /// at zero velocity (the base-attitude rows of the reaction-null-space approach): call the solve()
-  /// that takes them. The pseudo-inverse, projector and singular values are then those of the stack.
-  TaskSolver(int n, std::vector<int> rows, int extra_rows, double singular_value_threshold, double max_damping)
+  /// The same with `extra_rows` (>= 0) further constraint rows held at zero velocity with priority
+  /// over the task (the base-attitude rows of the reaction-null-space approach): call the solve()
+  /// that takes them.
+  TaskSolver(int n, std::vector<int> rows, int extra_rows, double singular_value_threshold,
+             double max_damping)
       : rows_(std::move(rows)),
         extra_(extra_rows),
         threshold_(singular_value_threshold),
@@ -98,6 +99,14 @@ class TaskSolver {
              Eigen::ComputeFullU | Eigen::ComputeFullV) {
     if (n < 1 || rows_.empty()) throw InputError("TaskSolver: needs at least one joint and one task row");
     if (extra_rows < 0) throw InputError("TaskSolver: the number of extra rows must be >= 0");
+    if (extra_rows > 0) {
+      svd_extra_ =
+          Eigen::JacobiSVD<Eigen::MatrixXd>(extra_rows, n, Eigen::ComputeFullU | Eigen::ComputeFullV);
+      svd_task_ = Eigen::JacobiSVD<Eigen::MatrixXd>(static_cast<Eigen::Index>(rows_.size()), n,
+                                                    Eigen::ComputeFullU | Eigen::ComputeFullV);
+      NA_.resize(n, n);
+      JtN_.resize(static_cast<Eigen::Index>(rows_.size()), n);
+    }
     for (int r : rows_)
       if (r < 0 || r > 5) throw InputError(detail::str("TaskSolver: task row ", r, " is not in 0..5"));
     out_.theta_dot.resize(n);
@@ -118,18 +127,41 @@ class TaskSolver {
     return factorize(with_projector);
   }
 
-  /// One evaluation with the extra rows `A` (extra_rows() x n) stacked below the task rows and held
-  /// at zero velocity: theta_dot = [J_t; A]^+ [cmd_t; 0], N the projector on the null space of the
-  /// stack. Reads Jf, cmd, A. No allocation.
+  /// One evaluation with the extra rows `A` (extra_rows() x n) held at zero velocity with priority
+  /// over the task: with N_A the projector on the null space of A, theta_dot = (J_t N_A)^+ cmd_t (so
+  /// A theta_dot = 0 exactly, also where J_t N_A is damped), N = N_A minus the task directions of
+  /// J_t N_A (the null space of the stack [J_t; A]); sigma_min and the damping are those of J_t N_A.
+  /// task_jacobian() is the stack. Reads Jf, cmd, A. No allocation.
   const TaskRates& solve(const Eigen::Ref<const Eigen::MatrixXd>& Jf, const Vector6& cmd, bool with_projector,
                          const Eigen::Ref<const Eigen::MatrixXd>& A) {
     if (A.rows() != extra_ || A.cols() != Jt_.cols())
       throw InputError(detail::str("TaskSolver: the extra rows are ", A.rows(), "x", A.cols(), ", expected ",
                                    extra_, "x", Jt_.cols()));
+    const int m = task_rows();
     select_task_rows(Jf, cmd);
     Jt_.bottomRows(extra_) = A;
     xdot_.tail(extra_).setZero();
-    return factorize(with_projector);
+    svd_extra_.compute(A);
+    NA_.setIdentity();
+    for (Eigen::Index i = 0; i < svd_extra_.singularValues().size(); ++i)
+      if (svd_extra_.singularValues()(i) > 1e-12)
+        NA_.noalias() -= svd_extra_.matrixV().col(i) * svd_extra_.matrixV().col(i).transpose();
+    JtN_.noalias() = Jt_.topRows(m) * NA_;
+    svd_task_.compute(JtN_);
+    const auto& sv = svd_task_.singularValues();
+    set_damping(sv(sv.size() - 1));
+    Jpinv_.setZero();
+    for (Eigen::Index i = 0; i < sv.size(); ++i)
+      Jpinv_.leftCols(m).noalias() +=
+          pinv_gain(sv(i)) * svd_task_.matrixV().col(i) * svd_task_.matrixU().col(i).transpose();
+    out_.theta_dot.noalias() = Jpinv_ * xdot_;
+    if (with_projector) {
+      N_ = NA_;
+      for (Eigen::Index i = 0; i < sv.size(); ++i)
+        if (sv(i) > 1e-12)
+          N_.noalias() -= svd_task_.matrixV().col(i) * svd_task_.matrixV().col(i).transpose();
+    }
+    return out_;
   }
 
  private:
@@ -139,6 +171,23 @@ class TaskSolver {
       Jt_.row(r) = Jf.row(rows_[static_cast<size_t>(r)]);
       xdot_(r) = cmd(rows_[static_cast<size_t>(r)]);
     }
+  }
+
+  /// The report and the damping of the last factorization from its smallest singular value.
+  void set_damping(double sigma_min) {
+    out_.sigma_min = sigma_min;
+    out_.lambda2 = 0;
+    out_.damped = false;
+    out_.null_scale = 1;
+    if (out_.sigma_min < threshold_) {
+      const double r = out_.sigma_min / threshold_;
+      out_.lambda2 = (1 - r * r) * max_damping_ * max_damping_;
+      out_.damped = true;
+    }
+  }
+  /// The factor of a singular value in the (damped) pseudo-inverse.
+  double pinv_gain(double sigma) const {
+    return out_.lambda2 > 0 ? sigma / (sigma * sigma + out_.lambda2) : (sigma > 1e-12 ? 1.0 / sigma : 0.0);
   }
 
   const TaskRates& factorize(bool with_projector) {
@@ -201,6 +250,9 @@ class TaskSolver {
   Eigen::VectorXd xdot_;
   Eigen::MatrixXd Jpinv_, N_;
   Eigen::JacobiSVD<Eigen::MatrixXd> svd_;
+  // extra rows (held with priority): their SVD and projector N_A, J_t N_A and its SVD
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd_extra_, svd_task_;
+  Eigen::MatrixXd NA_, JtN_;
   TaskRates out_;
 };
 
