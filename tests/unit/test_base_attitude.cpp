@@ -128,6 +128,7 @@ TEST_CASE("base-attitude: bad modes and robots without the freedom, one line nam
   CHECK(planar.find('\n') == std::string::npos);
   const std::string pose = message("paper_7dof_pose.toml", "hold");
   CHECK(pose.find("6 task rows + 3 base-attitude rows = 9 of the robot's 7 joints") != std::string::npos);
+  CHECK(pose.find("gain = 0") == std::string::npos);  // 9 rows: no tracking either
   const std::string bad = message("paper_7dof_position.toml", "lock");
   CHECK(bad == "--base-attitude: unknown mode 'lock'; expected 'free' or 'hold'");
   // pure tracking (gain 0) on the planar arm: 2 + 1 = 3 joints suffice

@@ -620,7 +620,8 @@ inline bool base_attitude_of(const ScenarioKeys& k, const Model& model, const Ca
             r == 1 ? " base-attitude row = " : " base-attitude rows = ", task.rows() + r, " of the robot's ",
             model.n(), " joints: ",
             gain != 0.0 ? "no freedom left for the objective (it needs " : "too few joints (it needs ",
-            needed, " joints", gain != 0.0 ? "; gain = 0 tracks without optimizing)" : ")"));
+            needed, " joints",
+            gain != 0.0 && task.rows() + r <= model.n() ? "; gain = 0 tracks without optimizing)" : ")"));
   return true;
 }
 
