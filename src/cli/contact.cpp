@@ -3,6 +3,7 @@
 #include "figures.hpp"
 #include "subcommands.hpp"
 
+#include "ffsr/algorithm/base_disturbance.hpp"
 #include "ffsr/simulate/multibody.hpp"
 
 #include <iomanip>
@@ -26,6 +27,8 @@ struct Row {
   double M_ie, v_in, f_closed, f_exact, f_multibody, accuracy, xi, delta_max, t_peak, duration, restitution;
   std::vector<ContactSample> series;
   double mb_delta_max = 0, mb_delta_at_f_max = 0;  ///< of the multibody run, for the F-delta figure
+  BaseDisturbance base_jump{};                     ///< predicted from the configuration (single-body impulse)
+  Vector6 base_jump_multibody = Vector6::Zero();   ///< [dv_0; dw_0] of the multibody run, separation - first touch
 };
 
 Row evaluate(const Robot& r, const Target& target, const ContactOptions& o, const std::string& law_name) {
@@ -51,6 +54,9 @@ Row evaluate(const Robot& r, const Target& target, const ContactOptions& o, cons
   row.accuracy = model_accuracy(row.f_closed, row.f_multibody);
   row.mb_delta_max = mb.delta_max;
   row.mb_delta_at_f_max = mb.delta_at_f_max;
+  row.base_jump_multibody = mb.base_velocity_end - mb.base_velocity_start;
+  Data data(r.model);  // the target's position does not enter (only its attitude, inertia and offset)
+  row.base_jump = base_disturbance(r.model, data, r.base, r.theta, r.end_effector, target, law);
   return row;
 }
 
@@ -66,7 +72,16 @@ nlohmann::json row_json(const Row& r) {
           {"delta_max", r.delta_max},
           {"time_of_peak", r.t_peak},
           {"contact_duration", r.duration},
-          {"restitution_realized", r.restitution}};
+          {"restitution_realized", r.restitution},
+          {"base_disturbance",
+           {{"impulse", r.base_jump.impulse},
+            {"restitution_single_body", r.base_jump.restitution},
+            {"angular_velocity_jump", to_json(Eigen::VectorXd(r.base_jump.angular))},
+            {"angular_velocity_jump_multibody", to_json(Eigen::VectorXd(r.base_jump_multibody.tail<3>()))},
+            {"linear_velocity_jump", to_json(Eigen::VectorXd(r.base_jump.linear))},
+            {"linear_velocity_jump_multibody", to_json(Eigen::VectorXd(r.base_jump_multibody.head<3>()))},
+            {"angular_rate_jump_deg_s", r.base_jump.angular_rate() * 180.0 / M_PI},
+            {"angular_rate_jump_multibody_deg_s", r.base_jump_multibody.tail<3>().norm() * 180.0 / M_PI}}}};
 }
 
 /// The laws to evaluate: every law for --model all, else the one named (an unknown name lists them).
@@ -137,6 +152,12 @@ void print_contact_table(std::ostream& out, const std::vector<Row>& rows) {
         << std::setw(13) << row.f_closed << std::setw(13) << row.f_exact << std::setw(15) << row.f_multibody
         << std::setw(13) << row.accuracy << std::setw(10) << row.xi << std::setw(13) << row.duration * 1e3
         << std::setw(11) << std::setprecision(4) << row.restitution << "\n";
+  out << "\nbase angular velocity jump at the impact, deg/s (predicted: single-body impulse; multibody: "
+         "separation - first touch)\n";
+  for (const auto& row : rows)
+    out << std::left << std::setw(20) << row.model << std::right << std::scientific << std::setprecision(4)
+        << std::setw(13) << row.base_jump.angular_rate() * 180.0 / M_PI << std::setw(15)
+        << row.base_jump_multibody.tail<3>().norm() * 180.0 / M_PI << std::defaultfloat << "\n";
   out << "\nclosed: Eq. 24 (F at the maximum deformation); exact: peak of the single-body model Eq. 16;\n"
          "multibody: CVODE integration of robot + target (Figure 2); accuracy: Eq. 32, closed vs "
          "multibody.\n";

@@ -2,9 +2,12 @@
 #include "common.hpp"
 #include "subcommands.hpp"
 
+#include "ffsr/algorithm/base_disturbance.hpp"
+
 #include <iomanip>
 #include <iostream>
 #include <memory>
+#include <optional>
 
 namespace ffsr::cli {
 namespace {
@@ -12,8 +15,39 @@ namespace {
 struct InspectOptions {
   RobotOptions robot;
   TargetOptions target;
+  ContactLawOptions law;
   bool json = false;
 };
+
+/// The impact disturbance of the base at the configuration (single-body impulse), or nothing when the
+/// end-effector moving at the approach speed along u does not approach the target's contact point.
+std::optional<BaseDisturbance> inspect_disturbance(const Robot& r, const InspectOptions& o, Target target) {
+  o.law.set_target_motion(target);
+  if (!std::isfinite(o.law.approach_speed)) throw InputError("--approach-speed: must be finite");
+  const ContactParams params = o.law.params();
+  const Vector3 u = target.normal_world();
+  const double vin = approach_velocity(u, Vector3(o.law.approach_speed * u), target.velocity,
+                                       target.angular_velocity_world(), target.offset_world());
+  if (!(vin > 0)) return std::nullopt;
+  AnyContactLaw law = make_contact_law("hunt-crossley", params, vin);
+  try {
+    law = make_contact_law(o.law.model, params, vin);
+  } catch (const InputError& e) {
+    throw InputError(std::string("--model: ") + e.what());
+  }
+  Data data(r.model);
+  return base_disturbance(r.model, data, r.base, r.theta, r.end_effector, target, law);
+}
+
+nlohmann::json disturbance_json(const std::optional<BaseDisturbance>& d) {
+  if (!d) return nullptr;
+  return {{"impulse", d->impulse},
+          {"restitution_single_body", d->restitution},
+          {"approach_velocity", d->approach_velocity},
+          {"angular_velocity_jump", to_json(Eigen::VectorXd(d->angular))},
+          {"angular_rate_jump_deg_s", d->angular_rate() * 180.0 / M_PI},
+          {"linear_velocity_jump", to_json(Eigen::VectorXd(d->linear))}};
+}
 
 /// What the loader did to the file: merged links, mimic and locked joints, repairs.
 void print_load_report(const UrdfReport& rep) {
@@ -43,6 +77,7 @@ int run_inspect(const InspectOptions& o) {
   frame_jacobian(r.model, data, r.end_effector);
   const Eigen::MatrixXd Jf = generalized_jacobian(r.model, data);
   const Pose ee = frame_pose(r.model, data, r.end_effector);
+  const std::optional<BaseDisturbance> dist = inspect_disturbance(r, o, target);
 
   if (o.json) {
     nlohmann::json j;
@@ -60,6 +95,7 @@ int run_inspect(const InspectOptions& o) {
     j["total_mass"] = r.model.total_mass();
     j["effective_mass"] = m_e;
     j["integrated_effective_mass"] = M_ie;
+    j["base_disturbance"] = disturbance_json(dist);
     j["model_repairs"] = repairs_json(r.report);
     j["model_load"] = report_json(r.report);
     j["version"] = FFSR_VERSION;
@@ -80,6 +116,11 @@ int run_inspect(const InspectOptions& o) {
   std::cout << "direction u      [" << u.transpose().format(Eigen::IOFormat(6, 0, ", ")) << "]\n";
   std::cout << "effective mass   m_e  = " << m_e << " kg   (Eq. 4)\n";
   std::cout << "integrated mass  M_ie = " << M_ie << " kg   (Eq. 14)\n";
+  if (dist)
+    std::cout << "base jump        |dw_0| = " << dist->angular_rate() * 180.0 / M_PI << " deg/s, |dv_0| = "
+              << dist->linear.norm() << " m/s   (impulse " << dist->impulse << " N s, " << o.law.model << ")\n";
+  else
+    std::cout << "base jump        none: the end-effector does not approach the target at --approach-speed\n";
   std::cout << "J_f (generalized Jacobian, 6x" << r.model.n() << ", linear rows first):\n"
             << Jf.format(Eigen::IOFormat(5, 0, "  ", "\n", "  ")) << "\n";
   return 0;
@@ -93,6 +134,7 @@ void register_inspect(CLI::App& app, Action& action) {
       app.add_subcommand("inspect", "Evaluate one configuration: H, J_f, effective mass and M_ie");
   opts->robot.add_to(*sub);
   opts->target.add_to(*sub);
+  opts->law.add_to(*sub, "Hysteresis damping law (Table 1) of the impact's base disturbance");
   sub->add_flag("--json", opts->json, "Print one JSON object on stdout");
   sub->callback([opts, &action] { action = [opts] { return run_inspect(*opts); }; });
 }

@@ -233,6 +233,22 @@ void print_rows(std::ostream& out, const Scenario& sc, const ScenarioResult& r) 
   }
 }
 
+/// The impact disturbance of the base of each run (single-body impulse, algorithm/base_disturbance.hpp).
+void print_base_jump(std::ostream& out, const Scenario& sc, const ScenarioResult& r) {
+  Data data(*sc.model);
+  auto rate = [&](const CaptureResult& run) {
+    return detail::run_base_disturbance(sc, data, run).angular_rate() * 180.0 / M_PI;
+  };
+  const auto flags = out.flags();
+  const auto precision = out.precision();
+  out << std::scientific << std::setprecision(3) << "base angular rate jump at the impact: plain " << rate(r.plain)
+      << " deg/s, optimized " << rate(r.optimized) << " deg/s";
+  if (r.global) out << ", global " << rate(r.global->result.run) << " deg/s";
+  out << "\n";
+  out.flags(flags);
+  out.precision(precision);
+}
+
 void print_table(std::ostream& out, const Scenario& sc, const ScenarioResult& r) {
   const CaptureResult &base_run = r.plain, &opt_run = r.optimized;
   out << "ffsr-optimize " << FFSR_VERSION << ": " << sc.where << " (" << sc.model->n() << " joints, "
@@ -246,8 +262,9 @@ void print_table(std::ostream& out, const Scenario& sc, const ScenarioResult& r)
       << "base drift: plain " << base_run.base_position_drift * 1e3 << " mm / "
       << base_run.base_attitude_drift * 180.0 / M_PI << " deg, optimized "
       << opt_run.base_position_drift * 1e3 << " mm / " << opt_run.base_attitude_drift * 180.0 / M_PI
-      << " deg\n"
-      << "tasks: plain " << (sc.baseline_task.kind == CaptureTask::Kind::Pose ? "pose" : "position")
+      << " deg\n";
+  print_base_jump(out, sc, r);
+  out << "tasks: plain " << (sc.baseline_task.kind == CaptureTask::Kind::Pose ? "pose" : "position")
       << ", optimized " << (sc.task.kind == CaptureTask::Kind::Pose ? "pose" : "position")
       << "; F_max: Eq. 24 closed form; exact: peak of the single-body model (Eq. 16)\n";
   if (base_run.damped_steps + opt_run.damped_steps > 0)

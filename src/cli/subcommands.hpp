@@ -17,6 +17,8 @@ void register_xi(CLI::App& app, Action& action);
 void register_map(CLI::App& app, Action& action);
 /// `robust`: Monte Carlo of F_max over the scenario's [uncertainty] table.
 void register_robust(CLI::App& app, Action& action);
+/// `pareto`: the front of M_ie against the base's angular rate jump at the impact.
+void register_pareto(CLI::App& app, Action& action);
 /// The main job (no subcommand): run a capture scenario; a flag overrides the scenario file's key.
 void register_run(CLI::App& app, Action& action);
 

@@ -72,6 +72,8 @@ struct ScenarioKeys {
   std::set<std::string> overridden;  ///< keys set by an override (paths not resolved against the file)
   std::map<std::string, std::string> extra;     ///< keys of the caller (read_scenario_file), as text
   std::shared_ptr<const toml::table> document;  ///< the file as read (its [uncertainty] table)
+  // the spacecraft's side: the reaction-null-space approach
+  std::string base_attitude = "free";  ///< free or hold (the optimized run keeps w_0 = 0)
 };
 
 /// The kind of a key's value: one parser each, from a TOML node and from text.
@@ -120,6 +122,7 @@ struct Scenario {
   UrdfReport report;                                  ///< what the loader did to the file
   GlobalObjective objective = GlobalObjective::Mass;  ///< the global run's objective
   std::uint64_t seed = 1;                             ///< the global search's seed
+  bool hold_base_attitude = false;  ///< base-attitude = hold: the optimized run's CaptureOptions::hold_base_attitude
 };
 
 /// A URDF given as text for a built-in scenario whose `urdf` key names it (not read from disk).

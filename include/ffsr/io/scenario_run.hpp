@@ -76,3 +76,4 @@ inline double reduction_percent(double before, double after) { return 100.0 * (b
 }  // namespace ffsr
 
 #include "ffsr/io/detail/scenario_run.hxx"
+#include "ffsr/io/detail/base_disturbance_json.hxx"

@@ -36,6 +36,7 @@
 #include "ffsr/algorithm/momentum.hpp"
 #include "ffsr/contact/contact_law.hpp"
 #include "ffsr/model/target.hpp"
+#include "ffsr/optimize/base_attitude.hpp"
 #include "ffsr/optimize/capture_problem.hpp"
 #include "ffsr/optimize/free_floating_step.hpp"
 #include "ffsr/optimize/line_reference.hpp"
@@ -89,6 +90,26 @@ inline void check_capture_input(const CaptureProblem& pb, const CaptureTask& tas
 
 }  // namespace detail
 
+namespace detail {
+
+/// hold_base_attitude: the directions held (Q of base_attitude.hpp, at the initial state) into
+/// s.attitude_basis; InputError when the task and the held rows leave the objective no freedom.
+inline void prepare_base_attitude_hold(const CaptureProblem& pb, const CaptureOptions& opt, CaptureSetup& s,
+                                       const char* where) {
+  const Model& model = *pb.model;
+  Data data(model);
+  s.attitude_basis = base_attitude_directions(model, data, pb.base, pb.theta, pb.frame);
+  const int m = static_cast<int>(s.rows.size()), r = static_cast<int>(s.attitude_basis.cols());
+  const int needed = joints_needed_to_hold(m, r, opt.gain != 0.0);
+  if (needed > model.n())
+    throw InputError(str(where, ": holding the base attitude takes ", m, " task rows + ", r,
+                         r == 1 ? " base-attitude row = " : " base-attitude rows = ", m + r, " of the robot's ", model.n(), " joints",
+                         opt.gain != 0.0 ? ": no freedom left for the objective" : "", " (it needs ",
+                         needed, " joints)"));
+}
+
+}  // namespace detail
+
 /// Checks the problem, task and options (the errors of plan_capture, named after `where`) and builds
 /// the capture setup. Runs crba at the initial state.
 inline CaptureSetup prepare_capture(const CaptureProblem& pb, const CaptureTask& task,
@@ -103,6 +124,7 @@ inline CaptureSetup prepare_capture(const CaptureProblem& pb, const CaptureTask&
                  0,
                  0,
                  make_contact_law("hunt-crossley", ContactParams{}, 1.0),
+                 {},
                  {},
                  {},
                  {}};
@@ -128,6 +150,7 @@ inline CaptureSetup prepare_capture(const CaptureProblem& pb, const CaptureTask&
     for (int r = 0; r < 3; ++r)
       if (task.axes[static_cast<size_t>(r)]) s.rows.push_back(r);
   }
+  if (opt.hold_base_attitude) detail::prepare_base_attitude_hold(pb, opt, s, where);
   return s;
 }
 
@@ -149,6 +172,7 @@ struct CaptureRateField {
   Data data;
   TaskSolver solver;
   Eigen::VectorXd qd_null;
+  Eigen::MatrixXd attitude_rows;  ///< hold_base_attitude: Q^T A (r x n), the held rows
   double min_singular_value = std::numeric_limits<double>::infinity();
   long damped_steps = 0;
   double max_joint_rate = 0;
@@ -162,8 +186,10 @@ struct CaptureRateField {
         setup(setup_),
         policy(policy_),
         data(model),
-        solver(model.n(), setup_.rows, opt_.singular_value_threshold, opt_.max_damping),
-        qd_null(model.n()) {}
+        solver(model.n(), setup_.rows, static_cast<int>(setup_.attitude_basis.cols()),
+               opt_.singular_value_threshold, opt_.max_damping),
+        qd_null(model.n()),
+        attitude_rows(setup_.attitude_basis.cols(), model.n()) {}
 
   void operator()(double t, const BasePose& base, const Eigen::VectorXd& theta, Eigen::VectorXd& theta_dot,
                   Vector6& xb) {
@@ -173,7 +199,10 @@ struct CaptureRateField {
     const Pose ee = frame_pose(model, data, pb.frame);
     const Vector6 cmd =
         task_velocity_command(setup.line, t, ee, opt.feedback, task.kind == CaptureTask::Kind::Pose);
-    const TaskRates& r = solver.solve(data.Jf, cmd, policy.active());
+    if (solver.extra_rows() > 0)
+      attitude_rows.noalias() = setup.attitude_basis.transpose() * base_angular_rows(data);
+    const TaskRates& r = solver.extra_rows() > 0 ? solver.solve(data.Jf, cmd, policy.active(), attitude_rows)
+                                                 : solver.solve(data.Jf, cmd, policy.active());
     min_singular_value = std::min(min_singular_value, r.sigma_min);
     if (r.damped) ++damped_steps;
     if (policy.active()) {

@@ -48,6 +48,8 @@ struct CaptureOptions {
   int record_every = 1;                  ///< keep every k-th step in the series
   std::function<void(double)> progress;  ///< called with the fraction done (0..1), optional
   double max_joint_rate = 0;  ///< rad/s; the null-space term is scaled down to respect it (0: not limited)
+  /// Reaction-null-space approach: hold the base's angular velocity at zero (base_attitude.hpp)
+  bool hold_base_attitude = false;
 };
 
 /// The capture problem: robot, end-effector, initial state, target (its initial state at t = 0),
@@ -111,6 +113,8 @@ struct CaptureSetup {
   LineReference line;
   Matrix3 R_end = Matrix3::Identity();  ///< pose task: the end-effector orientation at T
   std::vector<int> rows;                ///< rows of J_f (and of the 6-D error) that the task constrains
+  /// hold_base_attitude: Q (3 x r), the base angular velocities held at zero (base_attitude.hpp); else empty
+  Eigen::MatrixXd attitude_basis;
 };
 
 }  // namespace ffsr

@@ -80,15 +80,33 @@ class TaskSolver {
   /// n joints; `rows` the rows of J_f (0-2 linear, 3-5 angular) the task constrains;
   /// singular_value_threshold sigma_t (> 0) and max_damping lambda_max of the damped least squares.
   TaskSolver(int n, std::vector<int> rows, double singular_value_threshold, double max_damping)
+      : TaskSolver(n, std::move(rows), 0, singular_value_threshold, max_damping) {}
+
+  /// The same with `extra_rows` (>= 0) further constraint rows held at zero velocity with priority
+  /// over the task (the base-attitude rows of the reaction-null-space approach): call the solve()
+  /// that takes them.
+  TaskSolver(int n, std::vector<int> rows, int extra_rows, double singular_value_threshold,
+             double max_damping)
       : rows_(std::move(rows)),
+        extra_(extra_rows),
         threshold_(singular_value_threshold),
         max_damping_(max_damping),
-        Jt_(static_cast<Eigen::Index>(rows_.size()), n),
-        xdot_(static_cast<Eigen::Index>(rows_.size())),
-        Jpinv_(n, static_cast<Eigen::Index>(rows_.size())),
+        Jt_(static_cast<Eigen::Index>(rows_.size()) + std::max(extra_rows, 0), n),
+        xdot_(static_cast<Eigen::Index>(rows_.size()) + std::max(extra_rows, 0)),
+        Jpinv_(n, static_cast<Eigen::Index>(rows_.size()) + std::max(extra_rows, 0)),
         N_(n, n),
-        svd_(static_cast<Eigen::Index>(rows_.size()), n, Eigen::ComputeFullU | Eigen::ComputeFullV) {
+        svd_(static_cast<Eigen::Index>(rows_.size()) + std::max(extra_rows, 0), n,
+             Eigen::ComputeFullU | Eigen::ComputeFullV) {
     if (n < 1 || rows_.empty()) throw InputError("TaskSolver: needs at least one joint and one task row");
+    if (extra_rows < 0) throw InputError("TaskSolver: the number of extra rows must be >= 0");
+    if (extra_rows > 0) {
+      svd_extra_ =
+          Eigen::JacobiSVD<Eigen::MatrixXd>(extra_rows, n, Eigen::ComputeFullU | Eigen::ComputeFullV);
+      svd_task_ = Eigen::JacobiSVD<Eigen::MatrixXd>(static_cast<Eigen::Index>(rows_.size()), n,
+                                                    Eigen::ComputeFullU | Eigen::ComputeFullV);
+      NA_.resize(n, n);
+      JtN_.resize(static_cast<Eigen::Index>(rows_.size()), n);
+    }
     for (int r : rows_)
       if (r < 0 || r > 5) throw InputError(detail::str("TaskSolver: task row ", r, " is not in 0..5"));
     out_.theta_dot.resize(n);
@@ -97,17 +115,82 @@ class TaskSolver {
 
   int joints() const { return static_cast<int>(N_.rows()); }
   int task_rows() const { return static_cast<int>(rows_.size()); }
+  int extra_rows() const { return extra_; }
 
   /// One evaluation: selects the task rows of `Jf` (6 x n) and of `cmd`, factorizes, writes the
   /// task joint rates J_t^+ cmd_t and the singular-value report into the result; with
   /// `with_projector` also the null-space projector N (projector()). Reads Jf, cmd. No allocation.
   const TaskRates& solve(const Eigen::Ref<const Eigen::MatrixXd>& Jf, const Vector6& cmd,
                          bool with_projector) {
+    if (extra_ > 0) throw InputError("TaskSolver: built with extra rows; pass them to solve()");
+    select_task_rows(Jf, cmd);
+    return factorize(with_projector);
+  }
+
+  /// One evaluation with the extra rows `A` (extra_rows() x n) held at zero velocity with priority
+  /// over the task: with N_A the projector on the null space of A, theta_dot = (J_t N_A)^+ cmd_t (so
+  /// A theta_dot = 0 exactly, also where J_t N_A is damped), N = N_A minus the task directions of
+  /// J_t N_A (the null space of the stack [J_t; A]); sigma_min and the damping are those of J_t N_A.
+  /// task_jacobian() is the stack. Reads Jf, cmd, A. No allocation.
+  const TaskRates& solve(const Eigen::Ref<const Eigen::MatrixXd>& Jf, const Vector6& cmd, bool with_projector,
+                         const Eigen::Ref<const Eigen::MatrixXd>& A) {
+    if (A.rows() != extra_ || A.cols() != Jt_.cols())
+      throw InputError(detail::str("TaskSolver: the extra rows are ", A.rows(), "x", A.cols(), ", expected ",
+                                   extra_, "x", Jt_.cols()));
+    const int m = task_rows();
+    select_task_rows(Jf, cmd);
+    Jt_.bottomRows(extra_) = A;
+    xdot_.tail(extra_).setZero();
+    svd_extra_.compute(A);
+    NA_.setIdentity();
+    for (Eigen::Index i = 0; i < svd_extra_.singularValues().size(); ++i)
+      if (svd_extra_.singularValues()(i) > 1e-12)
+        NA_.noalias() -= svd_extra_.matrixV().col(i) * svd_extra_.matrixV().col(i).transpose();
+    JtN_.noalias() = Jt_.topRows(m) * NA_;
+    svd_task_.compute(JtN_);
+    const auto& sv = svd_task_.singularValues();
+    set_damping(sv(sv.size() - 1));
+    Jpinv_.setZero();
+    for (Eigen::Index i = 0; i < sv.size(); ++i)
+      Jpinv_.leftCols(m).noalias() +=
+          pinv_gain(sv(i)) * svd_task_.matrixV().col(i) * svd_task_.matrixU().col(i).transpose();
+    out_.theta_dot.noalias() = Jpinv_ * xdot_;
+    if (with_projector) {
+      N_ = NA_;
+      for (Eigen::Index i = 0; i < sv.size(); ++i)
+        if (sv(i) > 1e-12)
+          N_.noalias() -= svd_task_.matrixV().col(i) * svd_task_.matrixV().col(i).transpose();
+    }
+    return out_;
+  }
+
+ private:
+  void select_task_rows(const Eigen::Ref<const Eigen::MatrixXd>& Jf, const Vector6& cmd) {
     const int m = task_rows();
     for (int r = 0; r < m; ++r) {
       Jt_.row(r) = Jf.row(rows_[static_cast<size_t>(r)]);
       xdot_(r) = cmd(rows_[static_cast<size_t>(r)]);
     }
+  }
+
+  /// The report and the damping of the last factorization from its smallest singular value.
+  void set_damping(double sigma_min) {
+    out_.sigma_min = sigma_min;
+    out_.lambda2 = 0;
+    out_.damped = false;
+    out_.null_scale = 1;
+    if (out_.sigma_min < threshold_) {
+      const double r = out_.sigma_min / threshold_;
+      out_.lambda2 = (1 - r * r) * max_damping_ * max_damping_;
+      out_.damped = true;
+    }
+  }
+  /// The factor of a singular value in the (damped) pseudo-inverse.
+  double pinv_gain(double sigma) const {
+    return out_.lambda2 > 0 ? sigma / (sigma * sigma + out_.lambda2) : (sigma > 1e-12 ? 1.0 / sigma : 0.0);
+  }
+
+  const TaskRates& factorize(bool with_projector) {
     svd_.compute(Jt_);
     const auto& sv = svd_.singularValues();
     out_.sigma_min = sv(sv.size() - 1);
@@ -136,6 +219,7 @@ class TaskSolver {
     return out_;
   }
 
+ public:
   /// Adds the null-space rates `qd_null` (already projected, N applied) to the task rates of the
   /// last solve(), scaled in place by the largest alpha in [0, 1] with |theta_dot_k + alpha
   /// qd_null_k| <= max_joint_rate for every k (max_joint_rate 0: not limited, alpha = 1). Writes
@@ -153,18 +237,22 @@ class TaskSolver {
   const Eigen::MatrixXd& projector() const { return N_; }
   /// The pseudo-inverse J_t^+ (n x m) of the last solve().
   const Eigen::MatrixXd& pseudo_inverse() const { return Jpinv_; }
-  /// The task rows J_t (m x n) of the last solve().
+  /// The task rows J_t (m x n; with the extra rows below them) of the last solve().
   const Eigen::MatrixXd& task_jacobian() const { return Jt_; }
   /// The result of the last solve() / add_null_space().
   const TaskRates& rates() const { return out_; }
 
  private:
   std::vector<int> rows_;
+  int extra_ = 0;  ///< constraint rows below the task rows (held at zero velocity)
   double threshold_, max_damping_;
   Eigen::MatrixXd Jt_;
   Eigen::VectorXd xdot_;
   Eigen::MatrixXd Jpinv_, N_;
   Eigen::JacobiSVD<Eigen::MatrixXd> svd_;
+  // extra rows (held with priority): their SVD and projector N_A, J_t N_A and its SVD
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd_extra_, svd_task_;
+  Eigen::MatrixXd NA_, JtN_;
   TaskRates out_;
 };
 

@@ -66,6 +66,8 @@ struct MultibodyContactResult {
   double energy_end = 0;                     ///< the same at separation (equal for c_r = 1)
   long steps = 0;                            ///< CVODE internal steps
   std::vector<ContactSample> series;         ///< when requested
+  Vector6 base_velocity_start = Vector6::Zero();  ///< robot base [v_0; w_0] at first touch (inertial)
+  Vector6 base_velocity_end = Vector6::Zero();    ///< the same at separation
 };
 
 namespace detail {
@@ -340,7 +342,7 @@ inline void record_contact_sample(MultibodyContactResult& res, double t, double 
 }
 
 /// Writes the separation into `res`: the time, delta_dot (and restitution against `vin`), the
-/// momentum and energy of the state `y`, the number of CVODE steps.
+/// momentum and energy of the state `y`, the number of CVODE steps, the robot's base velocity.
 inline void record_separation(MultibodyContactResult& res, ContactSystem& sys, const cvode::Integrator& integ,
                               double delta_dot, double vin) {
   res.contact_duration = integ.t();
@@ -349,6 +351,7 @@ inline void record_separation(MultibodyContactResult& res, ContactSystem& sys, c
   res.momentum_end = sys.total_momentum(integ.y());
   res.energy_end = sys.total_energy(integ.y());
   res.steps = integ.num_steps();
+  res.base_velocity_end = integ.y().segment<6>(sys.iv());
 }
 
 }  // namespace detail
@@ -401,6 +404,7 @@ inline MultibodyContactResult simulate_contact(const Model& model, const BasePos
                           {-1, -1});
   res.momentum_start = sys.total_momentum(y0);
   res.energy_start = sys.total_energy(y0);
+  res.base_velocity_start = y0.segment<6>(sys.iv());
   auto record = [&](double t, const Eigen::VectorXd& y) {
     const auto k = sys.kinematics(y);
     detail::record_contact_sample(res, t, sys.force(law, k), k.delta, options.record_series);

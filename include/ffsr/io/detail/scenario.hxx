@@ -242,6 +242,11 @@ inline std::vector<ScenarioKey> build_scenario_keys() {
                "Global run: largest joint rate, deg/s (> 0; default: not limited; the paper's method is not "
                "limited)"),
       FFSR_KEY("global-starts", global_starts, "Global search: random starts (>= 1)", "32"),
+      // the spacecraft's side: the reaction-null-space approach
+      FFSR_KEY("base-attitude", base_attitude,
+               "Optimized run: free, or hold (the base's angular velocity stays zero; the objective uses "
+               "the freedom left)",
+               "free"),
   };
 }
 
@@ -599,6 +604,27 @@ inline CaptureOptions capture_of(const ScenarioKeys& k) {
   return opt;
 }
 
+/// base-attitude: free (false) or hold (true); InputError naming the key for another mode or when the
+/// optimized run's task and the held base-attitude rows leave the objective no joint (base_attitude.hpp).
+inline bool base_attitude_of(const ScenarioKeys& k, const Model& model, const CaptureProblem& pb,
+                             const CaptureTask& task, double gain) {
+  if (k.base_attitude == "free") return false;
+  if (k.base_attitude != "hold")
+    throw InputError(str("--base-attitude: unknown mode '", k.base_attitude, "'; expected 'free' or 'hold'"));
+  Data data(model);
+  const int r = static_cast<int>(base_attitude_directions(model, data, pb.base, pb.theta, pb.frame).cols());
+  const int needed = joints_needed_to_hold(task.rows(), r, gain != 0.0);
+  if (needed > model.n())
+    throw InputError(
+        str("--base-attitude: hold takes ", task.rows(), " task rows + ", r,
+            r == 1 ? " base-attitude row = " : " base-attitude rows = ", task.rows() + r, " of the robot's ",
+            model.n(), " joints: ",
+            gain != 0.0 ? "no freedom left for the objective (it needs " : "too few joints (it needs ",
+            needed, " joints",
+            gain != 0.0 && task.rows() + r <= model.n() ? "; gain = 0 tracks without optimizing)" : ")"));
+  return true;
+}
+
 inline GlobalObjective global_objective_of(const std::string& name) {
   return name == "exact-force"       ? GlobalObjective::ExactForce
          : name == "multibody-force" ? GlobalObjective::MultibodyForce
@@ -637,6 +663,7 @@ inline Scenario build_scenario(ScenarioKeys k, const EmbeddedUrdf* embedded) {
     throw InputError(str("--gain: the ", k.task, " task has ", sc.task.rows(), " rows and the robot ",
                          model.n(),
                          " joints: no null space to optimize in (set gain = 0 or constrain fewer axes)"));
+  sc.hold_base_attitude = base_attitude_of(k, model, pb, sc.task, sc.capture.gain);
   sc.keys = std::move(k);
   return sc;
 }

@@ -9,6 +9,7 @@ inline std::pair<CaptureResult, CaptureResult> plan_plain_and_optimized(const Sc
   opt.record_series = opt.record_series || options.record_series;
   CaptureOptions plain = opt;
   plain.gain = 0.0;
+  opt.hold_base_attitude = sc.hold_base_attitude;  // the optimized run only
   plain.progress = options.plain_progress;
   opt.progress = options.optimized_progress;
   auto labelled = [](const char* label, auto&& f) {
@@ -216,6 +217,7 @@ inline nlohmann::json resolved_json(const Scenario& sc) {
   j["seed"] = o.seed;
   j["max-joint-rate-deg"] = o.max_joint_rate_deg;
   j["global-starts"] = o.global_starts;
+  j["base-attitude"] = o.base_attitude;
   return j;
 }
 
@@ -255,6 +257,11 @@ inline void add_global_json(nlohmann::json& j, const Scenario& sc, const GlobalR
 
 }  // namespace detail
 
+namespace detail {
+/// Defined in base_disturbance_json.hxx (the impact disturbance of each run).
+inline void add_base_disturbance_json(nlohmann::json& j, const Scenario& sc, const ScenarioResult& r);
+}  // namespace detail
+
 inline nlohmann::json scenario_json(const Scenario& sc, const ScenarioResult& r, const std::string& version) {
   nlohmann::json j;
   j["version"] = version;
@@ -268,6 +275,7 @@ inline nlohmann::json scenario_json(const Scenario& sc, const ScenarioResult& r,
   j["force_reduction_percent"] = reduction_percent(r.plain.f_max_closed_form, r.optimized.f_max_closed_form);
   j["exact_force_reduction_percent"] = reduction_percent(r.plain.f_max_exact, r.optimized.f_max_exact);
   if (r.global) detail::add_global_json(j, sc, *r.global, r.plain);
+  detail::add_base_disturbance_json(j, sc, r);
   if (r.robust) {
     nlohmann::json rj = {
         {"measure", "CVaR_95 (mean of the largest 5 %) and p95 (nearest rank) of the exact F_max, N"},

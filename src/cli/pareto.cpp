@@ -1,0 +1,140 @@
+// ffsr-optimize pareto: the front of (M_ie, base angular rate jump at the impact) on the capture
+// manifold at the global run's base pose (ffsr/optimize/pareto.hpp), for a scenario as the main job.
+#include "common.hpp"
+#include "scenario.hpp"
+#include "subcommands.hpp"
+
+#include "ffsr/optimize/pareto.hpp"
+
+#include <iomanip>
+#include <iostream>
+#include <memory>
+#include <sstream>
+
+namespace ffsr::cli {
+namespace {
+
+struct ParetoCliOptions {
+  ScenarioFlags flags;
+  std::string config, json, csv;
+  int levels = 30, starts = 16;
+  bool quiet = false;
+};
+
+constexpr double kDeg = 180.0 / M_PI;
+
+nlohmann::json point_json(const ParetoPoint& p) {
+  return {{"integrated_effective_mass", p.M_ie},
+          {"base_angular_rate_jump_deg_s", p.base_rate * kDeg},
+          {"capture_configuration_deg", to_json(Eigen::VectorXd(p.theta * kDeg))}};
+}
+
+nlohmann::json front_json(const Scenario& sc, const ParetoFront& f, const std::vector<ParetoPoint>& runs,
+                          const BasePose& base) {
+  nlohmann::json pts = nlohmann::json::array();
+  for (const ParetoPoint& p : f.points) pts.push_back(point_json(p));
+  const Eigen::Vector4d q = base.orientation.coeffs();
+  const char* names[] = {"baseline", "optimized", "global"};
+  nlohmann::json rj;
+  for (size_t i = 0; i < runs.size(); ++i) rj[names[i]] = point_json(runs[i]);
+  return {{"version", FFSR_VERSION},
+          {"scenario", sc.where},
+          {"base_position", to_json(Eigen::VectorXd(base.position))},
+          {"base_quaternion_wxyz", {q(3), q(0), q(1), q(2)}},
+          {"front", pts},
+          {"min_mass_end", point_json(f.min_mass)},
+          {"min_rate_end", point_json(f.min_rate)},
+          {"knee", point_json(f.points[f.knee])},
+          {"knee_index", f.knee},
+          {"hypervolume_kg_deg_s", f.hypervolume * kDeg},
+          {"hypervolume_normalized", f.hypervolume_normalized},
+          {"runs", rj},
+          {"evaluations", f.evaluations},
+          {"seconds", f.seconds}};
+}
+
+std::string front_csv(const ParetoFront& f) {
+  std::ostringstream out;
+  out << std::setprecision(12) << "index,M_ie_kg,base_rate_deg_s,knee";
+  for (Eigen::Index k = 0; k < f.points.front().theta.size(); ++k) out << ",theta" << k + 1 << "_deg";
+  out << "\n";
+  for (size_t i = 0; i < f.points.size(); ++i) {
+    const ParetoPoint& p = f.points[i];
+    out << i << "," << p.M_ie << "," << p.base_rate * kDeg << "," << (i == f.knee ? 1 : 0);
+    for (Eigen::Index k = 0; k < p.theta.size(); ++k) out << "," << p.theta(k) * kDeg;
+    out << "\n";
+  }
+  return out.str();
+}
+
+void print_front(std::ostream& out, const Scenario& sc, const ParetoFront& f,
+                 const std::vector<ParetoPoint>& runs) {
+  auto row = [&](const char* label, const ParetoPoint& p) {
+    out << std::left << std::setw(26) << label << std::right << std::fixed << std::setprecision(4)
+        << std::setw(11) << p.M_ie << std::scientific << std::setprecision(4) << std::setw(16)
+        << p.base_rate * kDeg << std::defaultfloat << "\n";
+  };
+  out << "ffsr-optimize pareto: " << sc.where << ": " << f.points.size()
+      << " non-dominated capture configurations at the global run's base pose\n\n"
+      << std::left << std::setw(26) << "" << std::right << std::setw(11) << "M_ie (kg)" << std::setw(16)
+      << "|dw_0| (deg/s)"
+      << "\n";
+  row("least M_ie (end)", f.min_mass);
+  row("knee", f.points[f.knee]);
+  row("least base rate (end)", f.min_rate);
+  const char* names[] = {"plain run", "paper's method", "global run"};
+  for (size_t i = 0; i < runs.size(); ++i) row(names[i], runs[i]);
+  out << "\nhypervolume " << f.hypervolume * kDeg << " kg deg/s up to the nadir of the ends (normalized "
+      << f.hypervolume_normalized << "); " << f.evaluations << " evaluations, " << f.seconds << " s\n"
+      << "|dw_0|: jump of the base's angular velocity from the contact impulse (single-body model)\n";
+}
+
+int run_pareto(const ParetoCliOptions& o) {
+  Outputs outputs;
+  outputs.add("--json", o.json);
+  outputs.add("--csv", o.csv);
+  if (o.levels < 1) throw InputError(detail::str("--levels: must be >= 1, got ", o.levels));
+  if (o.starts < 1) throw InputError(detail::str("--starts: must be >= 1, got ", o.starts));
+  Scenario sc = command_scenario(command_scenario_keys(o.config, o.flags));
+  if (!sc.keys.global) throw InputError("--global: pareto needs the global run's base pose (global = true)");
+  ScenarioRunOptions ro;
+  const ScenarioResult r = run_scenario(sc, ro);
+  const CaptureResult& g = r.global->result.run;
+  const CaptureSetup setup = prepare_capture(sc.problem, sc.task, sc.capture);
+  ParetoOptions po;
+  po.levels = o.levels;
+  po.starts = o.starts;
+  po.seed = sc.seed;
+  const ParetoFront f = pareto_front(sc.problem, sc.task, setup, g.base, po, {r.optimized.theta, g.theta});
+  Data data(*sc.model);
+  const double e = single_body_restitution(setup.law);
+  std::vector<ParetoPoint> runs;
+  for (const CaptureResult* x : {&r.plain, &r.optimized, &g})
+    runs.push_back(detail::pareto_point(*sc.model, data, sc.problem, setup, x->base, x->theta, e));
+  outputs.set("--json", front_json(sc, f, runs, g.base).dump(2) + "\n");
+  outputs.set("--csv", front_csv(f));
+  outputs.write();
+  print_front(outputs.table(), sc, f, runs);
+  return 0;
+}
+
+}  // namespace
+
+void register_pareto(CLI::App& app, Action& action) {
+  auto o = std::make_shared<ParetoCliOptions>();
+  CLI::App* sub = app.add_subcommand(
+      "pareto", "Front of M_ie against the base's angular rate jump at the impact, on the capture manifold");
+  sub->add_option("--config", o->config, "Scenario file (TOML); default: the built-in paper 3-DOF scenario")
+      ->check(CLI::ExistingFile);
+  o->flags.add_to(*sub);
+  sub->add_option("--levels", o->levels, "Epsilon levels of the sweep between the two ends")
+      ->capture_default_str();
+  sub->add_option("--starts", o->starts, "Random starts of the two single-objective searches")
+      ->capture_default_str();
+  sub->add_option("--json", o->json,
+                  "Write the front (configurations, ends, knee, hypervolume) to this JSON file");
+  sub->add_option("--csv", o->csv, "Write the front, one configuration per row, to this CSV file");
+  sub->callback([o, &action] { action = [o] { return run_pareto(*o); }; });
+}
+
+}  // namespace ffsr::cli
