@@ -13,6 +13,7 @@
 #include "ffsr/optimize/branches.hpp"
 
 #include <cstdio>
+#include <nlohmann/json.hpp>
 #include <filesystem>
 #include <random>
 
@@ -180,7 +181,7 @@ TEST_CASE("Manifold search, paper 7-DOF pose task: every optimum in the final or
   const ManifoldSearchResult res =
       search_capture_manifold(in.sc.problem, in.sc.task, in.setup, in.base, so, {in.plain_theta});
   const std::vector<CaptureBranch> br =
-      capture_branches(in.sc.problem, in.sc.task, in.opt, in.setup, res, in.base, false);
+      capture_branches(in.sc.problem, in.sc.task, in.opt, in.setup, res, in.base, 0);
   REQUIRE(!br.empty());
   for (const CaptureBranch& b : br) {
     std::printf("paper 7-DOF pose branch: M_ie %.4f kg, orientation error %.2e deg\n", b.M_ie,
@@ -200,13 +201,14 @@ TEST_CASE("UR5 pose task: the branches equal an independent enumeration of the I
   so.starts = in.sc.keys.global_starts;
   const ManifoldSearchResult res =
       search_capture_manifold(in.sc.problem, in.sc.task, in.setup, in.base, so, {in.plain_theta});
-  const std::vector<CaptureBranch> br = capture_branches(in.sc.problem, in.sc.task, in.opt, in.setup, res, in.base);
+  const std::vector<CaptureBranch> br =
+      capture_branches(in.sc.problem, in.sc.task, in.opt, in.setup, res, in.base, 8);
   REQUIRE(!br.empty());
   for (size_t i = 0; i < br.size(); ++i) {
     std::printf("UR5 pose branch %zu: M_ie %.4f kg, [", i, br[i].M_ie);
     for (Eigen::Index k = 0; k < br[i].theta.size(); ++k) std::printf(" %.2f", br[i].theta(k) * 180 / M_PI);
     std::printf(" ] deg, orientation error %.1e deg, reachable %d\n", br[i].orientation_error * 180 / M_PI,
-                int(br[i].reachable_without_reconfiguration));
+                int(br[i].reachable_without_reconfiguration.value_or(false)));
     CHECK(br[i].orientation_error < 1e-9);
     CHECK(br[i].position_error < 1e-9);
     if (i > 0) CHECK(br[i - 1].objective <= br[i].objective);  // sorted
@@ -214,8 +216,9 @@ TEST_CASE("UR5 pose task: the branches equal an independent enumeration of the I
   // without a null space the approach ends on one branch: the task-only run's
   int reachable = 0;
   for (const CaptureBranch& b : br) {
-    reachable += b.reachable_without_reconfiguration;
-    if (b.reachable_without_reconfiguration) CHECK(wrapped_distance(b.theta, in.plain_theta) < 1e-3);
+    REQUIRE(b.reachable_without_reconfiguration.has_value());
+    reachable += *b.reachable_without_reconfiguration;
+    if (*b.reachable_without_reconfiguration) CHECK(wrapped_distance(b.theta, in.plain_theta) < 1e-3);
   }
   CHECK(reachable == 1);
 
@@ -254,6 +257,28 @@ TEST_CASE("UR5 pose task: the branches equal an independent enumeration of the I
   }
   std::printf("UR5 pose: %zu branches, %d of 500 random starts converged, %zu distinct\n", br.size(), converged,
               mine.size());
+}
+
+TEST_CASE("UR5 pose task: the main job's JSON lists the branches", "[branches]") {
+  if (!have_ur5()) return;
+  const Scenario sc = load_scenario(kData + "ur5_pose.toml");
+  const ScenarioResult r = run_scenario(sc, {});
+  const nlohmann::json j = scenario_json(sc, r, "test");
+  const nlohmann::json& br = j["global"]["branches"];
+  REQUIRE(br.size() == 8);  // the UR5's inverse-kinematics solutions at this capture point
+  int reachable = 0;
+  for (size_t i = 0; i < br.size(); ++i) {
+    CHECK(br[i]["configuration_deg"].size() == 6);
+    CHECK(br[i]["orientation_error_deg"].get<double>() < 1e-6);
+    if (i > 0) CHECK(br[i - 1]["objective_value"].get<double>() <= br[i]["objective_value"].get<double>());
+    if (br[i]["reachable_without_reconfiguration"].is_boolean() && br[i]["reachable_without_reconfiguration"].get<bool>()) {
+      ++reachable;
+      // the global run (no null space: the task-only run) ends on the reachable branch
+      CHECK(br[i]["integrated_effective_mass"].get<double>() ==
+            Approx(j["global"]["integrated_effective_mass"].get<double>()).epsilon(1e-6));
+    }
+  }
+  CHECK(reachable == 1);
 }
 
 }  // namespace test_branches

@@ -9,11 +9,14 @@
 // of the branch and stays within the joint limits. This is the test plan_capture_global's first
 // shooting iteration applies to a goal: a run that ends on another component of the self-motion
 // manifold (or, without a null space, on another inverse-kinematics solution) ends far from it.
-// Cost: one integrate_capture per branch.
+// Cost: one integrate_capture per branch tested (the best `max_tested` branches; the rest are
+// reported as not tested), on `threads` threads.
 #pragma once
 
+#include "ffsr/detail/parallel.hpp"
 #include "ffsr/optimize/global.hpp"
 
+#include <optional>
 #include <vector>
 
 namespace ffsr {
@@ -25,7 +28,8 @@ struct CaptureBranch {
   double objective = 0;              ///< as ManifoldPoint::objective
   double orientation_error = 0;      ///< angle between the end-effector's and the wanted orientation, rad
   double position_error = 0;         ///< distance from the capture point over the task's axes, m
-  bool reachable_without_reconfiguration = false;
+  /// empty: not tested (beyond the best max_tested of capture_branches)
+  std::optional<bool> reachable_without_reconfiguration;
 };
 
 /// Does the reaching run (see the top of this file) from pb.theta end on `goal`? Runs
@@ -48,13 +52,13 @@ inline bool reaches_without_reconfiguration(const CaptureProblem& pb, const Capt
 }
 
 /// The local optima of `search` (made at base pose `base`, sorted by objective) as branches, in the
-/// same order: the orientation and position errors at `base`, and (when `reachability`) whether the
-/// approach reaches each from the initial configuration (reaches_without_reconfiguration; one run
-/// each). Reads the model; runs crba per branch.
+/// same order: the orientation and position errors at `base`, and for the best `max_tested`
+/// whether the approach reaches each from the initial configuration (reaches_without_reconfiguration;
+/// one run each, on `threads` threads). Reads the model; runs crba per branch.
 inline std::vector<CaptureBranch> capture_branches(const CaptureProblem& pb, const CaptureTask& task,
                                                    const CaptureOptions& opt, const CaptureSetup& setup,
                                                    const ManifoldSearchResult& search, const BasePose& base,
-                                                   bool reachability = true) {
+                                                   int max_tested = 6, unsigned threads = 1) {
   const Model& model = *pb.model;
   Data data(model);
   std::vector<CaptureBranch> out;
@@ -71,9 +75,14 @@ inline std::vector<CaptureBranch> capture_branches(const CaptureProblem& pb, con
     for (int r : setup.rows)
       if (r < 3) e2 += (ee.p(r) - setup.x_cap(r)) * (ee.p(r) - setup.x_cap(r));
     b.position_error = std::sqrt(e2);
-    if (reachability) b.reachable_without_reconfiguration = reaches_without_reconfiguration(pb, task, opt, setup, p.theta);
     out.push_back(std::move(b));
   }
+  const size_t tested = std::min(out.size(), static_cast<size_t>(std::max(max_tested, 0)));
+  std::vector<char> reached(tested, 0);
+  detail::parallel_for(tested, threads, [&](std::uint64_t i) {
+    reached[i] = reaches_without_reconfiguration(pb, task, opt, setup, out[i].theta);
+  });
+  for (size_t i = 0; i < tested; ++i) out[i].reachable_without_reconfiguration = reached[i] != 0;
   return out;
 }
 

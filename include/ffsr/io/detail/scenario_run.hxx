@@ -72,7 +72,8 @@ inline GlobalRun run_global(const Scenario& sc, const CaptureResult& paper_run, 
   r.paper_objective =
       evaluate_capture(sc.problem, setup, paper_run.base, paper_run.theta, objective, {}, robust.get())
           .objective;
-  r.branches = capture_branches(sc.problem, sc.task, opt, setup, r.result.search, r.result.run.base);
+  r.branches = capture_branches(sc.problem, sc.task, opt, setup, r.result.search, r.result.run.base, 6,
+                                std::max(1u, std::thread::hardware_concurrency()));
   return r;
 }
 
@@ -231,7 +232,9 @@ inline nlohmann::json branches_json(const std::vector<CaptureBranch>& branches) 
                  {"objective_value", b.objective},
                  {"orientation_error_deg", b.orientation_error * 180.0 / M_PI},
                  {"position_error", b.position_error},
-                 {"reachable_without_reconfiguration", b.reachable_without_reconfiguration}});
+                 {"reachable_without_reconfiguration",
+                  b.reachable_without_reconfiguration ? nlohmann::json(*b.reachable_without_reconfiguration)
+                                                      : nlohmann::json(nullptr)}});
   }
   return a;
 }
