@@ -5,6 +5,7 @@
 #pragma once
 
 #include "ffsr/io/scenario.hpp"
+#include "ffsr/optimize/branches.hpp"
 #include "ffsr/uncertainty/robust_objective.hpp"
 
 #include <functional>
@@ -21,6 +22,8 @@ namespace ffsr {
 struct GlobalRun {
   GlobalCaptureResult result;
   double paper_objective = 0;  ///< the objective at the paper's-method run's capture configuration
+  /// the distinct local optima of the last search (at the reached base pose), sorted by objective
+  std::vector<CaptureBranch> branches;
 };
 
 /// The tail measure of one row over the robust-force objective's sample set, N.

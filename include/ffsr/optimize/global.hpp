@@ -7,16 +7,23 @@
 // 1. Capture manifold. With the base at a given pose B (the pose at T), the configurations that put
 //    the end-effector on the capture point (and, for a pose task, in the final orientation) are
 //      C(B) = { theta : c(theta) = 0, theta within the URDF's joint limits },
-//    c the task rows of [p_e(theta) - x_cap ; vee(skew(R_end R_e(theta)^T))]. The base is fixed
-//    there, so the constraint Jacobian is the task rows of J_m (the joint columns of J_bm, Eq. 2);
-//    for the orientation rows d vee(skew(R))/d omega = -1/2 (tr(R) E - R^T), R = R_end R_e^T (= -E at
-//    the solution).
-// 2. Search (search_capture_manifold). Multistart: `starts` configurations drawn uniformly within
-//    the limits ([-pi, pi] for a continuous joint) by std::mt19937_64 with our own mapping to
-//    [0, 1) (so a seed gives the same draws on every platform), each put on C(B) by damped Newton on
-//    c, then NLopt's SLSQP minimizes M_ie with its analytic gradient (effective_mass.hpp) under the
-//    equality constraints c = 0. The distinct local optima are kept, sorted. The global stage is the
-//    multistart itself (many SLSQP runs from spread-out points, the best kept); for the
+//    c the task rows of [p_e(theta) - x_cap ; log(R_end R_e(theta)^T)], log the rotation vector
+//    (angle in [0, pi] times the axis): zero only at the wanted orientation, of norm pi for a gripper
+//    turned half a turn. The base is fixed there, so the constraint Jacobian is the task rows of J_m
+//    (the joint columns of J_bm, Eq. 2); for the orientation rows d log(R)/d omega = -J_r^-1(log R),
+//    the inverse right Jacobian of SO(3) (detail::rotation_log_rate, manifold_sampling.hxx).
+// 2. Search (search_capture_manifold; docs/branches.md). Multistart: `starts` configurations drawn
+//    uniformly within the limits ([-pi, pi] for a continuous joint) by std::mt19937_64 with our own
+//    mapping to [0, 1) (so a seed gives the same draws on every platform), each put on C(B) by
+//    damped Newton on c, then NLopt's SLSQP minimizes M_ie with its analytic gradient
+//    (effective_mass.hpp) under the equality constraints c = 0. Then the branch stage:
+//    `branch_starts` Halton points over the joint box, each projected onto C(B); with a null space
+//    (more joints than task rows) a multi-level single-linkage rule picks which of them start SLSQP
+//    (the lowest M_ie within `branch_radius`), at most `branch_local_searches`; without one (a
+//    6-joint arm with a pose task: C(B) is a set of points, the inverse-kinematics solutions) every
+//    projection is polished to |c| <= 1e-12 and the distinct ones are the branches. Revolute joints
+//    with limits are moved by whole turns to the value nearest the initial configuration (one
+//    configuration per posture). The distinct local optima are kept, sorted. For the
 //    multibody-force objective, which has no gradient, the distinct local optima of M_ie are ranked
 //    by the CVODE multibody peak (simulate/multibody.hpp), evaluated directly at each of them.
 //    exact-force is a monotone function of M_ie (Eq. 16 scaling), so its optimum is M_ie's.
@@ -33,6 +40,7 @@
 #pragma once
 
 #include "ffsr/optimize/capture.hpp"
+#include "ffsr/optimize/detail/manifold_sampling.hxx"
 #include "ffsr/simulate/multibody.hpp"
 #include "ffsr/uncertainty/robust_objective.hpp"
 
@@ -74,6 +82,12 @@ struct ManifoldSearchOptions {
   /// robust-force: CVaR_95 of the exact F_max over this fixed sample set (robust_objective.hpp),
   /// minimized by SLSQP with its gradient. Shared by copies of the options; not thread-safe.
   std::shared_ptr<RobustForceObjective> robust;
+  /// Branch stage of a full search (docs/branches.md): Halton starts projected onto the manifold
+  /// (0: none); with a null space, SLSQP runs from those with the lowest M_ie within branch_radius
+  /// (rad, Euclidean over the joints), at most branch_local_searches of them.
+  int branch_starts = 256;
+  double branch_radius = 0.5;
+  int branch_local_searches = 24;
 };
 
 /// A configuration on the capture manifold with its M_ie and objective value.
@@ -105,9 +119,7 @@ inline void capture_residual(const Model& model, Data& data, const CaptureProble
   const Pose ee = frame_pose(model, data, pb.frame);
   Vector6 e;
   e.head<3>() = ee.p - s.x_cap;
-  const Matrix3 R = s.R_end * ee.R.transpose();
-  const Matrix3 A = 0.5 * (R - R.transpose());
-  e.tail<3>() = Vector3(A(2, 1), A(0, 2), A(1, 0));
+  e.tail<3>() = detail::rotation_log(s.R_end * ee.R.transpose());
   const int m = task.rows();
   r.resize(m);
   for (int i = 0; i < m; ++i) r(i) = e(s.rows[static_cast<size_t>(i)]);
@@ -115,8 +127,7 @@ inline void capture_residual(const Model& model, Data& data, const CaptureProble
   frame_jacobian(model, data, pb.frame);
   Eigen::MatrixXd Jm(6, n);
   Jm.topRows<3>() = data.J.topRightCorner(3, n);
-  Jm.bottomRows<3>() =
-      -0.5 * (R.trace() * Matrix3::Identity() - R.transpose()) * data.J.bottomRightCorner(3, n);
+  Jm.bottomRows<3>() = detail::rotation_log_rate(e.tail<3>()) * data.J.bottomRightCorner(3, n);
   J->resize(m, n);
   for (int i = 0; i < m; ++i) J->row(i) = Jm.row(s.rows[static_cast<size_t>(i)]);
 }
@@ -279,6 +290,9 @@ inline ManifoldSearchResult search_capture_manifold(const CaptureProblem& pb, co
   if (so.max_local_evaluations < 1)
     throw InputError("search_capture_manifold: max_local_evaluations must be >= 1");
   if (so.max_ranked < 1) throw InputError("search_capture_manifold: max_ranked must be >= 1");
+  if (so.branch_starts < 0 || so.branch_local_searches < 0 || !(so.branch_radius > 0))
+    throw InputError("search_capture_manifold: branch_starts and branch_local_searches must be >= 0, "
+                     "branch_radius positive");
   return detail::search_manifold(pb, task, s, base, so, extra_starts, so.starts);
 }
 
@@ -337,7 +351,7 @@ inline bool local_capture_optimum(const Model& model, Data& data, const CaptureP
   if (q.size() != n || !q.allFinite())
     throw InputError("search_capture_manifold: an extra start has the wrong size or is not finite");
   if (!detail::project_to_manifold(model, data, pb, task, s, base, q, so.constraint_tolerance)) return false;
-  if (!detail::within_limits(model, q)) return false;
+  if (!detail::nearest_representative(model, pb.theta, q) || !detail::within_limits(model, q)) return false;
   ++res.projected_starts;
   std::vector<double> x(q.data(), q.data() + n);
   double f = 0;
@@ -350,7 +364,7 @@ inline bool local_capture_optimum(const Model& model, Data& data, const CaptureP
   Eigen::VectorXd th = Eigen::Map<const Eigen::VectorXd>(x.data(), n);
   if (!detail::project_to_manifold(model, data, pb, task, s, base, th, so.constraint_tolerance, 20))
     return false;
-  if (!detail::within_limits(model, th)) return false;
+  if (!detail::nearest_representative(model, pb.theta, th) || !detail::within_limits(model, th)) return false;
   crba(model, data, base, th);
   const double M = 1.0 / (inverse_effective_mass(model, data, pb.frame, s.u_cap) + s.target_inv_mass);
   if (!std::isfinite(M)) return false;
@@ -371,6 +385,93 @@ inline void keep_distinct(const Model& model, std::vector<ManifoldPoint>& found,
       if (p.objective < f.objective) f = p;
     }
   if (!duplicate) found.push_back(p);
+}
+
+/// The value the optima are compared by at a configuration on C(base): M_ie, or CVaR_95 for
+/// robust-force. Writes M. Runs crba.
+inline double manifold_value(const Model& model, Data& data, const CaptureProblem& pb, const CaptureSetup& s,
+                             const BasePose& base, const ManifoldSearchOptions& so, const Eigen::VectorXd& th,
+                             double& M) {
+  crba(model, data, base, th);
+  M = 1.0 / (inverse_effective_mass(model, data, pb.frame, s.u_cap) + s.target_inv_mass);
+  return so.objective == GlobalObjective::RobustForce
+             ? so.robust->value(robot_inverse_inertia(model, data, base, th, pb.frame)).cvar95
+             : M;
+}
+
+/// Without a null space (as many task rows as joints) C(base) is a set of points, the
+/// inverse-kinematics solutions: every start is projected (damped Newton to |c| <= 1e-12, or the
+/// search's tolerance when roundoff stops it first), moved to the representative of its posture,
+/// and kept when within the limits and more than 1e-6 rad (posture_distance) from every solution
+/// kept. No SLSQP: each solution is its own local optimum. Appends to `found`; counts into res.
+inline void enumerate_solutions(const Model& model, Data& data, const CaptureProblem& pb, const CaptureTask& task,
+                                const CaptureSetup& s, const BasePose& base, const ManifoldSearchOptions& so,
+                                const std::vector<Eigen::VectorXd>& starts, ManifoldSearchResult& res,
+                                std::vector<ManifoldPoint>& found) {
+  Eigen::VectorXd r;
+  for (Eigen::VectorXd q : starts) {
+    if (q.size() != model.n() || !q.allFinite())
+      throw InputError("search_capture_manifold: an extra start has the wrong size or is not finite");
+    if (!project_to_manifold(model, data, pb, task, s, base, q, 1e-12)) {
+      capture_residual(model, data, pb, task, s, base, q, r, nullptr);
+      if (!(r.norm() <= so.constraint_tolerance)) continue;
+    }
+    if (!nearest_representative(model, pb.theta, q) || !within_limits(model, q)) continue;
+    ++res.projected_starts;
+    bool known = false;
+    for (const ManifoldPoint& f : found) known = known || posture_distance(model, f.theta, q) < 1e-6;
+    if (known) continue;
+    double M = 0;
+    const double v = manifold_value(model, data, pb, s, base, so, q, M);
+    if (std::isfinite(M)) found.push_back({q, M, v});
+  }
+}
+
+/// Squared Euclidean distance between two postures (revolute joints modulo 2 pi); no allocation.
+inline double posture_distance2(const Model& model, const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
+  double d = 0;
+  for (int k = 0; k < model.n(); ++k) {
+    double e = a(k) - b(k);
+    if (model.joint(k).type == JointType::Revolute) e = std::remainder(e, 2 * M_PI);
+    d += e * e;
+  }
+  return d;
+}
+
+/// The branch stage with a null space: so.branch_starts Halton points projected onto C(base) and
+/// sorted by M_ie; multi-level single linkage (Rinnooy Kan and Timmer 1987) starts SLSQP
+/// (local_capture_optimum) from a sample only when no sample of lower M_ie and no local optimum
+/// found so far lies within so.branch_radius, at most so.branch_local_searches times. Appends the
+/// distinct optima to `found`; counts into res.
+inline void branch_stage(const Model& model, Data& data, const CaptureProblem& pb, const CaptureTask& task,
+                         const CaptureSetup& s, const BasePose& base, const ManifoldSearchOptions& so,
+                         nlopt::opt& local, ManifoldSearchResult& res, std::vector<ManifoldPoint>& found) {
+  std::vector<ManifoldPoint> samples;
+  for (Eigen::VectorXd q : halton_starts(model, so.branch_starts)) {
+    if (!project_to_manifold(model, data, pb, task, s, base, q, so.constraint_tolerance)) continue;
+    if (!nearest_representative(model, pb.theta, q) || !within_limits(model, q)) continue;
+    double M = 0;
+    crba(model, data, base, q);
+    M = 1.0 / (inverse_effective_mass(model, data, pb.frame, s.u_cap) + s.target_inv_mass);
+    if (std::isfinite(M)) samples.push_back({q, M, M});
+  }
+  std::stable_sort(samples.begin(), samples.end(),
+                   [](const ManifoldPoint& a, const ManifoldPoint& b) { return a.M_ie < b.M_ie; });
+  const double r2 = so.branch_radius * so.branch_radius;
+  auto near = [&](const ManifoldPoint& a, const ManifoldPoint& b) {
+    return posture_distance2(model, a.theta, b.theta) < r2;
+  };
+  int runs = 0;
+  ManifoldPoint p;
+  for (size_t i = 0; i < samples.size() && runs < so.branch_local_searches; ++i) {
+    bool linked = false;
+    for (size_t j = 0; j < i && !linked; ++j) linked = near(samples[j], samples[i]);
+    for (size_t j = 0; j < found.size() && !linked; ++j) linked = near(found[j], samples[i]);
+    if (linked) continue;
+    ++runs;
+    if (local_capture_optimum(model, data, pb, task, s, base, so, local, samples[i].theta, res, p))
+      keep_distinct(model, found, p);
+  }
 }
 
 /// Fills res.best and the objective of res.local_optima (sorted by the compared value): the CVODE
@@ -429,10 +530,25 @@ inline ManifoldSearchResult detail::search_manifold(const CaptureProblem& pb, co
   nlopt::opt local(nlopt::LD_SLSQP, static_cast<unsigned>(model.n()));
   configure_slsqp(local, model, task.rows(), ctx, so);
   std::vector<ManifoldPoint> found;
-  ManifoldPoint p;
-  for (const Eigen::VectorXd& q : starts)
-    if (local_capture_optimum(model, data, pb, task, s, base, so, local, q, res, p))
-      keep_distinct(model, found, p);
+  const bool branch_stage_on = random_starts > 0 && so.branch_starts > 0;
+  if (task.rows() >= model.n()) {  // no null space: the inverse-kinematics solutions
+    std::vector<Eigen::VectorXd> all = starts;
+    if (branch_stage_on)
+      for (Eigen::VectorXd& q : halton_starts(model, so.branch_starts)) all.push_back(std::move(q));
+    res.starts = static_cast<int>(all.size());
+    res.method = "all inverse-kinematics solutions from random and Halton starts (damped Newton)";
+    enumerate_solutions(model, data, pb, task, s, base, so, all, res, found);
+  } else {
+    ManifoldPoint p;
+    for (const Eigen::VectorXd& q : starts)
+      if (local_capture_optimum(model, data, pb, task, s, base, so, local, q, res, p))
+        keep_distinct(model, found, p);
+    if (branch_stage_on) {
+      res.starts += so.branch_starts;
+      res.method += ", then multi-level single linkage over Halton starts";
+      branch_stage(model, data, pb, task, s, base, so, local, res, found);
+    }
+  }
   res.evaluations = ctx.evaluations;
   if (found.empty())
     throw InputError(

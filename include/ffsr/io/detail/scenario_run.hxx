@@ -73,6 +73,8 @@ inline GlobalRun run_global(const Scenario& sc, const CaptureResult& paper_run, 
   r.paper_objective =
       evaluate_capture(sc.problem, setup, paper_run.base, paper_run.theta, objective, {}, robust.get())
           .objective;
+  r.branches = capture_branches(sc.problem, sc.task, opt, setup, r.result.search, r.result.run.base, 6,
+                                std::max(1u, std::thread::hardware_concurrency()));
   return r;
 }
 
@@ -221,6 +223,24 @@ inline nlohmann::json resolved_json(const Scenario& sc) {
   return j;
 }
 
+/// The branches (distinct local optima at the reached base pose), sorted by objective.
+inline nlohmann::json branches_json(const std::vector<CaptureBranch>& branches) {
+  nlohmann::json a = nlohmann::json::array();
+  for (const CaptureBranch& b : branches) {
+    std::vector<double> q_deg(b.theta.data(), b.theta.data() + b.theta.size());
+    for (double& v : q_deg) v *= 180.0 / M_PI;
+    a.push_back({{"configuration_deg", q_deg},
+                 {"integrated_effective_mass", b.M_ie},
+                 {"objective_value", b.objective},
+                 {"orientation_error_deg", b.orientation_error * 180.0 / M_PI},
+                 {"position_error", b.position_error},
+                 {"reachable_without_reconfiguration",
+                  b.reachable_without_reconfiguration ? nlohmann::json(*b.reachable_without_reconfiguration)
+                                                      : nlohmann::json(nullptr)}});
+  }
+  return a;
+}
+
 inline void add_global_json(nlohmann::json& j, const Scenario& sc, const GlobalRun& g,
                             const CaptureResult& base_run) {
   const GlobalCaptureResult& r = g.result;
@@ -248,6 +268,7 @@ inline void add_global_json(nlohmann::json& j, const Scenario& sc, const GlobalR
     x["f_max_multibody"] = r.objective;
     j["optimized"]["f_max_multibody"] = g.paper_objective;
   }
+  x["branches"] = branches_json(g.branches);
   j["global"] = x;
   j["global_mass_reduction_percent"] = reduction_percent(base_run.M_ie, r.run.M_ie);
   j["global_force_reduction_percent"] =
