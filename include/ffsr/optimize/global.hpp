@@ -643,6 +643,10 @@ inline std::optional<GlobalCaptureResult> reach_goal(const CaptureProblem& pb, c
 /// Throws InputError for bad arguments (as plan_capture, plus a rate limit below what the task alone
 /// needs), NumericalError when a run fails the checks of integrate_capture or no goal is reached.
 /// A reaching run that would leave a joint's limits gives its goal up (goals_out_of_limits).
+/// g.reconfigure (reconfigure.hpp): never, the approach alone; always, every goal reached with a
+/// reconfiguration first; auto, each goal with the approach alone first, then, unless reached,
+/// with a reconfiguration. A reconfiguration the joint-rate limit does not allow in its time throws
+/// ReconfigurationRateError (an InputError).
 inline GlobalCaptureResult plan_capture_global(const CaptureProblem& pb, const CaptureTask& task,
                                                const CaptureOptions& opt, const GlobalCaptureOptions& g) {
   using detail::str;
@@ -686,7 +690,7 @@ inline GlobalCaptureResult plan_capture_global(const CaptureProblem& pb, const C
       if (r && r->reached_manifold_optimum) return std::move(*r);
       keep(r);
     }
-    if (mode == ReconfigureMode::Always || (mode == ReconfigureMode::Auto && i == 0)) {
+    if (mode != ReconfigureMode::Never) {  // auto: the goal was not reached by the approach alone
       const double t_r = g.reconfigure.duration > 0
                              ? g.reconfigure.duration
                              : default_reconfiguration_duration(*pb.model, pb.theta, goals[i].theta, o);
