@@ -20,6 +20,7 @@ using plot::Panel3;
 constexpr int kInstants = 8;
 constexpr int kBlack = 6;
 constexpr int kTargetColor = 3;  // reddish purple: runs use 0, 1, 2
+constexpr int kReconfigurationColor = 4;  // orange: the end-effector's path in a reconfiguration
 
 std::string fixed(double x, int digits) {
   std::ostringstream s;
@@ -202,6 +203,7 @@ bool planar_motion(const Model& model, Data& data, double z0, const std::vector<
 struct RunDrawings {
   std::vector<Drawing> arms;
   Drawing path, target;
+  Drawing reconfiguration_path;  ///< the end-effector during a reconfiguration (empty: none)
   int color = 0;
   double duration = 0;
   bool planar = true;
@@ -212,14 +214,19 @@ struct RunDrawings {
 };
 
 RunDrawings run_drawings(const Model& model, Data& data, int frame, const CaptureResult& res,
-                         const Drawing& target, bool planar) {
+                         const Drawing& target, bool planar, long reconfiguration_samples = 0) {
   RunDrawings d;
   for (size_t k : instants(res.series.size()))
     d.arms.push_back(robot_drawing(model, data, frame, res.series[k], planar));
   d.target = target;
   d.planar = planar;
   d.path.lines.emplace_back();
-  for (const auto& s : res.series) d.path.lines.back().push_back(s.end_effector);
+  const size_t k = static_cast<size_t>(std::max(0L, reconfiguration_samples));
+  if (k > 0) d.reconfiguration_path.lines.emplace_back();
+  for (size_t i = 0; i < res.series.size(); ++i) {
+    if (i < k) d.reconfiguration_path.lines.back().push_back(res.series[i].end_effector);
+    if (i + 1 >= k) d.path.lines.back().push_back(res.series[i].end_effector);  // joined at t_r
+  }
   return d;
 }
 
@@ -241,7 +248,13 @@ void top_view(Panel& p, const RunDrawings& d) {
       for (size_t c = first_curve; c < p.curves.size(); ++c)
         if (p.curves[c].line_style == 1) p.curves[c].line_style = 3;
   }
-  add(p, d.path, 0, 1, kBlack, 1.0, 1.0, "end-effector path", "", 1.0);
+  if (!d.reconfiguration_path.lines.empty()) {
+    add(p, d.reconfiguration_path, 0, 1, kReconfigurationColor, 1.0, 1.5, "end-effector, reconfiguration", "",
+        1.0);
+    p.curves.back().line_style = 4;
+  }
+  add(p, d.path, 0, 1, kBlack, 1.0, 1.0,
+      d.reconfiguration_path.lines.empty() ? "end-effector path" : "end-effector, approach", "", 1.0);
   p.curves.back().line_style = 2;
   add(p, d.target, 0, 1, kTargetColor, 1.0, 1.5, "target at T, normal", "●", 0.9);
 }
@@ -254,6 +267,10 @@ Panel3 oblique_view(const RunDrawings& d) {
   q.ylabel = "y (m)";
   q.zlabel = "z (m)";
   for (size_t i = 0; i < d.arms.size(); ++i) add(q, d.arms[i], d.color, d.alpha(i), 2.0, "●", 0.6);
+  if (!d.reconfiguration_path.lines.empty()) {
+    add(q, d.reconfiguration_path, kReconfigurationColor, 1.0, 1.5, "", 1.0);
+    q.curves.back().line_style = 4;
+  }
   add(q, d.path, kBlack, 1.0, 1.0, "", 1.0);
   q.curves.back().line_style = 2;
   add(q, d.target, kTargetColor, 1.0, 1.5, "●", 0.8);
@@ -380,7 +397,8 @@ std::vector<plot::Figure> capture(const Model& model, int frame, const Target& t
 
   std::vector<plot::Figure> out;
   for (size_t r = 0; r < runs.size(); ++r) {
-    RunDrawings d = run_drawings(model, data, frame, *runs[r].result, target_at_T, planar);
+    RunDrawings d = run_drawings(model, data, frame, *runs[r].result, target_at_T, planar,
+                                 runs[r].reconfiguration_samples);
     d.color = static_cast<int>(r);
     d.duration = duration;
     out.push_back(capture_figure(runs[r].label, *runs[r].result, d));

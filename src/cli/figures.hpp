@@ -17,6 +17,7 @@ struct CaptureRun {
   std::string label;  ///< e.g. "plain"; the file is capture_<label>
   const CaptureResult* result = nullptr;
   CaptureTask task;
+  long reconfiguration_samples = 0;  ///< the first samples of the series that are a reconfiguration
 };
 
 /// Figures 10, 11, 13-15: for each run the arm at eight instants (links as segments, joints as

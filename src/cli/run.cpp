@@ -122,24 +122,31 @@ std::string deg_list(const Eigen::VectorXd& theta, int precision = 2) {
   return os.str();
 }
 
-/// The time series of every run, one row per sample.
+/// The number of the global run's first samples that belong to its reconfiguration (0: none).
+long reconfiguration_samples(const ScenarioResult& r) {
+  if (!r.global || !r.global->result.reconfigured) return 0;
+  return r.global->result.phases.front().samples;
+}
+
+/// The time series of every run, one row per sample; `phase`: reconfiguration or approach.
 std::string series_csv(const Scenario& sc, const ScenarioResult& r) {
   std::ostringstream c;
   c << std::setprecision(12) << "run,t";
   for (const auto& name : sc.model->joint_names()) c << "," << name << "_deg";
-  c << ",base_x,base_y,base_z,base_qw,base_qx,base_qy,base_qz,ee_x,ee_y,ee_z,M_ie,F_max_estimate\n";
+  c << ",base_x,base_y,base_z,base_qw,base_qx,base_qy,base_qz,ee_x,ee_y,ee_z,M_ie,F_max_estimate,phase\n";
   std::vector<std::pair<const char*, const CaptureResult*>> runs{{"baseline", &r.plain},
                                                                  {"optimized", &r.optimized}};
   if (r.global) runs.emplace_back("global", &r.global->result.run);
   for (const auto& [label, run] : runs) {
+    const long reconfiguring = r.global && run == &r.global->result.run ? reconfiguration_samples(r) : 0;
     for (const CaptureSample& s : run->series) {
       c << label << "," << s.t;
       for (Eigen::Index i = 0; i < s.theta.size(); ++i) c << "," << s.theta(i) * 180.0 / M_PI;
       const auto& q = s.base.orientation;
       c << "," << s.base.position.x() << "," << s.base.position.y() << "," << s.base.position.z() << ","
         << q.w() << "," << q.x() << "," << q.y() << "," << q.z() << "," << s.end_effector.x() << ","
-        << s.end_effector.y() << "," << s.end_effector.z() << "," << s.M_ie << "," << s.f_max_estimate
-        << "\n";
+        << s.end_effector.y() << "," << s.end_effector.z() << "," << s.M_ie << "," << s.f_max_estimate << ","
+        << (&s - run->series.data() < reconfiguring ? "reconfiguration" : "approach") << "\n";
     }
   }
   return c.str();
@@ -151,7 +158,7 @@ void write_outputs(const Scenario& sc, const ScenarioResult& r, const RunSetting
   if (!o.plot.empty()) {  // the pictures of the same result structs; the runs are one vector entry each
     std::vector<figures::CaptureRun> runs{{"plain", &r.plain, sc.baseline_task},
                                           {"optimized", &r.optimized, sc.task}};
-    if (r.global) runs.push_back({"global", &r.global->result.run, sc.task});
+    if (r.global) runs.push_back({"global", &r.global->result.run, sc.task, reconfiguration_samples(r)});
     plot::render(figures::capture(*sc.model, sc.problem.frame, sc.problem.target, sc.capture.duration, runs),
                  o.plot, q.plot_format);
   }
@@ -176,6 +183,11 @@ void print_global_notes(std::ostream& out, const Scenario& sc, const GlobalRun& 
       << "; search: " << r.search.method << ", " << r.search.starts << " starts, " << r.evaluations
       << " evaluations" << (mb ? ", " + std::to_string(r.objective_evaluations) + " CVODE runs" : "") << ", "
       << r.search_seconds << " s\n";
+  for (const RunPhase& p : r.reconfigured ? r.phases : std::vector<RunPhase>{})
+    out << "global " << p.name << " phase: t = " << std::setprecision(2) << p.t_begin << " to " << p.t_end
+        << " s, base attitude change " << std::setprecision(3) << p.base_attitude_change * 180.0 / M_PI
+        << " deg, base position change " << p.base_position_change << " m, largest joint rate "
+        << p.max_joint_rate * 180.0 / M_PI << " deg/s\n";
   if (!r.reached_manifold_optimum)
     out << "note: the better optima at the reached base pose lie on other components of the self-motion "
            "manifold; "

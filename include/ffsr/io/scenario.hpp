@@ -65,6 +65,8 @@ struct ScenarioKeys {
   std::string seed = "1";         ///< the global search's seed (text: a bad value names the key)
   double max_joint_rate_deg = 0;  ///< 0: not set
   int global_starts = 32;
+  std::string reconfigure = "auto";  ///< reconfiguration before the approach: auto, always, never
+  double reconfigure_duration = 0;   ///< s; 0: not set (duration / 4, longer if the rate limit needs it)
 
   std::string file;                  ///< the scenario file; empty: a built-in scenario
   std::string where;                 ///< "scenario FILE" or "built-in scenario", for messages

@@ -41,6 +41,7 @@
 
 #include "ffsr/optimize/capture.hpp"
 #include "ffsr/optimize/detail/manifold_sampling.hxx"
+#include "ffsr/optimize/reconfigure.hpp"
 #include "ffsr/simulate/multibody.hpp"
 #include "ffsr/uncertainty/robust_objective.hpp"
 
@@ -569,6 +570,9 @@ struct GlobalCaptureOptions {
   int max_goals = 6;         ///< local optima tried as goals, best first
   double gap_percent = 1.0;  ///< required (reached - optimum) / optimum at the reached base pose, %
   std::vector<Eigen::VectorXd> extra_starts;  ///< e.g. the paper's method's capture configuration
+  /// A reconfiguration before the approach (reconfigure.hpp): never (the default), auto (only when
+  /// the best goal is not reached by the approach alone) or always; its duration.
+  ReconfigureOptions reconfigure;
 };
 
 struct GlobalCaptureResult {
@@ -586,6 +590,9 @@ struct GlobalCaptureResult {
   long evaluations = 0;            ///< over every search
   long objective_evaluations = 0;  ///< multibody simulations over every search
   double search_seconds = 0;       ///< over every search
+  /// The phases of `run`: the approach alone, or the reconfiguration then the approach.
+  std::vector<RunPhase> phases;
+  bool reconfigured = false;  ///< `run` begins with a reconfiguration
 };
 
 namespace detail {
@@ -603,6 +610,30 @@ inline void account(GlobalCaptureResult& res, const ManifoldSearchResult& sr) {
   res.search_seconds += sr.seconds;
 }
 
+/// Pose task: the angle between the end-effector's orientation at (base, theta) and the final one
+/// (0 for a position task). Runs crba.
+inline double goal_orientation_error(const CaptureProblem& pb, const CaptureTask& task, const CaptureSetup& s,
+                                     const BasePose& base, const Eigen::VectorXd& theta) {
+  if (task.kind != CaptureTask::Kind::Pose) return 0.0;
+  Data data(*pb.model);
+  crba(*pb.model, data, base, theta);
+  return rotation_angle(s.R_end * frame_pose(*pb.model, data, pb.frame).R.transpose());
+}
+
+/// Drops the local optima whose end-effector is not in the final orientation (a residual that
+/// vanishes at a half turn too lets them through) and makes the best remaining one res.best. The
+/// result keeps at least one point (the best, even if off). Runs crba per optimum.
+inline void drop_turned_optima(const CaptureProblem& pb, const CaptureTask& task, const CaptureSetup& s,
+                               const BasePose& base, const GlobalCaptureOptions& g, ManifoldSearchResult& res) {
+  if (task.kind != CaptureTask::Kind::Pose || g.search.objective == GlobalObjective::MultibodyForce) return;
+  std::vector<ManifoldPoint> kept;
+  for (const ManifoldPoint& p : res.local_optima)
+    if (goal_orientation_error(pb, task, s, base, p.theta) < 1e-4) kept.push_back(p);
+  if (kept.empty() || kept.size() == res.local_optima.size()) return;
+  res.local_optima = std::move(kept);
+  res.best = res.local_optima.front();
+}
+
 /// The goals of plan_capture_global at the base pose of the task-only run: the best max_goals local
 /// optima of a search from `extra` and random starts (multibody-force: the ranked ones), and the
 /// local optima next to each extra start (on the component of the self-motion manifold the arm is
@@ -612,8 +643,9 @@ inline std::vector<ManifoldPoint> capture_goals(const CaptureProblem& pb, const 
                                                 const GlobalCaptureOptions& g,
                                                 const std::vector<Eigen::VectorXd>& extra,
                                                 GlobalCaptureResult& res) {
-  const ManifoldSearchResult first = search_capture_manifold(pb, task, setup, base, g.search, extra);
+  ManifoldSearchResult first = search_capture_manifold(pb, task, setup, base, g.search, extra);
   account(res, first);
+  drop_turned_optima(pb, task, setup, base, g, first);
   std::vector<ManifoldPoint> goals;
   for (const ManifoldPoint& p : first.local_optima)
     if (p.objective > 0) goals.push_back(p);  // multibody-force: the ranked ones
@@ -640,20 +672,35 @@ inline std::vector<ManifoldPoint> capture_goals(const CaptureProblem& pb, const 
 /// then), or nothing when the goal is given up: a joint limit on the way (goals_out_of_limits), the
 /// goal off the manifold at the reached base pose, the run ending on another component (more than
 /// 0.5 rad from the goal on some joint), or max_iterations spent. Counts into res.
+/// t_r > 0: each run reconfigures the arm to the goal in t_r seconds first (plan_reconfigured_capture),
+/// and a better optimum of the full search (on another component, which the reconfiguration can
+/// reach) becomes the next goal while iterations remain.
 inline std::optional<GlobalCaptureResult> reach_goal(const CaptureProblem& pb, const CaptureTask& task,
                                                      const CaptureOptions& run_opt, const CaptureSetup& setup,
                                                      const GlobalCaptureOptions& g, Eigen::VectorXd goal,
-                                                     GlobalCaptureResult& res, const char* where) {
+                                                     GlobalCaptureResult& res, const char* where,
+                                                     double t_r = 0) {
   for (int it = 1; it <= g.max_iterations; ++it) {
     ServoPolicy servo;
     servo.theta_goal = goal;
     ++res.shooting_iterations;
     CaptureResult run;
+    std::vector<RunPhase> phases;
     try {
-      run = integrate_capture(pb, task, run_opt, setup, servo, where);
+      if (t_r > 0) {
+        ReconfiguredRun rr = plan_reconfigured_capture(pb, task, run_opt, setup, goal, t_r, servo, where);
+        run = std::move(rr.run);
+        phases = std::move(rr.phases);
+      } else {
+        run = integrate_capture(pb, task, run_opt, setup, servo, where);
+        phases = approach_only_phases(run, run_opt.duration);
+      }
     } catch (const JointLimitError&) {
       ++res.goals_out_of_limits;
       return std::nullopt;
+    } catch (const NumericalError&) {
+      if (t_r > 0) return std::nullopt;  // the approach after this reconfiguration fails: give it up
+      throw;
     }
     const ManifoldPoint reached = evaluate_capture(pb, setup, run.base, run.theta, g.search.objective,
                                                    g.search.multibody, g.search.robust.get());
@@ -679,7 +726,12 @@ inline std::optional<GlobalCaptureResult> reach_goal(const CaptureProblem& pb, c
     ex.push_back(run.theta);
     ManifoldSearchResult full = search_capture_manifold(pb, task, setup, run.base, g.search, ex);
     account(res, full);
+    drop_turned_optima(pb, task, setup, run.base, g, full);
     const double gap = 100.0 * (reached.objective - full.best.objective) / full.best.objective;
+    if (t_r > 0 && gap > g.gap_percent && it < g.max_iterations) {
+      goal = full.best.theta;  // reachable too: the reconfiguration moves to its component
+      continue;
+    }
     GlobalCaptureResult r = res;
     r.run = std::move(run);
     r.search = std::move(full);
@@ -687,6 +739,8 @@ inline std::optional<GlobalCaptureResult> reach_goal(const CaptureProblem& pb, c
     r.manifold_optimum = r.search.best.objective;
     r.optimality_gap_percent = gap;
     r.reached_manifold_optimum = gap <= g.gap_percent;
+    r.phases = std::move(phases);
+    r.reconfigured = t_r > 0;
     return r;
   }
   return std::nullopt;
@@ -705,6 +759,10 @@ inline std::optional<GlobalCaptureResult> reach_goal(const CaptureProblem& pb, c
 /// Throws InputError for bad arguments (as plan_capture, plus a rate limit below what the task alone
 /// needs), NumericalError when a run fails the checks of integrate_capture or no goal is reached.
 /// A reaching run that would leave a joint's limits gives its goal up (goals_out_of_limits).
+/// g.reconfigure (reconfigure.hpp): never, the approach alone; always, every goal reached with a
+/// reconfiguration first; auto, each goal with the approach alone first, then, unless reached,
+/// with a reconfiguration. A reconfiguration the joint-rate limit does not allow in its time throws
+/// ReconfigurationRateError (an InputError).
 inline GlobalCaptureResult plan_capture_global(const CaptureProblem& pb, const CaptureTask& task,
                                                const CaptureOptions& opt, const GlobalCaptureOptions& g) {
   using detail::str;
@@ -714,6 +772,10 @@ inline GlobalCaptureResult plan_capture_global(const CaptureProblem& pb, const C
   o.progress = nullptr;
   const CaptureSetup setup = prepare_capture(pb, task, o, where);
   detail::check_global_options(g, where);
+  if (!std::isfinite(g.reconfigure.duration) || g.reconfigure.duration < 0 ||
+      (g.reconfigure.duration > 0 && g.reconfigure.duration >= o.duration))
+    throw InputError(str(where, ": the reconfiguration duration must lie in (0, ", o.duration, ") s, got ",
+                         g.reconfigure.duration));
   CaptureOptions quiet = o;
   quiet.record_series = false;
 
@@ -732,13 +794,26 @@ inline GlobalCaptureResult plan_capture_global(const CaptureProblem& pb, const C
   CaptureOptions run_opt = quiet;
   run_opt.record_series = opt.record_series;
   std::optional<GlobalCaptureResult> fallback;
-  for (const ManifoldPoint& target_goal : goals) {
+  auto keep = [&fallback](std::optional<GlobalCaptureResult>& r) {
+    if (r && (!fallback || r->objective < fallback->objective)) fallback = std::move(r);
+  };
+  const ReconfigureMode mode = g.reconfigure.mode;
+  for (size_t i = 0; i < goals.size(); ++i) {
     ++res.goals_tried;
-    std::optional<GlobalCaptureResult> r =
-        detail::reach_goal(pb, task, run_opt, setup, g, target_goal.theta, res, where);
-    if (!r) continue;
-    if (r->reached_manifold_optimum) return std::move(*r);
-    if (!fallback || r->objective < fallback->objective) fallback = std::move(r);
+    std::optional<GlobalCaptureResult> r;
+    if (mode != ReconfigureMode::Always) {  // the approach alone
+      r = detail::reach_goal(pb, task, run_opt, setup, g, goals[i].theta, res, where);
+      if (r && r->reached_manifold_optimum) return std::move(*r);
+      keep(r);
+    }
+    if (mode != ReconfigureMode::Never) {  // auto: the goal was not reached by the approach alone
+      const double t_r = g.reconfigure.duration > 0
+                             ? g.reconfigure.duration
+                             : default_reconfiguration_duration(*pb.model, pb.theta, goals[i].theta, o);
+      r = detail::reach_goal(pb, task, run_opt, setup, g, goals[i].theta, res, where, t_r);
+      if (r && r->reached_manifold_optimum) return std::move(*r);
+      keep(r);
+    }
   }
   if (fallback) {
     // the counters of every goal tried, the run of the best reached one

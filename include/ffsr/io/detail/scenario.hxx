@@ -247,6 +247,14 @@ inline std::vector<ScenarioKey> build_scenario_keys() {
                "Optimized run: free, or hold (the base's angular velocity stays zero; the objective uses "
                "the freedom left)",
                "free"),
+      // reconfiguration before the approach (optimize/reconfigure.hpp)
+      FFSR_KEY("reconfigure", reconfigure,
+               "Global run: reconfigure the arm before the approach: auto (only when the best capture "
+               "configuration is not reached otherwise), always or never",
+               "auto"),
+      FFSR_KEY("reconfigure-duration", reconfigure_duration,
+               "Global run: time of the reconfiguration, s, 0 < t < duration (default: duration / 4, longer "
+               "if max-joint-rate-deg needs it)"),
   };
 }
 
@@ -659,6 +667,11 @@ inline Scenario build_scenario(ScenarioKeys k, const EmbeddedUrdf* embedded) {
   if (k.global_starts < 1) throw InputError(str("--global-starts: must be >= 1, got ", k.global_starts));
   if (k.given.count("max-joint-rate-deg") && !(finite(k.max_joint_rate_deg, "max-joint-rate-deg") > 0))
     throw InputError(str("--max-joint-rate-deg: must be positive, got ", k.max_joint_rate_deg));
+  reconfigure_mode_of(k.reconfigure, "--reconfigure");
+  if (k.given.count("reconfigure-duration") &&
+      !(finite(k.reconfigure_duration, "reconfigure-duration") > 0 && k.reconfigure_duration < k.duration))
+    throw InputError(str("--reconfigure-duration: must lie in (0, duration = ", k.duration, ") s, got ",
+                         k.reconfigure_duration));
   if (sc.capture.gain != 0.0 && sc.task.rows() >= model.n())
     throw InputError(str("--gain: the ", k.task, " task has ", sc.task.rows(), " rows and the robot ",
                          model.n(),

@@ -59,9 +59,15 @@ inline GlobalRun run_global(const Scenario& sc, const CaptureResult& paper_run, 
     g.max_iterations = 16;
   }
   g.extra_starts = {paper_run.theta};
+  g.reconfigure.mode = reconfigure_mode_of(sc.keys.reconfigure, "--reconfigure");
+  g.reconfigure.duration = sc.keys.reconfigure_duration;
   GlobalRun r;
   try {
     r.result = plan_capture_global(sc.problem, sc.task, opt, g);
+  } catch (const ReconfigurationRateError& e) {
+    throw InputError(str("--reconfigure-duration: a reconfiguration in ", e.duration, " s: joint '", e.joint,
+                         "' needs ", e.needed * 180 / M_PI, " deg/s, max-joint-rate-deg is ",
+                         e.limit * 180 / M_PI));
   } catch (const InputError& e) {
     if (std::string(e.what()).find("max joint rate") != std::string::npos)
       throw InputError(str("--max-joint-rate-deg: ", e.what()));
@@ -220,6 +226,8 @@ inline nlohmann::json resolved_json(const Scenario& sc) {
   j["max-joint-rate-deg"] = o.max_joint_rate_deg;
   j["global-starts"] = o.global_starts;
   j["base-attitude"] = o.base_attitude;
+  j["reconfigure"] = o.reconfigure;
+  if (o.given.count("reconfigure-duration")) j["reconfigure-duration"] = o.reconfigure_duration;
   return j;
 }
 
@@ -253,6 +261,17 @@ inline void add_global_json(nlohmann::json& j, const Scenario& sc, const GlobalR
   x["goals_tried"] = r.goals_tried;
   x["goals_out_of_limits"] = r.goals_out_of_limits;
   x["reached_manifold_optimum"] = r.reached_manifold_optimum;
+  x["reconfigured"] = r.reconfigured;
+  nlohmann::json phases = nlohmann::json::array();
+  for (const RunPhase& p : r.phases)
+    phases.push_back({{"name", p.name},
+                      {"t_begin", p.t_begin},
+                      {"t_end", p.t_end},
+                      {"duration", p.t_end - p.t_begin},
+                      {"base_attitude_change_deg", p.base_attitude_change * 180.0 / M_PI},
+                      {"base_position_change_m", p.base_position_change},
+                      {"max_joint_rate_deg_s", p.max_joint_rate * 180.0 / M_PI}});
+  x["phases"] = phases;
   x["search"] = {{"method", r.search.method},
                  {"starts", r.search.starts},
                  {"evaluations", r.evaluations},
