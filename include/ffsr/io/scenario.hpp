@@ -65,6 +65,9 @@ struct ScenarioKeys {
   std::string seed = "1";         ///< the global search's seed (text: a bad value names the key)
   double max_joint_rate_deg = 0;  ///< 0: not set
   int global_starts = 32;
+  // joint models of the contact (algorithm/joint_models.hpp) and the multibody reference's servo
+  std::string contact_joints = "free";
+  std::vector<double> armature, joint_stiffness, joint_damping;
 
   std::string file;                  ///< the scenario file; empty: a built-in scenario
   std::string where;                 ///< "scenario FILE" or "built-in scenario", for messages
@@ -120,6 +123,8 @@ struct Scenario {
   UrdfReport report;                                  ///< what the loader did to the file
   GlobalObjective objective = GlobalObjective::Mass;  ///< the global run's objective
   std::uint64_t seed = 1;                             ///< the global search's seed
+  /// Multibody reference: per-joint PD gains holding the pre-contact rates (N m/rad, N m s/rad; size n).
+  Eigen::VectorXd joint_stiffness, joint_damping;
 };
 
 /// A URDF given as text for a built-in scenario whose `urdf` key names it (not read from disk).

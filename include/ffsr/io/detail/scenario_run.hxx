@@ -216,6 +216,10 @@ inline nlohmann::json resolved_json(const Scenario& sc) {
   j["seed"] = o.seed;
   j["max-joint-rate-deg"] = o.max_joint_rate_deg;
   j["global-starts"] = o.global_starts;
+  if (o.contact_joints != "free") {  // joint models of the contact: absent means free (the paper's)
+    j["contact-joints"] = o.contact_joints;
+    j["armature"] = vector_json(sc.problem.joints.armature);
+  }
   return j;
 }
 
