@@ -16,6 +16,7 @@
 
 #include "ffsr/algorithm/joint_models.hpp"
 #include "ffsr/io/scenario.hpp"
+#include "ffsr/io/scenario_run.hpp"
 #include "ffsr/simulate/multibody.hpp"
 
 #include <filesystem>
@@ -94,10 +95,9 @@ Vector3 random_unit(std::mt19937& rng) {
 Model rotor_arm(bool rotors, bool rigid_rotors, double N, double J, bool prismatic = false) {
   ModelBuilder b("base", {300, {0.02, -0.01, 0.03}, Vector3(40, 50, 45).asDiagonal()});
   const Vector3 axes[4] = {Vector3::UnitZ(), Vector3::UnitY(), Vector3::UnitX(), Vector3::UnitY()};
-  const Pose origins[4] = {Pose::from_xyz_rpy({0.3, 0.1, 0.2}, {0.1, 0, 0}),
-                           Pose::from_xyz_rpy({0.2, 0, 0.1}, {0, 0.2, 0}),
-                           Pose::from_xyz_rpy({0.6, 0.05, 0}, {0, 0, 0.3}),
-                           Pose::from_xyz_rpy({0.5, 0, -0.05}, {0.2, 0, 0})};
+  const Pose origins[4] = {
+      Pose::from_xyz_rpy({0.3, 0.1, 0.2}, {0.1, 0, 0}), Pose::from_xyz_rpy({0.2, 0, 0.1}, {0, 0.2, 0}),
+      Pose::from_xyz_rpy({0.6, 0.05, 0}, {0, 0, 0.3}), Pose::from_xyz_rpy({0.5, 0, -0.05}, {0.2, 0, 0})};
   std::string parent = "base";
   for (int k = 0; k < 4; ++k) {
     const std::string link = "l" + std::to_string(k + 1), joint = "j" + std::to_string(k + 1);
@@ -170,7 +170,8 @@ TEST_CASE("armature: H of counter-rotating rotor pairs on the joint axes", "[joi
   // the effective mass: armature on the rigid-rotor arm = free joints of the geared-rotor arm
   const int f = plain.frame_index("l4");
   for (const Vector3& u : {Vector3(1, 0, 0), Vector3(0.3, -0.4, 0.866).normalized()}) {
-    const double q_arm = inverse_effective_mass(rigid, dr, rigid.frame_index("l4"), u, armature(Eigen::VectorXd::Constant(4, a)));
+    const double q_arm = inverse_effective_mass(rigid, dr, rigid.frame_index("l4"), u,
+                                                armature(Eigen::VectorXd::Constant(4, a)));
     const double q_rot = inverse_effective_mass(rotors, dm, rotors.frame_index("l4"), u);
     CHECK(std::abs(q_arm - q_rot) <= 1e-10 * q_rot);
   }
@@ -265,8 +266,8 @@ TEST_CASE("joint models: no allocation per call, H left as it was", "[joints]") 
   for (const ContactJoints* j : {&arm}) {
     sum += inverse_effective_mass(model, data, sc.problem.frame, u, *j);
     sum += inverse_effective_mass(model, data, sc.problem.frame, u, locked());
-    sum += integrated_effective_mass_gradient(model, data, sc.problem.base, sc.problem.theta, sc.problem.frame,
-                                              u, 0.01, *j, g);
+    sum += integrated_effective_mass_gradient(model, data, sc.problem.base, sc.problem.theta,
+                                              sc.problem.frame, u, 0.01, *j, g);
   }
   Eigen::internal::set_is_malloc_allowed(true);
   CHECK(std::isfinite(sum));
@@ -287,7 +288,6 @@ TEST_CASE("joint models: parse and validate", "[joints]") {
   CHECK(per_joint_values({}, m, "--armature") == Eigen::VectorXd::Zero(4));
   CHECK(per_joint_values({0.5}, m, "--armature") == Eigen::VectorXd::Constant(4, 0.5));
 }
-
 
 namespace {
 
@@ -326,13 +326,14 @@ TEST_CASE("multibody with joint PD: from free to locked", "[joints][multibody]")
   const ServoRun free = servo_run(0, 0, 0);
   const ServoRun soft = servo_run(1e-3, 1e-3, 0);
   const ServoRun stiff = servo_run(1e12, 1e8, 0);
-  INFO("M_ie free " << free.M_free << " kg, locked " << free.M_locked << " kg; F_max free run " << free.mb.f_max
-                    << " N (single body " << free.f_free << "), soft " << soft.mb.f_max << ", stiff "
-                    << stiff.mb.f_max << " N (locked single body " << free.f_locked << ")");
+  INFO("M_ie free " << free.M_free << " kg, locked " << free.M_locked << " kg; F_max free run "
+                    << free.mb.f_max << " N (single body " << free.f_free << "), soft " << soft.mb.f_max
+                    << ", stiff " << stiff.mb.f_max << " N (locked single body " << free.f_locked << ")");
   CHECK(std::abs(soft.mb.f_max - free.mb.f_max) <= 1e-4 * free.mb.f_max);
   CHECK(std::abs(stiff.mb.f_max - free.f_locked) <= 1e-2 * free.f_locked);
   // the servo's torques are internal: robot plus target keep their momentum
-  CHECK((stiff.mb.momentum_end - stiff.mb.momentum_start).norm() <= 1e-6 * stiff.mb.momentum_start.norm() + 1e-9);
+  CHECK((stiff.mb.momentum_end - stiff.mb.momentum_start).norm() <=
+        1e-6 * stiff.mb.momentum_start.norm() + 1e-9);
 }
 
 TEST_CASE("multibody with armature: the armature model's prediction", "[joints][multibody]") {
@@ -347,8 +348,8 @@ TEST_CASE("multibody with armature: the armature model's prediction", "[joints][
                                                armature(Eigen::VectorXd::Constant(3, a)));
   const AnyContactLaw law = make_contact_law(pb.law, pb.contact, r.mb.approach_velocity);
   const double f_a = max_force_exact(law, M_a);
-  INFO("M_ie free " << r.M_free << ", armature " << M_a << ", locked " << r.M_locked << " kg; F_max multibody "
-                    << r.mb.f_max << " N, single body " << f_a << " N");
+  INFO("M_ie free " << r.M_free << ", armature " << M_a << ", locked " << r.M_locked
+                    << " kg; F_max multibody " << r.mb.f_max << " N, single body " << f_a << " N");
   CHECK(M_a > r.M_free);
   CHECK(M_a < r.M_locked);
   CHECK(std::abs(r.mb.f_max - f_a) <= 1e-2 * f_a);
@@ -360,8 +361,65 @@ TEST_CASE("multibody servo table (measurement)", "[.measure]") {
   for (auto [K, D] : std::vector<std::pair<double, double>>{{0, 0}, {1e4, 1e2}, {1e8, 1e5}, {1e12, 1e8}}) {
     const ServoRun r = servo_run(K, D, 0);
     WARN("K " << K << " D " << D << ": F_max " << r.mb.f_max << " N, t_peak " << r.mb.t_at_f_max
-              << " s, duration " << r.mb.contact_duration << " s, steps " << r.mb.steps << "; single body free "
-              << r.f_free << " N (M " << r.M_free << "), locked " << r.f_locked << " N (M " << r.M_locked << ")");
+              << " s, duration " << r.mb.contact_duration << " s, steps " << r.mb.steps
+              << "; single body free " << r.f_free << " N (M " << r.M_free << "), locked " << r.f_locked
+              << " N (M " << r.M_locked << ")");
+  }
+}
+
+TEST_CASE("scenario keys of the joint models: bad values name the key", "[joints]") {
+  auto build = [&](const std::string& extra) {
+    ScenarioKeys k = read_scenario_file(source("robots/paper_3dof.toml"));
+    for (const auto& line : {extra}) {
+      const auto eq = line.find('=');
+      override_scenario_key(k, line.substr(0, eq), line.substr(eq + 1));
+    }
+    return build_scenario(k);
+  };
+  CHECK(build("contact-joints=locked").problem.joints.model == JointModel::Locked);
+  CHECK(build("armature=0.2,0.3,0.4").problem.joints.armature == Eigen::Vector3d(0.2, 0.3, 0.4));
+  CHECK_THROWS_WITH(build("contact-joints=rigid"),
+                    Catch::Contains("--contact-joints: unknown joint model 'rigid'"));
+  CHECK_THROWS_WITH(build("armature=-1"), Catch::Contains("--armature: the value of joint"));
+  CHECK_THROWS_WITH(build("armature=1,2"),
+                    Catch::Contains("--armature: 2 values for 3 joints (joint1, joint2, joint3)"));
+  CHECK_THROWS_WITH(build("joint-stiffness=-5"), Catch::Contains("--joint-stiffness: the value of joint"));
+  CHECK_THROWS_WITH(build("joint-damping=1,2,3,4"),
+                    Catch::Contains("--joint-damping: 4 values for 3 joints"));
+  CHECK_THROWS_WITH(build("armature=nan"), Catch::Contains("--armature"));
+}
+
+TEST_CASE("joint models on the paper's scenarios (measurement)", "[.measure]") {
+  const char* names[] = {"free", "locked", "armature"};
+  for (const char* file : {"robots/paper_3dof.toml", "robots/paper_7dof_position.toml"}) {
+    for (const char* chosen : names) {
+      ScenarioKeys k = read_scenario_file(source(file));
+      override_scenario_key(k, "contact-joints", chosen);
+      override_scenario_key(k, "armature", "0.5");
+      const Scenario sc = build_scenario(k);
+      const ScenarioResult r = run_scenario(sc);
+      const CaptureSetup setup = prepare_capture(sc.problem, sc.task, sc.capture);
+      const Model& model = *sc.model;
+      Data data(model);
+      const std::pair<const char*, const CaptureResult*> rows[] = {
+          {"plain", &r.plain}, {"paper", &r.optimized}, {"global", &r.global->result.run}};
+      for (const auto& [label, run] : rows) {
+        std::ostringstream os;
+        os << file << " objective " << chosen << " " << label << " [";
+        for (int i = 0; i < model.n(); ++i) os << (i ? ", " : "") << run->theta(i) * 180 / M_PI;
+        os << "] deg:";
+        crba(model, data, run->base, run->theta);
+        for (const char* m : names) {
+          const ContactJoints j{parse_joint_model(m, "m"), sc.problem.joints.armature};
+          const double M = 1.0 / (inverse_effective_mass(model, data, sc.problem.frame, setup.u_cap, j) +
+                                  setup.target_inv_mass);
+          const AnyContactLaw law =
+              make_contact_law(sc.problem.law, sc.problem.contact, run->approach_velocity);
+          os << "  " << m << " M " << M << " kg F " << max_force_exact(law, M) << " N;";
+        }
+        WARN(os.str());
+      }
+    }
   }
 }
 

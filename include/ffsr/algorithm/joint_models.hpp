@@ -28,9 +28,12 @@ enum class JointModel { Free, Locked, Armature };
 
 inline const char* joint_model_name(JointModel m) {
   switch (m) {
-    case JointModel::Locked: return "locked";
-    case JointModel::Armature: return "armature";
-    default: return "free";
+    case JointModel::Locked:
+      return "locked";
+    case JointModel::Armature:
+      return "armature";
+    default:
+      return "free";
   }
 }
 
@@ -146,7 +149,8 @@ inline double inverse_effective_mass(const Model& model, Data& data, int frame, 
       data.y = data.w;
       detail::cholesky_forward(data.L, data.y);
       return data.y.squaredNorm();
-    default: return inverse_effective_mass(model, data, frame, u);
+    default:
+      return inverse_effective_mass(model, data, frame, u);
   }
 }
 
@@ -175,7 +179,8 @@ inline double integrated_effective_mass(const Model& model, Data& data, const Ba
 inline double integrated_effective_mass_gradient(const Model& model, Data& data, const BasePose& base,
                                                  const Eigen::Ref<const Eigen::VectorXd>& theta, int frame,
                                                  const Vector3& u, double target_inverse_mass,
-                                                 const ContactJoints& joints, Eigen::Ref<Eigen::VectorXd> grad) {
+                                                 const ContactJoints& joints,
+                                                 Eigen::Ref<Eigen::VectorXd> grad) {
   if (joints.model == JointModel::Free)
     return integrated_effective_mass_gradient(model, data, base, theta, frame, u, target_inverse_mass, grad);
   detail::require_size(grad.size(), model.n(), "integrated_effective_mass_gradient", "grad");

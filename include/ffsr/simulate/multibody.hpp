@@ -1,7 +1,8 @@
 // ffsr/simulate/multibody.hpp -- the full robot-plus-target contact simulation (Figure 2), the
 // "classical numerical integration method" that the paper uses as its reference (Tables 3 and 6).
 //
-// The free-floating robot (joints passive: zero torque; gravity model.gravity, zero by default) and
+// The free-floating robot (joints passive: zero torque, unless MultibodyContactOptions gives a joint PD
+// servo holding the pre-contact rates and an armature; gravity model.gravity, zero by default) and
 // the target (a free rigid body) touch at one point. The target's surface near the contact is the
 // plane through its material contact point (r_tp) with normal u_n, both fixed in the target; the
 // end-effector is a point: the origin of the end-effector frame, or a point fixed in the end-effector
@@ -104,7 +105,8 @@ struct ContactSystem {
   Vector3 ct0, r0;  ///< target centre of mass and contact offset (in o) at the first touch
   Vector3 rho_ee;   ///< the robot's contact point from the end-effector origin, end-effector frame
   int n;
-  Eigen::VectorXd qd0, K, D, armature;  ///< joint servo and armature (MultibodyContactOptions; zeros if unset)
+  Eigen::VectorXd qd0, K, D,
+      armature;  ///< joint servo and armature (MultibodyContactOptions; zeros if unset)
   // scratch
   Eigen::VectorXd theta, v, tau, a, ydot_scratch, y_scratch;
 
@@ -179,8 +181,8 @@ struct ContactSystem {
 
   /// The servo's joint torques at time t (from the first touch) added to tau's joint entries.
   void add_joint_servo(double t, const Eigen::Ref<const Eigen::VectorXd>& y) {
-    tau.tail(n).array() -= K.array() * (y.segment(6, n) - qd0 * t).array() +
-                           D.array() * (y.segment(iv() + 6, n) - qd0).array();
+    tau.tail(n).array() -=
+        K.array() * (y.segment(6, n) - qd0 * t).array() + D.array() * (y.segment(iv() + 6, n) - qd0).array();
   }
 
   /// a = (H + diag(0, armature))^-1 (tau - C): forward_dynamics with the armature on H's joint diagonal.
@@ -196,7 +198,8 @@ struct ContactSystem {
   }
 
   template <class Law>
-  void rhs(const Law& law, double t, const Eigen::Ref<const Eigen::VectorXd>& y, Eigen::Ref<Eigen::VectorXd> ydot) {
+  void rhs(const Law& law, double t, const Eigen::Ref<const Eigen::VectorXd>& y,
+           Eigen::Ref<Eigen::VectorXd> ydot) {
     const Kin k = kinematics(y);
     const double F = law.force(k.delta, k.delta_dot);
     // robot: H a = J^T [-F u; rho x (-F u)] - C + [0; servo torques]
@@ -342,8 +345,9 @@ inline cvode::Options contact_cvode_options(const MultibodyContactOptions& optio
 /// a strongly damped contact hovers at the clamp, where dF/dt vanishes on an interval, which CVODE's
 /// root finder must not see. `yd`, `yp` are scratch of the state's size.
 template <class Law>
-void contact_roots(ContactSystem& sys, const Law& law, double h, double t, const Eigen::Ref<const Eigen::VectorXd>& y,
-                   Eigen::Ref<Eigen::VectorXd> g, Eigen::VectorXd& yd, Eigen::VectorXd& yp) {
+void contact_roots(ContactSystem& sys, const Law& law, double h, double t,
+                   const Eigen::Ref<const Eigen::VectorXd>& y, Eigen::Ref<Eigen::VectorXd> g,
+                   Eigen::VectorXd& yd, Eigen::VectorXd& yp) {
   const auto k = sys.kinematics(y);
   g(0) = k.delta;
   if (!(sys.force(law, k) > 0.0) || !(k.delta_dot > 0.0)) {

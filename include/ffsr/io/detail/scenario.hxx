@@ -248,10 +248,12 @@ inline std::vector<ScenarioKey> build_scenario_keys() {
                "(free with the armature's reflected rotor inertia)",
                "free"),
       FFSR_KEY("armature", armature,
-               "Reflected rotor inertia per joint, kg m^2 (kg for prismatic): one value or one per joint", "0"),
-      FFSR_KEY("joint-stiffness", joint_stiffness,
-               "Multibody reference: joint PD stiffness holding the pre-contact rates, N m/rad (one or per joint)",
+               "Reflected rotor inertia per joint, kg m^2 (kg for prismatic): one value or one per joint",
                "0"),
+      FFSR_KEY(
+          "joint-stiffness", joint_stiffness,
+          "Multibody reference: joint PD stiffness holding the pre-contact rates, N m/rad (one or per joint)",
+          "0"),
       FFSR_KEY("joint-damping", joint_damping,
                "Multibody reference: joint PD damping, N m s/rad (one or per joint)", "0"),
   };

@@ -50,6 +50,9 @@ inline GlobalRun run_global(const Scenario& sc, const CaptureResult& paper_run, 
   g.search.starts = sc.keys.global_starts;
   g.search.objective = objective;
   g.search.robust = robust;
+  g.search.multibody.joint_stiffness = sc.joint_stiffness;  // joint models: the servoed multibody reference
+  g.search.multibody.joint_damping = sc.joint_damping;
+  g.search.multibody.armature = sc.problem.joints.armature;
   // robust-force scenarios: the reaching runs land within 0.01 % of the manifold optimum at the reached
   // base pose (the library's default, 1 %, is coarser than the difference between the robust and the
   // nominal optimum), the nominal global run beside the robust one too, so the two compare fairly
