@@ -18,6 +18,7 @@
 #include "ffsr/io/scenario.hpp"
 #include "ffsr/io/scenario_run.hpp"
 #include "ffsr/simulate/multibody.hpp"
+#include "support/command.hpp"
 
 #include <filesystem>
 #include <random>
@@ -419,6 +420,75 @@ TEST_CASE("joint models on the paper's scenarios (measurement)", "[.measure]") {
         }
         WARN(os.str());
       }
+    }
+  }
+}
+
+TEST_CASE("ffsr-optimize with joint models: contact, map, the main job, bad flags", "[joints][command]") {
+  using ffsr::test::cli;
+  using ffsr::test::kUrdf3;
+  const Scenario sc = load_scenario(source("robots/paper_3dof.toml"));
+  const Eigen::VectorXd th = Eigen::Vector3d(0, 90, -90) * (M_PI / 180);
+  Data data(*sc.model);
+  Target target;  // the contact command's default target: the paper's, at rest
+  target.mass = 200;
+  target.inertia = 100 * Matrix3::Identity();
+  target.contact_offset = Vector3(-0.25, 0.15, 0);
+  const double M_locked =
+      integrated_effective_mass(*sc.model, data, sc.problem.base, th, sc.problem.frame, target, locked());
+  SECTION("contact --joints all: the three predictions beside the multibody run with the armature") {
+    const auto r = cli({"contact", "--urdf", kUrdf3, "--joints-deg", "0,90,-90", "--joints", "all",
+                        "--armature", "0.5", "--json"});
+    REQUIRE(r.exit_code == 0);
+    const auto j = nlohmann::json::parse(r.out);
+    REQUIRE(j["joint_models"].size() == 3);
+    CHECK(j["joint_models"][1]["contact_joints"] == "locked");
+    CHECK(j["joint_models"][1]["integrated_effective_mass"].get<double>() == Approx(M_locked).epsilon(1e-12));
+    const double f_arm = j["joint_models"][2]["f_max_exact"], f_mb = j["f_max_multibody"];
+    CHECK(std::abs(f_arm - f_mb) <= 1e-2 * f_mb);
+  }
+  SECTION("contact with stiff servo gains: the multibody peak at the locked prediction") {
+    const auto r = cli({"contact", "--urdf", kUrdf3, "--joints-deg", "0,90,-90", "--contact-joints", "locked",
+                        "--joint-stiffness", "1e12", "--joint-damping", "1e8", "--json"});
+    REQUIRE(r.exit_code == 0);
+    const auto j = nlohmann::json::parse(r.out);
+    CHECK(j["contact_joints"] == "locked");
+    CHECK(j["integrated_effective_mass"].get<double>() == Approx(M_locked).epsilon(1e-12));
+    const double f_exact = j["f_max_exact"], f_mb = j["f_max_multibody"];
+    CHECK(std::abs(f_exact - f_mb) <= 1e-2 * f_exact);
+  }
+  SECTION("map of the locked model") {
+    const auto r = cli({"map", "--urdf", kUrdf3, "--joints-deg", "0,90,-90", "--vary", "3", "--range-deg",
+                        "-90,-89", "--step-deg", "1", "--contact-joints", "locked", "--csv", "-"});
+    REQUIRE(r.exit_code == 0);
+    CHECK(r.out.find("joint3_deg,M_ie_locked_kg,F_max_N") != std::string::npos);
+    const auto line = r.out.substr(r.out.find('\n') + 1);
+    CHECK(std::stod(line.substr(line.find(',') + 1)) == Approx(M_locked).epsilon(1e-12));
+  }
+  SECTION("the main job records the model") {
+    const auto r = cli({"--config", source("robots/paper_3dof.toml"), "--contact-joints", "locked",
+                        "--global", "false", "--json", "-", "--quiet"});
+    REQUIRE(r.exit_code == 0);
+    const auto j = nlohmann::json::parse(r.out);
+    CHECK(j["scenario"]["contact-joints"] == "locked");
+    CHECK(j["baseline"]["integrated_effective_mass"].get<double>() > 50);
+  }
+  SECTION("bad flags: one line naming the flag") {
+    const std::vector<std::pair<std::vector<std::string>, std::string>> bad{
+        {{"--contact-joints", "rigid"}, "--contact-joints: unknown joint model 'rigid'"},
+        {{"--armature", "-1"}, "--armature: the value of joint 'joint1' must be finite and >= 0"},
+        {{"--armature", "1,2"}, "--armature: 2 values for 3 joints (joint1, joint2, joint3)"},
+        {{"--joint-stiffness", "-1"}, "--joint-stiffness: the value of joint 'joint1'"},
+        {{"--joint-damping", "1,2,3,4"}, "--joint-damping: 4 values for 3 joints"}};
+    for (const auto& [args, message] : bad) {
+      std::vector<std::string> a{"contact", "--urdf", kUrdf3, "--joints-deg", "0,90,-90"};
+      a.insert(a.end(), args.begin(), args.end());
+      const auto r = cli(a);
+      INFO(args.front() << ": " << r.err);
+      CHECK(r.exit_code != 0);
+      CHECK(r.err.find(message) != std::string::npos);
+      CHECK(std::count(r.err.begin(), r.err.end(), '\n') == 1);
+      CHECK(r.out.empty());
     }
   }
 }
