@@ -1,6 +1,7 @@
 // ffsr-optimize contact: closed-form, exact and multibody (CVODE) maximum contact force.
 #include "common.hpp"
 #include "figures.hpp"
+#include "joint_options.hpp"
 #include "subcommands.hpp"
 
 #include "ffsr/algorithm/base_disturbance.hpp"
@@ -18,6 +19,7 @@ struct ContactOptions {
   RobotOptions robot;
   TargetOptions target;
   ContactLawOptions law;
+  JointOptions joints;  ///< joint models of the contact; the multibody run's servo and armature
   std::string series, plot, plot_format = "png";
   bool json = false;
 };
@@ -28,29 +30,61 @@ struct Row {
   std::vector<ContactSample> series;
   double mb_delta_max = 0, mb_delta_at_f_max = 0;  ///< of the multibody run, for the F-delta figure
   BaseDisturbance base_jump{};                     ///< predicted from the configuration (single-body impulse)
-  Vector6 base_jump_multibody = Vector6::Zero();   ///< [dv_0; dw_0] of the multibody run, separation - first touch
+  Vector6 base_jump_multibody =
+      Vector6::Zero();  ///< [dv_0; dw_0] of the multibody run, separation - first touch
+  struct Prediction {
+    JointModel joints;
+    double M_ie, f_closed, f_exact;
+  };
+  std::vector<Prediction> predictions;  ///< --contact-joints all: free, locked, armature
 };
+
+/// The closed-form predictions under each joint model asked for (the chosen one, or all three).
+std::vector<Row::Prediction> joint_predictions(const Robot& r, const Target& target, const ContactOptions& o,
+                                               const AnyContactLaw& law, double M_free) {
+  ContactJoints joints = o.joints.build(r.model);
+  std::vector<JointModel> models{joints.model};
+  if (o.joints.all()) models = {JointModel::Free, JointModel::Locked, JointModel::Armature};
+  std::vector<Row::Prediction> out;
+  Data data(r.model);
+  for (JointModel m : models) {
+    joints.model = m;
+    const double M = m == JointModel::Free ? M_free  // the multibody run's, the same computation
+                                           : integrated_effective_mass(r.model, data, r.base, r.theta,
+                                                                       r.end_effector, target, joints);
+    out.push_back({m, M, max_force_closed_form(law, M), max_force_exact(law, M)});
+  }
+  return out;
+}
 
 Row evaluate(const Robot& r, const Target& target, const ContactOptions& o, const std::string& law_name) {
   const ContactParams p{o.law.stiffness, o.law.exponent, o.law.restitution};
   MultibodyContactOptions mo;
   mo.record_series = !o.series.empty() || !o.plot.empty();
+  mo.joint_stiffness = JointOptions::values(o.joints.stiffness, r.model, "--joint-stiffness");
+  mo.joint_damping = JointOptions::values(o.joints.damping, r.model, "--joint-damping");
+  mo.armature = JointOptions::values(o.joints.armature, r.model, "--armature");
   MultibodyContactResult mb = simulate_contact(r.model, r.base, r.theta, r.end_effector, target,
                                                o.law.approach_speed, p, law_name, mo);
   const AnyContactLaw law = make_contact_law(law_name, p, mb.approach_velocity);
+  auto predictions = joint_predictions(r, target, o, law, mb.integrated_effective_mass);
+  const double M_ie = predictions.front().M_ie;  // the chosen model's (free for all)
   Row row{law_name,
-          mb.integrated_effective_mass,
+          M_ie,
           mb.approach_velocity,
-          max_force_closed_form(law, mb.integrated_effective_mass),
-          max_force_exact(law, mb.integrated_effective_mass),
+          max_force_closed_form(law, M_ie),
+          max_force_exact(law, M_ie),
           mb.f_max,
           0,
           relative_error(law),
-          max_deformation(law, mb.integrated_effective_mass),
+          max_deformation(law, M_ie),
           mb.t_at_f_max,
           mb.contact_duration,
           mb.restitution,
-          std::move(mb.series)};
+          std::move(mb.series),
+          0,
+          0,
+          std::move(predictions)};
   row.accuracy = model_accuracy(row.f_closed, row.f_multibody);
   row.mb_delta_max = mb.delta_max;
   row.mb_delta_at_f_max = mb.delta_at_f_max;
@@ -61,27 +95,36 @@ Row evaluate(const Robot& r, const Target& target, const ContactOptions& o, cons
 }
 
 nlohmann::json row_json(const Row& r) {
-  return {{"model", r.model},
-          {"integrated_effective_mass", r.M_ie},
-          {"approach_velocity", r.v_in},
-          {"f_max_closed_form", r.f_closed},
-          {"f_max_exact", r.f_exact},
-          {"f_max_multibody", r.f_multibody},
-          {"model_accuracy", r.accuracy},
-          {"relative_error_xi", r.xi},
-          {"delta_max", r.delta_max},
-          {"time_of_peak", r.t_peak},
-          {"contact_duration", r.duration},
-          {"restitution_realized", r.restitution},
-          {"base_disturbance",
-           {{"impulse", r.base_jump.impulse},
-            {"restitution_single_body", r.base_jump.restitution},
-            {"angular_velocity_jump", to_json(Eigen::VectorXd(r.base_jump.angular))},
-            {"angular_velocity_jump_multibody", to_json(Eigen::VectorXd(r.base_jump_multibody.tail<3>()))},
-            {"linear_velocity_jump", to_json(Eigen::VectorXd(r.base_jump.linear))},
-            {"linear_velocity_jump_multibody", to_json(Eigen::VectorXd(r.base_jump_multibody.head<3>()))},
-            {"angular_rate_jump_deg_s", r.base_jump.angular_rate() * 180.0 / M_PI},
-            {"angular_rate_jump_multibody_deg_s", r.base_jump_multibody.tail<3>().norm() * 180.0 / M_PI}}}};
+  nlohmann::json j = {{"model", r.model},
+                      {"integrated_effective_mass", r.M_ie},
+                      {"approach_velocity", r.v_in},
+                      {"f_max_closed_form", r.f_closed},
+                      {"f_max_exact", r.f_exact},
+                      {"f_max_multibody", r.f_multibody},
+                      {"model_accuracy", r.accuracy},
+                      {"relative_error_xi", r.xi},
+                      {"delta_max", r.delta_max},
+                      {"time_of_peak", r.t_peak},
+                      {"contact_duration", r.duration},
+                      {"restitution_realized", r.restitution}};
+  j["base_disturbance"] = {
+      {"impulse", r.base_jump.impulse},
+      {"restitution_single_body", r.base_jump.restitution},
+      {"angular_velocity_jump", to_json(Eigen::VectorXd(r.base_jump.angular))},
+      {"angular_velocity_jump_multibody", to_json(Eigen::VectorXd(r.base_jump_multibody.tail<3>()))},
+      {"linear_velocity_jump", to_json(Eigen::VectorXd(r.base_jump.linear))},
+      {"linear_velocity_jump_multibody", to_json(Eigen::VectorXd(r.base_jump_multibody.head<3>()))},
+      {"angular_rate_jump_deg_s", r.base_jump.angular_rate() * 180.0 / M_PI},
+      {"angular_rate_jump_multibody_deg_s", r.base_jump_multibody.tail<3>().norm() * 180.0 / M_PI}};
+  if (r.predictions.size() > 1 || r.predictions.front().joints != JointModel::Free) {  // joint models
+    j["contact_joints"] = r.predictions.size() > 1 ? "all" : joint_model_name(r.predictions.front().joints);
+    for (const auto& x : r.predictions)
+      j["joint_models"].push_back({{"contact_joints", joint_model_name(x.joints)},
+                                   {"integrated_effective_mass", x.M_ie},
+                                   {"f_max_closed_form", x.f_closed},
+                                   {"f_max_exact", x.f_exact}});
+  }
+  return j;
 }
 
 /// The laws to evaluate: every law for --model all, else the one named (an unknown name lists them).
@@ -140,6 +183,21 @@ nlohmann::json contact_json(const std::vector<Row>& rows, const ContactOptions& 
   return j;
 }
 
+/// The closed-form predictions under the joint models beside the multibody run (when not only free).
+void print_joint_predictions(std::ostream& out, const std::vector<Row>& rows) {
+  const auto& first = rows.front().predictions;
+  if (first.size() == 1 && first.front().joints == JointModel::Free) return;
+  out << "\njoints during the contact (closed form and exact beside the multibody run):\n"
+      << std::left << std::setw(20) << "model" << std::setw(10) << "joints" << std::right << std::setw(11)
+      << "M_ie (kg)" << std::setw(13) << "closed (N)" << std::setw(13) << "exact (N)" << std::setw(15)
+      << "multibody (N)\n";
+  for (const auto& row : rows)
+    for (const auto& x : row.predictions)
+      out << std::left << std::setw(20) << row.model << std::setw(10) << joint_model_name(x.joints)
+          << std::right << std::fixed << std::setprecision(2) << std::setw(11) << x.M_ie << std::setw(13)
+          << x.f_closed << std::setw(13) << x.f_exact << std::setw(15) << row.f_multibody << "\n";
+}
+
 void print_contact_table(std::ostream& out, const std::vector<Row>& rows) {
   out << std::setprecision(6) << "integrated effective mass M_ie = " << rows.front().M_ie << " kg (Eq. 14)\n"
       << "approach velocity delta_dot^-  = " << rows.front().v_in << " m/s (Eq. 10-12)\n\n";
@@ -158,6 +216,7 @@ void print_contact_table(std::ostream& out, const std::vector<Row>& rows) {
     out << std::left << std::setw(20) << row.model << std::right << std::scientific << std::setprecision(4)
         << std::setw(13) << row.base_jump.angular_rate() * 180.0 / M_PI << std::setw(15)
         << row.base_jump_multibody.tail<3>().norm() * 180.0 / M_PI << std::defaultfloat << "\n";
+  print_joint_predictions(out, rows);
   out << "\nclosed: Eq. 24 (F at the maximum deformation); exact: peak of the single-body model Eq. 16;\n"
          "multibody: CVODE integration of robot + target (Figure 2); accuracy: Eq. 32, closed vs "
          "multibody.\n";
@@ -203,6 +262,7 @@ void register_contact(CLI::App& app, Action& action) {
   o->robot.add_to(*sub);
   o->target.add_to(*sub);
   o->law.add_to(*sub, "Hysteresis damping law (Table 1) or 'all'");
+  o->joints.add_to(*sub, true);
   sub->add_option("--series", o->series,
                   "Write F(t), delta(t) of the multibody run(s) to this CSV file ('-': standard output)");
   sub->add_flag("--json", o->json, "Print one JSON object on stdout");

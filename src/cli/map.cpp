@@ -25,6 +25,7 @@
 // the grid only and is not plotted.
 #include "common.hpp"
 #include "figures.hpp"
+#include "joint_options.hpp"
 #include "subcommands.hpp"
 
 #include "ffsr/detail/parallel.hpp"
@@ -47,6 +48,7 @@ struct MapOptions {
   RobotOptions robot;
   TargetOptions target;
   ContactLawOptions law;
+  JointOptions joints;  ///< the joint model of the mapped M_ie
   std::string vary;
   std::string range_deg = "-180,180";
   std::string step_deg = "2";
@@ -137,6 +139,7 @@ struct Worker {
   const int frame;
   const Vector3 u;
   const double target_inverse_mass;
+  ContactJoints joints;  ///< the joint model of M_ie (free: the fast path)
   Data data;
   Eigen::VectorXd theta;
   std::vector<char> text;
@@ -161,6 +164,12 @@ struct Worker {
         text((g.axes.size() + 2) * 32 * block + 1),
         angles(g.axes.size()) {}
 
+  /// M_ie (Eq. 14) at theta under the joint model. Runs crba.
+  double joint_model_M() {
+    crba(model, data, base, theta);
+    return 1.0 / (inverse_effective_mass(model, data, frame, u, joints) + target_inverse_mass);
+  }
+
   /// Evaluates points [first, last) and formats their rows into `text`; returns the byte count.
   size_t run(std::uint64_t first, std::uint64_t last) {
     char* p = text.data();
@@ -174,8 +183,10 @@ struct Worker {
         rest /= ax.count;
         theta(ax.joint) = angles[a] * (M_PI / 180.0);  // as load_robot converts --joints-deg
       }
-      const double M =
-          integrated_effective_mass_fast(model, data, base, theta, frame, u, target_inverse_mass);  // Eq. 14
+      const double M = joints.model == JointModel::Free
+                           ? integrated_effective_mass_fast(model, data, base, theta, frame, u,
+                                                            target_inverse_mass)  // Eq. 14
+                           : joint_model_M();
       const double F = max_force_closed_form(law, M);                                               // Eq. 24
       if (values) values[idx - first_point] = M;
       if (M > max_M) max_M = M, argmax = idx;
@@ -348,12 +359,15 @@ int run_map(const MapOptions& o) {
   const std::vector<double> slice_deg = check_map_plot(o, grid, shard);
   std::vector<double> values(plotting ? count : 0);
 
+  const ContactJoints joints = o.joints.build(r.model);  // checked before any output
   StreamingOutput out("--csv", o.csv);
   if (shard.k == 0) {
     std::string header;
     const auto names = r.model.joint_names();
     for (const Axis& a : grid.axes) header += names[static_cast<size_t>(a.joint)] + "_deg,";
-    header += "M_ie_kg,F_max_N\n";
+    const JointModel jm = joints.model;
+    header +=
+        jm == JointModel::Free ? "M_ie_kg,F_max_N\n" : str("M_ie_", joint_model_name(jm), "_kg,F_max_N\n");
     out.write(header.data(), header.size());
   }
   constexpr std::uint64_t kBlock = 2048;
@@ -365,6 +379,7 @@ int run_map(const MapOptions& o) {
   const double target_inverse_mass = target.inverse_mass_along_normal();
   for (unsigned t = 0; t < g.threads; ++t) {
     g.workers.push_back(std::make_unique<Worker>(r.model, grid, law, r, u, target_inverse_mass, kBlock));
+    g.workers.back()->joints = joints;
     g.workers.back()->values = plotting ? values.data() : nullptr;
     g.workers.back()->first_point = first;
   }
@@ -393,6 +408,7 @@ void register_map(CLI::App& app, Action& action) {
   o->robot.add_to(*sub);
   o->target.add_to(*sub);
   o->law.add_to(*sub, "Hysteresis damping law (Table 1) of the F_max column");
+  o->joints.add_to(*sub, false);
   sub->add_option("--vary", o->vary,
                   "Joints to vary, 1-based in URDF tree order, e.g. 1,2,3; the others stay at --joints-deg")
       ->required();

@@ -218,6 +218,8 @@ void print_robust_note(std::ostream& out, const ScenarioResult& r) {
 /// The rows of the table: configuration, M_ie, F_max (closed form and exact), tracking error.
 void print_rows(std::ostream& out, const Scenario& sc, const ScenarioResult& r) {
   const int w = 8 * sc.model->n() + 4;
+  if (sc.problem.joints.model != JointModel::Free)  // joint models of the contact
+    out << "M_ie with " << joint_model_name(sc.problem.joints.model) << " joints during the contact\n";
   out << std::left << std::setw(24) << "" << std::setw(w) << "Capture configuration (deg)" << std::right
       << std::setw(11) << "M_ie (kg)" << std::setw(14) << "F_max (kN)" << std::setw(14) << "exact (kN)"
       << std::setw(15) << "tracking (m)"

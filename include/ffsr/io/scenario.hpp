@@ -67,6 +67,9 @@ struct ScenarioKeys {
   int global_starts = 32;
   std::string reconfigure = "auto";  ///< reconfiguration before the approach: auto, always, never
   double reconfigure_duration = 0;   ///< s; 0: not set (duration / 4, longer if the rate limit needs it)
+  // joint models of the contact (algorithm/joint_models.hpp) and the multibody reference's servo
+  std::string contact_joints = "free";
+  std::vector<double> armature, joint_stiffness, joint_damping;
 
   std::string file;                  ///< the scenario file; empty: a built-in scenario
   std::string where;                 ///< "scenario FILE" or "built-in scenario", for messages
@@ -125,6 +128,8 @@ struct Scenario {
   GlobalObjective objective = GlobalObjective::Mass;  ///< the global run's objective
   std::uint64_t seed = 1;                             ///< the global search's seed
   bool hold_base_attitude = false;  ///< base-attitude = hold: the optimized run's CaptureOptions::hold_base_attitude
+  /// Multibody reference: per-joint PD gains holding the pre-contact rates (N m/rad, N m s/rad; size n).
+  Eigen::VectorXd joint_stiffness, joint_damping;
 };
 
 /// A URDF given as text for a built-in scenario whose `urdf` key names it (not read from disk).

@@ -225,7 +225,7 @@ inline CaptureSample capture_sample(const Model& model, Data& data, const Captur
   c.base = base;
   crba(model, data, base, theta);
   c.end_effector = frame_pose(model, data, pb.frame).p;
-  c.M_ie = 1.0 / (inverse_effective_mass(model, data, pb.frame, s.u_cap) + s.target_inv_mass);
+  c.M_ie = 1.0 / (inverse_effective_mass(model, data, pb.frame, s.u_cap, pb.joints) + s.target_inv_mass);
   c.f_max_estimate = max_force_closed_form(s.law, c.M_ie);
   return c;
 }
@@ -252,7 +252,8 @@ inline void finish_capture(const Model& model, Data& data, const CaptureProblem&
   res.base_position_drift = (base.position - pb.base.position).norm();
   res.base_attitude_drift = rotation_angle(base.orientation.toRotationMatrix() *
                                            pb.base.orientation.normalized().toRotationMatrix().transpose());
-  res.M_ie = 1.0 / (inverse_effective_mass(model, data, pb.frame, setup.u_cap) + setup.target_inv_mass);
+  res.M_ie =
+      1.0 / (inverse_effective_mass(model, data, pb.frame, setup.u_cap, pb.joints) + setup.target_inv_mass);
   res.approach_velocity = setup.v_in;
   res.f_max_closed_form = max_force_closed_form(setup.law, res.M_ie);
   res.f_max_exact = max_force_exact(setup.law, res.M_ie);

@@ -4,6 +4,7 @@
 // them (prepare_capture in capture.hpp), and the result with the monitors' record.
 #pragma once
 
+#include "ffsr/algorithm/joint_models.hpp"
 #include "ffsr/contact/contact_law.hpp"
 #include "ffsr/model/data.hpp"
 #include "ffsr/model/target.hpp"
@@ -63,6 +64,8 @@ struct CaptureProblem {
   ContactParams contact;
   std::string law = "herbert-mcwhannell";
   double approach_speed = 0.2;
+  /// The joints during the contact: the model of M_ie in the objective and the reported M_ie.
+  ContactJoints joints;
 };
 
 struct CaptureSample {

@@ -213,8 +213,9 @@ inline double slsqp_objective(unsigned n, const double* x, double* grad, void* p
     if (grad) Eigen::Map<Eigen::VectorXd>(grad, n) = c.g;
     return f;
   }
-  const double M = integrated_effective_mass_gradient(*c.model, *c.data, *c.base, c.theta, c.pb->frame,
-                                                      c.setup->u_cap, c.setup->target_inv_mass, c.g);
+  const double M =
+      integrated_effective_mass_gradient(*c.model, *c.data, *c.base, c.theta, c.pb->frame, c.setup->u_cap,
+                                         c.setup->target_inv_mass, c.pb->joints, c.g);
   if (grad) Eigen::Map<Eigen::VectorXd>(grad, n) = c.g;
   return M;
 }
@@ -242,8 +243,9 @@ inline ManifoldPoint evaluate_capture(const CaptureProblem& pb, const CaptureSet
   const Model& model = *pb.model;
   Data data(model);
   crba(model, data, base, theta);
-  ManifoldPoint p{theta, 1.0 / (inverse_effective_mass(model, data, pb.frame, s.u_cap) + s.target_inv_mass),
-                  0};
+  ManifoldPoint p{
+      theta, 1.0 / (inverse_effective_mass(model, data, pb.frame, s.u_cap, pb.joints) + s.target_inv_mass),
+      0};
   switch (objective) {
     case GlobalObjective::Mass:
       p.objective = p.M_ie;
@@ -367,7 +369,8 @@ inline bool local_capture_optimum(const Model& model, Data& data, const CaptureP
     return false;
   if (!detail::nearest_representative(model, pb.theta, th) || !detail::within_limits(model, th)) return false;
   crba(model, data, base, th);
-  const double M = 1.0 / (inverse_effective_mass(model, data, pb.frame, s.u_cap) + s.target_inv_mass);
+  const double M =
+      1.0 / (inverse_effective_mass(model, data, pb.frame, s.u_cap, pb.joints) + s.target_inv_mass);
   if (!std::isfinite(M)) return false;
   const double v = so.objective == GlobalObjective::RobustForce
                        ? so.robust->value(robot_inverse_inertia(model, data, base, th, pb.frame)).cvar95

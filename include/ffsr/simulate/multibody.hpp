@@ -1,7 +1,8 @@
 // ffsr/simulate/multibody.hpp -- the full robot-plus-target contact simulation (Figure 2), the
 // "classical numerical integration method" that the paper uses as its reference (Tables 3 and 6).
 //
-// The free-floating robot (joints passive: zero torque; gravity model.gravity, zero by default) and
+// The free-floating robot (joints passive: zero torque, unless MultibodyContactOptions gives a joint PD
+// servo holding the pre-contact rates and an armature; gravity model.gravity, zero by default) and
 // the target (a free rigid body) touch at one point. The target's surface near the contact is the
 // plane through its material contact point (r_tp) with normal u_n, both fixed in the target; the
 // end-effector is a point: the origin of the end-effector frame, or a point fixed in the end-effector
@@ -23,6 +24,7 @@
 
 #include "ffsr/algorithm/effective_mass.hpp"
 #include "ffsr/algorithm/forward_dynamics.hpp"
+#include "ffsr/algorithm/joint_models.hpp"
 #include "ffsr/algorithm/jacobian.hpp"
 #include "ffsr/algorithm/momentum.hpp"
 #include "ffsr/contact/contact_law.hpp"
@@ -43,6 +45,12 @@ struct MultibodyContactOptions {
   /// rho: the robot's contact point is the end-effector frame's origin plus rho (inertial frame at
   /// the first touch; the point is fixed in the end-effector body). Zero: the origin itself.
   Vector3 robot_contact_offset = Vector3::Zero();
+  /// Servoed joints (empty: zero for every joint; else size n): a PD on each joint holding the
+  /// pre-contact rates theta_dot_0, tau_k = -K_k (theta_k - theta_0k - theta_dot_0k t) - D_k
+  /// (theta_dot_k - theta_dot_0k), N m/rad and N m s/rad (N/m, N s/m prismatic), and the reflected
+  /// rotor inertia a_k added to H's joint diagonal (algorithm/joint_models.hpp), kg m^2 (kg).
+  /// All zero: the passive free joints of the paper.
+  Eigen::VectorXd joint_stiffness, joint_damping, armature;
 };
 
 struct ContactSample {
@@ -99,6 +107,8 @@ struct ContactSystem {
   Vector3 ct0, r0;  ///< target centre of mass and contact offset (in o) at the first touch
   Vector3 rho_ee;   ///< the robot's contact point from the end-effector origin, end-effector frame
   int n;
+  Eigen::VectorXd qd0, K, D,
+      armature;  ///< joint servo and armature (MultibodyContactOptions; zeros if unset)
   // scratch
   Eigen::VectorXd theta, v, tau, a, ydot_scratch, y_scratch;
 
@@ -112,6 +122,10 @@ struct ContactSystem {
         frame(f),
         target(t),
         n(m.n()),
+        qd0(Eigen::VectorXd::Zero(m.n())),
+        K(Eigen::VectorXd::Zero(m.n())),
+        D(Eigen::VectorXd::Zero(m.n())),
+        armature(Eigen::VectorXd::Zero(m.n())),
         theta(m.n()),
         v(m.nv()),
         tau(m.nv()),
@@ -167,14 +181,34 @@ struct ContactSystem {
     return law.force(k.delta, k.delta_dot);
   }
 
+  /// The servo's joint torques at time t (from the first touch) added to tau's joint entries.
+  void add_joint_servo(double t, const Eigen::Ref<const Eigen::VectorXd>& y) {
+    tau.tail(n).array() -=
+        K.array() * (y.segment(6, n) - qd0 * t).array() + D.array() * (y.segment(iv() + 6, n) - qd0).array();
+  }
+
+  /// a = (H + diag(0, armature))^-1 (tau - C): forward_dynamics with the armature on H's joint diagonal.
+  void dynamics(const BasePose& base) {
+    if (armature.isZero()) {
+      forward_dynamics(model, data, base, theta, v, tau, a);
+      return;
+    }
+    crba(model, data, base, theta);
+    a = tau - bias_forces(model, data, base, theta, v);
+    detail::factor_with_armature(data, armature, "simulate_contact");
+    detail::cholesky_solve(data.L, a);
+  }
+
   template <class Law>
-  void rhs(const Law& law, const Eigen::Ref<const Eigen::VectorXd>& y, Eigen::Ref<Eigen::VectorXd> ydot) {
+  void rhs(const Law& law, double t, const Eigen::Ref<const Eigen::VectorXd>& y,
+           Eigen::Ref<Eigen::VectorXd> ydot) {
     const Kin k = kinematics(y);
     const double F = law.force(k.delta, k.delta_dot);
-    // robot: H a = J^T [-F u; rho x (-F u)] - C
+    // robot: H a = J^T [-F u; rho x (-F u)] - C + [0; servo torques]
     tau.noalias() = data.J.topRows<3>().transpose() * (-F * k.u);
     tau.noalias() += data.J.bottomRows<3>().transpose() * k.rho.cross(-F * k.u);
-    forward_dynamics(model, data, k.base, theta, v, tau, a);
+    add_joint_servo(t, y);
+    dynamics(k.base);
     ydot.segment<3>(0) = v.head<3>();
     ydot.segment<3>(3) = rotation_vector_rate(y.segment<3>(3), v.segment<3>(3));
     ydot.segment(6, n) = v.tail(n);
@@ -193,7 +227,8 @@ struct ContactSystem {
   double total_energy(const Eigen::Ref<const Eigen::VectorXd>& y) {
     const Kin k = kinematics(y);
     const Matrix3 I = k.Rt * target.inertia * k.Rt.transpose();
-    return kinetic_energy(model, data, v) + 0.5 * target.mass * k.vt.squaredNorm() + 0.5 * k.wt.dot(I * k.wt);
+    return kinetic_energy(model, data, v) + 0.5 * v.tail(n).dot(armature.cwiseProduct(v.tail(n))) +
+           0.5 * target.mass * k.vt.squaredNorm() + 0.5 * k.wt.dot(I * k.wt);
   }
 
   /// Total momentum of robot + target, [P; L about o].
@@ -312,20 +347,33 @@ inline cvode::Options contact_cvode_options(const MultibodyContactOptions& optio
 /// a strongly damped contact hovers at the clamp, where dF/dt vanishes on an interval, which CVODE's
 /// root finder must not see. `yd`, `yp` are scratch of the state's size.
 template <class Law>
-void contact_roots(ContactSystem& sys, const Law& law, double h, const Eigen::Ref<const Eigen::VectorXd>& y,
-                   Eigen::Ref<Eigen::VectorXd> g, Eigen::VectorXd& yd, Eigen::VectorXd& yp) {
+void contact_roots(ContactSystem& sys, const Law& law, double h, double t,
+                   const Eigen::Ref<const Eigen::VectorXd>& y, Eigen::Ref<Eigen::VectorXd> g,
+                   Eigen::VectorXd& yd, Eigen::VectorXd& yp) {
   const auto k = sys.kinematics(y);
   g(0) = k.delta;
   if (!(sys.force(law, k) > 0.0) || !(k.delta_dot > 0.0)) {
     g(1) = -1.0;
     return;
   }
-  sys.rhs(law, y, yd);
+  sys.rhs(law, t, y, yd);
   yp = y + h * yd;
   const double Fp = sys.force(law, sys.kinematics(yp));
   yp = y - h * yd;
   const double Fm = sys.force(law, sys.kinematics(yp));
   g(1) = (Fp - Fm) / (2 * h);
+}
+
+/// The servo's per-joint values (MultibodyContactOptions): empty gives zeros; otherwise size n,
+/// finite and >= 0. InputError "simulate_contact: <what> ...".
+inline Eigen::VectorXd servo_values(const Eigen::VectorXd& v, const Model& model, const char* what) {
+  if (v.size() == 0) return Eigen::VectorXd::Zero(model.n());
+  require_size(v.size(), model.n(), "simulate_contact", what);
+  for (Eigen::Index k = 0; k < v.size(); ++k)
+    if (!(v(k) >= 0) || !std::isfinite(v(k)))
+      throw InputError(str("simulate_contact: ", what, " of joint '", model.joint(int(k)).name,
+                           "' must be finite and >= 0, got ", v(k)));
+  return v;
 }
 
 /// Updates the running maxima of `res` (delta_max, f_max and where it occurred) with the sample
@@ -393,12 +441,16 @@ inline MultibodyContactResult simulate_contact(const Model& model, const BasePos
   const double t_hertz = detail::hertz_time(params, start.M_ie, vin);
   const double t_max = options.max_duration > 0 ? options.max_duration : 100.0 * t_hertz;
 
-  auto rhs = [&](double, const Eigen::Ref<const Eigen::VectorXd>& y, Eigen::Ref<Eigen::VectorXd> yd) {
-    sys.rhs(law, y, yd);
+  sys.qd0 = start.qd;
+  sys.K = detail::servo_values(options.joint_stiffness, model, "joint stiffness");
+  sys.D = detail::servo_values(options.joint_damping, model, "joint damping");
+  sys.armature = detail::servo_values(options.armature, model, "armature");
+  auto rhs = [&](double t, const Eigen::Ref<const Eigen::VectorXd>& y, Eigen::Ref<Eigen::VectorXd> yd) {
+    sys.rhs(law, t, y, yd);
   };
   Eigen::VectorXd yd(sys.size()), yp(sys.size());
-  auto roots = [&](double, const Eigen::Ref<const Eigen::VectorXd>& y, Eigen::Ref<Eigen::VectorXd> g) {
-    detail::contact_roots(sys, law, 1e-6 * t_hertz, y, g, yd, yp);
+  auto roots = [&](double t, const Eigen::Ref<const Eigen::VectorXd>& y, Eigen::Ref<Eigen::VectorXd> g) {
+    detail::contact_roots(sys, law, 1e-6 * t_hertz, t, y, g, yd, yp);
   };
   cvode::Integrator integ(rhs, y0, 0.0, detail::contact_cvode_options(options, sys, t_hertz), 2, roots,
                           {-1, -1});

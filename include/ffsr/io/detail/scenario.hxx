@@ -255,6 +255,20 @@ inline std::vector<ScenarioKey> build_scenario_keys() {
       FFSR_KEY("reconfigure-duration", reconfigure_duration,
                "Global run: time of the reconfiguration, s, 0 < t < duration (default: duration / 4, longer "
                "if max-joint-rate-deg needs it)"),
+      // joint models of the contact (algorithm/joint_models.hpp)
+      FFSR_KEY("contact-joints", contact_joints,
+               "The joints during the contact: free (the paper's), locked (one rigid body) or armature "
+               "(free with the armature's reflected rotor inertia)",
+               "free"),
+      FFSR_KEY("armature", armature,
+               "Reflected rotor inertia per joint, kg m^2 (kg for prismatic): one value or one per joint",
+               "0"),
+      FFSR_KEY(
+          "joint-stiffness", joint_stiffness,
+          "Multibody reference: joint PD stiffness holding the pre-contact rates, N m/rad (one or per joint)",
+          "0"),
+      FFSR_KEY("joint-damping", joint_damping,
+               "Multibody reference: joint PD damping, N m s/rad (one or per joint)", "0"),
   };
 }
 
@@ -664,6 +678,9 @@ inline Scenario build_scenario(ScenarioKeys k, const EmbeddedUrdf* embedded) {
   sc.capture = capture_of(k);
   sc.objective = global_objective_of(k.objective);
   sc.seed = seed_of(k.seed);
+  pb.joints = contact_joints_of(k.contact_joints, k.armature, model);  // joint models of the contact
+  sc.joint_stiffness = per_joint_values(k.joint_stiffness, model, "--joint-stiffness");
+  sc.joint_damping = per_joint_values(k.joint_damping, model, "--joint-damping");
   if (k.global_starts < 1) throw InputError(str("--global-starts: must be >= 1, got ", k.global_starts));
   if (k.given.count("max-joint-rate-deg") && !(finite(k.max_joint_rate_deg, "max-joint-rate-deg") > 0))
     throw InputError(str("--max-joint-rate-deg: must be positive, got ", k.max_joint_rate_deg));

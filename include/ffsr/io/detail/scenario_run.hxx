@@ -51,6 +51,9 @@ inline GlobalRun run_global(const Scenario& sc, const CaptureResult& paper_run, 
   g.search.starts = sc.keys.global_starts;
   g.search.objective = objective;
   g.search.robust = robust;
+  g.search.multibody.joint_stiffness = sc.joint_stiffness;  // joint models: the servoed multibody reference
+  g.search.multibody.joint_damping = sc.joint_damping;
+  g.search.multibody.armature = sc.problem.joints.armature;
   // robust-force scenarios: the reaching runs land within 0.01 % of the manifold optimum at the reached
   // base pose (the library's default, 1 %, is coarser than the difference between the robust and the
   // nominal optimum), the nominal global run beside the robust one too, so the two compare fairly
@@ -228,6 +231,10 @@ inline nlohmann::json resolved_json(const Scenario& sc) {
   j["base-attitude"] = o.base_attitude;
   j["reconfigure"] = o.reconfigure;
   if (o.given.count("reconfigure-duration")) j["reconfigure-duration"] = o.reconfigure_duration;
+  if (o.contact_joints != "free") {  // joint models of the contact: absent means free (the paper's)
+    j["contact-joints"] = o.contact_joints;
+    j["armature"] = vector_json(sc.problem.joints.armature);
+  }
   return j;
 }
 
