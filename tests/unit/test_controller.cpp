@@ -39,7 +39,8 @@ double drive_and_compare(CaptureController<Policy>& ctrl, const CaptureProblem& 
   ControllerState st{base, theta};
   const TargetEstimate est = target_estimate(pb.target);
   bool fault = false;
-  auto field = [&](double t, const BasePose& b, const Eigen::VectorXd& th, Eigen::VectorXd& thd, Vector6& xb) {
+  auto field = [&](double t, const BasePose& b, const Eigen::VectorXd& th, Eigen::VectorXd& thd,
+                   Vector6& xb) {
     st.base = b;
     st.theta = th;
     ctrl.step(t, st, est, cmd);
@@ -76,6 +77,17 @@ CaptureOptions global_options(const Scenario& sc) {
   o.gain = 0.0;
   o.max_joint_rate = sc.keys.max_joint_rate_deg * M_PI / 180.0;
   return o;
+}
+
+/// The same reference position and velocity at t (1e-9 m, 1e-11 m/s).
+void same_reference(const LineReference& a, const LineReference& b, double t) {
+  Vector3 x1, v1, w1, x2, v2, w2;
+  Matrix3 R1, R2;
+  a.at(t, x1, v1, R1, w1);
+  b.at(t, x2, v2, R2, w2);
+  CAPTURE(t);
+  CHECK((x1 - x2).norm() <= 1e-9);
+  CHECK((v1 - v2).norm() <= 1e-11);
 }
 
 }  // namespace
@@ -139,8 +151,9 @@ TEST_CASE("controller: update_target re-anchors the line with a continuous refer
   Matrix3 R1, R2;
   before.at(tu, x1, v1, R1, w1);
   after.at(tu, x2, v2, R2, w2);
-  CHECK((v2 - v1).norm() <= 1e-12 * (1 + v1.norm()));  // velocity continuous
-  CHECK((x2 - cmd.end_effector).norm() <= 1e-12);       // anchored at the last tick's end-effector
+  CHECK((v2 - v1).norm() <= 1e-12 * (1 + v1.norm()));                         // velocity continuous
+  CHECK((x2 - x1).norm() <= 1e-12);                                           // position continuous
+  CHECK((after.acceleration(tu) - before.acceleration(tu)).norm() <= 1e-12);  // acceleration too
   // the new capture point: the moved target propagated independently to T
   const Vector3 expected = propagate_target(moved, T - tu).contact_point();
   CHECK((ctrl.setup().x_cap - expected).norm() <= 1e-12);
@@ -155,9 +168,14 @@ TEST_CASE("controller: update_target re-anchors the line with a continuous refer
   // the exact target's estimate leaves the capture point where the plan put it (isotropic: closed form)
   auto exact = make_gradient_controller(sc.problem, sc.task, sc.capture);
   const Vector3 planned = exact.setup().x_cap;
+  const LineReference before_exact = exact.setup().line;
   REQUIRE(exact.update_target(tu, target_estimate(propagate_target(sc.problem.target, tu))) ==
           ControlFault::None);
   CHECK((exact.setup().x_cap - planned).norm() <= 1e-12);
+  // ... and the reference too: the quintic through the line's own position, velocity and
+  // acceleration at tu that ends at the same point is the line itself
+  for (double t : {tu, tu + 1.0, 100.0, 150.0, T}) same_reference(before_exact, exact.setup().line, t);
+  CHECK((exact.setup().line.acceleration(tu) - before_exact.acceleration(tu)).norm() <= 1e-12);
   // bad inputs leave the plan as it was
   const Vector3 kept = exact.setup().x_cap;
   TargetEstimate bad = target_estimate(sc.problem.target);
@@ -166,6 +184,33 @@ TEST_CASE("controller: update_target re-anchors the line with a continuous refer
   CHECK(exact.update_target(T, target_estimate(sc.problem.target)) == ControlFault::Time);
   CHECK(exact.update_target(-1, target_estimate(sc.problem.target)) == ControlFault::Time);
   CHECK(exact.setup().x_cap == kept);
+}
+
+TEST_CASE("controller: a prediction window averages the predicted capture points") {
+  const Scenario sc = load_scenario(kRobots + "paper_7dof_position.toml");
+  ControllerOptions copt;
+  copt.prediction_window = 3;
+  auto ctrl = make_gradient_controller(sc.problem, sc.task, sc.capture, copt);
+  const Vector3 planned = ctrl.setup().x_cap;  // the exact target's capture point
+  const Vector3 d(0.01, -0.02, 0.005);
+  // three estimates at 10, 20, 30 s: offsets +d, -d and 0 average to the exact point
+  const double ts[] = {10.0, 20.0, 30.0};
+  const Vector3 off[] = {d, -d, Vector3::Zero()};
+  for (int i = 0; i < 3; ++i) {
+    Target e = propagate_target(sc.problem.target, ts[i]);
+    e.position += off[i];
+    REQUIRE(ctrl.update_target(ts[i], target_estimate(e)) == ControlFault::None);
+    if (i == 0) CHECK((ctrl.setup().x_cap - planned - d).norm() <= 1e-12);  // one prediction: itself
+  }
+  CHECK((ctrl.setup().x_cap - planned).norm() <= 1e-12);
+  // a fourth replaces the first (+d): the mean of -d, 0, +2d is d/3
+  Target e = propagate_target(sc.problem.target, 40.0);
+  e.position += 2 * d;
+  REQUIRE(ctrl.update_target(40.0, target_estimate(e)) == ControlFault::None);
+  CHECK((ctrl.setup().x_cap - planned - d / 3).norm() <= 1e-12);
+  copt.prediction_window = 0;
+  CHECK_THROWS_WITH(make_gradient_controller(sc.problem, sc.task, sc.capture, copt),
+                    Catch::Contains("prediction window"));
 }
 
 TEST_CASE("controller: a fault names the field and gives zero rates") {
@@ -235,8 +280,9 @@ TEST_CASE("controller: a fault names the field and gives zero rates") {
   const std::string from = "<joint name=\"joint2\" type=\"continuous\">";
   REQUIRE(xml.find(from) != std::string::npos);
   xml.replace(xml.find(from), from.size(),
-              "<joint name=\"joint2\" type=\"revolute\"><limit lower=\"" + std::to_string(sc.problem.theta(1) - 1.0) +
-                  "\" upper=\"" + std::to_string(sc.problem.theta(1) + 1.0) + "\" effort=\"1\" velocity=\"1\"/>");
+              "<joint name=\"joint2\" type=\"revolute\"><limit lower=\"" +
+                  std::to_string(sc.problem.theta(1) - 1.0) + "\" upper=\"" +
+                  std::to_string(sc.problem.theta(1) + 1.0) + "\" effort=\"1\" velocity=\"1\"/>");
   const Model limited = model_from_urdf_string(xml, "limited");
   REQUIRE(limited.n() == 3);
   CaptureProblem pb = sc.problem;
@@ -296,7 +342,7 @@ TEST_CASE("closed loop: exact target, stiff rate loops: the global plan's captur
   o.record_every = 10;
   const ClosedLoopResult r = simulate_closed_loop(ctrl, o);
   CHECK(r.fault_ticks == 0);
-  CHECK(r.capture_error < 1e-3);  // the requirement: 1 mm
+  CHECK(r.capture_error < 1e-3);                           // the requirement: 1 mm
   CHECK(std::abs(r.M_ie - open.M_ie) / open.M_ie < 5e-3);  // within 0.5 % of the open-loop plan
   // zero momentum at rest, no external force: conserved along the loop (scale: a body's momentum
   // is ~ m v ~ 100 kg x 1 cm/s)

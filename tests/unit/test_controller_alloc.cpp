@@ -105,8 +105,10 @@ Count count_ticks(CaptureController<Policy>& ctrl, const CaptureProblem& pb, lon
       st.theta(j) = pb.theta(j) + 1e-3 * std::sin(1e-3 * static_cast<double>(k) + static_cast<double>(j));
     if (k % 1000 == 999) st.theta(0) = std::nan("");
     ctrl.step(t, st, est, cmd);
-    if (cmd.status == ControlStatus::Fault) ++faults;
-    else if (cmd.theta_dot.allFinite()) ++rated;
+    if (cmd.status == ControlStatus::Fault)
+      ++faults;
+    else if (cmd.theta_dot.allFinite())
+      ++rated;
   }
   return {g_news.load() - n0, g_deletes.load() - d0};
 }

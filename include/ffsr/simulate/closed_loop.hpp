@@ -56,9 +56,9 @@ struct ClosedLoopOptions {
   RateLoopGains loop;
   EstimateNoise noise;
   std::uint64_t seed = 1;
-  double rtol = 1e-9;            ///< CVODE
-  double atol = 1e-12;           ///< CVODE, m, rad, m/s, rad/s
-  double record_every = 0;       ///< s between recorded samples (0: none)
+  double rtol = 1e-9;       ///< CVODE
+  double atol = 1e-12;      ///< CVODE, m, rad, m/s, rad/s
+  double record_every = 0;  ///< s between recorded samples (0: none)
 };
 
 struct ClosedLoopSample {
@@ -69,21 +69,21 @@ struct ClosedLoopSample {
 };
 
 struct ClosedLoopResult {
-  Eigen::VectorXd theta;                  ///< reached configuration at T
-  BasePose base;                          ///< base pose at T
+  Eigen::VectorXd theta;  ///< reached configuration at T
+  BasePose base;          ///< base pose at T
   Vector3 end_effector = Vector3::Zero();
   Vector3 capture_point = Vector3::Zero();  ///< the true target's contact point at T
-  double capture_error = 0;               ///< |p_e(T) - capture point|, m
-  double M_ie = 0;                        ///< at the reached configuration (true target at T), kg
-  double f_max_closed_form = 0;           ///< Eq. 24 at that M_ie, N
-  double max_torque = 0;                  ///< largest |tau_k|, N m
-  double max_tracking_lag = 0;            ///< largest |u_k - theta_dot_k| at the end of a tick, rad/s
-  double max_reference_error = 0;         ///< largest |p_e - x_d| at the ticks, m
-  double base_attitude_change = 0;        ///< rotation angle of the base from 0 to T, rad
-  double base_position_change = 0;        ///< m
-  double max_momentum = 0;                ///< largest |P| + |L| at the ticks
+  double capture_error = 0;                 ///< |p_e(T) - capture point|, m
+  double M_ie = 0;                          ///< at the reached configuration (true target at T), kg
+  double f_max_closed_form = 0;             ///< Eq. 24 at that M_ie, N
+  double max_torque = 0;                    ///< largest |tau_k|, N m
+  double max_tracking_lag = 0;              ///< largest |u_k - theta_dot_k| at the end of a tick, rad/s
+  double max_reference_error = 0;           ///< largest |p_e - x_d| at the ticks, m
+  double base_attitude_change = 0;          ///< rotation angle of the base from 0 to T, rad
+  double base_position_change = 0;          ///< m
+  double max_momentum = 0;                  ///< largest |P| + |L| at the ticks
   long ticks = 0, estimates = 0, fault_ticks = 0, damped_ticks = 0, rate_limited_ticks = 0;
-  long saturated_ticks = 0;               ///< ticks with some joint's torque at the limit
+  long saturated_ticks = 0;  ///< ticks with some joint's torque at the limit
   long cvode_steps = 0;
   std::vector<ClosedLoopSample> series;
 };
@@ -100,8 +100,19 @@ struct ClosedLoopPlant {
   Eigen::VectorXd u, theta, v, tau, a, e, kp, ki;
 
   ClosedLoopPlant(const Model& m, const BasePose& b0, const Eigen::VectorXd& theta0, const RateLoopGains& g)
-      : model(m), data(m), base0(b0), n(m.n()), gains(g), u(Eigen::VectorXd::Zero(n)), theta(n), v(6 + n),
-        tau(Eigen::VectorXd::Zero(6 + n)), a(6 + n), e(n), kp(n), ki(n) {
+      : model(m),
+        data(m),
+        base0(b0),
+        n(m.n()),
+        gains(g),
+        u(Eigen::VectorXd::Zero(n)),
+        theta(n),
+        v(6 + n),
+        tau(Eigen::VectorXd::Zero(6 + n)),
+        a(6 + n),
+        e(n),
+        kp(n),
+        ki(n) {
     base0.orientation.normalize();
     crba(model, data, base0, theta0);  // M = H_mm - H_mb H_b^-1 H_bm, its diagonal
     const Eigen::LLT<Matrix6> Hb(data.H.topLeftCorner<6, 6>());
@@ -152,7 +163,9 @@ struct ClosedLoopPlant {
 /// The target estimate k: the truth at t plus the noise of `o` from SampleStream(seed, k).
 inline TargetEstimate noisy_estimate(const Target& truth, const ClosedLoopOptions& o, std::uint64_t k) {
   SampleStream s(o.seed, k);
-  auto gauss3 = [&](double sigma) { return Vector3(sigma * s.normal(), sigma * s.normal(), sigma * s.normal()); };
+  auto gauss3 = [&](double sigma) {
+    return Vector3(sigma * s.normal(), sigma * s.normal(), sigma * s.normal());
+  };
   TargetEstimate e = target_estimate(truth);
   e.position += gauss3(o.noise.position);
   e.attitude = Quaternion(rotation_from_vector(gauss3(o.noise.attitude)) * truth.rotation());
@@ -163,7 +176,8 @@ inline TargetEstimate noisy_estimate(const Target& truth, const ClosedLoopOption
 
 inline void check_closed_loop_options(const ClosedLoopOptions& o) {
   auto positive = [](double x, const char* what) {
-    if (!std::isfinite(x) || x <= 0) throw InputError(str("closed loop: ", what, " must be positive, got ", x));
+    if (!std::isfinite(x) || x <= 0)
+      throw InputError(str("closed loop: ", what, " must be positive, got ", x));
   };
   auto non_negative = [](double x, const char* what) {
     if (!std::isfinite(x) || x < 0) throw InputError(str("closed loop: ", what, " must be >= 0, got ", x));

@@ -57,9 +57,13 @@ ClosedLoopResult simulate_closed_loop(CaptureController<Policy>& ctrl, const Clo
   cvode::Options co;
   co.rtol = o.rtol;
   co.atol = o.atol;
+  if (T * o.control_rate > 1e8 || T * o.estimate_rate > 1e7)
+    throw InputError(str("closed loop: ", T * o.control_rate, " ticks and ", T * o.estimate_rate,
+                         " estimates over T = ", T, " s: too many (at most 1e8 and 1e7)"));
   const long ticks = std::max(1L, static_cast<long>(std::ceil(T * o.control_rate - 1e-9)));
   const double dt = T / static_cast<double>(ticks);
   co.max_step = dt;
+  co.initial_step = 0.1 * dt;  // each tick restarts CVODE: no step-size estimate from scratch
   cvode::Integrator integ([&](double, const Eigen::Ref<const Eigen::VectorXd>& yy,
                               Eigen::Ref<Eigen::VectorXd> yd) { plant.rhs(yy, yd); },
                           y, 0.0, co);
@@ -77,14 +81,16 @@ ClosedLoopResult simulate_closed_loop(CaptureController<Policy>& ctrl, const Clo
       est = detail::noisy_estimate(propagate_target(pb.target, te), o, static_cast<std::uint64_t>(next_est));
       const ControlFault f = ctrl.update_target(te, est);
       if (f != ControlFault::None)
-        throw NumericalError(str("closed loop: update_target at t = ", te, " s: fault (", fault_name(f), ")"));
+        throw NumericalError(
+            str("closed loop: update_target at t = ", te, " s: fault (", fault_name(f), ")"));
       ++res.estimates;
     }
     st.base = plant.base(y);
     st.theta = y.segment(6, n);
     ctrl.step(t, st, est, cmd);
     if (cmd.status == ControlStatus::Fault)
-      throw NumericalError(str("closed loop: the controller faulted at t = ", t, " s (", fault_name(cmd.fault),
+      throw NumericalError(str("closed loop: the controller faulted at t = ", t, " s (",
+                               fault_name(cmd.fault),
                                cmd.fault_index >= 0 ? str(" ", cmd.fault_index) : std::string(), ")"));
     plant.u = cmd.theta_dot;
     if (plant.torques(y)) ++res.saturated_ticks;
@@ -102,7 +108,8 @@ ClosedLoopResult simulate_closed_loop(CaptureController<Policy>& ctrl, const Clo
     integ.advance(k + 1 == ticks ? T : t + dt);
     y = integ.y();
     res.cvode_steps += integ.num_steps();
-    res.max_tracking_lag = std::max(res.max_tracking_lag, (plant.u - y.segment(plant.iv() + 6, n)).cwiseAbs().maxCoeff());
+    res.max_tracking_lag =
+        std::max(res.max_tracking_lag, (plant.u - y.segment(plant.iv() + 6, n)).cwiseAbs().maxCoeff());
   }
   detail::finish_closed_loop(ctrl, plant, y, res);
   return res;
