@@ -21,5 +21,7 @@ void register_robust(CLI::App& app, Action& action);
 void register_pareto(CLI::App& app, Action& action);
 /// The main job (no subcommand): run a capture scenario; a flag overrides the scenario file's key.
 void register_run(CLI::App& app, Action& action);
+/// `closed-loop`: the capture controller with the robot's dynamics and a noisy target estimate.
+void register_closed_loop(CLI::App& app, Action& action);
 
 }  // namespace ffsr::cli

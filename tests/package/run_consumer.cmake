@@ -115,6 +115,26 @@ foreach(exe consumer_dynamics consumer_urdf consumer_cvode)
   message(STATUS "${exe}:\n${step_output}")
 endforeach()
 
+# 4b. the capture controller example (examples/capture_controller) against the installed package:
+#     configure, build, run on the installed paper_7dof.urdf; it must reach the capture point
+if(FFSR_SOURCE_DIR)
+  set(example_args ${configure_args})
+  list(REMOVE_AT example_args 0 1)  # -S <consumer source>
+  run_step("configuring examples/capture_controller" "${CMAKE_COMMAND}" -S "${FFSR_SOURCE_DIR}/examples/capture_controller"
+           ${example_args} -B "${WORK_DIR}/build_example")
+  run_step("building examples/capture_controller" "${CMAKE_COMMAND}" --build "${WORK_DIR}/build_example" ${config_args})
+  file(GLOB_RECURSE path "${WORK_DIR}/build_example/capture_controller" "${WORK_DIR}/build_example/capture_controller.exe")
+  if(NOT path)
+    message(FATAL_ERROR "package consumer: examples/capture_controller was not built")
+  endif()
+  list(GET path 0 path)
+  run_step("running examples/capture_controller" "${path}" "${prefix}/share/ffsr/robots/paper_7dof.urdf")
+  if(NOT step_output MATCHES "capture point reached within [0-9.e+-]+ m")
+    message(FATAL_ERROR "package consumer: unexpected output of examples/capture_controller:\n${step_output}")
+  endif()
+  message(STATUS "examples/capture_controller:\n${step_output}")
+endif()
+
 # 5. ffsr_add_scenario_test: the stored baseline passes, a moved value fails and is named
 if(FFSR_SOURCE_DIR)
   set(ctest_args "${CMAKE_CTEST_COMMAND}" --output-on-failure -R "^consumer_scenario$")

@@ -322,6 +322,20 @@ CaptureResult integrate_capture(const CaptureProblem& pb, const CaptureTask& tas
   return res;
 }
 
+/// The paper's null-space policy for a capture setup: gain rho = opt.gain, the objective, and for the
+/// exact force the scale of F = f_scale M^(alpha/(alpha+1)). Shared by plan_capture and the capture
+/// controller (control/capture_controller.hpp).
+inline GradientPolicy gradient_policy(const CaptureProblem& pb, const CaptureOptions& opt,
+                                      const CaptureSetup& setup) {
+  GradientPolicy policy;
+  policy.gain = opt.gain;
+  policy.objective = opt.objective;
+  policy.alpha = pb.contact.alpha;
+  if (opt.objective == CaptureObjective::ExactMaxForce)
+    policy.f_scale = max_force_exact(setup.law, 1.0) * (pb.contact.alpha / (pb.contact.alpha + 1));
+  return policy;
+}
+
 /// Plans the approach with the paper's method (see the top of this file): the line reference, the
 /// gradient policy with gain rho, the RK4 integration. Throws InputError for bad arguments
 /// (including rho != 0 on a task without a null space), NumericalError when the capture point is not
@@ -329,12 +343,7 @@ CaptureResult integrate_capture(const CaptureProblem& pb, const CaptureTask& tas
 inline CaptureResult plan_capture(const CaptureProblem& pb, const CaptureTask& task,
                                   const CaptureOptions& opt) {
   const CaptureSetup setup = prepare_capture(pb, task, opt);
-  GradientPolicy policy;
-  policy.gain = opt.gain;
-  policy.objective = opt.objective;
-  policy.alpha = pb.contact.alpha;
-  if (opt.objective == CaptureObjective::ExactMaxForce)
-    policy.f_scale = max_force_exact(setup.law, 1.0) * (pb.contact.alpha / (pb.contact.alpha + 1));
+  GradientPolicy policy = gradient_policy(pb, opt, setup);
   return integrate_capture(pb, task, opt, setup, policy);
 }
 

@@ -1,0 +1,125 @@
+// Timings of the capture controller (control/capture_controller.hpp): step() per tick, median and
+// 99.9th percentile over 1e5 calls, and update_target() median, on the paper's 3-DOF robot and the
+// 7-DOF robot (position and pose tasks), paper's gradient policy and the servo. One thread, pinned
+// to one core when the system allows it. Run (Release): build/bench/ffsr-bench-controller [robots/]
+// [--calls N]. Prints one line per case; exit status 1 when a step median exceeds its budget
+// (3-DOF 5 us, 7-DOF 20 us) or the 99.9th percentile exceeds 3x the median.
+
+#include "ffsr/control/capture_controller.hpp"
+#include "ffsr/io/scenario.hpp"
+
+#include <sched.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+namespace {
+
+using namespace ffsr;
+using Clock = std::chrono::steady_clock;
+
+double percentile(std::vector<double> v, double p) {
+  const size_t k = std::min(v.size() - 1, static_cast<size_t>(p * static_cast<double>(v.size())));
+  std::nth_element(v.begin(), v.begin() + static_cast<long>(k), v.end());
+  return v[k];
+}
+
+struct Timing {
+  double median_us, p999_us, update_median_us;
+};
+
+template <class Policy>
+Timing time_controller(CaptureController<Policy>& ctrl, const CaptureProblem& pb, long calls) {
+  ControlCommand cmd = ctrl.make_command();
+  ControllerState st{pb.base, pb.theta};
+  const TargetEstimate est = target_estimate(pb.target);
+  const double T = ctrl.duration();
+  std::vector<double> us(static_cast<size_t>(calls));
+  for (long k = 0; k < 1000; ++k) ctrl.step(0.5 * T, st, est, cmd);  // warm up
+  for (long k = 0; k < calls; ++k) {
+    const double t = T * static_cast<double>(k) / static_cast<double>(calls);
+    for (Eigen::Index j = 0; j < st.theta.size(); ++j)
+      st.theta(j) = pb.theta(j) + 1e-3 * std::sin(1e-3 * static_cast<double>(k) + static_cast<double>(j));
+    const auto a = Clock::now();
+    ctrl.step(t, st, est, cmd);
+    const auto b = Clock::now();
+    if (cmd.status == ControlStatus::Fault) {
+      std::fprintf(stderr, "bench_controller: unexpected fault (%s)\n", fault_name(cmd.fault));
+      std::exit(2);
+    }
+    us[static_cast<size_t>(k)] = std::chrono::duration<double, std::micro>(b - a).count();
+  }
+  std::vector<double> up;
+  for (int k = 0; k < 200; ++k) {
+    const double t = T * (0.05 + 0.9 * k / 200.0);
+    const Target now = propagate_target(pb.target, t);
+    const auto a = Clock::now();
+    const ControlFault f = ctrl.update_target(t, target_estimate(now));
+    const auto b = Clock::now();
+    if (f != ControlFault::None) std::exit(2);
+    up.push_back(std::chrono::duration<double, std::micro>(b - a).count());
+  }
+  return {percentile(us, 0.5), percentile(us, 0.999), percentile(up, 0.5)};
+}
+
+bool report(const char* name, const Timing& t, double budget_us) {
+  const bool ok = t.median_us <= budget_us && t.p999_us <= 3 * t.median_us;
+  std::printf(
+      "%-34s step median %7.2f us  p99.9 %7.2f us (%.2fx)  budget %4.0f us  update_target median %9.2f us  "
+      "%s\n",
+      name, t.median_us, t.p999_us, t.p999_us / t.median_us, budget_us, t.update_median_us,
+      ok ? "ok" : "OVER");
+  return ok;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string robots = std::string(FFSR_SOURCE_DIR) + "/robots/";
+  long calls = 100000;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--calls" && i + 1 < argc)
+      calls = std::atol(argv[++i]);
+    else
+      robots = a + "/";
+  }
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  CPU_SET(0, &set);
+  sched_setaffinity(0, sizeof(set), &set);  // best effort
+  bool ok = true;
+  struct Case {
+    const char* file;
+    double budget;
+  };
+  for (const Case& c :
+       {Case{"paper_3dof", 5.0}, Case{"paper_7dof_position", 20.0}, Case{"paper_7dof_pose", 20.0}}) {
+    const Scenario sc = load_scenario(robots + c.file + ".toml");
+    auto paper = make_gradient_controller(sc.problem, sc.task, sc.capture);
+    ok = report((std::string(c.file) + " gradient").c_str(), time_controller(paper, sc.problem, calls),
+                c.budget) &&
+         ok;
+    CaptureOptions g = sc.capture;
+    g.max_joint_rate = 3 * M_PI / 180;
+    Eigen::VectorXd goal = sc.problem.theta;
+    goal(0) += 0.3;
+    auto servo = make_servo_controller(sc.problem, sc.task, g, goal);
+    ok = report((std::string(c.file) + " servo").c_str(), time_controller(servo, sc.problem, calls),
+                c.budget) &&
+         ok;
+  }
+  {  // update_target on an anisotropic target: the torque-free propagation by RK4 (1 ms steps)
+    const Scenario sc = load_scenario(robots + "paper_7dof_position.toml");
+    CaptureProblem pb = sc.problem;
+    pb.target.inertia = Vector3(80, 100, 120).asDiagonal();
+    auto paper = make_gradient_controller(pb, sc.task, sc.capture);
+    ok = report("paper_7dof_position anisotropic", time_controller(paper, pb, calls / 10), 20.0) && ok;
+  }
+  return ok ? 0 : 1;
+}

@@ -1,0 +1,217 @@
+// ffsr/simulate/closed_loop.hpp -- the capture controller in a closed loop with the robot's full
+// dynamics and a noisy target estimate. Component ffsr::cvode (SUNDIALS).
+//
+// Plant: the free-floating robot, forward dynamics of Eq. 1 (H a = tau - C, CRBA + RNEA, no external
+// force, no gravity unless the model has some), integrated by CVODE (BDF) with the state
+//   y = [p_0 - p_0(0) (3), phi_0 (3: base attitude as a rotation vector from the initial one),
+//        theta (n), v_0 (3), omega_0 (3), theta_dot (n), z (n: the PI integrators)].
+// Each joint has a rate loop: tau_k = sat(K_p,k (u_k - theta_dot_k) + K_i,k z_k, tau_max), z_k_dot =
+// u_k - theta_dot_k while the torque is not saturated (conditional integration: no wind-up), u the
+// controller's command held constant over a control period (zero-order hold). CVODE is restarted at
+// every tick (the command jumps there).
+// Controller: CaptureController::step at the control rate on the true state (the measured state is
+// exact: joint encoders and the base's attitude/position sensors are not modelled).
+// Target estimate: at the estimate rate (from t = 0), the truth (propagate_target of the problem's
+// target) plus independent Gaussian noise of the stated standard deviations: position (m, each
+// axis), attitude (rad: a rotation exp([n]) with n ~ N(0, sigma^2 I) applied on the inertial side),
+// velocity (m/s, each axis) and spin (rad/s, each axis of the target frame). Each estimate k draws
+// from its own stream SampleStream(seed, k) (uncertainty/sampling.hpp): the same seed gives the same
+// noise on every platform. update_target is called with it.
+// Result at T: the end-effector position against the TRUE capture point, M_ie and the closed-form
+// F_max at the reached configuration (true target at T), the largest joint torque, the largest
+// tracking lag |u_k - theta_dot_k| at the end of a control period (the command held over it), the largest end-effector distance from the reference, the base's
+// attitude change, and the largest |total momentum| (it is zero at the start and no external force
+// acts, so anything else is integration error).
+#pragma once
+
+#include "ffsr/control/capture_controller.hpp"
+#include "ffsr/simulate/multibody.hpp"
+#include "ffsr/uncertainty/sampling.hpp"
+
+#include <cstdint>
+#include <vector>
+
+namespace ffsr {
+
+/// The joints' rate loops: PI on the rate error, gains scaled by each joint's inertia so that one
+/// bandwidth fits every joint. With M the free-floating joint-space inertia H_mm - H_mb H_b^-1 H_bm
+/// at the start, K_p,k = omega M_kk and K_i,k = omega^2 / 4 M_kk: a joint alone (M_kk theta_ddot =
+/// tau) then has the closed-loop poles s = -omega / 2 (double: critically damped).
+struct RateLoopGains {
+  double bandwidth = 50.0;      ///< omega, rad/s
+  double torque_limit = 100.0;  ///< N m, |tau_k| <= it
+};
+
+/// The noise of the target estimate, standard deviations (Gaussian, independent per axis).
+struct EstimateNoise {
+  double position = 0;          ///< m
+  double attitude = 0;          ///< rad
+  double velocity = 0;          ///< m/s
+  double angular_velocity = 0;  ///< rad/s (target frame)
+};
+
+struct ClosedLoopOptions {
+  double control_rate = 1000.0;  ///< Hz: controller ticks (zero-order hold in between)
+  double estimate_rate = 5.0;    ///< Hz: target estimates (update_target)
+  RateLoopGains loop;
+  EstimateNoise noise;
+  std::uint64_t seed = 1;
+  double rtol = 1e-9;       ///< CVODE
+  double atol = 1e-12;      ///< CVODE, m, rad, m/s, rad/s
+  double record_every = 0;  ///< s between recorded samples (0: none)
+};
+
+struct ClosedLoopSample {
+  double t = 0;
+  Eigen::VectorXd theta, theta_dot, command, torque;
+  Vector3 end_effector = Vector3::Zero(), reference = Vector3::Zero();
+  double momentum = 0;  ///< |total momentum| (|P| + |L|)
+};
+
+struct ClosedLoopResult {
+  Eigen::VectorXd theta;  ///< reached configuration at T
+  BasePose base;          ///< base pose at T
+  Vector3 end_effector = Vector3::Zero();
+  Vector3 capture_point = Vector3::Zero();  ///< the true target's contact point at T
+  double capture_error = 0;                 ///< |p_e(T) - capture point|, m
+  double M_ie = 0;                          ///< at the reached configuration (true target at T), kg
+  double f_max_closed_form = 0;             ///< Eq. 24 at that M_ie, N
+  double max_torque = 0;                    ///< largest |tau_k|, N m
+  double max_tracking_lag = 0;              ///< largest |u_k - theta_dot_k| at the end of a tick, rad/s
+  double max_reference_error = 0;           ///< largest |p_e - x_d| at the ticks, m
+  double base_attitude_change = 0;          ///< rotation angle of the base from 0 to T, rad
+  double base_position_change = 0;          ///< m
+  double max_momentum = 0;                  ///< largest |P| + |L| at the ticks
+  long ticks = 0, estimates = 0, fault_ticks = 0, damped_ticks = 0, rate_limited_ticks = 0;
+  long saturated_ticks = 0;  ///< ticks with some joint's torque at the limit
+  long cvode_steps = 0;
+  std::vector<ClosedLoopSample> series;
+};
+
+namespace detail {
+
+/// The plant of the closed loop: the robot's dynamics with the PI rate loops (see the top of the file).
+struct ClosedLoopPlant {
+  const Model& model;
+  Data data;
+  BasePose base0;
+  int n;
+  RateLoopGains gains;
+  Eigen::VectorXd u, theta, v, tau, a, e, kp, ki;
+
+  ClosedLoopPlant(const Model& m, const BasePose& b0, const Eigen::VectorXd& theta0, const RateLoopGains& g)
+      : model(m),
+        data(m),
+        base0(b0),
+        n(m.n()),
+        gains(g),
+        u(Eigen::VectorXd::Zero(n)),
+        theta(n),
+        v(6 + n),
+        tau(Eigen::VectorXd::Zero(6 + n)),
+        a(6 + n),
+        e(n),
+        kp(n),
+        ki(n) {
+    base0.orientation.normalize();
+    crba(model, data, base0, theta0);  // M = H_mm - H_mb H_b^-1 H_bm, its diagonal
+    const Eigen::LLT<Matrix6> Hb(data.H.topLeftCorner<6, 6>());
+    const Eigen::MatrixXd Hbm = data.H.topRightCorner(6, n);
+    const Eigen::MatrixXd M = data.H.bottomRightCorner(n, n) - Hbm.transpose() * Hb.solve(Hbm);
+    for (int k = 0; k < n; ++k) {
+      kp(k) = g.bandwidth * M(k, k);
+      ki(k) = 0.25 * g.bandwidth * g.bandwidth * M(k, k);
+    }
+  }
+  Eigen::Index iv() const { return 6 + n; }
+  Eigen::Index iz() const { return 12 + 2 * n; }
+  BasePose base(const Eigen::Ref<const Eigen::VectorXd>& y) const {
+    BasePose b;
+    b.position = base0.position + y.segment<3>(0);
+    b.orientation = Quaternion(rotation_from_vector(y.segment<3>(3)) * base0.orientation.toRotationMatrix());
+    return b;
+  }
+  /// The joint torques of the rate loops at y (writes tau's joint part and e); true if one saturates.
+  bool torques(const Eigen::Ref<const Eigen::VectorXd>& y) {
+    e = u - y.segment(iv() + 6, n);
+    bool sat = false;
+    for (int k = 0; k < n; ++k) {
+      const double t = kp(k) * e(k) + ki(k) * y(iz() + k);
+      const double c = std::clamp(t, -gains.torque_limit, gains.torque_limit);
+      sat = sat || c != t;
+      tau(6 + k) = c;
+    }
+    return sat;
+  }
+  void rhs(const Eigen::Ref<const Eigen::VectorXd>& y, Eigen::Ref<Eigen::VectorXd> ydot) {
+    torques(y);
+    const BasePose b = base(y);
+    theta = y.segment(6, n);
+    v = y.segment(iv(), 6 + n);
+    forward_dynamics(model, data, b, theta, v, tau, a);
+    ydot.segment<3>(0) = v.head<3>();
+    ydot.segment<3>(3) = rotation_vector_rate(y.segment<3>(3), v.segment<3>(3));
+    ydot.segment(6, n) = v.tail(n);
+    ydot.segment(iv(), 6 + n) = a;
+    for (int k = 0; k < n; ++k) {  // conditional integration: hold z while the torque is at the limit
+      const bool at_limit = std::abs(tau(6 + k)) >= gains.torque_limit && tau(6 + k) * e(k) > 0;
+      ydot(iz() + k) = at_limit ? 0.0 : e(k);
+    }
+  }
+};
+
+/// The target estimate k: the truth at t plus the noise of `o` from SampleStream(seed, k).
+inline TargetEstimate noisy_estimate(const Target& truth, const ClosedLoopOptions& o, std::uint64_t k) {
+  SampleStream s(o.seed, k);
+  auto gauss3 = [&](double sigma) {
+    return Vector3(sigma * s.normal(), sigma * s.normal(), sigma * s.normal());
+  };
+  TargetEstimate e = target_estimate(truth);
+  e.position += gauss3(o.noise.position);
+  e.attitude = Quaternion(rotation_from_vector(gauss3(o.noise.attitude)) * truth.rotation());
+  e.velocity += gauss3(o.noise.velocity);
+  e.angular_velocity += gauss3(o.noise.angular_velocity);
+  return e;
+}
+
+inline void check_closed_loop_options(const ClosedLoopOptions& o) {
+  auto positive = [](double x, const char* what) {
+    if (!std::isfinite(x) || x <= 0)
+      throw InputError(str("closed loop: ", what, " must be positive, got ", x));
+  };
+  auto non_negative = [](double x, const char* what) {
+    if (!std::isfinite(x) || x < 0) throw InputError(str("closed loop: ", what, " must be >= 0, got ", x));
+  };
+  positive(o.control_rate, "control rate");
+  positive(o.estimate_rate, "estimate rate");
+  positive(o.loop.bandwidth, "rate-loop bandwidth");
+  positive(o.loop.torque_limit, "torque limit");
+  non_negative(o.noise.position, "position noise");
+  non_negative(o.noise.attitude, "attitude noise");
+  non_negative(o.noise.velocity, "velocity noise");
+  non_negative(o.noise.angular_velocity, "spin noise");
+  positive(o.rtol, "rtol");
+  positive(o.atol, "atol");
+  non_negative(o.record_every, "record interval");
+}
+
+/// What a tick records into the result (statuses, reference error).
+inline void record_tick(const ControlCommand& cmd, ClosedLoopResult& res) {
+  ++res.ticks;
+  if (cmd.status == ControlStatus::Fault) ++res.fault_ticks;
+  if (cmd.status == ControlStatus::Damped) ++res.damped_ticks;
+  if (cmd.status == ControlStatus::RateLimited) ++res.rate_limited_ticks;
+  res.max_reference_error = std::max(res.max_reference_error, (cmd.end_effector - cmd.reference).norm());
+}
+
+}  // namespace detail
+
+/// Runs the closed loop of `ctrl` (see the top of the file) from the problem's initial state at rest
+/// over [0, T]. InputError for bad options; IntegrationError from CVODE; NumericalError when the
+/// controller faults. The controller's plan is changed by the estimates (update_target).
+template <class Policy>
+ClosedLoopResult simulate_closed_loop(CaptureController<Policy>& ctrl, const ClosedLoopOptions& o);
+
+}  // namespace ffsr
+
+#include "ffsr/simulate/detail/closed_loop.hxx"

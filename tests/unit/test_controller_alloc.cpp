@@ -1,0 +1,160 @@
+// The capture controller does not touch the heap after its construction: global operator new and
+// delete are replaced by counting versions, and so are malloc, calloc, realloc, free and the aligned
+// allocations (glibc: interposed, forwarding to __libc_malloc and friends), since Eigen allocates
+// with malloc, not new (which is why this is an executable of its own). 1e5 calls of step() on the
+// paper's 3-DOF and 7-DOF robots (gradient and servo policies, position and pose tasks, a few faults
+// among them) must count zero allocations and zero frees. A control case checks that the counters
+// see both a `new` and an Eigen allocation.
+
+#include <atomic>
+#include <cstdlib>
+#include <malloc.h>
+#include <new>
+
+namespace {
+std::atomic<long> g_news{0}, g_deletes{0};
+}  // namespace
+
+extern "C" {
+void* __libc_malloc(std::size_t);
+void* __libc_calloc(std::size_t, std::size_t);
+void* __libc_realloc(void*, std::size_t);
+void* __libc_memalign(std::size_t, std::size_t);
+void __libc_free(void*);
+void* malloc(std::size_t size) noexcept {
+  ++g_news;
+  return __libc_malloc(size);
+}
+void* calloc(std::size_t n, std::size_t size) noexcept {
+  ++g_news;
+  return __libc_calloc(n, size);
+}
+void* realloc(void* p, std::size_t size) noexcept {
+  ++g_news;
+  return __libc_realloc(p, size);
+}
+void* memalign(std::size_t alignment, std::size_t size) noexcept {
+  ++g_news;
+  return __libc_memalign(alignment, size);
+}
+void* aligned_alloc(std::size_t alignment, std::size_t size) noexcept {
+  ++g_news;
+  return __libc_memalign(alignment, size);
+}
+int posix_memalign(void** out, std::size_t alignment, std::size_t size) noexcept {
+  ++g_news;
+  *out = __libc_memalign(alignment, size);
+  return *out ? 0 : 12;  // ENOMEM
+}
+void free(void* p) noexcept {
+  if (p) ++g_deletes;
+  __libc_free(p);
+}
+}
+
+// new and delete count once (through malloc and free)
+void* operator new(std::size_t size) {
+  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
+  throw std::bad_alloc();
+}
+void* operator new[](std::size_t size) { return operator new(size); }
+void* operator new(std::size_t size, const std::nothrow_t&) noexcept {
+  return std::malloc(size == 0 ? 1 : size);
+}
+void* operator new[](std::size_t size, const std::nothrow_t& t) noexcept { return operator new(size, t); }
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete[](void* p) noexcept { operator delete(p); }
+void operator delete(void* p, std::size_t) noexcept { operator delete(p); }
+void operator delete[](void* p, std::size_t) noexcept { operator delete(p); }
+
+#include <catch2/catch.hpp>
+
+#include "ffsr/control/capture_controller.hpp"
+#include "ffsr/io/scenario.hpp"
+
+#include <cmath>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace test_controller_alloc {
+
+using namespace ffsr;
+
+namespace {
+
+const std::string kRobots = std::string(FFSR_SOURCE_DIR) + "/robots/";
+
+struct Count {
+  long news, deletes;
+};
+
+/// 1e5 ticks over [0, T] with a state that moves a little from tick to tick; every 1000th tick has a
+/// NaN joint angle (the fault path). Returns the allocations and frees counted during the loop.
+template <class Policy>
+Count count_ticks(CaptureController<Policy>& ctrl, const CaptureProblem& pb, long& faults, long& rated) {
+  ControlCommand cmd = ctrl.make_command();
+  ControllerState st{pb.base, pb.theta};
+  const TargetEstimate est = target_estimate(pb.target);
+  const double T = ctrl.duration();
+  const long ticks = 100000;
+  const long n0 = g_news.load(), d0 = g_deletes.load();
+  for (long k = 0; k < ticks; ++k) {
+    const double t = T * static_cast<double>(k) / static_cast<double>(ticks);
+    for (Eigen::Index j = 0; j < st.theta.size(); ++j)
+      st.theta(j) = pb.theta(j) + 1e-3 * std::sin(1e-3 * static_cast<double>(k) + static_cast<double>(j));
+    if (k % 1000 == 999) st.theta(0) = std::nan("");
+    ctrl.step(t, st, est, cmd);
+    if (cmd.status == ControlStatus::Fault)
+      ++faults;
+    else if (cmd.theta_dot.allFinite())
+      ++rated;
+  }
+  return {g_news.load() - n0, g_deletes.load() - d0};
+}
+
+}  // namespace
+
+TEST_CASE("controller: 1e5 ticks allocate nothing (3-DOF and 7-DOF, gradient and servo)") {
+  for (const char* name : {"paper_3dof", "paper_7dof_position", "paper_7dof_pose"}) {
+    CAPTURE(name);
+    const Scenario sc = load_scenario(kRobots + name + ".toml");
+    auto paper = make_gradient_controller(sc.problem, sc.task, sc.capture);
+    long faults = 0, rated = 0;
+    const Count c = count_ticks(paper, sc.problem, faults, rated);
+    CHECK(c.news == 0);
+    CHECK(c.deletes == 0);
+    CHECK(faults == 100);
+    CHECK(rated == 100000 - 100);
+    CaptureOptions g = sc.capture;
+    g.max_joint_rate = 3 * M_PI / 180;
+    Eigen::VectorXd goal = sc.problem.theta;
+    goal(0) += 0.3;
+    auto servo = make_servo_controller(sc.problem, sc.task, g, goal);
+    faults = rated = 0;
+    const Count s = count_ticks(servo, sc.problem, faults, rated);
+    CHECK(s.news == 0);
+    CHECK(s.deletes == 0);
+    CHECK(faults == 100);
+  }
+}
+
+TEST_CASE("controller: the counters see new and Eigen's allocations (control)") {
+  long n0 = g_news.load(), d0 = g_deletes.load();
+  {
+    Eigen::VectorXd v(1000);
+    v.setZero();
+    CHECK(v.sum() == 0);
+  }
+  CHECK(g_news.load() - n0 == 1);
+  CHECK(g_deletes.load() - d0 == 1);
+  n0 = g_news.load();
+  d0 = g_deletes.load();
+  auto p = std::make_unique<std::vector<int>>(100, 1);
+  CHECK(p->size() == 100);
+  p.reset();
+  CHECK(g_news.load() - n0 == 2);
+  CHECK(g_deletes.load() - d0 == 2);
+}
+
+}  // namespace test_controller_alloc
