@@ -18,6 +18,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -225,5 +226,18 @@ inline RobotGeometry robot_geometry(const Model& model, const std::vector<LinkSh
   }
   return g;
 }
+
+/// The smallest distance of a configuration or along a path: overall and per kind of pair
+/// (arm-target, arm-bus, self), with the pair's name and the time (geometry/clearance.hpp fills it).
+struct ClearanceReport {
+  struct Entry {
+    double distance = std::numeric_limits<double>::infinity();
+    std::string pair;  ///< "link3 - target"; empty: no pair of this kind
+    double time = 0;   ///< s, along a path
+    Vector3 p_a = Vector3::Zero(), p_b = Vector3::Zero();  ///< nearest points (inertial frame)
+  };
+  Entry overall, arm_target, arm_bus, self;
+  std::string kind;  ///< the overall's kind
+};
 
 }  // namespace ffsr

@@ -72,6 +72,10 @@ struct ScenarioKeys {
   std::set<std::string> overridden;  ///< keys set by an override (paths not resolved against the file)
   std::map<std::string, std::string> extra;     ///< keys of the caller (read_scenario_file), as text
   std::shared_ptr<const toml::table> document;  ///< the file as read (its [uncertainty] table)
+  // shapes and clearance (io/scenario_geometry.hpp)
+  std::string target_shape;  ///< box, sphere, cylinder; empty: none
+  std::vector<double> target_size, target_shape_offset, link_radius{0.05}, bus_box;
+  double clearance = 0, contact_exemption = 0.2;
 };
 
 /// The kind of a key's value: one parser each, from a TOML node and from text.
@@ -107,6 +111,8 @@ ScenarioKeys read_scenario_text(const std::string& text, const std::string& wher
 /// Sets key `name` from text, as an override (a flag overrides the file). InputError naming the key.
 void override_scenario_key(ScenarioKeys& keys, const std::string& name, const std::string& text);
 
+struct SceneGeometry;  // io/scenario_geometry.hpp
+
 /// A validated scenario: the robot, the capture problem, the tasks of the optimized and the plain
 /// run, the optimized run's options (the plain run uses gain 0) and the global run's settings.
 struct Scenario {
@@ -120,6 +126,7 @@ struct Scenario {
   UrdfReport report;                                  ///< what the loader did to the file
   GlobalObjective objective = GlobalObjective::Mass;  ///< the global run's objective
   std::uint64_t seed = 1;                             ///< the global search's seed
+  std::shared_ptr<const SceneGeometry> geometry;      ///< shapes and clearance; null: none given
 };
 
 /// A URDF given as text for a built-in scenario whose `urdf` key names it (not read from disk).
@@ -144,4 +151,5 @@ UncertaintySpec uncertainty_spec(const ScenarioKeys& keys, std::optional<std::ui
 
 }  // namespace ffsr
 
+#include "ffsr/io/scenario_geometry.hpp"
 #include "ffsr/io/detail/scenario.hxx"

@@ -63,6 +63,15 @@ inline const char* objective_name(GlobalObjective o) {
   return "?";
 }
 
+/// Optional inequality constraints g(theta) <= 0 of the search at a fixed base pose (the clearance of
+/// geometry/clearance.hpp): `eval` writes the `count` values and, when grad is not null, their
+/// gradients (row-major, count x n, as NLopt). A local optimum with some g > tolerance is dropped.
+struct ManifoldInequalities {
+  unsigned count = 0;
+  std::function<void(const BasePose& base, const Eigen::VectorXd& theta, double* g, double* grad)> eval;
+  double tolerance = 1e-6;
+};
+
 struct ManifoldSearchOptions {
   int starts = 32;         ///< random starts of the multistart
   std::uint64_t seed = 1;  ///< seed of std::mt19937_64
@@ -74,6 +83,7 @@ struct ManifoldSearchOptions {
   /// robust-force: CVaR_95 of the exact F_max over this fixed sample set (robust_objective.hpp),
   /// minimized by SLSQP with its gradient. Shared by copies of the options; not thread-safe.
   std::shared_ptr<RobustForceObjective> robust;
+  std::shared_ptr<const ManifoldInequalities> inequalities;  ///< none: equality constraints only
 };
 
 /// A configuration on the capture manifold with its M_ie and objective value.
@@ -189,6 +199,7 @@ struct SlsqpContext {
   long evaluations = 0;
   Eigen::VectorXd theta, g, r;
   Eigen::MatrixXd J;
+  const ManifoldInequalities* inequalities = nullptr;
 };
 
 inline double slsqp_objective(unsigned n, const double* x, double* grad, void* p) {
@@ -216,6 +227,24 @@ inline void slsqp_constraints(unsigned m, double* result, unsigned n, const doub
   if (grad)  // NLopt: grad[i * n + j] = d c_i / d x_j (row-major)
     for (unsigned i = 0; i < m; ++i)
       for (unsigned j = 0; j < n; ++j) grad[i * n + j] = c.J(i, j);
+}
+
+inline void slsqp_inequalities(unsigned m, double* result, unsigned n, const double* x, double* grad, void* p) {
+  auto& c = *static_cast<SlsqpContext*>(p);
+  c.theta = Eigen::Map<const Eigen::VectorXd>(x, n);
+  (void)m;
+  c.inequalities->eval(*c.base, c.theta, result, grad);
+}
+
+/// True when the inequalities of `so` (if any) hold at theta within their tolerance.
+inline bool satisfies_inequalities(const ManifoldSearchOptions& so, const BasePose& base,
+                                   const Eigen::VectorXd& theta) {
+  if (!so.inequalities || so.inequalities->count == 0) return true;
+  std::vector<double> g(so.inequalities->count);
+  so.inequalities->eval(base, theta, g.data(), nullptr);
+  for (double v : g)
+    if (!(v <= so.inequalities->tolerance)) return false;
+  return true;
 }
 
 }  // namespace detail
@@ -317,6 +346,11 @@ inline void configure_slsqp(nlopt::opt& local, const Model& model, int m, SlsqpC
     lb[static_cast<size_t>(k)] = model.joint(k).lower;
     ub[static_cast<size_t>(k)] = model.joint(k).upper;
   }
+  if (so.inequalities && so.inequalities->count > 0) {
+    ctx.inequalities = so.inequalities.get();
+    local.add_inequality_mconstraint(detail::slsqp_inequalities, &ctx,
+                                     std::vector<double>(so.inequalities->count, so.inequalities->tolerance * 0.1));
+  }
   local.set_lower_bounds(lb);
   local.set_upper_bounds(ub);
   local.set_xtol_rel(1e-10);
@@ -350,7 +384,7 @@ inline bool local_capture_optimum(const Model& model, Data& data, const CaptureP
   Eigen::VectorXd th = Eigen::Map<const Eigen::VectorXd>(x.data(), n);
   if (!detail::project_to_manifold(model, data, pb, task, s, base, th, so.constraint_tolerance, 20))
     return false;
-  if (!detail::within_limits(model, th)) return false;
+  if (!detail::within_limits(model, th) || !detail::satisfies_inequalities(so, base, th)) return false;
   crba(model, data, base, th);
   const double M = 1.0 / (inverse_effective_mass(model, data, pb.frame, s.u_cap) + s.target_inv_mass);
   if (!std::isfinite(M)) return false;
@@ -453,6 +487,9 @@ struct GlobalCaptureOptions {
   int max_goals = 6;         ///< local optima tried as goals, best first
   double gap_percent = 1.0;  ///< required (reached - optimum) / optimum at the reached base pose, %
   std::vector<Eigen::VectorXd> extra_starts;  ///< e.g. the paper's method's capture configuration
+  /// Optional check of a reaching run (its series recorded): a message rejects the run, whose goal
+  /// is then given up (e.g. the clearance along the path, geometry/clearance.hpp).
+  std::function<std::optional<std::string>(const CaptureResult&)> check_run;
 };
 
 struct GlobalCaptureResult {
@@ -470,6 +507,8 @@ struct GlobalCaptureResult {
   long evaluations = 0;            ///< over every search
   long objective_evaluations = 0;  ///< multibody simulations over every search
   double search_seconds = 0;       ///< over every search
+  int goals_rejected = 0;          ///< reached goals whose run check_run rejected
+  std::string rejection;           ///< the last rejection's message
 };
 
 namespace detail {
@@ -614,13 +653,19 @@ inline GlobalCaptureResult plan_capture_global(const CaptureProblem& pb, const C
   const std::vector<ManifoldPoint> goals = detail::capture_goals(pb, task, setup, plain.base, g, extra, res);
 
   CaptureOptions run_opt = quiet;
-  run_opt.record_series = opt.record_series;
+  run_opt.record_series = opt.record_series || static_cast<bool>(g.check_run);
   std::optional<GlobalCaptureResult> fallback;
   for (const ManifoldPoint& target_goal : goals) {
     ++res.goals_tried;
     std::optional<GlobalCaptureResult> r =
         detail::reach_goal(pb, task, run_opt, setup, g, target_goal.theta, res, where);
     if (!r) continue;
+    if (g.check_run)
+      if (std::optional<std::string> why = g.check_run(r->run)) {
+        ++res.goals_rejected;
+        res.rejection = *why;
+        continue;
+      }
     if (r->reached_manifold_optimum) return std::move(*r);
     if (!fallback || r->objective < fallback->objective) fallback = std::move(r);
   }
@@ -632,11 +677,13 @@ inline GlobalCaptureResult plan_capture_global(const CaptureProblem& pb, const C
     fallback->evaluations = res.evaluations;
     fallback->objective_evaluations = res.objective_evaluations;
     fallback->search_seconds = res.search_seconds;
+    fallback->goals_rejected = res.goals_rejected;
     return *fallback;
   }
   throw NumericalError(str(where, ": no capture configuration chosen by the search was reached (",
                            res.goals_tried, " goals, ", res.goals_out_of_limits,
-                           " of them behind a joint limit, ", res.shooting_iterations, " reaching runs)"));
+                           " of them behind a joint limit, ", res.shooting_iterations, " reaching runs)",
+                           res.goals_rejected ? str("; the last reached goal was rejected: ", res.rejection) : ""));
 }
 
 }  // namespace ffsr
