@@ -14,8 +14,10 @@
 #include "ffsr/io/urdf_collision.hpp"
 #endif
 
+#include <algorithm>
 #include <memory>
 #include <string>
+#include <vector>
 
 namespace ffsr {
 
@@ -85,27 +87,63 @@ inline std::shared_ptr<const SceneGeometry> scenario_geometry(const Scenario& sc
   return g;
 }
 
-/// The global run's clearance: the search's constraints at the target's pose at T and the check of
-/// each reaching run along its path. Nothing when the scenario has no clearance.
-inline void apply_clearance(const Scenario& sc, GlobalCaptureOptions& g) {
-  const SceneGeometry* geo = sc.geometry.get();
-  if (!geo || !(geo->clearance > 0)) return;
-  // the target at T and every 2 s over the 30 s before (the reaching run is checked along its path)
+namespace detail {
+
+/// The target's poses at the times `times` (s from the start).
+inline std::vector<Pose> target_poses(const Target& t0, std::vector<double> times) {
+  std::sort(times.begin(), times.end());
   std::vector<Pose> poses;
-  Target t = propagate_target(sc.problem.target, sc.capture.duration);
-  const double dt = 2.0;
-  for (double back = 0; back <= std::min(30.0, sc.capture.duration) + 1e-9; back += dt) {
+  Target t = t0;
+  double at = 0;
+  for (double x : times) {
+    t = propagate_target(t, x - at);
+    at = x;
     poses.push_back(target_pose(t));
-    t = propagate_target(t, -dt);
   }
-  g.search.inequalities = clearance_constraints(*sc.model, geo->checker, poses, geo->clearance);
+  return poses;
+}
+
+}  // namespace detail
+
+/// The global run with the scenario's clearance (plan_capture_global as is without one). The search
+/// keeps distance >= clearance at its capture configurations (base at its pose at T) against the
+/// target at T and at the times of `sweep_times` before it (every 3 s over the last 30 s: the space the
+/// tumbling target sweeps while the arm, nearly at rest, closes in); each reaching run is checked
+/// along its path. When every reached goal fails that check, the target's poses 3 s before, at and
+/// 3 s after each violation (after the first round also every 10 s over the last 90 s) are added to
+/// the search's constraints and the plan is made again (up to 4 rounds); the last error is thrown
+/// when none keeps the clearance.
+inline GlobalCaptureResult plan_global_with_clearance(const Scenario& sc, const CaptureOptions& opt,
+                                                      GlobalCaptureOptions g) {
+  const SceneGeometry* geo = sc.geometry.get();
+  if (!geo || !(geo->clearance > 0)) return plan_capture_global(sc.problem, sc.task, opt, g);
+  const double T = sc.capture.duration;
+  std::vector<double> times;
+  for (double back = 0; back <= std::min(30.0, T) + 1e-9; back += 3.0) times.push_back(T - back);
   const Model* m = sc.model.get();
   const Target t0 = sc.problem.target;
   std::shared_ptr<const CollisionChecker> cc = geo->checker;
   const double c = geo->clearance;
-  g.check_run = [m, t0, cc, c](const CaptureResult& run) {
-    return clearance_violation(path_clearance(*m, *cc, t0, run), c);
+  auto violations = std::make_shared<std::vector<double>>();
+  g.check_run = [m, t0, cc, c, violations](const CaptureResult& run) {
+    const ClearanceReport r = path_clearance(*m, *cc, t0, run);
+    std::optional<std::string> why = clearance_violation(r, c);
+    if (why && r.kind == "arm-target") violations->push_back(r.overall.time);
+    return why;
   };
+  for (int round = 1;; ++round) {
+    g.search.inequalities = clearance_constraints(*m, cc, detail::target_poses(t0, times), c);
+    violations->clear();
+    try {
+      return plan_capture_global(sc.problem, sc.task, opt, g);
+    } catch (const NumericalError&) {
+      if (round == 4 || violations->empty()) throw;
+    }
+    for (double tv : *violations)
+      for (double x : {tv - 3.0, tv, tv + 3.0}) times.push_back(std::clamp(x, 0.0, T));
+    if (round == 1)  // a wider sweep: every 10 s over the last 90 s
+      for (double back = 40; back <= std::min(90.0, T) + 1e-9; back += 10.0) times.push_back(T - back);
+  }
 }
 
 /// The smallest distances along a run (its series recorded).
@@ -122,7 +160,10 @@ inline std::shared_ptr<const SceneGeometry> scenario_geometry(const Scenario& sc
     throw InputError("--clearance: this build has no geometry (ffsr::geometry needs FCL, Debian libfcl-dev)");
   return nullptr;
 }
-inline void apply_clearance(const Scenario&, GlobalCaptureOptions&) {}
+inline GlobalCaptureResult plan_global_with_clearance(const Scenario& sc, const CaptureOptions& opt,
+                                                      GlobalCaptureOptions g) {
+  return plan_capture_global(sc.problem, sc.task, opt, g);
+}
 inline ClearanceReport run_clearance(const Scenario&, const CaptureResult&) { return {}; }
 
 #endif

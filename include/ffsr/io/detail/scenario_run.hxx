@@ -58,11 +58,10 @@ inline GlobalRun run_global(const Scenario& sc, const CaptureResult& paper_run, 
     g.max_iterations = 16;
   }
   g.extra_starts = {paper_run.theta};
-  apply_clearance(sc, g);  // clearance: the search's constraints and the path check (scenario_geometry.hpp)
   opt.record_series = opt.record_series || sc.geometry;
   GlobalRun r;
   try {
-    r.result = plan_capture_global(sc.problem, sc.task, opt, g);
+    r.result = plan_global_with_clearance(sc, opt, g);  // as plan_capture_global without a clearance
   } catch (const InputError& e) {
     if (std::string(e.what()).find("max joint rate") != std::string::npos)
       throw InputError(str("--max-joint-rate-deg: ", e.what()));
