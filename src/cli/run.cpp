@@ -263,6 +263,20 @@ void print_base_jump(std::ostream& out, const Scenario& sc, const ScenarioResult
   out.precision(precision);
 }
 
+/// With shapes: each run's smallest distance along its path and the pair (docs/geometry.md).
+void print_clearance(std::ostream& out, const Scenario& sc, const ScenarioResult& r) {
+  if (r.clearances.empty()) return;
+  out << std::fixed << std::setprecision(4) << "smallest distance along the path (clearance " << sc.keys.clearance
+      << " m, last " << sc.keys.contact_exemption << " m of the end-effector link exempt at the target):";
+  for (const auto& [name, c] : r.clearances)
+    out << (name == "baseline" ? " plain " : ", " + name + " ") << c.overall.distance << " m (" << c.overall.pair
+        << ", t = " << std::setprecision(1) << c.overall.time << " s)" << std::setprecision(4);
+  out << "\n";
+  if (r.global && r.global->result.goals_rejected > 0)
+    out << "clearance: " << r.global->result.goals_rejected
+        << " reached goal(s) rejected along the path; last: " << r.global->result.rejection << "\n";
+}
+
 void print_table(std::ostream& out, const Scenario& sc, const ScenarioResult& r) {
   const CaptureResult &base_run = r.plain, &opt_run = r.optimized;
   out << "ffsr-optimize " << FFSR_VERSION << ": " << sc.where << " (" << sc.model->n() << " joints, "
@@ -285,6 +299,7 @@ void print_table(std::ostream& out, const Scenario& sc, const ScenarioResult& r)
     out << "note: near a singularity the pseudo-inverse was damped in "
         << base_run.damped_steps + opt_run.damped_steps << " evaluations (smallest singular value "
         << std::min(base_run.min_singular_value, opt_run.min_singular_value) << ")\n";
+  print_clearance(out, sc, r);
 }
 
 /// Regression run: every number of the result against the stored one; exit 4 when one moved.

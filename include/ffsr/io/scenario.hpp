@@ -79,6 +79,10 @@ struct ScenarioKeys {
   std::shared_ptr<const toml::table> document;  ///< the file as read (its [uncertainty] table)
   // the spacecraft's side: the reaction-null-space approach
   std::string base_attitude = "free";  ///< free or hold (the optimized run keeps w_0 = 0)
+  // shapes and clearance (io/scenario_geometry.hpp)
+  std::string target_shape;  ///< box, sphere, cylinder; empty: none
+  std::vector<double> target_size, target_shape_offset, link_radius{0.05}, bus_box;
+  double clearance = 0, contact_exemption = 0.2;
 };
 
 /// The kind of a key's value: one parser each, from a TOML node and from text.
@@ -114,6 +118,8 @@ ScenarioKeys read_scenario_text(const std::string& text, const std::string& wher
 /// Sets key `name` from text, as an override (a flag overrides the file). InputError naming the key.
 void override_scenario_key(ScenarioKeys& keys, const std::string& name, const std::string& text);
 
+struct SceneGeometry;  // io/scenario_geometry.hpp
+
 /// A validated scenario: the robot, the capture problem, the tasks of the optimized and the plain
 /// run, the optimized run's options (the plain run uses gain 0) and the global run's settings.
 struct Scenario {
@@ -130,6 +136,7 @@ struct Scenario {
   bool hold_base_attitude = false;  ///< base-attitude = hold: the optimized run's CaptureOptions::hold_base_attitude
   /// Multibody reference: per-joint PD gains holding the pre-contact rates (N m/rad, N m s/rad; size n).
   Eigen::VectorXd joint_stiffness, joint_damping;
+  std::shared_ptr<const SceneGeometry> geometry;      ///< shapes and clearance; null: none given
 };
 
 /// A URDF given as text for a built-in scenario whose `urdf` key names it (not read from disk).
@@ -154,4 +161,5 @@ UncertaintySpec uncertainty_spec(const ScenarioKeys& keys, std::optional<std::ui
 
 }  // namespace ffsr
 
+#include "ffsr/io/scenario_geometry.hpp"
 #include "ffsr/io/detail/scenario.hxx"

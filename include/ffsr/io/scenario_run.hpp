@@ -39,6 +39,8 @@ struct ScenarioResult {
   std::shared_ptr<RobustForceObjective> robust;
   UncertaintySpec robust_spec;
   std::vector<RobustRow> robust_rows;
+  /// with shapes (io/scenario_geometry.hpp): each run's smallest distances along its path
+  std::vector<std::pair<std::string, ClearanceReport>> clearances;  ///< baseline, optimized, global
 };
 
 struct ScenarioRunOptions {

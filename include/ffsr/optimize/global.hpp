@@ -72,6 +72,15 @@ inline const char* objective_name(GlobalObjective o) {
   return "?";
 }
 
+/// Optional inequality constraints g(theta) <= 0 of the search at a fixed base pose (the clearance of
+/// geometry/clearance.hpp): `eval` writes the `count` values and, when grad is not null, their
+/// gradients (row-major, count x n, as NLopt). A local optimum with some g > tolerance is dropped.
+struct ManifoldInequalities {
+  unsigned count = 0;
+  std::function<void(const BasePose& base, const Eigen::VectorXd& theta, double* g, double* grad)> eval;
+  double tolerance = 1e-6;
+};
+
 struct ManifoldSearchOptions {
   int starts = 32;         ///< random starts of the multistart
   std::uint64_t seed = 1;  ///< seed of std::mt19937_64
@@ -89,6 +98,7 @@ struct ManifoldSearchOptions {
   int branch_starts = 256;
   double branch_radius = 0.5;
   int branch_local_searches = 24;
+  std::shared_ptr<const ManifoldInequalities> inequalities;  ///< none: equality constraints only
 };
 
 /// A configuration on the capture manifold with its M_ie and objective value.
@@ -201,6 +211,7 @@ struct SlsqpContext {
   long evaluations = 0;
   Eigen::VectorXd theta, g, r;
   Eigen::MatrixXd J;
+  const ManifoldInequalities* inequalities = nullptr;
 };
 
 inline double slsqp_objective(unsigned n, const double* x, double* grad, void* p) {
@@ -229,6 +240,25 @@ inline void slsqp_constraints(unsigned m, double* result, unsigned n, const doub
   if (grad)  // NLopt: grad[i * n + j] = d c_i / d x_j (row-major)
     for (unsigned i = 0; i < m; ++i)
       for (unsigned j = 0; j < n; ++j) grad[i * n + j] = c.J(i, j);
+}
+
+inline void slsqp_inequalities(unsigned m, double* result, unsigned n, const double* x, double* grad,
+                               void* p) {
+  auto& c = *static_cast<SlsqpContext*>(p);
+  c.theta = Eigen::Map<const Eigen::VectorXd>(x, n);
+  (void)m;
+  c.inequalities->eval(*c.base, c.theta, result, grad);
+}
+
+/// True when the inequalities of `so` (if any) hold at theta within their tolerance.
+inline bool satisfies_inequalities(const ManifoldSearchOptions& so, const BasePose& base,
+                                   const Eigen::VectorXd& theta) {
+  if (!so.inequalities || so.inequalities->count == 0) return true;
+  std::vector<double> g(so.inequalities->count);
+  so.inequalities->eval(base, theta, g.data(), nullptr);
+  for (double v : g)
+    if (!(v <= so.inequalities->tolerance)) return false;
+  return true;
 }
 
 }  // namespace detail
@@ -294,8 +324,9 @@ inline ManifoldSearchResult search_capture_manifold(const CaptureProblem& pb, co
     throw InputError("search_capture_manifold: max_local_evaluations must be >= 1");
   if (so.max_ranked < 1) throw InputError("search_capture_manifold: max_ranked must be >= 1");
   if (so.branch_starts < 0 || so.branch_local_searches < 0 || !(so.branch_radius > 0))
-    throw InputError("search_capture_manifold: branch_starts and branch_local_searches must be >= 0, "
-                     "branch_radius positive");
+    throw InputError(
+        "search_capture_manifold: branch_starts and branch_local_searches must be >= 0, "
+        "branch_radius positive");
   return detail::search_manifold(pb, task, s, base, so, extra_starts, so.starts);
 }
 
@@ -334,6 +365,12 @@ inline void configure_slsqp(nlopt::opt& local, const Model& model, int m, SlsqpC
     lb[static_cast<size_t>(k)] = model.joint(k).lower;
     ub[static_cast<size_t>(k)] = model.joint(k).upper;
   }
+  if (so.inequalities && so.inequalities->count > 0) {
+    ctx.inequalities = so.inequalities.get();
+    local.add_inequality_mconstraint(
+        detail::slsqp_inequalities, &ctx,
+        std::vector<double>(so.inequalities->count, so.inequalities->tolerance * 0.1));
+  }
   local.set_lower_bounds(lb);
   local.set_upper_bounds(ub);
   local.set_xtol_rel(1e-10);
@@ -367,7 +404,9 @@ inline bool local_capture_optimum(const Model& model, Data& data, const CaptureP
   Eigen::VectorXd th = Eigen::Map<const Eigen::VectorXd>(x.data(), n);
   if (!detail::project_to_manifold(model, data, pb, task, s, base, th, so.constraint_tolerance, 20))
     return false;
-  if (!detail::nearest_representative(model, pb.theta, th) || !detail::within_limits(model, th)) return false;
+  if (!detail::nearest_representative(model, pb.theta, th) || !detail::within_limits(model, th) ||
+      !detail::satisfies_inequalities(so, base, th))
+    return false;
   crba(model, data, base, th);
   const double M =
       1.0 / (inverse_effective_mass(model, data, pb.frame, s.u_cap, pb.joints) + s.target_inv_mass);
@@ -408,10 +447,10 @@ inline double manifold_value(const Model& model, Data& data, const CaptureProble
 /// search's tolerance when roundoff stops it first), moved to the representative of its posture,
 /// and kept when within the limits and more than 1e-6 rad (posture_distance) from every solution
 /// kept. No SLSQP: each solution is its own local optimum. Appends to `found`; counts into res.
-inline void enumerate_solutions(const Model& model, Data& data, const CaptureProblem& pb, const CaptureTask& task,
-                                const CaptureSetup& s, const BasePose& base, const ManifoldSearchOptions& so,
-                                const std::vector<Eigen::VectorXd>& starts, ManifoldSearchResult& res,
-                                std::vector<ManifoldPoint>& found) {
+inline void enumerate_solutions(const Model& model, Data& data, const CaptureProblem& pb,
+                                const CaptureTask& task, const CaptureSetup& s, const BasePose& base,
+                                const ManifoldSearchOptions& so, const std::vector<Eigen::VectorXd>& starts,
+                                ManifoldSearchResult& res, std::vector<ManifoldPoint>& found) {
   Eigen::VectorXd r;
   for (Eigen::VectorXd q : starts) {
     if (q.size() != model.n() || !q.allFinite())
@@ -576,6 +615,9 @@ struct GlobalCaptureOptions {
   /// A reconfiguration before the approach (reconfigure.hpp): never (the default), auto (only when
   /// the best goal is not reached by the approach alone) or always; its duration.
   ReconfigureOptions reconfigure;
+  /// Optional check of a reaching run (its series recorded): a message rejects the run, whose goal
+  /// is then given up (e.g. the clearance along the path, geometry/clearance.hpp).
+  std::function<std::optional<std::string>(const CaptureResult&)> check_run;
 };
 
 struct GlobalCaptureResult {
@@ -596,6 +638,8 @@ struct GlobalCaptureResult {
   /// The phases of `run`: the approach alone, or the reconfiguration then the approach.
   std::vector<RunPhase> phases;
   bool reconfigured = false;  ///< `run` begins with a reconfiguration
+  int goals_rejected = 0;     ///< reached goals whose run check_run rejected
+  std::string rejection;      ///< the last rejection's message
 };
 
 namespace detail {
@@ -627,7 +671,8 @@ inline double goal_orientation_error(const CaptureProblem& pb, const CaptureTask
 /// vanishes at a half turn too lets them through) and makes the best remaining one res.best. The
 /// result keeps at least one point (the best, even if off). Runs crba per optimum.
 inline void drop_turned_optima(const CaptureProblem& pb, const CaptureTask& task, const CaptureSetup& s,
-                               const BasePose& base, const GlobalCaptureOptions& g, ManifoldSearchResult& res) {
+                               const BasePose& base, const GlobalCaptureOptions& g,
+                               ManifoldSearchResult& res) {
   if (task.kind != CaptureTask::Kind::Pose || g.search.objective == GlobalObjective::MultibodyForce) return;
   std::vector<ManifoldPoint> kept;
   for (const ManifoldPoint& p : res.local_optima)
@@ -795,10 +840,18 @@ inline GlobalCaptureResult plan_capture_global(const CaptureProblem& pb, const C
   const std::vector<ManifoldPoint> goals = detail::capture_goals(pb, task, setup, plain.base, g, extra, res);
 
   CaptureOptions run_opt = quiet;
-  run_opt.record_series = opt.record_series;
+  run_opt.record_series = opt.record_series || static_cast<bool>(g.check_run);
   std::optional<GlobalCaptureResult> fallback;
   auto keep = [&fallback](std::optional<GlobalCaptureResult>& r) {
     if (r && (!fallback || r->objective < fallback->objective)) fallback = std::move(r);
+  };
+  auto reject = [&g, &res](std::optional<GlobalCaptureResult>& r) {  // the run's check (e.g. the clearance)
+    if (!r || !g.check_run) return;
+    if (std::optional<std::string> why = g.check_run(r->run)) {
+      ++res.goals_rejected;
+      res.rejection = *why;
+      r.reset();
+    }
   };
   const ReconfigureMode mode = g.reconfigure.mode;
   for (size_t i = 0; i < goals.size(); ++i) {
@@ -806,6 +859,7 @@ inline GlobalCaptureResult plan_capture_global(const CaptureProblem& pb, const C
     std::optional<GlobalCaptureResult> r;
     if (mode != ReconfigureMode::Always) {  // the approach alone
       r = detail::reach_goal(pb, task, run_opt, setup, g, goals[i].theta, res, where);
+      reject(r);
       if (r && r->reached_manifold_optimum) return std::move(*r);
       keep(r);
     }
@@ -814,6 +868,7 @@ inline GlobalCaptureResult plan_capture_global(const CaptureProblem& pb, const C
                              ? g.reconfigure.duration
                              : default_reconfiguration_duration(*pb.model, pb.theta, goals[i].theta, o);
       r = detail::reach_goal(pb, task, run_opt, setup, g, goals[i].theta, res, where, t_r);
+      reject(r);
       if (r && r->reached_manifold_optimum) return std::move(*r);
       keep(r);
     }
@@ -826,11 +881,13 @@ inline GlobalCaptureResult plan_capture_global(const CaptureProblem& pb, const C
     fallback->evaluations = res.evaluations;
     fallback->objective_evaluations = res.objective_evaluations;
     fallback->search_seconds = res.search_seconds;
+    fallback->goals_rejected = res.goals_rejected;
     return *fallback;
   }
-  throw NumericalError(str(where, ": no capture configuration chosen by the search was reached (",
-                           res.goals_tried, " goals, ", res.goals_out_of_limits,
-                           " of them behind a joint limit, ", res.shooting_iterations, " reaching runs)"));
+  throw NumericalError(str(
+      where, ": no capture configuration chosen by the search was reached (", res.goals_tried, " goals, ",
+      res.goals_out_of_limits, " of them behind a joint limit, ", res.shooting_iterations, " reaching runs)",
+      res.goals_rejected ? str("; the last reached goal was rejected: ", res.rejection) : ""));
 }
 
 }  // namespace ffsr

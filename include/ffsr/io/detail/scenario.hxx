@@ -269,6 +269,19 @@ inline std::vector<ScenarioKey> build_scenario_keys() {
           "0"),
       FFSR_KEY("joint-damping", joint_damping,
                "Multibody reference: joint PD damping, N m s/rad (one or per joint)", "0"),
+      // shapes and clearance (io/scenario_geometry.hpp, docs/geometry.md)
+      FFSR_KEY("target-shape", target_shape, "Target's collision shape: box, sphere or cylinder (default: none)"),
+      FFSR_KEY("target-size", target_size,
+               "Target shape's size, m: box edge lengths; sphere radius; cylinder radius, length (along z)"),
+      FFSR_KEY("target-shape-offset", target_shape_offset, "Target shape's centre in the target frame, m", "0,0,0"),
+      FFSR_KEY("link-radius", link_radius,
+               "Capsule radius of links without URDF collision primitives, m (one, or one per moving body)", "0.05"),
+      FFSR_KEY("bus-box", bus_box, "The bus as a box centred on the base frame (edge lengths, m), when the URDF's "
+                                   "base has no collision primitive"),
+      FFSR_KEY("clearance", clearance, "Least distance the global run keeps between arm, bus and target, m (0: none)",
+               "0"),
+      FFSR_KEY("contact-exemption", contact_exemption,
+               "Length of the end-effector link before the contact point not checked against the target, m", "0.2"),
   };
 }
 
@@ -695,6 +708,7 @@ inline Scenario build_scenario(ScenarioKeys k, const EmbeddedUrdf* embedded) {
                          " joints: no null space to optimize in (set gain = 0 or constrain fewer axes)"));
   sc.hold_base_attitude = base_attitude_of(k, model, pb, sc.task, sc.capture.gain);
   sc.keys = std::move(k);
+  sc.geometry = scenario_geometry(sc, embedded);
   return sc;
 }
 

@@ -6,7 +6,7 @@ namespace ffsr {
 inline std::pair<CaptureResult, CaptureResult> plan_plain_and_optimized(const Scenario& sc,
                                                                         const ScenarioRunOptions& options) {
   CaptureOptions opt = sc.capture;
-  opt.record_series = opt.record_series || options.record_series;
+  opt.record_series = opt.record_series || options.record_series || sc.geometry;  // distances along the path
   CaptureOptions plain = opt;
   plain.gain = 0.0;
   opt.hold_base_attitude = sc.hold_base_attitude;  // the optimized run only
@@ -64,9 +64,10 @@ inline GlobalRun run_global(const Scenario& sc, const CaptureResult& paper_run, 
   g.extra_starts = {paper_run.theta};
   g.reconfigure.mode = reconfigure_mode_of(sc.keys.reconfigure, "--reconfigure");
   g.reconfigure.duration = sc.keys.reconfigure_duration;
+  opt.record_series = opt.record_series || sc.geometry;
   GlobalRun r;
   try {
-    r.result = plan_capture_global(sc.problem, sc.task, opt, g);
+    r.result = plan_global_with_clearance(sc, opt, g);  // as plan_capture_global without a clearance
   } catch (const ReconfigurationRateError& e) {
     throw InputError(str("--reconfigure-duration: a reconfiguration in ", e.duration, " s: joint '", e.joint,
                          "' needs ", e.needed * 180 / M_PI, " deg/s, max-joint-rate-deg is ",
@@ -105,12 +106,17 @@ inline UncertaintySpec robust_force_spec(const Scenario& sc) {
 inline ScenarioResult run_scenario(const Scenario& sc, const ScenarioRunOptions& options) {
   ScenarioResult r;
   std::tie(r.plain, r.optimized) = plan_plain_and_optimized(sc, options);
+  if (sc.geometry) {
+    r.clearances.emplace_back("baseline", run_clearance(sc, r.plain));
+    r.clearances.emplace_back("optimized", run_clearance(sc, r.optimized));
+  }
   if (!sc.keys.global) return r;
   if (sc.objective == GlobalObjective::RobustForce) {
     r.robust_spec = detail::robust_force_spec(sc);
     r.robust = scenario_robust_objective(sc, r.robust_spec);
   }
   r.global = run_global(sc, r.optimized, sc.objective, r.robust);
+  if (sc.geometry) r.clearances.emplace_back("global", run_clearance(sc, r.global->result.run));
   if (r.robust) {
     const Model& model = *sc.model;
     Data data(model);
@@ -302,6 +308,32 @@ inline void add_global_json(nlohmann::json& j, const Scenario& sc, const GlobalR
   j["global_exact_force_reduction_percent"] = reduction_percent(base_run.f_max_exact, r.run.f_max_exact);
 }
 
+/// Shapes and clearance: the keys in "scenario", each run's "min_clearance" (overall and per kind
+/// of pair: distance m, pair, time s), the global run's goals rejected by the path check.
+inline void add_clearance_json(nlohmann::json& j, const Scenario& sc, const ScenarioResult& r) {
+  const ScenarioKeys& k = sc.keys;
+  j["scenario"]["target-shape"] = k.target_shape;
+  j["scenario"]["target-size"] = k.target_size;
+  j["scenario"]["target-shape-offset"] = k.target_shape_offset;
+  j["scenario"]["link-radius"] = k.link_radius;
+  j["scenario"]["bus-box"] = k.bus_box;
+  j["scenario"]["clearance"] = k.clearance;
+  j["scenario"]["contact-exemption"] = k.contact_exemption;
+  auto entry = [](const ClearanceReport::Entry& e) {
+    if (e.pair.empty()) return nlohmann::json(nullptr);
+    return nlohmann::json{{"distance", e.distance}, {"pair", e.pair}, {"time", e.time}};
+  };
+  for (const auto& [name, c] : r.clearances) {
+    nlohmann::json x = entry(c.overall);
+    if (!x.is_null()) x["kind"] = c.kind;
+    x["arm_target"] = entry(c.arm_target);
+    x["arm_bus"] = entry(c.arm_bus);
+    x["self"] = entry(c.self);
+    j[name]["min_clearance"] = x;
+  }
+  if (r.global) j["global"]["goals_rejected_by_clearance"] = r.global->result.goals_rejected;
+}
+
 }  // namespace detail
 
 namespace detail {
@@ -323,6 +355,7 @@ inline nlohmann::json scenario_json(const Scenario& sc, const ScenarioResult& r,
   j["exact_force_reduction_percent"] = reduction_percent(r.plain.f_max_exact, r.optimized.f_max_exact);
   if (r.global) detail::add_global_json(j, sc, *r.global, r.plain);
   detail::add_base_disturbance_json(j, sc, r);
+  if (sc.geometry) detail::add_clearance_json(j, sc, r);
   if (r.robust) {
     nlohmann::json rj = {
         {"measure", "CVaR_95 (mean of the largest 5 %) and p95 (nearest rank) of the exact F_max, N"},
