@@ -54,7 +54,13 @@ int main(int argc, char** argv) {
   ScenarioKeys keys = sc.keys;
   override_scenario_key(keys, "base-attitude", "hold");
   const Scenario held_sc = build_scenario(std::move(keys));
-  const CaptureResult held = plan_plain_and_optimized(held_sc).second;
+  CaptureResult held;
+  try {
+    held = plan_plain_and_optimized(held_sc).second;
+  } catch (const NumericalError& e) {  // the held approach may meet an algorithmic singularity
+    std::printf("\nbase-attitude = hold: %s\n", e.what());
+    return 0;
+  }
   std::printf("\n%-28s %10s %14s %16s %14s\n", "optimized run", "M_ie (kg)", "attitude (deg)",
               "momentum (N s)", "tracking (m)");
   for (const auto& [name, x] :
