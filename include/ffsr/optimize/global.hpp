@@ -291,8 +291,9 @@ inline ManifoldSearchResult search_capture_manifold(const CaptureProblem& pb, co
     throw InputError("search_capture_manifold: max_local_evaluations must be >= 1");
   if (so.max_ranked < 1) throw InputError("search_capture_manifold: max_ranked must be >= 1");
   if (so.branch_starts < 0 || so.branch_local_searches < 0 || !(so.branch_radius > 0))
-    throw InputError("search_capture_manifold: branch_starts and branch_local_searches must be >= 0, "
-                     "branch_radius positive");
+    throw InputError(
+        "search_capture_manifold: branch_starts and branch_local_searches must be >= 0, "
+        "branch_radius positive");
   return detail::search_manifold(pb, task, s, base, so, extra_starts, so.starts);
 }
 
@@ -404,10 +405,10 @@ inline double manifold_value(const Model& model, Data& data, const CaptureProble
 /// search's tolerance when roundoff stops it first), moved to the representative of its posture,
 /// and kept when within the limits and more than 1e-6 rad (posture_distance) from every solution
 /// kept. No SLSQP: each solution is its own local optimum. Appends to `found`; counts into res.
-inline void enumerate_solutions(const Model& model, Data& data, const CaptureProblem& pb, const CaptureTask& task,
-                                const CaptureSetup& s, const BasePose& base, const ManifoldSearchOptions& so,
-                                const std::vector<Eigen::VectorXd>& starts, ManifoldSearchResult& res,
-                                std::vector<ManifoldPoint>& found) {
+inline void enumerate_solutions(const Model& model, Data& data, const CaptureProblem& pb,
+                                const CaptureTask& task, const CaptureSetup& s, const BasePose& base,
+                                const ManifoldSearchOptions& so, const std::vector<Eigen::VectorXd>& starts,
+                                ManifoldSearchResult& res, std::vector<ManifoldPoint>& found) {
   Eigen::VectorXd r;
   for (Eigen::VectorXd q : starts) {
     if (q.size() != model.n() || !q.allFinite())
