@@ -68,25 +68,30 @@ void bench_scenario(const std::string& file, int runs) {
   ManifoldSearchResult search;
   double c_search = 0, c_plan = 0, c_reach = 0;
   const double t_search = median_seconds(
-      runs, [&] { search = search_capture_manifold(sc.problem, sc.task, setup, plain.base, so, {plain.theta}); },
+      runs,
+      [&] { search = search_capture_manifold(sc.problem, sc.task, setup, plain.base, so, {plain.theta}); },
       c_search);
   GlobalCaptureOptions g;
   g.search = so;
   g.extra_starts = {paper.theta};
   GlobalCaptureResult global;
-  const double t_plan =
-      median_seconds(runs, [&] { global = plan_capture_global(sc.problem, sc.task, opt, g); }, c_plan);
+  const double t_plan = median_seconds(
+      runs, [&] { global = plan_capture_global(sc.problem, sc.task, opt, g); }, c_plan);
   std::vector<CaptureBranch> br;
   const double t_reach = median_seconds(
-      runs, [&] { br = capture_branches(sc.problem, sc.task, opt, setup, global.search, global.run.base, 6, 1); },
+      runs,
+      [&] { br = capture_branches(sc.problem, sc.task, opt, setup, global.search, global.run.base, 6, 1); },
       c_reach);
   std::printf("%s (%d joints, %d task rows)\n", file.c_str(), sc.model->n(), sc.task.rows());
-  std::printf("  branch search:        %8.3f s wall, %8.3f s CPU  (%zu local optima, best %.4f kg; %s)\n", t_search,
-              c_search, search.local_optima.size(), search.best.M_ie, search.method.c_str());
-  std::printf("  whole global plan:    %8.3f s wall, %8.3f s CPU  (reached %.4f kg, manifold optimum %.4f kg)\n",
-              t_plan, c_plan, global.objective, global.manifold_optimum);
-  std::printf("  branch reachability:  %8.3f s wall, %8.3f s CPU  (%zu branches, the best %zu tested, one run each)\n",
-              t_reach, c_reach, br.size(), std::min<size_t>(br.size(), 6));
+  std::printf("  branch search:        %8.3f s wall, %8.3f s CPU  (%zu local optima, best %.4f kg; %s)\n",
+              t_search, c_search, search.local_optima.size(), search.best.M_ie, search.method.c_str());
+  std::printf(
+      "  whole global plan:    %8.3f s wall, %8.3f s CPU  (reached %.4f kg, manifold optimum %.4f kg)\n",
+      t_plan, c_plan, global.objective, global.manifold_optimum);
+  std::printf(
+      "  branch reachability:  %8.3f s wall, %8.3f s CPU  (%zu branches, the best %zu tested, one run "
+      "each)\n",
+      t_reach, c_reach, br.size(), std::min<size_t>(br.size(), 6));
 }
 
 }  // namespace

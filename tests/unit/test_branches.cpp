@@ -82,7 +82,8 @@ bool test_pose_projection(const Model& m, Data& d, int frame, const BasePose& ba
       Eigen::VectorXd qp = q, qm = q;
       qp(k) += h;
       qm(k) -= h;
-      J.col(k) = (pose_rows(m, d, frame, base, qp, x, R_end) - pose_rows(m, d, frame, base, qm, x, R_end)) / (2 * h);
+      J.col(k) =
+          (pose_rows(m, d, frame, base, qp, x, R_end) - pose_rows(m, d, frame, base, qm, x, R_end)) / (2 * h);
     }
     const double damping = r.norm() > 1e-6 ? 1e-6 : 0.0;
     const Eigen::MatrixXd A = J.transpose() * J + damping * Eigen::MatrixXd::Identity(n, n);
@@ -103,13 +104,15 @@ Eigen::VectorXd wrapped(const Eigen::VectorXd& q) {
 double wrapped_distance(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
   const Eigen::VectorXd e = wrapped(a) - wrapped(b);
   double d = 0;
-  for (Eigen::Index k = 0; k < e.size(); ++k) d = std::max(d, std::min(std::abs(e(k)), 2 * M_PI - std::abs(e(k))));
+  for (Eigen::Index k = 0; k < e.size(); ++k)
+    d = std::max(d, std::min(std::abs(e(k)), 2 * M_PI - std::abs(e(k))));
   return d;
 }
 
 }  // namespace
 
-TEST_CASE("Orientation residual: the rotation vector, its Jacobian equals central differences", "[branches]") {
+TEST_CASE("Orientation residual: the rotation vector, its Jacobian equals central differences",
+          "[branches]") {
   const Model m = model_from_urdf_file(ffsr::test::kRobots + "paper_7dof.urdf");
   CaptureProblem pb = ffsr::test::problem_7dof(m);
   CaptureTask task;
@@ -140,7 +143,8 @@ TEST_CASE("Orientation residual: the rotation vector, its Jacobian equals centra
       capture_residual(m, d, pb, task, s, b, qp, rp, nullptr);
       capture_residual(m, d, pb, task, s, b, qm, rm, nullptr);
       const Eigen::VectorXd fd = (rp - rm) / (2 * h);
-      INFO(angle_deg << " deg, joint " << k << ": analytic " << J.col(k).transpose() << ", fd " << fd.transpose());
+      INFO(angle_deg << " deg, joint " << k << ": analytic " << J.col(k).transpose() << ", fd "
+                     << fd.transpose());
       CHECK((J.col(k) - fd).norm() < 1e-7);  // central differences: O(h^2) + roundoff/h ~ 1e-9
     }
   }
@@ -189,7 +193,8 @@ TEST_CASE("Manifold search, paper 7-DOF pose task: every optimum in the final or
     CHECK(b.orientation_error < 1e-8);  // the search's tolerance 1e-10 on |c|
     CHECK(b.position_error < 1e-8);
   }
-  std::printf("paper 7-DOF pose: %zu local optima, best %.4f kg, %.3f s\n", br.size(), res.best.M_ie, res.seconds);
+  std::printf("paper 7-DOF pose: %zu local optima, best %.4f kg, %.3f s\n", br.size(), res.best.M_ie,
+              res.seconds);
 }
 
 TEST_CASE("UR5 pose task: the branches equal an independent enumeration of the IK solutions", "[branches]") {
@@ -233,13 +238,15 @@ TEST_CASE("UR5 pose task: the branches equal an independent enumeration of the I
       const double u = static_cast<double>(rng() >> 11) * 0x1.0p-53;
       q(k) = m.joint(k).lower + (m.joint(k).upper - m.joint(k).lower) * u;
     }
-    if (!test_pose_projection(m, d, in.sc.problem.frame, in.base, in.setup.x_cap, in.setup.R_end, q)) continue;
+    if (!test_pose_projection(m, d, in.sc.problem.frame, in.base, in.setup.x_cap, in.setup.R_end, q))
+      continue;
     ++converged;
     bool known = false;
     for (const Eigen::VectorXd& k : mine) known = known || wrapped_distance(k, q) < 1e-6;
     if (!known) mine.push_back(q);
   }
-  INFO(converged << " of 500 converged, " << mine.size() << " distinct solutions, " << br.size() << " branches");
+  INFO(converged << " of 500 converged, " << mine.size() << " distinct solutions, " << br.size()
+                 << " branches");
   CHECK(converged >= 250);
   CHECK(mine.size() == br.size());
   for (const Eigen::VectorXd& q : mine) {  // each solution of this test is a reported branch ...
@@ -255,8 +262,8 @@ TEST_CASE("UR5 pose task: the branches equal an independent enumeration of the I
     for (const Eigen::VectorXd& q : mine) nearest = std::min(nearest, wrapped_distance(b.theta, q));
     CHECK(nearest < 1e-6);
   }
-  std::printf("UR5 pose: %zu branches, %d of 500 random starts converged, %zu distinct\n", br.size(), converged,
-              mine.size());
+  std::printf("UR5 pose: %zu branches, %d of 500 random starts converged, %zu distinct\n", br.size(),
+              converged, mine.size());
 }
 
 TEST_CASE("UR5 pose task: the main job's JSON lists the branches", "[branches]") {
@@ -271,7 +278,8 @@ TEST_CASE("UR5 pose task: the main job's JSON lists the branches", "[branches]")
     CHECK(br[i]["configuration_deg"].size() == 6);
     CHECK(br[i]["orientation_error_deg"].get<double>() < 1e-6);
     if (i > 0) CHECK(br[i - 1]["objective_value"].get<double>() <= br[i]["objective_value"].get<double>());
-    if (br[i]["reachable_without_reconfiguration"].is_boolean() && br[i]["reachable_without_reconfiguration"].get<bool>()) {
+    if (br[i]["reachable_without_reconfiguration"].is_boolean() &&
+        br[i]["reachable_without_reconfiguration"].get<bool>()) {
       ++reachable;
       // the global run (no null space: the task-only run) ends on the reachable branch
       CHECK(br[i]["integrated_effective_mass"].get<double>() ==

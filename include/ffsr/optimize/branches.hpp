@@ -23,11 +23,11 @@ namespace ffsr {
 
 /// One distinct local optimum of the capture manifold.
 struct CaptureBranch {
-  Eigen::VectorXd theta;             ///< rad
-  double M_ie = 0;                   ///< kg
-  double objective = 0;              ///< as ManifoldPoint::objective
-  double orientation_error = 0;      ///< angle between the end-effector's and the wanted orientation, rad
-  double position_error = 0;         ///< distance from the capture point over the task's axes, m
+  Eigen::VectorXd theta;         ///< rad
+  double M_ie = 0;               ///< kg
+  double objective = 0;          ///< as ManifoldPoint::objective
+  double orientation_error = 0;  ///< angle between the end-effector's and the wanted orientation, rad
+  double position_error = 0;     ///< distance from the capture point over the task's axes, m
   /// empty: not tested (beyond the best max_tested of capture_branches)
   std::optional<bool> reachable_without_reconfiguration;
 };

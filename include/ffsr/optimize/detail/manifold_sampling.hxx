@@ -73,7 +73,8 @@ inline std::vector<Eigen::VectorXd> halton_starts(const Model& model, int count)
     Eigen::VectorXd q(n);
     for (int k = 0; k < n; ++k) {
       const Joint& j = model.joint(k);
-      const double lo = std::isfinite(j.lower) ? j.lower : -M_PI, hi = std::isfinite(j.upper) ? j.upper : M_PI;
+      const double lo = std::isfinite(j.lower) ? j.lower : -M_PI,
+                   hi = std::isfinite(j.upper) ? j.upper : M_PI;
       q(k) = lo + (hi - lo) * radical_inverse(static_cast<std::uint64_t>(i), bases[static_cast<size_t>(k)]);
     }
     out.push_back(std::move(q));
