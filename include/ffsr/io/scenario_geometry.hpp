@@ -15,6 +15,7 @@
 #endif
 
 #include <algorithm>
+#include <cstdio>
 #include <memory>
 #include <string>
 #include <vector>
@@ -38,6 +39,13 @@ struct SceneGeometry {
 
 namespace detail {
 
+/// A distance in a message: 6 significant digits.
+inline std::string metres(double x) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.6g", x);
+  return b;
+}
+
 /// The URDF's collision primitives: from the embedded text of a built-in scenario, else the file.
 inline std::vector<LinkShape> scenario_urdf_shapes(const ScenarioKeys& k, const EmbeddedUrdf* embedded) {
   if (embedded && k.urdf == embedded->name)
@@ -49,7 +57,7 @@ inline std::vector<LinkShape> scenario_urdf_shapes(const ScenarioKeys& k, const 
 inline void check_contact_on_surface(const Shape& target, const Vector3& r_tp) {
   const double d = point_surface_distance(target, r_tp);
   if (std::abs(d) > 1e-6)
-    throw InputError(str("--contact-offset: the contact point is ", std::abs(d), " m ", d > 0 ? "outside" : "inside",
+    throw InputError(str("--contact-offset: the contact point is ", metres(std::abs(d)), " m ", d > 0 ? "outside" : "inside",
                          " the target-shape's surface (it must lie on it)"));
 }
 
@@ -58,8 +66,8 @@ inline void check_start_clearance(const Scenario& sc, const SceneGeometry& g) {
   const ClearanceReport r = configuration_clearance(*sc.model, *g.checker, sc.problem.base, sc.problem.theta,
                                                     target_pose(sc.problem.target));
   if (!r.overall.pair.empty() && r.overall.distance < g.clearance)
-    throw InputError(str("--clearance: the start configuration is already closer than ", g.clearance, " m: ",
-                         r.overall.pair, " (", r.kind, ") ", r.overall.distance, " m"));
+    throw InputError(str("--clearance: the start configuration is already closer than ", metres(g.clearance), " m: ",
+                         r.overall.pair, " (", r.kind, ") ", metres(r.overall.distance), " m"));
 }
 
 }  // namespace detail
