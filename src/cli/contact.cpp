@@ -84,6 +84,8 @@ Row evaluate(const Robot& r, const Target& target, const ContactOptions& o, cons
           std::move(mb.series),
           0,
           0,
+          {},
+          Vector6::Zero(),
           std::move(predictions)};
   row.accuracy = model_accuracy(row.f_closed, row.f_multibody);
   row.mb_delta_max = mb.delta_max;
