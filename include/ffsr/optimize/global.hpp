@@ -867,7 +867,14 @@ inline GlobalCaptureResult plan_capture_global(const CaptureProblem& pb, const C
       const double t_r = g.reconfigure.duration > 0
                              ? g.reconfigure.duration
                              : default_reconfiguration_duration(*pb.model, pb.theta, goals[i].theta, o);
-      r = detail::reach_goal(pb, task, run_opt, setup, g, goals[i].theta, res, where, t_r);
+      try {
+        r = detail::reach_goal(pb, task, run_opt, setup, g, goals[i].theta, res, where, t_r);
+      } catch (const ReconfigurationRateError&) {
+        // a duration chosen here (not given) fits the first goal; a goal that moved while shooting
+        // may need more: that goal is not reached, the next is tried. A given duration is the user's.
+        if (g.reconfigure.duration > 0) throw;
+        r.reset();
+      }
       reject(r);
       if (r && r->reached_manifold_optimum) return std::move(*r);
       keep(r);

@@ -70,7 +70,7 @@ inline GlobalRun run_global(const Scenario& sc, const CaptureResult& paper_run, 
     r.result = plan_global_with_clearance(sc, opt, g);  // as plan_capture_global without a clearance
   } catch (const ReconfigurationRateError& e) {
     throw InputError(str("--reconfigure-duration: a reconfiguration in ", e.duration, " s: joint '", e.joint,
-                         "' needs ", e.needed * 180 / M_PI, " deg/s, max-joint-rate-deg is ",
+                         "' needs ", std::ceil(e.needed * 18000 / M_PI) / 100, " deg/s, max-joint-rate-deg is ",
                          e.limit * 180 / M_PI));
   } catch (const InputError& e) {
     if (std::string(e.what()).find("max joint rate") != std::string::npos)
