@@ -55,10 +55,13 @@ void check_series_csv(const std::string& path, size_t n_joints) {
     INFO(col);
     CHECK(c.column(col) >= 0);
   }
-  CHECK(c.header.size() == 2 + n_joints + 7 + 3 + 2);
+  CHECK(c.header.size() == 2 + n_joints + 7 + 3 + 2 + 1);  // run, t, joints, base, ee, M_ie, F_max, phase
+  REQUIRE(c.column("phase") == static_cast<int>(c.header.size()) - 1);
   size_t baseline = 0, optimized = 0, global = 0;
   for (const auto& row : c.rows) {
     REQUIRE(row.size() == c.header.size());
+    // the paper's scenarios need no reconfiguration: every row is the approach
+    CHECK(row.back() == "approach");
     if (row[0] == "baseline") ++baseline;
     if (row[0] == "optimized") ++optimized;
     if (row[0] == "global") ++global;
