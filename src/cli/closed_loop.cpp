@@ -5,6 +5,8 @@
 // main job first) or the servo to a given capture configuration (--goal-joints-deg). A flag overrides
 // the scenario file's key.
 #include "common.hpp"
+#include "figures.hpp"
+#include "plot.hpp"
 #include "scenario.hpp"
 #include "subcommands.hpp"
 
@@ -31,7 +33,7 @@ struct ClosedLoopCliOptions : OutputKeys {
   ControllerOptions controller;
 };
 
-const std::set<std::string> kClosedLoopKeys = {"json", "csv", "quiet"};
+const std::set<std::string> kClosedLoopKeys = {"json", "csv", "plot", "plot-format", "quiet"};
 
 /// The open-loop plan and the controller that follows it.
 struct Plan {
@@ -45,6 +47,8 @@ Plan make_plan(const Scenario& sc, const ClosedLoopCliOptions& o) {
   Plan p;
   p.options = sc.capture;
   p.options.progress = nullptr;
+  p.options.record_series = !o.plot.empty();  // the plan's joint angles beside the closed loop's
+  p.options.record_every = std::max(1, static_cast<int>(sc.capture.duration / sc.capture.step / 1000));
   if (!o.goal_joints_deg.empty()) {
     if (static_cast<int>(o.goal_joints_deg.size()) != sc.model->n())
       throw InputError(str("--goal-joints-deg: got ", o.goal_joints_deg.size(), " angles, the robot has ",
@@ -161,6 +165,26 @@ void print_table(std::ostream& out, const Scenario& sc, const Plan& p, const Clo
       << r.saturated_ticks << " with a torque at its limit), " << r.estimates << " estimates\n";
 }
 
+/// The picture: the recorded series of the closed loop beside the open-loop plan's.
+plot::Figure closed_loop_figure(const Scenario& sc, const Plan& p, const ClosedLoopOptions& o,
+                                const ClosedLoopResult& r) {
+  figures::ClosedLoopSeries f;
+  f.joint_names = sc.model->joint_names();
+  for (const ClosedLoopSample& x : r.series) {
+    f.t.push_back(x.t);
+    f.theta.push_back(x.theta);
+    f.lag.push_back(x.command - x.theta_dot);
+    f.torque.push_back(x.torque);
+    f.reference_error.push_back((x.end_effector - x.reference).norm());
+  }
+  f.torque_limit = o.loop.torque_limit;
+  f.open_loop = &p.open;
+  f.title = str("Closed loop, ", p.name, " plan, control ", o.control_rate, " Hz: capture error ",
+                std::setprecision(3), r.capture_error * 1e3, " mm, M#die#u ", r.M_ie, " kg (plan ", p.open.M_ie,
+                ")");
+  return figures::closed_loop(f);
+}
+
 /// The closed loop's flags, each error naming its flag.
 void check_flags(const ClosedLoopCliOptions& o) {
   auto check = [](double x, bool zero_ok, const char* flag) {
@@ -189,14 +213,18 @@ int run_closed_loop(ClosedLoopCliOptions o, const CLI::App& app) {
   o.loop.noise.angular_velocity = deg2rad(o.spin_noise_deg);
   o.loop.seed = parse_count(o.noise_seed, "--noise-seed");
   if (!o.csv.empty() && !(o.loop.record_every > 0)) o.loop.record_every = 1.0;
+  if (!o.plot.empty() && !(o.loop.record_every > 0))  // about 1000 points per curve
+    o.loop.record_every = std::max(sc.capture.duration / 1000, 1.0 / o.loop.control_rate);
   Outputs outputs;
   outputs.add("--json", o.json);
   outputs.add("--csv", o.csv);
   check_flags(o);  // before the planning
+  const plot::Format plot_format = plot::check_request(o.plot, o.plot_format);
   if (o.controller.prediction_window < 1 || o.controller.prediction_window > 100000)
     throw InputError(str("--prediction-window: must be in 1..100000, got ", o.controller.prediction_window));
   const Plan plan = make_plan(sc, o);
   const ClosedLoopResult r = simulate(sc, plan, o.loop, o.controller);
+  if (!o.plot.empty()) plot::render({closed_loop_figure(sc, plan, o.loop, r)}, o.plot, plot_format);
   outputs.set("--json", result_json(sc, plan, o.loop, o.controller, r).dump(2) + "\n");
   outputs.set("--csv", series_csv(r));
   outputs.write();
@@ -244,6 +272,10 @@ void register_closed_loop(CLI::App& app, Action& action) {
       ->capture_default_str();
   sub->add_option("--json", o->json, "Write the result to this JSON file ('-': standard output)");
   sub->add_option("--csv", o->csv, "Write the time series (one row per second and joint) to this CSV file");
+  sub->add_option("--plot", o->plot,
+                  "Draw the closed loop beside the plan (joint angles, tracking, torques, lag) into this "
+                  "(existing) folder");
+  sub->add_option("--plot-format", o->plot_format, "Figure format: png, svg or pdf")->capture_default_str();
   sub->add_flag("--quiet", o->quiet, "No progress line");
   sub->callback([o, sub, &action] { action = [o, sub] { return run_closed_loop(*o, *sub); }; });
 }

@@ -408,6 +408,76 @@ std::vector<plot::Figure> capture(const Model& model, int frame, const Target& t
   return out;
 }
 
+plot::Figure closed_loop(const ClosedLoopSeries& s) {
+  const size_t m = s.t.size();
+  if (s.theta.size() != m || s.lag.size() != m || s.torque.size() != m || s.reference_error.size() != m)
+    throw InputError("figures::closed_loop: the series have different lengths");
+  plot::Figure fig;
+  fig.name = "closed_loop";
+  fig.title = s.title;
+  fig.rows = fig.cols = 2;
+  fig.width = 1200;
+  fig.height = 900;
+  // the tracking error in the unit that keeps its axis numbers plain: mm, or um below 0.1 mm
+  double e_max = 0, tau_max = 0;
+  for (size_t i = 0; i < m; ++i) {
+    e_max = std::max(e_max, s.reference_error[i]);
+    tau_max = std::max(tau_max, s.torque[i].cwiseAbs().maxCoeff());
+  }
+  const bool micro = e_max < 1e-4;
+  const bool limit_lines = s.torque_limit > 0 && tau_max > 0.3 * s.torque_limit;
+  Panel angles = labelled("joint angles: closed loop (solid), plan (dashed)", "time t (s)", "joint angle (deg)"),
+        track = labelled("end effector to the reference line", "time t (s)",
+                         micro ? "|p#de#u - x#dd#u| (µm)" : "|p#de#u - x#dd#u| (mm)"),
+        torque = labelled(limit_lines ? str("joint torques (limit ±", s.torque_limit, " N m: dashed)")
+                                      : str("joint torques (limit ±", s.torque_limit, " N m)"),
+                          "time t (s)", "torque (N m)"),
+        lag = labelled("rate loops' lag: command - joint rate", "time t (s)", "lag (deg/s)");
+  const size_t n = s.joint_names.size();
+  for (size_t j = 0; j < n; ++j) {
+    const auto k = static_cast<Eigen::Index>(j);
+    Curve a, q, u, e;
+    a.label = s.joint_names[j];
+    a.color = q.color = u.color = e.color = static_cast<int>(j % plot::kPaletteSize);
+    a.width = q.width = u.width = e.width = 1.6;
+    q.line_style = 2;
+    for (size_t i = 0; i < m; ++i) {
+      a.x.push_back(s.t[i]);
+      a.y.push_back(s.theta[i](k) * 180.0 / M_PI);
+      u.y.push_back(s.torque[i](k));
+      e.y.push_back(s.lag[i](k) * 180.0 / M_PI);
+    }
+    u.x = e.x = a.x;
+    if (s.open_loop)
+      for (const CaptureSample& o : s.open_loop->series) {
+        q.x.push_back(o.t);
+        q.y.push_back(o.theta(k) * 180.0 / M_PI);
+      }
+    angles.curves.push_back(std::move(a));
+    if (!q.x.empty()) angles.curves.push_back(std::move(q));
+    torque.curves.push_back(std::move(u));
+    lag.curves.push_back(std::move(e));
+  }
+  Curve d;
+  d.color = kBlack;
+  d.width = 1.6;
+  d.x = s.t;
+  for (double x : s.reference_error) d.y.push_back(x * (micro ? 1e6 : 1e3));
+  track.curves.push_back(std::move(d));
+  if (m > 0 && limit_lines)
+    for (double sign : {1.0, -1.0}) {
+      Curve l;
+      l.color = kBlack;
+      l.line_style = 2;
+      l.width = 1.0;
+      l.x = {s.t.front(), s.t.back()};
+      l.y = {sign * s.torque_limit, sign * s.torque_limit};
+      torque.curves.push_back(std::move(l));
+    }
+  fig.panels = {angles, track, torque, lag};
+  return fig;
+}
+
 plot::Figure contact(const std::vector<ContactCurve>& curves, double M_ie, double approach_velocity) {
   plot::Figure fig;
   fig.name = "contact";

@@ -30,6 +30,24 @@ struct CaptureRun {
 std::vector<plot::Figure> capture(const Model& model, int frame, const Target& target_at_start,
                                   double duration, const std::vector<CaptureRun>& runs);
 
+/// A closed-loop run of `closed-loop` (plain data: the command copies it from the simulation's
+/// recorded series) beside the open-loop plan it follows.
+struct ClosedLoopSeries {
+  std::vector<std::string> joint_names;
+  std::vector<double> t;                      ///< s
+  std::vector<Eigen::VectorXd> theta;         ///< rad, one per t
+  std::vector<Eigen::VectorXd> lag;           ///< command - joint rate, rad/s, one per t
+  std::vector<Eigen::VectorXd> torque;        ///< N m, one per t
+  std::vector<double> reference_error;        ///< |p_e - x_d|, m, one per t
+  double torque_limit = 0;                    ///< N m
+  const CaptureResult* open_loop = nullptr;   ///< the plan, with its recorded series
+  std::string title;
+};
+/// "closed_loop": the joint angles of the closed loop (solid) and of the open-loop plan (dashed),
+/// the end-effector's distance to the reference line, the joint torques with their limit and the
+/// rate loops' lag, against time.
+plot::Figure closed_loop(const ClosedLoopSeries& s);
+
 /// One contact run of `contact`: F(t), delta(t) and the two marked points of Figure 3.
 struct ContactCurve {
   std::string law;

@@ -258,6 +258,8 @@ void print_base_jump(std::ostream& out, const Scenario& sc, const ScenarioResult
   out << std::scientific << std::setprecision(3) << "base angular rate jump at the impact: plain " << rate(r.plain)
       << " deg/s, optimized " << rate(r.optimized) << " deg/s";
   if (r.global) out << ", global " << rate(r.global->result.run) << " deg/s";
+  if (r.global && sc.keys.max_base_rate_deg > 0)
+    out << std::defaultfloat << " (searched within max-base-rate-deg " << sc.keys.max_base_rate_deg << ")";
   out << "\n";
   out.flags(flags);
   out.precision(precision);

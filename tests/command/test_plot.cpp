@@ -13,6 +13,7 @@
 #include "ffsr/io/urdf.hpp"
 
 #include <catch2/catch.hpp>
+#include <nlohmann/json.hpp>
 
 #include <filesystem>
 #include <fstream>
@@ -341,6 +342,56 @@ TEST_CASE("map --plot bad inputs: one error line naming the flag, no CSV and no 
   }
 }
 
+TEST_CASE("closed-loop --plot: the closed loop beside its plan, the JSON's numbers on the picture's curves",
+          "[plot][cli][controller]") {
+  TempDir dir;
+  // the built-in 3-DOF scenario, the paper's plan, the exact target, 20 Hz control
+  const auto r = run_command({kCli, "closed-loop", "--control-rate", "20", "--estimate-rate", "1", "--plot",
+                              dir.str(), "--json", dir / "cl.json", "--quiet"});
+  REQUIRE(r.exit_code == 0);
+  check_png(dir / "closed_loop.png", 1200, 900, 8);
+  std::ifstream in(dir / "cl.json");
+  const nlohmann::json j = nlohmann::json::parse(in);
+  CHECK(j["closed_loop"]["capture_error"].get<double>() < 1e-4);  // the exact target: tracked
+  CHECK(j["closed_loop"]["max_torque"].get<double>() <= 100.0 + 1e-9);  // the default torque limit
+}
+
+TEST_CASE("closed-loop figure: one curve per joint and run, the limit lines, equal lengths required", "[plot]") {
+  CaptureResult open;
+  for (int i = 0; i <= 4; ++i) {
+    CaptureSample x;
+    x.t = i;
+    x.theta = Eigen::Vector2d(0.1 * i, -0.1 * i);
+    open.series.push_back(x);
+  }
+  figures::ClosedLoopSeries s;
+  s.joint_names = {"a", "b"};
+  s.torque_limit = 50;
+  s.open_loop = &open;
+  for (int i = 0; i <= 8; ++i) {
+    s.t.push_back(0.5 * i);
+    s.theta.push_back(Eigen::Vector2d(0.05 * i, -0.05 * i));
+    s.lag.push_back(Eigen::Vector2d(1e-3, -1e-3));
+    s.torque.push_back(Eigen::Vector2d(10.0, -60.0));
+    s.reference_error.push_back(2e-3);
+  }
+  const plot::Figure f = figures::closed_loop(s);
+  REQUIRE(f.panels.size() == 4);
+  const auto& angles = std::get<plot::Panel>(f.panels[0]);
+  CHECK(angles.curves.size() == 4);  // closed loop and plan per joint
+  CHECK(angles.curves[0].y.back() == Approx(0.4 * 180 / M_PI));
+  CHECK(angles.curves[1].x.size() == 5);
+  CHECK(std::get<plot::Panel>(f.panels[1]).curves.front().y.front() == Approx(2.0));  // mm
+  CHECK(std::get<plot::Panel>(f.panels[2]).curves.size() == 4);  // two joints, +limit, -limit (60 > 0.3 x 50)
+  s.reference_error.assign(s.t.size(), 2e-6);  // small errors in micrometres
+  CHECK(std::get<plot::Panel>(figures::closed_loop(s).panels[1]).curves.front().y.front() == Approx(2.0));
+  s.torque.assign(s.t.size(), Eigen::Vector2d(1.0, -1.0));  // far below the limit: no limit lines
+  CHECK(std::get<plot::Panel>(figures::closed_loop(s).panels[2]).curves.size() == 2);
+  CHECK(std::get<plot::Panel>(f.panels[3]).curves[1].y.front() == Approx(-1e-3 * 180 / M_PI));  // deg/s
+  s.torque.pop_back();
+  CHECK_THROWS_AS(figures::closed_loop(s), InputError);
+}
+
 TEST_CASE("plot bad inputs: a missing folder or an unknown format give one error line and no output",
           "[plot][cli]") {
   TempDir dir;
@@ -359,6 +410,7 @@ TEST_CASE("plot bad inputs: a missing folder or an unknown format give one error
         "bmp"},
        "--plot-format: unknown format 'bmp'"},
       {{kCli, "xi", "--plot", missing}, "--plot: folder '" + missing},
+      {{kCli, "closed-loop", "--plot", missing, "--quiet"}, "--plot: folder '" + missing},
       {{kCli, "xi", "--points", "1"}, "--points: expected 2 to 100000, got 1"},
   };
   for (const auto& c : cases) {

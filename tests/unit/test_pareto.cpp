@@ -3,6 +3,9 @@
 
 #include "support/paper.hpp"
 
+#include <string>
+
+#include "ffsr/io/scenario_run.hpp"
 #include "ffsr/io/urdf.hpp"
 #include "ffsr/optimize/pareto.hpp"
 
@@ -67,6 +70,102 @@ TEST_CASE("Pareto front: bad options", "[pareto]") {
   ParetoOptions o;
   o.levels = 0;
   CHECK_THROWS_AS(pareto_front(pb, CaptureTask{}, s, BasePose{}, o), InputError);
+}
+
+TEST_CASE("Inequalities combined: rows stacked, each gradient row in its place", "[pareto]") {
+  auto a = std::make_shared<ManifoldInequalities>();
+  a->count = 1;
+  a->tolerance = 1e-3;
+  a->eval = [](const BasePose&, const Eigen::VectorXd& th, double* g, double* G) {
+    g[0] = th(0);
+    if (G) G[0] = 1, G[1] = 0, G[2] = 0;
+  };
+  auto b = std::make_shared<ManifoldInequalities>();
+  b->count = 2;
+  b->tolerance = 1e-6;
+  b->eval = [](const BasePose&, const Eigen::VectorXd& th, double* g, double* G) {
+    g[0] = th(1);
+    g[1] = th(0) * th(2);
+    if (G) G[0] = 0, G[1] = 1, G[2] = 0, G[3] = th(2), G[4] = 0, G[5] = th(0);
+  };
+  CHECK(combine_inequalities(nullptr, b) == b);
+  CHECK(combine_inequalities(a, nullptr) == a);
+  const auto c = combine_inequalities(a, b);
+  REQUIRE(c->count == 3);
+  CHECK(c->tolerance == 1e-6);
+  const Eigen::Vector3d th(2, 3, 5);
+  double g[3], G[9];
+  c->eval(BasePose{}, th, g, G);
+  CHECK(g[0] == 2);
+  CHECK(g[1] == 3);
+  CHECK(g[2] == 10);
+  const double expected[9] = {1, 0, 0, 0, 1, 0, 5, 0, 2};
+  for (int i = 0; i < 9; ++i) CHECK(G[i] == expected[i]);
+  c->eval(BasePose{}, th, g, nullptr);  // values alone
+  CHECK(g[2] == 10);
+}
+
+TEST_CASE("The base-rate constraint: the search's least M_ie within it matches the front's point", "[pareto]") {
+  const Model m = model_from_urdf_file(kRobots + "paper_7dof.urdf");
+  CaptureProblem pb = ffsr::test::problem_7dof(m);
+  pb.contact = ffsr::test::kPaperContact;
+  CaptureTask task;  // position
+  CaptureOptions opt;
+  opt.duration = 157;
+  const CaptureSetup s = prepare_capture(pb, task, opt);
+  const BasePose base;
+  ParetoOptions o;
+  o.starts = 8;
+  o.levels = 12;
+  const ParetoFront f = pareto_front(pb, task, s, base, o);
+  REQUIRE(f.points.size() >= 5);
+  const ParetoPoint& mid = f.points[f.points.size() / 2];
+  ManifoldSearchOptions so;
+  so.starts = 8;
+  so.inequalities = base_rate_inequality(pb, s, mid.base_rate);
+  const ManifoldSearchResult r = search_capture_manifold(pb, task, s, base, so);
+  Data d(m);
+  const AnyContactLaw law = make_contact_law(pb.law, pb.contact, s.v_in);
+  for (const ManifoldPoint& p : r.local_optima)  // every optimum kept keeps the limit
+    CHECK(base_disturbance(m, d, base, p.theta, pb.frame, s.capture_target, law).angular_rate() <=
+          mid.base_rate * (1 + 1e-5));
+  INFO("front point " << mid.M_ie << " kg at " << mid.base_rate << " rad/s, constrained search " << r.best.M_ie
+                      << " kg");
+  CHECK(r.best.M_ie >= f.min_mass.M_ie * (1 - 1e-9));  // the limit costs M_ie ...
+  CHECK(r.best.M_ie <= mid.M_ie * (1 + 1e-3));          // ... no more than the front says
+  CHECK(r.best.M_ie >= mid.M_ie * (1 - 1e-2));          // and the front's point is (near) optimal
+  CHECK_THROWS_AS(base_rate_inequality(pb, s, -1.0), InputError);
+  CHECK_THROWS_AS(base_rate_inequality(pb, s, std::nan("")), InputError);
+}
+
+TEST_CASE("max-base-rate-deg: the global run of the 7-DOF scenario within the limit; bad values name the key",
+          "[pareto]") {
+  ScenarioKeys k = read_scenario_file(kRobots + "paper_7dof_position.toml");
+  override_scenario_key(k, "max-base-rate-deg", "1.5e-3");  // the unconstrained global run: 3.2e-3 deg/s
+  const Scenario sc = build_scenario(std::move(k));
+  const CaptureResult paper = plan_capture(sc.problem, sc.task, sc.capture);
+  const GlobalRun g = run_global(sc, paper, sc.objective);
+  Data d(*sc.model);
+  const double rate = detail::run_base_disturbance(sc, d, g.result.run).angular_rate() * 180 / M_PI;
+  INFO("global run: M_ie " << g.result.run.M_ie << " kg, base rate jump " << rate << " deg/s");
+  CHECK(g.result.run.capture_distance <= sc.capture.tolerance);
+  CHECK(g.result.reached_manifold_optimum);
+  CHECK(rate <= 1.5e-3 * 1.01);  // a reached configuration beyond 1 % is planned again (shooting)
+  CHECK(g.result.run.M_ie >= 1.2764 * (1 - 1e-3));  // not below the unconstrained optimum
+  auto message = [](const std::string& value) {
+    ScenarioKeys keys = read_scenario_file(kRobots + "paper_7dof_position.toml");
+    try {
+      override_scenario_key(keys, "max-base-rate-deg", value);
+      build_scenario(std::move(keys));
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  CHECK(message("-1").rfind("--max-base-rate-deg: must be positive", 0) == 0);
+  CHECK(message("0").rfind("--max-base-rate-deg: must be positive", 0) == 0);
+  CHECK(message("nan").rfind("--max-base-rate-deg:", 0) == 0);
+  CHECK(message("fast").rfind("--max-base-rate-deg:", 0) == 0);
 }
 
 }  // namespace test_pareto

@@ -64,6 +64,7 @@ struct ScenarioKeys {
   bool global = true;             ///< also run the global capture optimization
   std::string seed = "1";         ///< the global search's seed (text: a bad value names the key)
   double max_joint_rate_deg = 0;  ///< 0: not set
+  double max_base_rate_deg = 0;   ///< global search: largest impact base-rate jump, deg/s; 0: not set
   int global_starts = 32;
   std::string reconfigure = "auto";  ///< reconfiguration before the approach: auto, always, never
   double reconfigure_duration = 0;   ///< s; 0: not set (duration / 4, longer if the rate limit needs it)

@@ -133,6 +133,7 @@ inline GlobalCaptureResult plan_global_with_clearance(const Scenario& sc, const 
   std::shared_ptr<const CollisionChecker> cc = geo->checker;
   const double c = geo->clearance;
   auto violations = std::make_shared<std::vector<double>>();
+  const std::shared_ptr<const ManifoldInequalities> given = g.search.inequalities;  // e.g. the base rate
   g.check_run = [m, t0, cc, c, violations](const CaptureResult& run) {
     const ClearanceReport r = path_clearance(*m, *cc, t0, run);
     std::optional<std::string> why = clearance_violation(r, c);
@@ -140,7 +141,7 @@ inline GlobalCaptureResult plan_global_with_clearance(const Scenario& sc, const 
     return why;
   };
   for (int round = 1;; ++round) {
-    g.search.inequalities = clearance_constraints(*m, cc, detail::target_poses(t0, times), c);
+    g.search.inequalities = combine_inequalities(given, clearance_constraints(*m, cc, detail::target_poses(t0, times), c));
     violations->clear();
     try {
       return plan_capture_global(sc.problem, sc.task, opt, g);

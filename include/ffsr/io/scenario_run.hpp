@@ -6,6 +6,7 @@
 
 #include "ffsr/io/scenario.hpp"
 #include "ffsr/optimize/branches.hpp"
+#include "ffsr/optimize/pareto.hpp"
 #include "ffsr/uncertainty/robust_objective.hpp"
 
 #include <functional>

@@ -49,6 +49,7 @@
 
 #include <chrono>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <random>
@@ -79,7 +80,28 @@ struct ManifoldInequalities {
   unsigned count = 0;
   std::function<void(const BasePose& base, const Eigen::VectorXd& theta, double* g, double* grad)> eval;
   double tolerance = 1e-6;
+  /// plan_capture_global: a reaching run's configuration at T whose values exceed this is planned
+  /// again from the constrained optimum at its base pose (the shooting loop); infinity: not checked.
+  double reach_tolerance = std::numeric_limits<double>::infinity();
 };
+
+/// Both sets of inequalities, a's rows first (either may be null or empty: the other is returned),
+/// with the smaller of the two tolerances.
+inline std::shared_ptr<const ManifoldInequalities> combine_inequalities(
+    std::shared_ptr<const ManifoldInequalities> a, std::shared_ptr<const ManifoldInequalities> b) {
+  if (!a || a->count == 0) return b;
+  if (!b || b->count == 0) return a;
+  auto q = std::make_shared<ManifoldInequalities>();
+  q->count = a->count + b->count;
+  q->tolerance = std::min(a->tolerance, b->tolerance);
+  q->reach_tolerance = std::min(a->reach_tolerance, b->reach_tolerance);
+  q->eval = [a, b](const BasePose& base, const Eigen::VectorXd& theta, double* g, double* grad) {
+    a->eval(base, theta, g, grad);  // grad row-major, one row of theta.size() per inequality
+    b->eval(base, theta, g + a->count,
+            grad ? grad + static_cast<std::ptrdiff_t>(a->count) * theta.size() : nullptr);
+  };
+  return q;
+}
 
 struct ManifoldSearchOptions {
   int starts = 32;         ///< random starts of the multistart
@@ -248,6 +270,18 @@ inline void slsqp_inequalities(unsigned m, double* result, unsigned n, const dou
   c.theta = Eigen::Map<const Eigen::VectorXd>(x, n);
   (void)m;
   c.inequalities->eval(*c.base, c.theta, result, grad);
+}
+
+/// True when some inequality of `so` exceeds its reach_tolerance at theta (a reached configuration).
+inline bool exceeds_reach_tolerance(const ManifoldSearchOptions& so, const BasePose& base,
+                                    const Eigen::VectorXd& theta) {
+  if (!so.inequalities || so.inequalities->count == 0 || !std::isfinite(so.inequalities->reach_tolerance))
+    return false;
+  std::vector<double> g(so.inequalities->count);
+  so.inequalities->eval(base, theta, g.data(), nullptr);
+  for (double v : g)
+    if (!(v <= so.inequalities->reach_tolerance)) return true;
+  return false;
 }
 
 /// True when the inequalities of `so` (if any) hold at theta within their tolerance.
@@ -593,6 +627,11 @@ inline ManifoldSearchResult detail::search_manifold(const CaptureProblem& pb, co
     }
   }
   res.evaluations = ctx.evaluations;
+  if (found.empty() && so.inequalities && so.inequalities->count > 0)
+    throw InputError(
+        str("search_capture_manifold: no configuration that puts the end-effector on the capture point [",
+            s.x_cap.transpose(), "] from the base pose at T satisfies the search's inequality constraints (",
+            res.starts, " starts)"));
   if (found.empty())
     throw InputError(
         str("search_capture_manifold: no configuration puts the end-effector on the capture point [",
@@ -763,6 +802,10 @@ inline std::optional<GlobalCaptureResult> reach_goal(const CaptureProblem& pb, c
     // the servo leaves ~e^-10 of the error; the rest is the move of the manifold with the base pose,
     // small against the distance between components
     if (detail::configuration_distance(*pb.model, run.theta, local.best.theta) > 0.5) return std::nullopt;
+    if (detail::exceeds_reach_tolerance(g.search, run.base, run.theta)) {  // outside the constraints
+      goal = local.best.theta;
+      continue;
+    }
     const double local_gap = 100.0 * (reached.objective - local.best.objective) / local.best.objective;
     if (!std::isfinite(local_gap)) throw NumericalError(str(where, ": the optimality gap is not finite"));
     if (local_gap > g.gap_percent) {

@@ -273,4 +273,47 @@ inline ParetoFront pareto_front(const CaptureProblem& pb, const CaptureTask& tas
   return f;
 }
 
+/// The base-rate constraint of a capture search: ((|Delta w_0| / max_rate)^2 - 1 <= 0 at the search's
+/// base pose, with the restitution of the law; gradient by central differences as in the sweep), the
+/// epsilon-constraint of the front as a ManifoldInequalities for search_capture_manifold and
+/// plan_capture_global: their least M_ie under it is the front's point at eps = max_rate, and the
+/// reaching planner plans to it as to the unconstrained optimum. max_rate in rad/s, > 0.
+inline std::shared_ptr<const ManifoldInequalities> base_rate_inequality(const CaptureProblem& pb,
+                                                                        const CaptureSetup& s,
+                                                                        double max_rate) {
+  if (!pb.model) throw InputError("base_rate_inequality: no model");
+  if (!(max_rate > 0) || !std::isfinite(max_rate))
+    throw InputError(detail::str("base_rate_inequality: the largest base rate must be positive and finite, got ",
+                                 max_rate));
+  auto q = std::make_shared<ManifoldInequalities>();
+  q->count = 1;
+  q->tolerance = 1e-6;        // relative: (rate / max)^2 - 1
+  q->reach_tolerance = 0.0201;  // a reached configuration: rate <= 1.01 max
+  const double restitution = single_body_restitution(s.law);
+  auto problem = std::make_shared<const CaptureProblem>(pb);
+  auto setup = std::make_shared<const CaptureSetup>(s);
+  q->eval = [problem, setup, restitution, max_rate](const BasePose& base, const Eigen::VectorXd& theta, double* g,
+                                                    double* grad) {
+    const Model& model = *problem->model;
+    Data data(model);  // per call: the inequality may be evaluated from several searches
+    auto f = [&](const Eigen::VectorXd& th) {
+      const double r =
+          detail::pareto_point(model, data, *problem, *setup, base, th, restitution).base_rate / max_rate;
+      return r * r;
+    };
+    g[0] = f(theta) - 1.0;
+    if (!grad) return;
+    const double h = 1e-6;
+    Eigen::VectorXd t = theta;
+    for (Eigen::Index k = 0; k < theta.size(); ++k) {
+      t(k) = theta(k) + h;
+      const double fp = f(t);
+      t(k) = theta(k) - h;
+      grad[k] = (fp - f(t)) / (2 * h);
+      t(k) = theta(k);
+    }
+  };
+  return q;
+}
+
 }  // namespace ffsr

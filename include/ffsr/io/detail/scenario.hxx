@@ -242,6 +242,9 @@ inline std::vector<ScenarioKey> build_scenario_keys() {
                "Global run: largest joint rate, deg/s (> 0; default: not limited; the paper's method is not "
                "limited)"),
       FFSR_KEY("global-starts", global_starts, "Global search: random starts (>= 1)", "32"),
+      FFSR_KEY("max-base-rate-deg", max_base_rate_deg,
+               "Global search: largest jump of the base's angular velocity at the impact, deg/s (a constraint; "
+               "> 0; default: not limited; `pareto` shows the trade-off against M_ie)"),
       // the spacecraft's side: the reaction-null-space approach
       FFSR_KEY("base-attitude", base_attitude,
                "Optimized run: free, or hold (the base's angular velocity stays zero; the objective uses "
@@ -697,6 +700,8 @@ inline Scenario build_scenario(ScenarioKeys k, const EmbeddedUrdf* embedded) {
   if (k.global_starts < 1) throw InputError(str("--global-starts: must be >= 1, got ", k.global_starts));
   if (k.given.count("max-joint-rate-deg") && !(finite(k.max_joint_rate_deg, "max-joint-rate-deg") > 0))
     throw InputError(str("--max-joint-rate-deg: must be positive, got ", k.max_joint_rate_deg));
+  if (k.given.count("max-base-rate-deg") && !(finite(k.max_base_rate_deg, "max-base-rate-deg") > 0))
+    throw InputError(str("--max-base-rate-deg: must be positive, got ", k.max_base_rate_deg));
   reconfigure_mode_of(k.reconfigure, "--reconfigure");
   if (k.given.count("reconfigure-duration") &&
       !(finite(k.reconfigure_duration, "reconfigure-duration") > 0 && k.reconfigure_duration < k.duration))
