@@ -138,7 +138,7 @@ TEST_CASE("The base-rate constraint: the search's least M_ie within it matches t
   CHECK_THROWS_AS(base_rate_inequality(pb, s, std::nan("")), InputError);
 }
 
-TEST_CASE("max-base-rate-deg: the global run of the 7-DOF scenario within the limit; bad values name the key",
+TEST_CASE("max-base-rate-deg: the global run of the 7-DOF scenario within the limit, bad values name the key",
           "[pareto]") {
   ScenarioKeys k = read_scenario_file(kRobots + "paper_7dof_position.toml");
   override_scenario_key(k, "max-base-rate-deg", "1.5e-3");  // the unconstrained global run: 3.2e-3 deg/s
