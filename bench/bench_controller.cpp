@@ -2,8 +2,11 @@
 // 99.9th percentile over 1e5 calls, and update_target() median, on the paper's 3-DOF robot and the
 // 7-DOF robot (position and pose tasks), paper's gradient policy and the servo. One thread, pinned
 // to one core when the system allows it. Run (Release): build/bench/ffsr-bench-controller [robots/]
-// [--calls N]. Prints one line per case; exit status 1 when a step median exceeds its budget
+// [--calls N] [--cpu K]. Prints one line per case; exit status 1 when a step median exceeds its budget
 // (3-DOF 5 us, 7-DOF 20 us) or the 99.9th percentile exceeds 3x the median.
+// First line: a reference workload timed the same way (a fixed chain of 6x6 products, no branch, no
+// memory beyond the stack, about as long as a 3-DOF step). Its p99.9 / median is the machine's
+// (timer interrupts, a hypervisor's steal): a controller ratio near it is not the controller's tail.
 
 #include "ffsr/control/capture_controller.hpp"
 #include "ffsr/io/scenario.hpp"
@@ -67,6 +70,23 @@ Timing time_controller(CaptureController<Policy>& ctrl, const CaptureProblem& pb
   return {percentile(us, 0.5), percentile(us, 0.999), percentile(up, 0.5)};
 }
 
+/// The reference workload's median and p99.9 (same clock, same number of calls).
+Timing time_reference(long calls) {
+  Eigen::Matrix<double, 6, 6> a = Eigen::Matrix<double, 6, 6>::Identity() * 0.5, b;
+  a(0, 5) = 0.1;
+  std::vector<double> us(static_cast<size_t>(calls));
+  volatile double sink = 0;
+  for (long k = 0; k < calls; ++k) {
+    const auto t0 = Clock::now();
+    b = a;
+    for (int r = 0; r < 110; ++r) b = (b * a).eval();
+    sink = sink + b(0, 0);
+    const auto t1 = Clock::now();
+    us[static_cast<size_t>(k)] = std::chrono::duration<double, std::micro>(t1 - t0).count();
+  }
+  return {percentile(us, 0.5), percentile(us, 0.999), 0.0};
+}
+
 bool report(const char* name, const Timing& t, double budget_us) {
   const bool ok = t.median_us <= budget_us && t.p999_us <= 3 * t.median_us;
   std::printf(
@@ -82,17 +102,23 @@ bool report(const char* name, const Timing& t, double budget_us) {
 int main(int argc, char** argv) {
   std::string robots = std::string(FFSR_SOURCE_DIR) + "/robots/";
   long calls = 100000;
+  int cpu = 0;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--calls" && i + 1 < argc)
       calls = std::atol(argv[++i]);
+    else if (a == "--cpu" && i + 1 < argc)
+      cpu = std::atoi(argv[++i]);
     else
       robots = a + "/";
   }
   cpu_set_t set;
   CPU_ZERO(&set);
-  CPU_SET(0, &set);
+  CPU_SET(cpu, &set);
   sched_setaffinity(0, sizeof(set), &set);  // best effort
+  const Timing ref = time_reference(calls);
+  std::printf("%-34s median %7.2f us  p99.9 %7.2f us (%.2fx): the machine's tail\n", "reference workload",
+              ref.median_us, ref.p999_us, ref.p999_us / ref.median_us);
   bool ok = true;
   struct Case {
     const char* file;

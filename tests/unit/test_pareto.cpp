@@ -166,6 +166,20 @@ TEST_CASE("max-base-rate-deg: the global run of the 7-DOF scenario within the li
   CHECK(message("0").rfind("--max-base-rate-deg: must be positive", 0) == 0);
   CHECK(message("nan").rfind("--max-base-rate-deg:", 0) == 0);
   CHECK(message("fast").rfind("--max-base-rate-deg:", 0) == 0);
+  // a limit below the front's least rate (the rate end is zero to rounding, 1e-13 deg/s): one line
+  ScenarioKeys tight = read_scenario_file(kRobots + "paper_7dof_position.toml");
+  override_scenario_key(tight, "max-base-rate-deg", "1e-12");
+  const Scenario tight_sc = build_scenario(std::move(tight));
+  try {
+    run_global(tight_sc, paper, tight_sc.objective);
+    FAIL("expected no capture configuration within 1e-12 deg/s");
+  } catch (const InputError& e) {
+    const std::string w = e.what();
+    CHECK(w.rfind("--max-base-rate-deg: no capture configuration found keeps the impact's base-rate jump "
+                  "within 1e-12 deg/s",
+                  0) == 0);
+    CHECK(w.find('\n') == std::string::npos);
+  }
 }
 
 }  // namespace test_pareto

@@ -82,7 +82,7 @@ inline GlobalRun run_global(const Scenario& sc, const CaptureResult& paper_run, 
       throw InputError(str("--max-joint-rate-deg: ", e.what()));
     if (sc.keys.max_base_rate_deg > 0 && std::string(e.what()).find("inequality") != std::string::npos)
       throw InputError(str("--max-base-rate-deg: no capture configuration found keeps the impact's base-rate "
-                           "jump within ", sc.keys.max_base_rate_deg, " deg/s",
+                           "jump within ", std::setprecision(6), sc.keys.max_base_rate_deg, " deg/s",
                            sc.geometry ? " and the clearance" : "", " (`ffsr-optimize pareto` shows the least)"));
     throw InputError(str("global run: ", e.what()));
   } catch (const NumericalError& e) {
