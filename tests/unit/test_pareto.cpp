@@ -14,16 +14,35 @@ namespace test_pareto {
 using namespace ffsr;
 using ffsr::test::kRobots;
 
+/// The 7-DOF position task of the paper (T = 157 s) at its initial base pose.
+struct Paper7Position {
+  Model m = model_from_urdf_file(kRobots + "paper_7dof.urdf");
+  CaptureProblem pb = problem();
+  CaptureTask task;  // position
+  CaptureSetup s = setup();
+  BasePose base;  // the initial base pose
+
+ private:
+  CaptureProblem problem() const {
+    CaptureProblem p = ffsr::test::problem_7dof(m);
+    p.contact = ffsr::test::kPaperContact;
+    return p;
+  }
+  CaptureSetup setup() const {
+    CaptureOptions opt;
+    opt.duration = 157;
+    return prepare_capture(pb, task, opt);
+  }
+};
+
 TEST_CASE("Pareto front of M_ie and the base rate jump: non-dominated, on the manifold, ends optimal",
           "[pareto]") {
-  const Model m = model_from_urdf_file(kRobots + "paper_7dof.urdf");
-  CaptureProblem pb = ffsr::test::problem_7dof(m);
-  pb.contact = ffsr::test::kPaperContact;
-  CaptureTask task;  // position
-  CaptureOptions opt;
-  opt.duration = 157;
-  const CaptureSetup s = prepare_capture(pb, task, opt);
-  const BasePose base;  // the initial base pose
+  const Paper7Position p7;
+  const Model& m = p7.m;
+  const CaptureProblem& pb = p7.pb;
+  const CaptureTask& task = p7.task;
+  const CaptureSetup& s = p7.s;
+  const BasePose& base = p7.base;
   ParetoOptions o;
   o.starts = 8;
   o.levels = 24;
@@ -106,14 +125,12 @@ TEST_CASE("Inequalities combined: rows stacked, each gradient row in its place",
 }
 
 TEST_CASE("The base-rate constraint: the search's least M_ie within it matches the front's point", "[pareto]") {
-  const Model m = model_from_urdf_file(kRobots + "paper_7dof.urdf");
-  CaptureProblem pb = ffsr::test::problem_7dof(m);
-  pb.contact = ffsr::test::kPaperContact;
-  CaptureTask task;  // position
-  CaptureOptions opt;
-  opt.duration = 157;
-  const CaptureSetup s = prepare_capture(pb, task, opt);
-  const BasePose base;
+  const Paper7Position p7;
+  const Model& m = p7.m;
+  const CaptureProblem& pb = p7.pb;
+  const CaptureTask& task = p7.task;
+  const CaptureSetup& s = p7.s;
+  const BasePose& base = p7.base;
   ParetoOptions o;
   o.starts = 8;
   o.levels = 12;

@@ -85,6 +85,11 @@ struct ManifoldInequalities {
   double reach_tolerance = std::numeric_limits<double>::infinity();
 };
 
+/// No configuration on the capture manifold satisfies the search's inequality constraints.
+struct InfeasibleInequalitiesError : InputError {
+  using InputError::InputError;
+};
+
 /// Both sets of inequalities, a's rows first (either may be null or empty: the other is returned),
 /// with the smaller of the two tolerances.
 inline std::shared_ptr<const ManifoldInequalities> combine_inequalities(
@@ -272,27 +277,28 @@ inline void slsqp_inequalities(unsigned m, double* result, unsigned n, const dou
   c.inequalities->eval(*c.base, c.theta, result, grad);
 }
 
-/// True when some inequality of `so` exceeds its reach_tolerance at theta (a reached configuration).
-inline bool exceeds_reach_tolerance(const ManifoldSearchOptions& so, const BasePose& base,
-                                    const Eigen::VectorXd& theta) {
-  if (!so.inequalities || so.inequalities->count == 0 || !std::isfinite(so.inequalities->reach_tolerance))
-    return false;
+/// True when every inequality of `so` (if any) is at most `tolerance` at theta (NaN is not).
+inline bool inequalities_within(const ManifoldSearchOptions& so, const BasePose& base, const Eigen::VectorXd& theta,
+                                double tolerance) {
+  if (!so.inequalities || so.inequalities->count == 0) return true;
   std::vector<double> g(so.inequalities->count);
   so.inequalities->eval(base, theta, g.data(), nullptr);
   for (double v : g)
-    if (!(v <= so.inequalities->reach_tolerance)) return true;
-  return false;
+    if (!(v <= tolerance)) return false;
+  return true;
 }
 
 /// True when the inequalities of `so` (if any) hold at theta within their tolerance.
 inline bool satisfies_inequalities(const ManifoldSearchOptions& so, const BasePose& base,
                                    const Eigen::VectorXd& theta) {
-  if (!so.inequalities || so.inequalities->count == 0) return true;
-  std::vector<double> g(so.inequalities->count);
-  so.inequalities->eval(base, theta, g.data(), nullptr);
-  for (double v : g)
-    if (!(v <= so.inequalities->tolerance)) return false;
-  return true;
+  return !so.inequalities || inequalities_within(so, base, theta, so.inequalities->tolerance);
+}
+
+/// True when some inequality of `so` exceeds its reach_tolerance at theta (a reached configuration).
+inline bool exceeds_reach_tolerance(const ManifoldSearchOptions& so, const BasePose& base,
+                                    const Eigen::VectorXd& theta) {
+  return so.inequalities && std::isfinite(so.inequalities->reach_tolerance) &&
+         !inequalities_within(so, base, theta, so.inequalities->reach_tolerance);
 }
 
 }  // namespace detail
@@ -628,7 +634,7 @@ inline ManifoldSearchResult detail::search_manifold(const CaptureProblem& pb, co
   }
   res.evaluations = ctx.evaluations;
   if (found.empty() && so.inequalities && so.inequalities->count > 0)
-    throw InputError(
+    throw InfeasibleInequalitiesError(
         str("search_capture_manifold: no configuration that puts the end-effector on the capture point [",
             s.x_cap.transpose(), "] from the base pose at T satisfies the search's inequality constraints (",
             res.starts, " starts)"));

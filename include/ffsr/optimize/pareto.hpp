@@ -289,29 +289,23 @@ inline std::shared_ptr<const ManifoldInequalities> base_rate_inequality(const Ca
   q->count = 1;
   q->tolerance = 1e-6;        // relative: (rate / max)^2 - 1
   q->reach_tolerance = 0.0201;  // a reached configuration: rate <= 1.01 max
-  const double restitution = single_body_restitution(s.law);
-  auto problem = std::make_shared<const CaptureProblem>(pb);
-  auto setup = std::make_shared<const CaptureSetup>(s);
-  q->eval = [problem, setup, restitution, max_rate](const BasePose& base, const Eigen::VectorXd& theta, double* g,
-                                                    double* grad) {
-    const Model& model = *problem->model;
-    Data data(model);  // per call: the inequality may be evaluated from several searches
-    auto f = [&](const Eigen::VectorXd& th) {
-      const double r =
-          detail::pareto_point(model, data, *problem, *setup, base, th, restitution).base_rate / max_rate;
-      return r * r;
-    };
-    g[0] = f(theta) - 1.0;
-    if (!grad) return;
-    const double h = 1e-6;
-    Eigen::VectorXd t = theta;
-    for (Eigen::Index k = 0; k < theta.size(); ++k) {
-      t(k) = theta(k) + h;
-      const double fp = f(t);
-      t(k) = theta(k) - h;
-      grad[k] = (fp - f(t)) / (2 * h);
-      t(k) = theta(k);
-    }
+  // the sweep's constraint function on a context of its own (the searches call it one at a time)
+  struct Context {
+    CaptureProblem pb;
+    CaptureSetup s;
+    Data data;
+    detail::ParetoContext ctx{};
+  };
+  auto c = std::make_shared<Context>(Context{pb, s, Data(*pb.model), {}});
+  c->ctx.manifold.model = c->pb.model;
+  c->ctx.manifold.data = &c->data;
+  c->ctx.manifold.pb = &c->pb;
+  c->ctx.manifold.setup = &c->s;
+  c->ctx.restitution = single_body_restitution(s.law);
+  c->ctx.scale = max_rate;
+  q->eval = [c](const BasePose& base, const Eigen::VectorXd& theta, double* g, double* grad) {
+    c->ctx.manifold.base = &base;
+    g[0] = detail::pareto_rate_constraint(static_cast<unsigned>(theta.size()), theta.data(), grad, &c->ctx);
   };
   return q;
 }

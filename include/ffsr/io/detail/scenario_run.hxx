@@ -77,13 +77,14 @@ inline GlobalRun run_global(const Scenario& sc, const CaptureResult& paper_run, 
     throw InputError(str("--reconfigure-duration: a reconfiguration in ", e.duration, " s: joint '", e.joint,
                          "' needs ", std::ceil(e.needed * 18000 / M_PI) / 100, " deg/s, max-joint-rate-deg is ",
                          e.limit * 180 / M_PI));
+  } catch (const InfeasibleInequalitiesError& e) {
+    if (!(sc.keys.max_base_rate_deg > 0)) throw InputError(str("global run: ", e.what()));
+    throw InputError(str("--max-base-rate-deg: no capture configuration found keeps the impact's base-rate "
+                         "jump within ", std::setprecision(6), sc.keys.max_base_rate_deg, " deg/s",
+                         sc.geometry ? " and the clearance" : "", " (`ffsr-optimize pareto` shows the least)"));
   } catch (const InputError& e) {
     if (std::string(e.what()).find("max joint rate") != std::string::npos)
       throw InputError(str("--max-joint-rate-deg: ", e.what()));
-    if (sc.keys.max_base_rate_deg > 0 && std::string(e.what()).find("inequality") != std::string::npos)
-      throw InputError(str("--max-base-rate-deg: no capture configuration found keeps the impact's base-rate "
-                           "jump within ", std::setprecision(6), sc.keys.max_base_rate_deg, " deg/s",
-                           sc.geometry ? " and the clearance" : "", " (`ffsr-optimize pareto` shows the least)"));
     throw InputError(str("global run: ", e.what()));
   } catch (const NumericalError& e) {
     throw NumericalError(str("global run: ", e.what()));
