@@ -11,6 +11,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <cmath>
 #include <fstream>
 #include <sstream>
 #include <limits>
@@ -356,6 +357,32 @@ TEST_CASE("closed loop: exact target, stiff rate loops: the global plan's captur
                         << r.max_torque << " N m, max lag " << r.max_tracking_lag << " rad/s, steps "
                         << r.cvode_steps);
   CHECK(r.saturated_ticks == 0);
+}
+
+TEST_CASE("closed loop, 3-DOF paper scenario: the gradient controller through the dynamics reaches its plan") {
+  // the short companion of the 7-DOF case above (which the sanitizer stage leaves out: minutes
+  // under ASan): the same checks on the planar robot with the paper's gradient policy
+  const Scenario sc = load_scenario(kRobots + "paper_3dof.toml");
+  const CaptureResult open = plan_capture(sc.problem, sc.task, sc.capture);
+  auto ctrl = make_gradient_controller(sc.problem, sc.task, sc.capture);
+  ClosedLoopOptions o;
+  o.control_rate = 100;
+  o.estimate_rate = 5;
+  o.record_every = 1;
+  const ClosedLoopResult r = simulate_closed_loop(ctrl, o);
+  INFO("capture error " << r.capture_error << " m, M_ie " << r.M_ie << " vs " << open.M_ie << ", max torque "
+                        << r.max_torque << " N m, steps " << r.cvode_steps);
+  CHECK(r.fault_ticks == 0);
+  CHECK(r.ticks == static_cast<long>(std::lround(sc.capture.duration * o.control_rate)));
+  CHECK(r.capture_error < 1e-3);
+  CHECK(std::abs(r.M_ie - open.M_ie) / open.M_ie < 5e-3);
+  // the joint angles at T: the closed loop lands where the open-loop plan does
+  CHECK((r.theta - open.theta).cwiseAbs().maxCoeff() < 1e-2);
+  CHECK(r.max_momentum < 1e-7);
+  for (const ClosedLoopSample& s : r.series) CHECK(s.momentum < 1e-7);
+  CHECK(r.base_attitude_change > 0);
+  CHECK(r.max_torque > 0);
+  CHECK(r.max_torque <= o.loop.torque_limit);
 }
 
 TEST_CASE("closed loop: bad options are refused") {
