@@ -8,32 +8,24 @@
 // Prints the exact-target run, one line per seed, then the worst and the median. Seeds first-seed to
 // first-seed + seeds - 1: split a long study into processes run side by side (e.g. GNU parallel).
 
+#include "support/baselines.hpp"
+
 #include "ffsr/control/capture_controller.hpp"
 #include "ffsr/io/scenario.hpp"
 #include "ffsr/simulate/closed_loop.hpp"
 
-#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
-#include <fstream>
 #include <string>
 #include <vector>
 
 namespace {
 
 using namespace ffsr;
-
-Eigen::VectorXd global_configuration(const std::string& name) {
-  std::ifstream in(std::string(FFSR_SOURCE_DIR) + "/tests/data/baselines/" + name + ".json");
-  const nlohmann::json j = nlohmann::json::parse(in);
-  const auto deg = j.at("global").at("capture_configuration_deg").get<std::vector<double>>();
-  Eigen::VectorXd q(static_cast<Eigen::Index>(deg.size()));
-  for (size_t i = 0; i < deg.size(); ++i) q(static_cast<Eigen::Index>(i)) = deg[i] * M_PI / 180;
-  return q;
-}
+using ffsr::test::global_configuration;
 
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());

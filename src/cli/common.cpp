@@ -1,4 +1,5 @@
 #include "common.hpp"
+#include "scenario.hpp"
 
 #include "ffsr/io/urdf.hpp"
 
@@ -80,103 +81,62 @@ Shard parse_shard(const std::string& text) {
 double deg2rad(double deg) { return deg * M_PI / 180.0; }
 double rad2deg(double rad) { return rad * 180.0 / M_PI; }
 
-void RobotOptions::add_to(CLI::App& app) {
-  app.add_option("--urdf", urdf, "Robot URDF file; its root link is the free-floating base")->required();
-  app.add_option("--joints-deg", joints_deg, "Joint angles in degrees, comma-separated, URDF tree order")
-      ->required();
-  app.add_option("--end-effector", end_effector,
-                 "End-effector frame (a link name); default: the single leaf link");
-  app.add_option("--base-position", base_position, "Base frame origin in the inertial frame, m")
-      ->capture_default_str();
-  app.add_option("--base-rpy-deg", base_rpy_deg, "Base attitude, URDF roll,pitch,yaw in degrees")
-      ->capture_default_str();
-  load.add_to(app);
+namespace {
+
+/// The keys of a subject (SubjectOptions): the robot and its start state, the bus and the loader, the
+/// target and the contact law.
+const std::set<std::string>& subject_keys() {
+  static const std::set<std::string> keys = {
+      "urdf", "end-effector", "joints-deg", "base-position", "base-rpy-deg", "bus-mass", "bus-inertia",
+      "bus-com", "mount-xyz", "mount-rpy-deg", "lock-joints", "inertia-repair", "min-mass", "min-inertia",
+      "end-effector-offset", "target-mass", "target-inertia", "target-rpy-deg", "target-angular-velocity-deg",
+      "target-velocity", "contact-offset", "normal", "model", "stiffness", "exponent", "restitution",
+      "approach-speed"};
+  return keys;
 }
 
-std::string joint_count_error(size_t got, const Model& model, const std::string& where) {
-  std::string names;
-  for (const auto& n : model.joint_names()) names += (names.empty() ? "" : ", ") + n;
-  return str("--joints-deg: got ", got, " angles, the robot", where, " has ", model.n(), " joints (", names,
-             ")");
+}  // namespace
+
+void SubjectOptions::add_to(CLI::App& app, const std::set<std::string>& also) {
+  app.add_option("--config", config,
+                 "Scenario file (TOML) whose robot, start state, target and contact law to take; flags "
+                 "override its keys (default: the built-in paper 3-DOF scenario)")
+      ->check(CLI::ExistingFile);
+  flags.add_to(app, [&also](const std::string& name) { return subject_keys().count(name) || also.count(name); });
 }
 
-void TargetOptions::add_to(CLI::App& app) {
-  app.add_option("--target-mass", mass, "Target mass m_t, kg")->capture_default_str();
-  app.add_option("--target-inertia", inertia,
-                 "Target inertia about its centre of mass (target frame): Ixx,Iyy,Izz or "
-                 "Ixx,Iyy,Izz,Ixy,Ixz,Iyz, kg m^2")
-      ->capture_default_str();
-  app.add_option("--target-rpy-deg", rpy_deg, "Target attitude, roll,pitch,yaw in degrees")
-      ->capture_default_str();
-  app.add_option("--contact-offset", contact_offset,
-                 "r_tp: contact point from the target's centre of mass (target frame), m")
-      ->capture_default_str();
-  app.add_option("--normal", normal, "u_n: contact normal (target frame); normalized")->capture_default_str();
-}
-
-Matrix3 parse_inertia(const std::string& text, const std::string& flag) {
-  return ffsr::detail::inertia_from_components(parse_list(text, flag, {3, 6}));
-}
-
-Target TargetOptions::build() const {
-  Target t;
-  if (!std::isfinite(mass) || mass <= 0)
-    throw InputError(str("--target-mass: must be positive and finite, got ", mass));
-  t.mass = mass;
-  t.inertia = parse_inertia(inertia, "--target-inertia");
-  const Vector3 rpy = parse_vec3(rpy_deg, "--target-rpy-deg") * (M_PI / 180.0);
-  t.attitude = Quaternion(rotation_from_rpy(rpy));
-  t.contact_offset = parse_vec3(contact_offset, "--contact-offset");
-  ffsr::detail::finish_target(t, parse_vec3(normal, "--normal"), "--target-inertia/--target-mass");
-  return t;
-}
-
-void ContactLawOptions::add_to(CLI::App& app, const std::string& model_help) {
-  app.add_option("--stiffness", stiffness, "Contact stiffness K, N/m^alpha")->capture_default_str();
-  app.add_option("--exponent", exponent, "Contact exponent alpha")->capture_default_str();
-  app.add_option("--restitution", restitution, "Coefficient of restitution c_r, 0 < c_r <= 1")
-      ->capture_default_str();
-  app.add_option("--model", model, model_help)->capture_default_str();
-  app.add_option("--approach-speed", approach_speed,
-                 "End-effector speed along the normal at first touch, m/s")
-      ->capture_default_str();
-  app.add_option("--target-angular-velocity-deg", target_angular_velocity_deg,
-                 "Target spin (target frame), deg/s")
-      ->capture_default_str();
-  app.add_option("--target-velocity", target_velocity, "Target linear velocity (inertial frame), m/s")
-      ->capture_default_str();
-}
-
-ContactParams ContactLawOptions::params() const {
-  const ContactParams p{stiffness, exponent, restitution};
+Subject load_subject(const SubjectOptions& o) {
+  Subject s;
+  s.keys = command_scenario_keys(o.config, o.flags);
+  ScenarioKeys& k = s.keys;
+  if (o.flags.given("urdf")) {  // another robot: its end-effector and joint angles from the flags alone
+    if (!o.flags.given("end-effector")) k.end_effector.clear();
+    if (!o.flags.given("joints-deg"))
+      throw InputError("--joints-deg: required with --urdf (the robot's joint angles in degrees, URDF tree order)");
+  }
+  const EmbeddedUrdf embedded = builtin_urdf();
+  s.robot.model = std::move(*ffsr::detail::model_of(k, &embedded, s.robot.report));
+  warn_repairs(s.robot.report);
+  CaptureProblem pb;
+  ffsr::detail::start_of(k, s.robot.model, pb);
+  s.robot.end_effector = s.robot.model.end_effector();
+  s.robot.theta = pb.theta;
+  s.robot.base = pb.base;
+  s.target = ffsr::detail::target_of(k);
+  s.params = {k.stiffness, k.exponent, k.restitution};  // validate names a non-finite value
   try {
-    validate(p, "contact");
+    validate(s.params, "contact");
   } catch (const InputError& e) {
     throw InputError(std::string("--stiffness/--exponent/--restitution: ") + e.what());
   }
-  return p;
+  s.law = k.model;
+  s.approach_speed = ffsr::detail::finite(k.approach_speed, "approach-speed");
+  return s;
 }
 
-void ContactLawOptions::set_target_motion(Target& target) const {
-  target.angular_velocity =
-      parse_vec3(target_angular_velocity_deg, "--target-angular-velocity-deg") * (M_PI / 180.0);
-  target.velocity = parse_vec3(target_velocity, "--target-velocity");
-}
-
-Robot load_robot(const RobotOptions& o) {
-  UrdfReport report;
-  Robot r{model_from_urdf_file(o.urdf, o.load.build(o.end_effector), &report), 0, {}, {}, {}};
-  r.report = std::move(report);
-  warn_repairs(r.report);
-  r.end_effector = r.model.end_effector();
-  const auto q = parse_list(o.joints_deg, "--joints-deg");
-  if (static_cast<int>(q.size()) != r.model.n())
-    throw InputError(joint_count_error(q.size(), r.model, " in " + o.urdf));
-  r.theta = Eigen::Map<const Eigen::VectorXd>(q.data(), static_cast<Eigen::Index>(q.size())) * (M_PI / 180.0);
-  r.base.position = parse_vec3(o.base_position, "--base-position");
-  r.base.orientation =
-      Quaternion(rotation_from_rpy(parse_vec3(o.base_rpy_deg, "--base-rpy-deg") * (M_PI / 180.0)));
-  return r;
+ContactJoints Subject::contact_joints() const {
+  const JointModel m = all_joint_models() ? JointModel::Free : parse_joint_model(keys.contact_joints, "--contact-joints");
+  return {m, per_joint_values(keys.armature, robot.model, "--armature")};
 }
 
 // --- output files ---------------------------------------------------------------------------------

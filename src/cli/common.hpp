@@ -1,6 +1,7 @@
 // src/cli/common.hpp -- options shared by the subcommands, parsing helpers and output files.
 #pragma once
 
+#include "ffsr/algorithm/joint_models.hpp"
 #include "ffsr/contact/contact_law.hpp"
 #include "ffsr/ffsr.hpp"
 #include "model_options.hpp"
@@ -10,6 +11,7 @@
 
 #include <chrono>
 #include <ostream>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -38,49 +40,19 @@ Shard parse_shard(const std::string& text);
 double deg2rad(double deg);
 double rad2deg(double rad);
 
-/// --urdf, --joints-deg, --end-effector, --base-position, --base-rpy-deg.
-struct RobotOptions {
-  std::string urdf;
-  std::string joints_deg;
-  std::string end_effector;
-  std::string base_position = "0,0,0";
-  std::string base_rpy_deg = "0,0,0";
-  ModelLoadOptions load;  ///< bus, locks, repairs, end-effector offset (model_options.hpp)
-  void add_to(CLI::App& app);
+/// The robot at one configuration, the target and the contact law that inspect, contact and map
+/// evaluate: the keys of a scenario file (--config) or of the built-in scenario, then the scenario
+/// keys given as flags (the robot and its start state, the bus, the target, the contact law), read,
+/// checked and built by the library (ffsr/io/scenario.hpp) as for the main job. --urdf replaces the
+/// robot: its joint angles (--joints-deg, then required) and end-effector come from the flags alone.
+struct SubjectOptions {
+  std::string config;
+  ScenarioFlags flags;
+  /// --config and the flags of the subject's keys; `also` adds keys of the key table (their flags).
+  void add_to(CLI::App& app, const std::set<std::string>& also = {});
 };
 
-/// --target-mass, --target-inertia, --target-rpy-deg, --contact-offset, --normal (the paper's target
-/// by default).
-struct TargetOptions {
-  double mass = 200.0;
-  std::string inertia = "100,100,100";
-  std::string rpy_deg = "0,0,0";
-  std::string contact_offset = "-0.25,0.15,0";
-  std::string normal = "1,0,0";
-  void add_to(CLI::App& app);
-  /// The target (attitude, inertia, offset, normal, mass), validated.
-  Target build() const;
-};
-
-/// --model, --stiffness, --exponent, --restitution, --approach-speed, --target-angular-velocity-deg,
-/// --target-velocity: the contact law and the relative motion at the first touch (contact, map).
-struct ContactLawOptions {
-  double stiffness = 1e9;
-  double exponent = 1.5;
-  double restitution = 0.9;
-  std::string model = "herbert-mcwhannell";
-  double approach_speed = 0.2;
-  std::string target_angular_velocity_deg = "0,0,2";
-  std::string target_velocity = "0,0,0";
-  /// `model_help` describes --model (contact accepts 'all', map one law).
-  void add_to(CLI::App& app, const std::string& model_help);
-  /// K, alpha, c_r, validated (InputError naming the flags).
-  ContactParams params() const;
-  /// Sets the target's velocity and spin from the flags. Throws InputError naming the flag.
-  void set_target_motion(Target& target) const;
-};
-
-/// A robot loaded from --urdf at the configuration of the flags.
+/// A robot at one configuration.
 struct Robot {
   Model model;
   int end_effector = 0;
@@ -88,13 +60,24 @@ struct Robot {
   Eigen::VectorXd theta;
   UrdfReport report;  ///< what the loader did to the file
 };
-Robot load_robot(const RobotOptions& options);
 
-/// "--joints-deg: got 3 angles, the robot has 7 joints (a, b, ...)": the joints in order.
-std::string joint_count_error(size_t got, const Model& model, const std::string& where);
+/// What SubjectOptions describe, built.
+struct Subject {
+  ScenarioKeys keys;  ///< as resolved (the URDF path relative to the scenario file)
+  Robot robot;
+  Target target;               ///< at t = 0, with its spin and velocity
+  ContactParams params;        ///< K, alpha, c_r, checked
+  std::string law;             ///< the damping law's name as given (contact also takes 'all')
+  double approach_speed = 0;   ///< m/s, finite (its sign is the subcommand's to judge)
+  /// The joint models of the contact (contact-joints, armature; algorithm/joint_models.hpp); 'all'
+  /// (contact: each model in turn) gives free. InputError naming the key.
+  ContactJoints contact_joints() const;
+  bool all_joint_models() const { return keys.contact_joints == "all"; }
+};
+/// Builds the subject; warns about every repair of the model. InputError naming the key or the file,
+/// ModelError from the loader.
+Subject load_subject(const SubjectOptions& options);
 
-/// Parses an inertia given as "Ixx,Iyy,Izz" or "Ixx,Iyy,Izz,Ixy,Ixz,Iyz".
-Matrix3 parse_inertia(const std::string& text, const std::string& flag);
 
 /// Output files, as people name them in a shell. Every subcommand writes its outputs through
 /// `Outputs` (or the two functions below, which use the same writer):

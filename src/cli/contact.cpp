@@ -1,7 +1,6 @@
 // ffsr-optimize contact: closed-form, exact and multibody (CVODE) maximum contact force.
 #include "common.hpp"
 #include "figures.hpp"
-#include "joint_options.hpp"
 #include "subcommands.hpp"
 
 #include "ffsr/algorithm/base_disturbance.hpp"
@@ -16,10 +15,7 @@ namespace ffsr::cli {
 namespace {
 
 struct ContactOptions {
-  RobotOptions robot;
-  TargetOptions target;
-  ContactLawOptions law;
-  JointOptions joints;  ///< joint models of the contact; the multibody run's servo and armature
+  SubjectOptions subject;
   std::string series, plot, plot_format = "png";
   bool json = false;
 };
@@ -40,11 +36,12 @@ struct Row {
 };
 
 /// The closed-form predictions under each joint model asked for (the chosen one, or all three).
-std::vector<Row::Prediction> joint_predictions(const Robot& r, const Target& target, const ContactOptions& o,
-                                               const AnyContactLaw& law, double M_free) {
-  ContactJoints joints = o.joints.build(r.model);
+std::vector<Row::Prediction> joint_predictions(const Subject& s, const AnyContactLaw& law, double M_free) {
+  const Robot& r = s.robot;
+  const Target& target = s.target;
+  ContactJoints joints = s.contact_joints();
   std::vector<JointModel> models{joints.model};
-  if (o.joints.all()) models = {JointModel::Free, JointModel::Locked, JointModel::Armature};
+  if (s.all_joint_models()) models = {JointModel::Free, JointModel::Locked, JointModel::Armature};
   std::vector<Row::Prediction> out;
   Data data(r.model);
   for (JointModel m : models) {
@@ -57,17 +54,19 @@ std::vector<Row::Prediction> joint_predictions(const Robot& r, const Target& tar
   return out;
 }
 
-Row evaluate(const Robot& r, const Target& target, const ContactOptions& o, const std::string& law_name) {
-  const ContactParams p{o.law.stiffness, o.law.exponent, o.law.restitution};
+Row evaluate(const Subject& s, const ContactOptions& o, const std::string& law_name) {
+  const Robot& r = s.robot;
+  const Target& target = s.target;
+  const ContactParams& p = s.params;
   MultibodyContactOptions mo;
   mo.record_series = !o.series.empty() || !o.plot.empty();
-  mo.joint_stiffness = JointOptions::values(o.joints.stiffness, r.model, "--joint-stiffness");
-  mo.joint_damping = JointOptions::values(o.joints.damping, r.model, "--joint-damping");
-  mo.armature = JointOptions::values(o.joints.armature, r.model, "--armature");
+  mo.joint_stiffness = per_joint_values(s.keys.joint_stiffness, r.model, "--joint-stiffness");
+  mo.joint_damping = per_joint_values(s.keys.joint_damping, r.model, "--joint-damping");
+  mo.armature = per_joint_values(s.keys.armature, r.model, "--armature");
   MultibodyContactResult mb = simulate_contact(r.model, r.base, r.theta, r.end_effector, target,
-                                               o.law.approach_speed, p, law_name, mo);
+                                               s.approach_speed, p, law_name, mo);
   const AnyContactLaw law = make_contact_law(law_name, p, mb.approach_velocity);
-  auto predictions = joint_predictions(r, target, o, law, mb.integrated_effective_mass);
+  auto predictions = joint_predictions(s, law, mb.integrated_effective_mass);
   const double M_ie = predictions.front().M_ie;  // the chosen model's (free for all)
   Row row{law_name,
           M_ie,
@@ -130,18 +129,18 @@ nlohmann::json row_json(const Row& r) {
 }
 
 /// The laws to evaluate: every law for --model all, else the one named (an unknown name lists them).
-std::vector<std::string> contact_laws(const ContactOptions& o, const ContactParams& params) {
+std::vector<std::string> contact_laws(const Subject& s) {
   std::vector<std::string> names;
-  if (o.law.model == "all") {
+  if (s.law == "all") {
     for (auto n : contact_law_names()) names.emplace_back(n);
     return names;
   }
   try {
-    make_contact_law(o.law.model, params, 1.0);  // unknown name: lists the laws
+    make_contact_law(s.law, s.params, 1.0);  // unknown name: lists the laws
   } catch (const InputError& e) {
     throw InputError(std::string("--model: ") + e.what());
   }
-  names.push_back(o.law.model);
+  names.push_back(s.law);
   return names;
 }
 
@@ -167,20 +166,20 @@ void plot_contact(const std::vector<Row>& rows, const ContactParams& params, con
   plot::render({figures::contact(curves, rows.front().M_ie, rows.front().v_in)}, o.plot, plot_format);
 }
 
-nlohmann::json contact_json(const std::vector<Row>& rows, const ContactOptions& o) {
-  nlohmann::json j = o.law.model == "all" ? nlohmann::json::object() : row_json(rows.front());
-  if (o.law.model == "all") {
+nlohmann::json contact_json(const std::vector<Row>& rows, const Subject& s) {
+  nlohmann::json j = s.law == "all" ? nlohmann::json::object() : row_json(rows.front());
+  if (s.law == "all") {
     j["integrated_effective_mass"] = rows.front().M_ie;
     j["approach_velocity"] = rows.front().v_in;
     j["laws"] = nlohmann::json::array();
     for (const auto& row : rows) j["laws"].push_back(row_json(row));
   }
-  j["parameters"] = {{"stiffness", o.law.stiffness},
-                     {"exponent", o.law.exponent},
-                     {"restitution", o.law.restitution},
-                     {"approach_speed", o.law.approach_speed},
-                     {"urdf", o.robot.urdf},
-                     {"joints_deg", o.robot.joints_deg}};
+  j["parameters"] = {{"stiffness", s.params.K},
+                     {"exponent", s.params.alpha},
+                     {"restitution", s.params.c_r},
+                     {"approach_speed", s.approach_speed},
+                     {"urdf", s.keys.urdf},
+                     {"joints_deg", s.keys.joints_deg}};
   j["version"] = FFSR_VERSION;
   return j;
 }
@@ -228,16 +227,12 @@ int run_contact(const ContactOptions& o) {
   Outputs outputs;  // --series '-' and --json both print on standard output: one of them only
   if (o.json) outputs.claim_stdout("--json");
   outputs.add("--series", o.series);
-  const Robot r = load_robot(o.robot);
-  Target target = o.target.build();
-  o.law.set_target_motion(target);
-  if (!std::isfinite(o.law.approach_speed)) throw InputError("--approach-speed: must be finite");
-  const ContactParams params = o.law.params();
+  const Subject subject = load_subject(o.subject);
   const plot::Format plot_format = plot::check_request(o.plot, o.plot_format);
   std::vector<Row> rows;
-  for (const auto& n : contact_laws(o, params)) rows.push_back(evaluate(r, target, o, n));
+  for (const auto& n : contact_laws(subject)) rows.push_back(evaluate(subject, o, n));
 
-  if (!o.plot.empty()) plot_contact(rows, params, o, plot_format);
+  if (!o.plot.empty()) plot_contact(rows, subject.params, o, plot_format);
   if (!o.series.empty()) {
     std::ostringstream csv;
     csv << std::setprecision(12) << "model,t_s,force_N,delta_m\n";
@@ -248,7 +243,7 @@ int run_contact(const ContactOptions& o) {
     outputs.write();
   }
   if (o.json) {
-    std::cout << contact_json(rows, o).dump(2) << "\n";
+    std::cout << contact_json(rows, subject).dump(2) << "\n";
     return 0;
   }
   print_contact_table(outputs.table(), rows);  // standard error when --series is '-'
@@ -261,10 +256,8 @@ void register_contact(CLI::App& app, Action& action) {
   auto o = std::make_shared<ContactOptions>();
   CLI::App* sub = app.add_subcommand(
       "contact", "Maximum contact force: closed form, exact, and CVODE multibody reference");
-  o->robot.add_to(*sub);
-  o->target.add_to(*sub);
-  o->law.add_to(*sub, "Hysteresis damping law (Table 1) or 'all'");
-  o->joints.add_to(*sub, true);
+  // --model and --contact-joints also take 'all': every law of Table 1, every joint model
+  o->subject.add_to(*sub, {"contact-joints", "armature", "joint-stiffness", "joint-damping"});
   sub->add_option("--series", o->series,
                   "Write F(t), delta(t) of the multibody run(s) to this CSV file ('-': standard output)");
   sub->add_flag("--json", o->json, "Print one JSON object on stdout");

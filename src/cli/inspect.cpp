@@ -1,5 +1,7 @@
-// ffsr-optimize inspect: evaluate one configuration (H, J_f, m_e, M_ie).
+// ffsr-optimize inspect: evaluate one configuration (H, J_f, m_e, M_ie, the base's jump at the impact,
+// the distances between the shapes).
 #include "common.hpp"
+#include "scenario.hpp"
 #include "subcommands.hpp"
 
 #include "ffsr/algorithm/base_disturbance.hpp"
@@ -13,25 +15,22 @@ namespace ffsr::cli {
 namespace {
 
 struct InspectOptions {
-  RobotOptions robot;
-  TargetOptions target;
-  ContactLawOptions law;
+  SubjectOptions subject;
   bool json = false;
 };
 
 /// The impact disturbance of the base at the configuration (single-body impulse), or nothing when the
 /// end-effector moving at the approach speed along u does not approach the target's contact point.
-std::optional<BaseDisturbance> inspect_disturbance(const Robot& r, const InspectOptions& o, Target target) {
-  o.law.set_target_motion(target);
-  if (!std::isfinite(o.law.approach_speed)) throw InputError("--approach-speed: must be finite");
-  const ContactParams params = o.law.params();
+std::optional<BaseDisturbance> inspect_disturbance(const Subject& s) {
+  const Robot& r = s.robot;
+  const Target& target = s.target;
   const Vector3 u = target.normal_world();
-  const double vin = approach_velocity(u, Vector3(o.law.approach_speed * u), target.velocity,
+  const double vin = approach_velocity(u, Vector3(s.approach_speed * u), target.velocity,
                                        target.angular_velocity_world(), target.offset_world());
   if (!(vin > 0)) return std::nullopt;
-  AnyContactLaw law = make_contact_law("hunt-crossley", params, vin);
+  AnyContactLaw law = make_contact_law("hunt-crossley", s.params, vin);
   try {
-    law = make_contact_law(o.law.model, params, vin);
+    law = make_contact_law(s.law, s.params, vin);
   } catch (const InputError& e) {
     throw InputError(std::string("--model: ") + e.what());
   }
@@ -47,6 +46,32 @@ nlohmann::json disturbance_json(const std::optional<BaseDisturbance>& d) {
           {"angular_velocity_jump", to_json(Eigen::VectorXd(d->angular))},
           {"angular_rate_jump_deg_s", d->angular_rate() * 180.0 / M_PI},
           {"linear_velocity_jump", to_json(Eigen::VectorXd(d->linear))}};
+}
+
+/// The distances of the configuration to the target at t = 0 (and to the bus, between the links) when
+/// the scenario gives shapes (io/scenario_geometry.hpp), else nothing.
+std::optional<ClearanceReport> inspect_clearance(const Subject& s) {
+  const EmbeddedUrdf embedded = builtin_urdf();
+  const std::shared_ptr<const SceneGeometry> g =
+      scene_geometry(s.keys, s.robot.model, s.target.contact_offset, &embedded);
+#ifdef FFSR_HAVE_GEOMETRY
+  if (g)
+    return configuration_clearance(s.robot.model, *g->checker, s.robot.base, s.robot.theta, target_pose(s.target));
+#endif
+  return std::nullopt;
+}
+
+void print_clearance(const ClearanceReport& c) {
+  std::cout << "distances        ";
+  const std::pair<const char*, const ClearanceReport::Entry*> kinds[] = {
+      {"arm-target", &c.arm_target}, {"arm-bus", &c.arm_bus}, {"self", &c.self}};
+  bool first = true;
+  for (const auto& [name, e] : kinds) {
+    if (e->pair.empty()) continue;
+    std::cout << (first ? "" : ", ") << name << " " << e->distance << " m (" << e->pair << ")";
+    first = false;
+  }
+  std::cout << (first ? "no pair of bodies" : "") << "\n";
 }
 
 /// What the loader did to the file: merged links, mimic and locked joints, repairs.
@@ -68,8 +93,9 @@ void print_load_report(const UrdfReport& rep) {
 }
 
 int run_inspect(const InspectOptions& o) {
-  const Robot r = load_robot(o.robot);
-  const Target target = o.target.build();
+  const Subject s = load_subject(o.subject);
+  const Robot& r = s.robot;
+  const Target& target = s.target;
   Data data(r.model);
   const Vector3 u = target.normal_world();
   const double M_ie = integrated_effective_mass(r.model, data, r.base, r.theta, r.end_effector, target);
@@ -77,11 +103,12 @@ int run_inspect(const InspectOptions& o) {
   frame_jacobian(r.model, data, r.end_effector);
   const Eigen::MatrixXd Jf = generalized_jacobian(r.model, data);
   const Pose ee = frame_pose(r.model, data, r.end_effector);
-  const std::optional<BaseDisturbance> dist = inspect_disturbance(r, o, target);
+  const std::optional<BaseDisturbance> dist = inspect_disturbance(s);
+  const std::optional<ClearanceReport> clearance = inspect_clearance(s);
 
   if (o.json) {
     nlohmann::json j;
-    j["urdf"] = o.robot.urdf;
+    j["urdf"] = s.keys.urdf;
     j["end_effector"] = r.model.frame(r.end_effector).name;
     j["joint_names"] = r.model.joint_names();
     j["joints_deg"] = to_json(Eigen::VectorXd(r.theta * (180.0 / M_PI)));
@@ -96,6 +123,7 @@ int run_inspect(const InspectOptions& o) {
     j["effective_mass"] = m_e;
     j["integrated_effective_mass"] = M_ie;
     j["base_disturbance"] = disturbance_json(dist);
+    j["clearance"] = clearance ? ffsr::detail::clearance_json(*clearance) : nlohmann::json(nullptr);
     j["model_repairs"] = repairs_json(r.report);
     j["model_load"] = report_json(r.report);
     j["version"] = FFSR_VERSION;
@@ -103,7 +131,7 @@ int run_inspect(const InspectOptions& o) {
     return 0;
   }
   std::cout << std::setprecision(6);
-  std::cout << "robot            " << o.robot.urdf << " (" << r.model.n() << " joints, "
+  std::cout << "robot            " << s.keys.urdf << " (" << r.model.n() << " joints, "
             << r.model.total_mass() << " kg)\n";
   std::cout << "end-effector     " << r.model.frame(r.end_effector).name << " at ["
             << ee.p.transpose().format(Eigen::IOFormat(6, 0, ", ")) << "] m\n";
@@ -118,9 +146,10 @@ int run_inspect(const InspectOptions& o) {
   std::cout << "integrated mass  M_ie = " << M_ie << " kg   (Eq. 14)\n";
   if (dist)
     std::cout << "base jump        |dw_0| = " << dist->angular_rate() * 180.0 / M_PI << " deg/s, |dv_0| = "
-              << dist->linear.norm() << " m/s   (impulse " << dist->impulse << " N s, " << o.law.model << ")\n";
+              << dist->linear.norm() << " m/s   (impulse " << dist->impulse << " N s, " << s.law << ")\n";
   else
     std::cout << "base jump        none: the end-effector does not approach the target at --approach-speed\n";
+  if (clearance) print_clearance(*clearance);
   std::cout << "J_f (generalized Jacobian, 6x" << r.model.n() << ", linear rows first):\n"
             << Jf.format(Eigen::IOFormat(5, 0, "  ", "\n", "  ")) << "\n";
   return 0;
@@ -131,10 +160,10 @@ int run_inspect(const InspectOptions& o) {
 void register_inspect(CLI::App& app, Action& action) {
   auto opts = std::make_shared<InspectOptions>();
   CLI::App* sub =
-      app.add_subcommand("inspect", "Evaluate one configuration: H, J_f, effective mass and M_ie");
-  opts->robot.add_to(*sub);
-  opts->target.add_to(*sub);
-  opts->law.add_to(*sub, "Hysteresis damping law (Table 1) of the impact's base disturbance");
+      app.add_subcommand("inspect", "Evaluate one configuration (a scenario's start state; flags override it): H, J_f, "
+                                    "effective mass, M_ie, the base's jump at the impact, distances between shapes");
+  opts->subject.add_to(*sub, {"target-position", "target-shape", "target-size", "target-shape-offset", "link-radius", "bus-box",
+                              "contact-exemption"});
   sub->add_flag("--json", opts->json, "Print one JSON object on stdout");
   sub->callback([opts, &action] { action = [opts] { return run_inspect(*opts); }; });
 }

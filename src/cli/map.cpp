@@ -25,7 +25,6 @@
 // the grid only and is not plotted.
 #include "common.hpp"
 #include "figures.hpp"
-#include "joint_options.hpp"
 #include "subcommands.hpp"
 
 #include "ffsr/detail/parallel.hpp"
@@ -45,10 +44,7 @@ namespace map_impl {  // named, not anonymous: the command is one unity translat
 using detail::str;
 
 struct MapOptions {
-  RobotOptions robot;
-  TargetOptions target;
-  ContactLawOptions law;
-  JointOptions joints;  ///< the joint model of the mapped M_ie
+  SubjectOptions subject;  ///< the robot, the target, the law and the joint model of the mapped M_ie
   std::string vary;
   std::string range_deg = "-180,180";
   std::string step_deg = "2";
@@ -74,13 +70,13 @@ struct Grid {
 };
 
 /// Parses --vary, --range-deg, --step-deg and checks the size against --max-points.
-Grid parse_grid(const MapOptions& o, int n_joints) {
+Grid parse_grid(const MapOptions& o, const std::string& urdf, int n_joints) {
   const auto joints = parse_list(o.vary, "--vary");
   Grid g;
   for (double j : joints) {
     if (j != std::floor(j) || j < 1 || j > n_joints)
       throw InputError(str("--vary: joint ", j, " is not one of 1..", n_joints, " (the robot in ",
-                           o.robot.urdf, " has ", n_joints, " joints, numbered from 1 in URDF tree order)"));
+                           urdf, " has ", n_joints, " joints, numbered from 1 in URDF tree order)"));
     for (const Axis& a : g.axes)
       if (a.joint == static_cast<int>(j) - 1) throw InputError(str("--vary: joint ", j, " is given twice"));
     g.axes.push_back({static_cast<int>(j) - 1, 0, 0, 0});
@@ -259,17 +255,18 @@ std::vector<plot::Figure> map_figures(const Grid& grid, const std::vector<std::s
 
 /// The contact law at the approach velocity of the flags (Eq. 10-12); InputError when the end-effector
 /// does not approach the target or the law is unknown.
-AnyContactLaw map_law(const MapOptions& o, const Target& target, const ContactParams& params) {
-  if (o.law.model == "all")
+AnyContactLaw map_law(const Subject& s) {
+  const Target& target = s.target;
+  if (s.law == "all")
     throw InputError("--model: map evaluates one law; 'all' is for the contact subcommand");
   const Vector3 u = target.normal_world();
-  const double v_in = approach_velocity(u, Vector3(o.law.approach_speed * u), target.velocity,
+  const double v_in = approach_velocity(u, Vector3(s.approach_speed * u), target.velocity,
                                         target.angular_velocity_world(), target.offset_world());  // Eq. 10-12
   if (!(v_in > 0))
     throw InputError(str("--approach-speed: the end-effector does not approach the target (delta_dot^- = ",
                          v_in, " m/s); increase the approach speed"));
   try {
-    return make_contact_law(o.law.model, params, v_in);
+    return make_contact_law(s.law, s.params, v_in);
   } catch (const InputError& e) {
     throw InputError(std::string("--model: ") + e.what());
   }
@@ -344,12 +341,11 @@ void print_map_summary(std::ostream& os, const MapOptions& o, const Grid& grid, 
 }
 
 int run_map(const MapOptions& o) {
-  const Robot r = load_robot(o.robot);
-  Target target = o.target.build();
-  o.law.set_target_motion(target);
-  if (!std::isfinite(o.law.approach_speed)) throw InputError("--approach-speed: must be finite");
-  const AnyContactLaw law = map_law(o, target, o.law.params());
-  const Grid grid = parse_grid(o, r.model.n());
+  const Subject subject = load_subject(o.subject);
+  const Robot& r = subject.robot;
+  const Target& target = subject.target;
+  const AnyContactLaw law = map_law(subject);
+  const Grid grid = parse_grid(o, subject.keys.urdf, r.model.n());
   const Shard shard = parse_shard(o.shard);
   const std::uint64_t first = shard_begin(shard, grid.size, shard.k),
                       last = shard_begin(shard, grid.size, shard.k + 1);
@@ -359,7 +355,9 @@ int run_map(const MapOptions& o) {
   const std::vector<double> slice_deg = check_map_plot(o, grid, shard);
   std::vector<double> values(plotting ? count : 0);
 
-  const ContactJoints joints = o.joints.build(r.model);  // checked before any output
+  if (subject.all_joint_models())
+    throw InputError("--contact-joints: map evaluates one joint model; 'all' is for the contact subcommand");
+  const ContactJoints joints = subject.contact_joints();  // checked before any output
   StreamingOutput out("--csv", o.csv);
   if (shard.k == 0) {
     std::string header;
@@ -405,10 +403,7 @@ void register_map(CLI::App& app, Action& action) {
   auto o = std::make_shared<MapOptions>();
   CLI::App* sub =
       app.add_subcommand("map", "M_ie (Eq. 14) and closed-form F_max (Eq. 24) over a grid of joint angles");
-  o->robot.add_to(*sub);
-  o->target.add_to(*sub);
-  o->law.add_to(*sub, "Hysteresis damping law (Table 1) of the F_max column");
-  o->joints.add_to(*sub, false);
+  o->subject.add_to(*sub, {"contact-joints", "armature"});
   sub->add_option("--vary", o->vary,
                   "Joints to vary, 1-based in URDF tree order, e.g. 1,2,3; the others stay at --joints-deg")
       ->required();

@@ -6,27 +6,14 @@ namespace ffsr::cli {
 
 using detail::str;
 
-namespace {
-
-/// The load keys of the key table (bus-mass ... end-effector-offset).
-bool is_load_key(const std::string& name) {
-  static const char* const kLoadKeys[] = {
-      "bus-mass",    "bus-inertia",    "bus-com",  "mount-xyz",   "mount-rpy-deg",
-      "lock-joints", "inertia-repair", "min-mass", "min-inertia", "end-effector-offset"};
-  for (const char* k : kLoadKeys)
-    if (name == k) return true;
-  return false;
-}
-
-}  // namespace
-
 void ScenarioFlags::add_to(CLI::App& app, const std::function<bool(const std::string&)>& only) {
   for (const ScenarioKey& key : scenario_keys()) {
     const std::string flag = "--" + key.name;
     if ((only && !only(key.name)) || app.get_option_no_throw(flag)) continue;
     CLI::Option* opt = nullptr;
     if (key.kind == KeyKind::Numbers || key.kind == KeyKind::Texts)
-      opt = app.add_option(flag, lists_[key.name], key.help)->delimiter(',')->allow_extra_args(false);
+      // no delimiter: the list reaches the scenario parser whole, which names an empty item or a trailing comma
+      opt = app.add_option(flag, lists_[key.name], key.help)->allow_extra_args(false);
     else
       opt = app.add_option(flag, text_[key.name], key.help);
     if (!key.default_text.empty()) opt->default_str(key.default_text);
@@ -51,14 +38,6 @@ void ScenarioFlags::apply(ScenarioKeys& keys) const {
     }
     override_scenario_key(keys, key->name, text);
   }
-}
-
-void ModelLoadOptions::add_to(CLI::App& app) { flags_.add_to(app, is_load_key); }
-
-UrdfOptions ModelLoadOptions::build(const std::string& end_effector) const {
-  ScenarioKeys keys;
-  flags_.apply(keys);
-  return keys.load.build(end_effector);
 }
 
 void warn_repairs(const UrdfReport& report) {

@@ -1,7 +1,5 @@
-// src/cli/model_options.hpp -- how a URDF becomes a model (the spacecraft bus it is mounted on, locked
-// joints, inertia repairs, the contact point at the gripper) for the subcommands that load a robot
-// from flags (inspect, contact, map). The keys, their parsers and the checks are the library's
-// (ffsr::ModelLoadKeys, ffsr/io/scenario.hpp); the main job and robust take them from the key table.
+// src/cli/model_options.hpp -- the scenario keys as flags (one per key of the library's key table,
+// ffsr/io/scenario.hpp: its parsers and checks) and the warnings of the model loader.
 #pragma once
 
 #include "ffsr/io/scenario.hpp"
@@ -32,18 +30,6 @@ class ScenarioFlags {
   std::map<std::string, std::string> text_;
   std::map<std::string, std::vector<std::string>> lists_;
   std::vector<std::pair<const ScenarioKey*, const CLI::Option*>> options_;
-};
-
-/// --bus-mass, --bus-inertia, --bus-com, --mount-xyz, --mount-rpy-deg, --lock-joints,
-/// --inertia-repair, --min-mass, --min-inertia, --end-effector-offset: the load keys of the key table.
-class ModelLoadOptions {
- public:
-  void add_to(CLI::App& app);
-  /// The loader options; throws InputError naming the key on a bad value.
-  UrdfOptions build(const std::string& end_effector) const;
-
- private:
-  ScenarioFlags flags_;
 };
 
 /// One warning line on stderr per repair ("ffsr-optimize: warning: link 'x': ...").

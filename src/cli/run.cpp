@@ -28,8 +28,10 @@ ScenarioKeys command_scenario_keys(const std::string& config, const ScenarioFlag
   return keys;
 }
 
+EmbeddedUrdf builtin_urdf() { return {"paper_3dof.urdf", "built-in paper_3dof.urdf", kPaper3dofUrdf}; }
+
 Scenario command_scenario(ScenarioKeys keys) {
-  const EmbeddedUrdf embedded{"paper_3dof.urdf", "built-in paper_3dof.urdf", kPaper3dofUrdf};
+  const EmbeddedUrdf embedded = builtin_urdf();
   Scenario sc = build_scenario(std::move(keys), &embedded);
   warn_repairs(sc.report);
   return sc;

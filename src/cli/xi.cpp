@@ -1,8 +1,11 @@
 // ffsr-optimize xi: the relative error xi of the closed-form maximum force (Eq. 24 against the
 // exact peak of Eq. 16) for the eight damping laws, against K, delta_dot^- and c_r -- the studies of
-// Figures 4-6. CSV always (a file, or stdout), pictures on request.
+// Figures 4-6. The parameters held fixed in each study are a scenario's contact law (--config, or the
+// built-in scenario: the paper's), flags override them. CSV always (a file, or stdout), pictures on
+// request.
 #include "common.hpp"
 #include "figures.hpp"
+#include "scenario.hpp"
 #include "subcommands.hpp"
 
 #include <iomanip>
@@ -14,7 +17,8 @@ namespace ffsr::cli {
 namespace {
 
 struct XiOptions {
-  double stiffness = 1e9, exponent = 1.5, restitution = 0.9, approach_speed = 0.2;
+  std::string config;
+  ScenarioFlags flags;  ///< stiffness, exponent, restitution, approach-speed
   int points = 41;
   std::string csv, plot, plot_format = "png";
 };
@@ -52,16 +56,17 @@ XiSetup parse(const XiOptions& o) {
   using detail::str;
   if (o.points < 2 || o.points > 100000)
     throw InputError(str("--points: expected 2 to 100000, got ", o.points));
+  const ScenarioKeys k = command_scenario_keys(o.config, o.flags);
   XiSetup s;
-  s.base = {o.stiffness, o.exponent, o.restitution};
+  s.base = {k.stiffness, k.exponent, k.restitution};
   try {
     validate(s.base, "contact");
   } catch (const InputError& e) {
     throw InputError(str("--stiffness/--exponent/--restitution: ", e.what()));
   }
-  if (!std::isfinite(o.approach_speed) || o.approach_speed <= 0)
-    throw InputError(str("--approach-speed: must be positive and finite, got ", o.approach_speed));
-  s.approach_speed = o.approach_speed;
+  if (!std::isfinite(k.approach_speed) || k.approach_speed <= 0)
+    throw InputError(str("--approach-speed: must be positive and finite, got ", k.approach_speed));
+  s.approach_speed = k.approach_speed;
   s.plot_format = plot::check_request(o.plot, o.plot_format);
   std::vector<std::string> laws;
   for (auto n : contact_law_names()) laws.emplace_back(n);
@@ -70,9 +75,9 @@ XiSetup parse(const XiOptions& o) {
     os << std::setprecision(4) << x;
     return os.str();
   };
-  const std::string fixed_k = "K = " + g(o.stiffness) + " N/m^" + g(o.exponent),
-                    fixed_v = "δ̇⁻ = " + g(o.approach_speed) + " m/s",
-                    fixed_c = "c#dr#u = " + g(o.restitution);
+  const std::string fixed_k = "K = " + g(s.base.K) + " N/m^" + g(s.base.alpha),
+                    fixed_v = "δ̇⁻ = " + g(s.approach_speed) + " m/s",
+                    fixed_c = "c#dr#u = " + g(s.base.c_r);
   s.studies = {
       study(kColumns[0], "ξ against K (Figure 4): " + fixed_v + ", " + fixed_c, "contact stiffness K (N/m^α)",
             true, spaced(1e7, 1e11, o.points, true), laws),
@@ -135,13 +140,13 @@ void register_xi(CLI::App& app, Action& action) {
   CLI::App* sub = app.add_subcommand(
       "xi",
       "Relative error xi of the closed-form maximum force against K, delta_dot^- and c_r (Figures 4-6)");
-  sub->add_option("--stiffness", o->stiffness, "K held fixed in the other studies, N/m^alpha")
-      ->capture_default_str();
-  sub->add_option("--exponent", o->exponent, "Contact exponent alpha")->capture_default_str();
-  sub->add_option("--restitution", o->restitution, "c_r held fixed in the other studies")
-      ->capture_default_str();
-  sub->add_option("--approach-speed", o->approach_speed, "delta_dot^- held fixed in the other studies, m/s")
-      ->capture_default_str();
+  sub->add_option("--config", o->config,
+                  "Scenario file (TOML) whose contact law (stiffness, exponent, restitution, approach-speed) "
+                  "the studies hold fixed; flags override it (default: the built-in scenario, the paper's)")
+      ->check(CLI::ExistingFile);
+  o->flags.add_to(*sub, [](const std::string& name) {
+    return name == "stiffness" || name == "exponent" || name == "restitution" || name == "approach-speed";
+  });
   sub->add_option("--points", o->points, "Values per study")->capture_default_str();
   sub->add_option("--csv", o->csv, "Write study,parameter,law,xi_percent to this file (default: stdout)");
   sub->add_option("--plot", o->plot, "Draw the three studies into this (existing) folder");

@@ -8,6 +8,9 @@
 // directory of the test runner.
 #include "support/command.hpp"
 
+#include "ffsr/ffsr.hpp"
+#include "ffsr/io/urdf.hpp"
+
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
 
@@ -68,6 +71,138 @@ TEST_CASE("inspect without --json prints a readable summary", "[cli]") {
   CHECK(r.err.empty());
   CHECK(r.out.find("M_ie") != std::string::npos);
   CHECK(r.out.find("5.81") != std::string::npos);
+}
+
+TEST_CASE("inspect, contact and map evaluate a scenario's start state (--config), flags override it",
+          "[cli]") {
+  // robots/paper_7dof_position.toml's robot at its start state and its target, evaluated here through
+  // the library from the values the file states (an independent path: no scenario reader)
+  const std::string file = kSource + "/robots/paper_7dof_position.toml";
+  const ffsr::Model m = ffsr::model_from_urdf_file(kUrdf7);
+  ffsr::Data d(m);
+  ffsr::Target target;  // mass 200, inertia 100 I, upright, normal x: the defaults; the offset is the file's
+  target.contact_offset = ffsr::Vector3(-0.25, 0.15, 0.1);
+  Eigen::VectorXd q(7);
+  q << 0, 90, 90, -90, 90, 90, 0;
+  q *= M_PI / 180;
+  const double M_start = ffsr::integrated_effective_mass(m, d, ffsr::BasePose{}, q, m.end_effector(), target);
+  q(5) = 80 * M_PI / 180;  // joint 7 turns about the contact normal through the hand: M_ie would not move
+  const double M_moved = ffsr::integrated_effective_mass(m, d, ffsr::BasePose{}, q, m.end_effector(), target);
+  REQUIRE(std::abs(M_moved - M_start) > 1e-3 * M_start);
+
+  const auto i = cli({"inspect", "--config", file, "--json"});
+  INFO(i.err);
+  REQUIRE(i.exit_code == 0);
+  CHECK(nlohmann::json::parse(i.out).at("integrated_effective_mass").get<double>() ==
+        Approx(M_start).epsilon(1e-12));
+  const auto o = cli({"inspect", "--config", file, "--joints-deg", "0,90,90,-90,90,80,0", "--json"});
+  REQUIRE(o.exit_code == 0);
+  CHECK(nlohmann::json::parse(o.out).at("integrated_effective_mass").get<double>() ==
+        Approx(M_moved).epsilon(1e-12));
+  const auto c = cli({"contact", "--config", file, "--json"});
+  INFO(c.err);
+  REQUIRE(c.exit_code == 0);
+  const auto cj = nlohmann::json::parse(c.out);
+  CHECK(cj.at("integrated_effective_mass").get<double>() == Approx(M_start).epsilon(1e-12));
+  CHECK(cj.at("parameters").at("urdf").get<std::string>() == kSource + "/robots/paper_7dof.urdf");
+  // one grid point of map at the start angle of joint 7
+  const auto g = cli({"map", "--config", file, "--vary", "7", "--range-deg", "0,1", "--step-deg", "1", "--csv", "-",
+                      "--quiet"});
+  INFO(g.err);
+  REQUIRE(g.exit_code == 0);
+  const std::string row = g.out.substr(g.out.find('\n') + 1);
+  CHECK(std::stod(row.substr(row.find(',') + 1)) == Approx(M_start).epsilon(1e-12));
+  // no arguments: the built-in scenario's start state, the paper's 3-DOF robot at [0, 150, -100] deg
+  const auto b = cli({"inspect", "--json"});
+  REQUIRE(b.exit_code == 0);
+  const auto bj = nlohmann::json::parse(b.out);
+  const auto joints = bj.at("joints_deg").get<std::vector<double>>();
+  REQUIRE(joints.size() == 3);
+  CHECK(joints[0] == Approx(0).margin(1e-12));
+  CHECK(joints[1] == Approx(150));
+  CHECK(joints[2] == Approx(-100));
+  const ffsr::Model m3 = ffsr::model_from_urdf_file(kUrdf3);
+  ffsr::Data d3(m3);
+  ffsr::Target paper;
+  Eigen::VectorXd q3(3);
+  q3 << 0, 150, -100;
+  q3 *= M_PI / 180;
+  CHECK(bj.at("integrated_effective_mass").get<double>() ==
+        Approx(ffsr::integrated_effective_mass(m3, d3, ffsr::BasePose{}, q3, m3.end_effector(), paper))
+            .epsilon(1e-12));
+}
+
+TEST_CASE("xi holds a scenario's contact law fixed (--config), flags override it", "[cli]") {
+  // robots/paper_7dof_position_cr03.toml: c_r = 0.3. The first row of the stiffness study (K = 1e7,
+  // the first law) against the library's relative error at the file's c_r and approach speed
+  const std::string file = kSource + "/robots/paper_7dof_position_cr03.toml";
+  auto first_row = [](const CommandResult& r) {
+    REQUIRE(r.exit_code == 0);
+    std::stringstream ss(r.out);
+    std::string header, row;
+    std::getline(ss, header);
+    std::getline(ss, row);
+    std::vector<std::string> f;
+    ss = std::stringstream(row);
+    for (std::string x; std::getline(ss, x, ',');) f.push_back(x);
+    REQUIRE(f.size() == 4);
+    CHECK(f[0] == "stiffness");
+    CHECK(std::stod(f[1]) == Approx(1e7));
+    return std::make_pair(f[2], std::stod(f[3]));
+  };
+  for (const auto& [args, c_r, v] :
+       {std::make_tuple(std::vector<std::string>{"xi", "--config", file, "--points", "2"}, 0.3, 0.2),
+        std::make_tuple(std::vector<std::string>{"xi", "--config", file, "--points", "2", "--restitution", "0.6",
+                                                 "--approach-speed", "0.5"},
+                        0.6, 0.5)}) {
+    const auto [law, xi] = first_row(cli(args));
+    const double expected = ffsr::relative_error(ffsr::make_contact_law(law, ffsr::ContactParams{1e7, 1.5, c_r}, v));
+    CHECK(xi == Approx(expected).epsilon(1e-9));
+  }
+  const auto plain = first_row(cli({"xi", "--points", "2"}));  // the built-in scenario: c_r = 0.9
+  CHECK(plain.second == Approx(ffsr::relative_error(ffsr::make_contact_law(plain.first, ffsr::ContactParams{1e7, 1.5, 0.9}, 0.2)))
+                            .epsilon(1e-9));
+}
+
+TEST_CASE("inspect: the distances of a configuration with shapes, against a closed form", "[cli]") {
+  // robots/paper_3dof_clearance.toml: the target a 0.5 m cube (upright, centred on its centre of mass),
+  // the links capsules of radius 0.05 m between their joint origins. link2 is the nearest link; its
+  // distance to the cube is the least over the segment of the point-box distance, minus the radius
+  // (convex along the segment: a ternary search finds it)
+  const std::string file = kSource + "/robots/paper_3dof_clearance.toml";
+  const ffsr::Model m = ffsr::model_from_urdf_file(kUrdf3);
+  ffsr::Data d(m);
+  Eigen::VectorXd q(3);
+  q << 10, 120, -80;
+  ffsr::forward_kinematics(m, d, ffsr::BasePose{}, q * (M_PI / 180));
+  const ffsr::Vector3 a = d.p[2], b = d.p[3];  // joint2 and joint3 origins: link2's segment
+  for (double x : {2.75, 3.25, 3.75}) {
+    const ffsr::Vector3 centre(x, 1.45, 0);
+    auto box_distance = [&](double t) {
+      const ffsr::Vector3 p = a + t * (b - a) - centre;
+      return (p.cwiseAbs() - ffsr::Vector3::Constant(0.25)).cwiseMax(0.0).norm();
+    };
+    double lo = 0, hi = 1;
+    for (int i = 0; i < 200; ++i) {
+      const double m1 = lo + (hi - lo) / 3, m2 = hi - (hi - lo) / 3;
+      if (box_distance(m1) < box_distance(m2))
+        hi = m2;
+      else
+        lo = m1;
+    }
+    const double expected = box_distance(0.5 * (lo + hi)) - 0.05;
+    const auto r = cli({"inspect", "--config", file, "--joints-deg", "10,120,-80", "--target-position",
+                        std::to_string(x) + ",1.45,0", "--json"});
+    INFO(r.err);
+    REQUIRE(r.exit_code == 0);
+    const auto c = nlohmann::json::parse(r.out).at("clearance").at("arm_target");
+    CHECK(c.at("pair").get<std::string>() == "link2 - target");
+    CHECK(c.at("distance").get<double>() == Approx(expected).margin(1e-9));
+  }
+  // without shapes: no distances
+  const auto plain = cli({"inspect", "--json"});
+  REQUIRE(plain.exit_code == 0);
+  CHECK(nlohmann::json::parse(plain.out).at("clearance").is_null());
 }
 
 // ------------------------------------------------------------------------------------------------
@@ -206,14 +341,15 @@ std::vector<BadCase> bad_cases() {
       {"missing URDF file",
        {"inspect", "--urdf", "{TMP}/no_such_robot.urdf", "--joints-deg", "0,90,-90"},
        {"no_such_robot.urdf", "cannot open"}},
-      {"missing --urdf", {"inspect", "--joints-deg", "0,90,-90"}, {"--urdf"}},
+      {"missing scenario file", {"inspect", "--config", "{TMP}/no_such_scenario.toml"}, {"--config", "no_such_scenario.toml"}},
+      {"--urdf without --joints-deg", {"inspect", "--urdf", kUrdf7}, {"--joints-deg", "required with --urdf"}},
       {"wrong joint count", inspect3({"--joints-deg", "0,90"}), {"--joints-deg", "3 joints"}},
       {"wrong joint count, 7-DOF",
        {"inspect", "--urdf", kUrdf7, "--joints-deg", "0,90,-90"},
        {"--joints-deg", "7 joints"}},
       {"non-numeric angle", inspect3({"--joints-deg", "0,abc,-90"}), {"--joints-deg", "'abc'"}},
-      {"NaN angle", inspect3({"--joints-deg", "0,nan,-90"}), {"--joints-deg", "'nan'", "finite"}},
-      {"inf angle", inspect3({"--joints-deg", "0,inf,-90"}), {"--joints-deg", "'inf'", "finite"}},
+      {"NaN angle", inspect3({"--joints-deg", "0,nan,-90"}), {"--joints-deg", "nan", "finite"}},
+      {"inf angle", inspect3({"--joints-deg", "0,inf,-90"}), {"--joints-deg", "inf", "finite"}},
       {"overflowing angle", inspect3({"--joints-deg", "0,1e999,-90"}), {"--joints-deg", "1e999"}},
       {"trailing comma", inspect3({"--joints-deg", "0,90,"}), {"--joints-deg", "trailing comma"}},
       {"empty angle list", inspect3({"--joints-deg", ""}), {"--joints-deg", "empty"}},
@@ -244,7 +380,7 @@ std::vector<BadCase> bad_cases() {
       {"triangle inequality",
        inspect3q({"--target-inertia", "1,1,10"}),
        {"--target-inertia", "triangle inequality"}},
-      {"NaN target attitude", inspect3q({"--target-rpy-deg", "nan,0,0"}), {"--target-rpy-deg", "'nan'"}},
+      {"NaN target attitude", inspect3q({"--target-rpy-deg", "nan,0,0"}), {"--target-rpy-deg", "nan"}},
       // --- contact --------------------------------------------------------------------------------
       {"negative stiffness",
        contact3({"--stiffness", "-1e9"}),
@@ -300,6 +436,7 @@ std::vector<BadCase> bad_cases() {
       {"run: unknown end-effector", run_default({"--end-effector", "nope"}), {"'nope'", "link3, ee"}},
       {"run: missing URDF", run_default({"--urdf", "{TMP}/no_such_robot.urdf"}), {"no_such_robot.urdf"}},
       {"run: stray positional argument", run_default({"orbit"}), {"orbit"}},
+      {"xi: non-existent --config", {"xi", "--config", "{TMP}/no_such_scenario.toml"}, {"--config", "no_such_scenario.toml"}},
       {"run: non-existent --config",
        run_default({"--config", "{TMP}/no_such_scenario.toml"}),
        {"--config", "no_such_scenario.toml"}},

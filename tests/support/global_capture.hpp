@@ -101,4 +101,25 @@ inline void check_run(const Shared& s, double bound_M_ie) {
       g.shooting_iterations, g.evaluations, g.search_seconds);
 }
 
+/// capture_residual's Jacobian against central differences (h = 1e-6) at `q`, column by column:
+/// O(h^2) + roundoff/h is about 1e-9, checked to 1e-7.
+inline void check_residual_jacobian(const Model& m, const CaptureProblem& pb, const CaptureTask& task,
+                                    const CaptureSetup& s, const BasePose& b, const Eigen::VectorXd& q) {
+  Data d(m);
+  Eigen::VectorXd r, rp, rm;
+  Eigen::MatrixXd J;
+  capture_residual(m, d, pb, task, s, b, q, r, &J);
+  for (int k = 0; k < m.n(); ++k) {
+    const double h = 1e-6;
+    Eigen::VectorXd qp = q, qm = q;
+    qp(k) += h;
+    qm(k) -= h;
+    capture_residual(m, d, pb, task, s, b, qp, rp, nullptr);
+    capture_residual(m, d, pb, task, s, b, qm, rm, nullptr);
+    const Eigen::VectorXd fd = (rp - rm) / (2 * h);
+    INFO("joint " << k << " analytic " << J.col(k).transpose() << " fd " << fd.transpose());
+    CHECK((J.col(k) - fd).norm() < 1e-7);
+  }
+}
+
 }  // namespace ffsr::test::global_capture

@@ -6,6 +6,7 @@
 // here (a Gauss-Newton on the 12 rows [p - x_cap; R - R_end], finite-difference Jacobian).
 #include <catch2/catch.hpp>
 
+#include "support/global_capture.hpp"
 #include "support/paper.hpp"
 
 #include "ffsr/io/scenario.hpp"
@@ -53,6 +54,17 @@ struct SearchInputs {
     const CaptureResult plain = integrate_capture(sc.problem, sc.task, opt, setup, none);
     base = plain.base;
     plain_theta = plain.theta;
+  }
+  /// The manifold search of the scenario (its seed and starts) from the paper's method's end.
+  ManifoldSearchResult search() const {
+    ManifoldSearchOptions so;
+    so.seed = sc.seed;
+    so.starts = sc.keys.global_starts;
+    return search_capture_manifold(sc.problem, sc.task, setup, base, so, {plain_theta});
+  }
+  /// The branches of `res`, the reachability of the best `reach` of them checked.
+  std::vector<CaptureBranch> branches(const ManifoldSearchResult& res, int reach) const {
+    return capture_branches(sc.problem, sc.task, opt, setup, res, base, reach);
   }
 };
 
@@ -131,22 +143,11 @@ TEST_CASE("Orientation residual: the rotation vector, its Jacobian equals centra
     const Vector3 axis = Vector3(1, -2, 0.5).normalized();
     task.final_orientation = Matrix3(Eigen::AngleAxisd(angle_deg * M_PI / 180, axis)) * Re;
     const CaptureSetup s = prepare_capture(pb, task, o);
-    Eigen::VectorXd r, rp, rm;
-    Eigen::MatrixXd J;
-    capture_residual(m, d, pb, task, s, b, q, r, &J);
+    Eigen::VectorXd r;
+    capture_residual(m, d, pb, task, s, b, q, r, nullptr);
     CHECK((r.tail<3>() - angle_deg * M_PI / 180 * axis).norm() < 1e-12);  // the rotation vector itself
-    for (int k = 0; k < m.n(); ++k) {
-      const double h = 1e-6;
-      Eigen::VectorXd qp = q, qm = q;
-      qp(k) += h;
-      qm(k) -= h;
-      capture_residual(m, d, pb, task, s, b, qp, rp, nullptr);
-      capture_residual(m, d, pb, task, s, b, qm, rm, nullptr);
-      const Eigen::VectorXd fd = (rp - rm) / (2 * h);
-      INFO(angle_deg << " deg, joint " << k << ": analytic " << J.col(k).transpose() << ", fd "
-                     << fd.transpose());
-      CHECK((J.col(k) - fd).norm() < 1e-7);  // central differences: O(h^2) + roundoff/h ~ 1e-9
-    }
+    INFO(angle_deg << " deg");
+    ffsr::test::global_capture::check_residual_jacobian(m, pb, task, s, b, q);
   }
 }
 
@@ -179,13 +180,8 @@ TEST_CASE("Orientation residual: a gripper turned half a turn is not on the mani
 
 TEST_CASE("Manifold search, paper 7-DOF pose task: every optimum in the final orientation", "[branches]") {
   const SearchInputs in(ffsr::test::kRobots + "paper_7dof_pose.toml");
-  ManifoldSearchOptions so;
-  so.seed = in.sc.seed;
-  so.starts = in.sc.keys.global_starts;
-  const ManifoldSearchResult res =
-      search_capture_manifold(in.sc.problem, in.sc.task, in.setup, in.base, so, {in.plain_theta});
-  const std::vector<CaptureBranch> br =
-      capture_branches(in.sc.problem, in.sc.task, in.opt, in.setup, res, in.base, 0);
+  const ManifoldSearchResult res = in.search();
+  const std::vector<CaptureBranch> br = in.branches(res, 0);
   REQUIRE(!br.empty());
   for (const CaptureBranch& b : br) {
     std::printf("paper 7-DOF pose branch: M_ie %.4f kg, orientation error %.2e deg\n", b.M_ie,
@@ -201,13 +197,8 @@ TEST_CASE("UR5 pose task: the branches equal an independent enumeration of the I
   if (!have_ur5()) return;
   const SearchInputs in(kData + "ur5_pose.toml");
   const Model& m = *in.sc.model;
-  ManifoldSearchOptions so;
-  so.seed = in.sc.seed;
-  so.starts = in.sc.keys.global_starts;
-  const ManifoldSearchResult res =
-      search_capture_manifold(in.sc.problem, in.sc.task, in.setup, in.base, so, {in.plain_theta});
-  const std::vector<CaptureBranch> br =
-      capture_branches(in.sc.problem, in.sc.task, in.opt, in.setup, res, in.base, 8);
+  const ManifoldSearchResult res = in.search();
+  const std::vector<CaptureBranch> br = in.branches(res, 8);
   REQUIRE(!br.empty());
   for (size_t i = 0; i < br.size(); ++i) {
     std::printf("UR5 pose branch %zu: M_ie %.4f kg, [", i, br[i].M_ie);

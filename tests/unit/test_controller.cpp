@@ -5,11 +5,12 @@
 
 #include <catch2/catch.hpp>
 
+#include "support/baselines.hpp"
+
 #include "ffsr/control/capture_controller.hpp"
 #include "ffsr/io/scenario.hpp"
 #include "ffsr/simulate/closed_loop.hpp"
 
-#include <nlohmann/json.hpp>
 
 #include <cmath>
 #include <fstream>
@@ -21,6 +22,7 @@
 namespace test_controller {
 
 using namespace ffsr;
+using ffsr::test::global_configuration;
 
 namespace {
 
@@ -62,15 +64,6 @@ double drive_and_compare(CaptureController<Policy>& ctrl, const CaptureProblem& 
   }
   CHECK_FALSE(fault);
   return worst;
-}
-
-Eigen::VectorXd global_configuration(const std::string& name) {
-  std::ifstream in(std::string(FFSR_SOURCE_DIR) + "/tests/data/baselines/" + name + ".json");
-  const nlohmann::json j = nlohmann::json::parse(in);
-  const auto deg = j.at("global").at("capture_configuration_deg").get<std::vector<double>>();
-  Eigen::VectorXd q(static_cast<Eigen::Index>(deg.size()));
-  for (size_t i = 0; i < deg.size(); ++i) q(static_cast<Eigen::Index>(i)) = deg[i] * M_PI / 180;
-  return q;
 }
 
 CaptureOptions global_options(const Scenario& sc) {

@@ -110,24 +110,9 @@ TEST_CASE("Capture residual: orientation rows' Jacobian equals central differenc
   task.kind = CaptureTask::Kind::Pose;
   task.final_orientation = Matrix3(Eigen::AngleAxisd(0.7, Vector3(1, 2, 3).normalized()));
   const CaptureSetup s = prepare_capture(pb, task, options(157));
-  Data d(m);
   BasePose b;
   b.position = Vector3(0.1, -0.2, 0.05);
-  const Eigen::VectorXd q = deg({10, 80, 70, -60, 100, 80, 20});
-  Eigen::VectorXd r, rp, rm;
-  Eigen::MatrixXd J;
-  capture_residual(m, d, pb, task, s, b, q, r, &J);
-  for (int k = 0; k < m.n(); ++k) {
-    const double h = 1e-6;
-    Eigen::VectorXd qp = q, qm = q;
-    qp(k) += h;
-    qm(k) -= h;
-    capture_residual(m, d, pb, task, s, b, qp, rp, nullptr);
-    capture_residual(m, d, pb, task, s, b, qm, rm, nullptr);
-    const Eigen::VectorXd fd = (rp - rm) / (2 * h);
-    INFO("joint " << k << " analytic " << J.col(k).transpose() << " fd " << fd.transpose());
-    CHECK((J.col(k) - fd).norm() < 1e-7);  // central differences: O(h^2) + roundoff/h ~ 1e-9
-  }
+  check_residual_jacobian(m, pb, task, s, b, deg({10, 80, 70, -60, 100, 80, 20}));
 }
 
 TEST_CASE("Global capture: bad inputs", "[global]") {

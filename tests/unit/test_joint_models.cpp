@@ -436,8 +436,8 @@ TEST_CASE("ffsr-optimize with joint models: contact, map, the main job, bad flag
   target.contact_offset = Vector3(-0.25, 0.15, 0);
   const double M_locked =
       integrated_effective_mass(*sc.model, data, sc.problem.base, th, sc.problem.frame, target, locked());
-  SECTION("contact --joints all: the three predictions beside the multibody run with the armature") {
-    const auto r = cli({"contact", "--urdf", kUrdf3, "--joints-deg", "0,90,-90", "--joints", "all",
+  SECTION("contact --contact-joints all: the three predictions beside the multibody run with the armature") {
+    const auto r = cli({"contact", "--urdf", kUrdf3, "--joints-deg", "0,90,-90", "--contact-joints", "all",
                         "--armature", "0.5", "--json"});
     REQUIRE(r.exit_code == 0);
     const auto j = nlohmann::json::parse(r.out);

@@ -22,6 +22,14 @@ struct Paper7Position {
   CaptureSetup s = setup();
   BasePose base;  // the initial base pose
 
+  /// The front from 8 starts at `levels` base-rate levels.
+  ParetoFront front(int levels) const {
+    ParetoOptions o;
+    o.starts = 8;
+    o.levels = levels;
+    return pareto_front(pb, task, s, base, o);
+  }
+
  private:
   CaptureProblem problem() const {
     CaptureProblem p = ffsr::test::problem_7dof(m);
@@ -35,18 +43,10 @@ struct Paper7Position {
   }
 };
 
-TEST_CASE("Pareto front of M_ie and the base rate jump: non-dominated, on the manifold, ends optimal",
-          "[pareto]") {
-  const Paper7Position p7;
-  const Model& m = p7.m;
-  const CaptureProblem& pb = p7.pb;
-  const CaptureTask& task = p7.task;
-  const CaptureSetup& s = p7.s;
-  const BasePose& base = p7.base;
-  ParetoOptions o;
-  o.starts = 8;
-  o.levels = 24;
-  const ParetoFront f = pareto_front(pb, task, s, base, o);
+TEST_CASE_METHOD(Paper7Position,
+                 "Pareto front of M_ie and the base rate jump: non-dominated, on the manifold, ends optimal",
+                 "[pareto]") {
+  const ParetoFront f = front(24);
   INFO("points " << f.points.size() << " ends " << f.min_mass.M_ie << " kg / " << f.min_mass.base_rate
                  << " rad/s and " << f.min_rate.M_ie << " kg / " << f.min_rate.base_rate << " rad/s, hv "
                  << f.hypervolume_normalized);
@@ -124,17 +124,10 @@ TEST_CASE("Inequalities combined: rows stacked, each gradient row in its place",
   CHECK(g[2] == 10);
 }
 
-TEST_CASE("The base-rate constraint: the search's least M_ie within it matches the front's point", "[pareto]") {
-  const Paper7Position p7;
-  const Model& m = p7.m;
-  const CaptureProblem& pb = p7.pb;
-  const CaptureTask& task = p7.task;
-  const CaptureSetup& s = p7.s;
-  const BasePose& base = p7.base;
-  ParetoOptions o;
-  o.starts = 8;
-  o.levels = 12;
-  const ParetoFront f = pareto_front(pb, task, s, base, o);
+TEST_CASE_METHOD(Paper7Position,
+                 "The base-rate constraint: the search's least M_ie within it matches the front's point",
+                 "[pareto]") {
+  const ParetoFront f = front(12);
   REQUIRE(f.points.size() >= 5);
   const ParetoPoint& mid = f.points[f.points.size() / 2];
   ManifoldSearchOptions so;

@@ -72,26 +72,34 @@ inline void check_start_clearance(const Scenario& sc, const SceneGeometry& g) {
 
 }  // namespace detail
 
-/// The scenario's geometry (null when it uses none of the keys). InputError naming the key.
-inline std::shared_ptr<const SceneGeometry> scenario_geometry(const Scenario& sc, const EmbeddedUrdf* embedded) {
+/// The shapes of the keys for `model` and a target with contact point `r_tp` (null when none of the
+/// keys is given), without the start configuration's check. InputError naming the key.
+inline std::shared_ptr<const SceneGeometry> scene_geometry(const ScenarioKeys& k, const Model& model,
+                                                           const Vector3& r_tp, const EmbeddedUrdf* embedded) {
   using detail::str;
-  const ScenarioKeys& k = sc.keys;
   if (!scenario_uses_geometry(k)) return nullptr;
   if (!std::isfinite(k.clearance) || k.clearance < 0)
     throw InputError(str("--clearance: must be >= 0 and finite, got ", k.clearance));
   std::optional<Shape> target;
   if (!k.target_shape.empty()) {
     target = target_shape_of(k.target_shape, k.target_size, k.target_shape_offset);
-    detail::check_contact_on_surface(*target, sc.problem.target.contact_offset);
+    detail::check_contact_on_surface(*target, r_tp);
   } else if (k.given.count("target-size") || k.given.count("target-shape-offset")) {
     throw InputError("--target-size: needs --target-shape");
   }
-  const RobotGeometry rg =
-      robot_geometry(*sc.model, detail::scenario_urdf_shapes(k, embedded), k.link_radius, k.bus_box);
+  const RobotGeometry rg = robot_geometry(model, detail::scenario_urdf_shapes(k, embedded), k.link_radius, k.bus_box);
   auto g = std::make_shared<SceneGeometry>();
-  g->checker = std::make_shared<CollisionChecker>(*sc.model, rg, target, k.contact_exemption);
+  g->checker = std::make_shared<CollisionChecker>(model, rg, target, k.contact_exemption);
   g->clearance = k.clearance;
-  if (g->clearance > 0) detail::check_start_clearance(sc, *g);
+  return g;
+}
+
+/// The scenario's geometry (null when it uses none of the keys); the start configuration must keep
+/// the clearance. InputError naming the key.
+inline std::shared_ptr<const SceneGeometry> scenario_geometry(const Scenario& sc, const EmbeddedUrdf* embedded) {
+  std::shared_ptr<const SceneGeometry> g =
+      scene_geometry(sc.keys, *sc.model, sc.problem.target.contact_offset, embedded);
+  if (g && g->clearance > 0) detail::check_start_clearance(sc, *g);
   return g;
 }
 
@@ -164,10 +172,14 @@ inline ClearanceReport run_clearance(const Scenario& sc, const CaptureResult& ru
 
 struct SceneGeometry {};
 
-inline std::shared_ptr<const SceneGeometry> scenario_geometry(const Scenario& sc, const EmbeddedUrdf*) {
-  if (scenario_uses_geometry(sc.keys))
+inline std::shared_ptr<const SceneGeometry> scene_geometry(const ScenarioKeys& k, const Model&, const Vector3&,
+                                                           const EmbeddedUrdf*) {
+  if (scenario_uses_geometry(k))
     throw InputError("--clearance: this build has no geometry (ffsr::geometry needs FCL, Debian libfcl-dev)");
   return nullptr;
+}
+inline std::shared_ptr<const SceneGeometry> scenario_geometry(const Scenario& sc, const EmbeddedUrdf* embedded) {
+  return scene_geometry(sc.keys, *sc.model, sc.problem.target.contact_offset, embedded);
 }
 inline GlobalCaptureResult plan_global_with_clearance(const Scenario& sc, const CaptureOptions& opt,
                                                       GlobalCaptureOptions g) {

@@ -843,6 +843,24 @@ inline std::optional<GlobalCaptureResult> reach_goal(const CaptureProblem& pb, c
   return std::nullopt;
 }
 
+/// InputError unless the reconfiguration duration is 0 (not set) or lies in (0, duration).
+inline void check_reconfiguration_duration(double t_r, double duration, const char* where) {
+  if (!std::isfinite(t_r) || t_r < 0 || (t_r > 0 && t_r >= duration))
+    throw InputError(str(where, ": the reconfiguration duration must lie in (0, ", duration, ") s, got ", t_r));
+}
+
+/// The best reached goal's result with the counters of every goal tried (`counts`).
+inline GlobalCaptureResult with_counters(GlobalCaptureResult best, const GlobalCaptureResult& counts) {
+  best.shooting_iterations = counts.shooting_iterations;
+  best.goals_tried = counts.goals_tried;
+  best.goals_out_of_limits = counts.goals_out_of_limits;
+  best.evaluations = counts.evaluations;
+  best.objective_evaluations = counts.objective_evaluations;
+  best.search_seconds = counts.search_seconds;
+  best.goals_rejected = counts.goals_rejected;
+  return best;
+}
+
 }  // namespace detail
 
 /// Global capture planning (see the top of this file). Goals are the local optima of the search at
@@ -869,10 +887,7 @@ inline GlobalCaptureResult plan_capture_global(const CaptureProblem& pb, const C
   o.progress = nullptr;
   const CaptureSetup setup = prepare_capture(pb, task, o, where);
   detail::check_global_options(g, where);
-  if (!std::isfinite(g.reconfigure.duration) || g.reconfigure.duration < 0 ||
-      (g.reconfigure.duration > 0 && g.reconfigure.duration >= o.duration))
-    throw InputError(str(where, ": the reconfiguration duration must lie in (0, ", o.duration, ") s, got ",
-                         g.reconfigure.duration));
+  detail::check_reconfiguration_duration(g.reconfigure.duration, o.duration, where);
   CaptureOptions quiet = o;
   quiet.record_series = false;
 
@@ -929,17 +944,7 @@ inline GlobalCaptureResult plan_capture_global(const CaptureProblem& pb, const C
       keep(r);
     }
   }
-  if (fallback) {
-    // the counters of every goal tried, the run of the best reached one
-    fallback->shooting_iterations = res.shooting_iterations;
-    fallback->goals_tried = res.goals_tried;
-    fallback->goals_out_of_limits = res.goals_out_of_limits;
-    fallback->evaluations = res.evaluations;
-    fallback->objective_evaluations = res.objective_evaluations;
-    fallback->search_seconds = res.search_seconds;
-    fallback->goals_rejected = res.goals_rejected;
-    return *fallback;
-  }
+  if (fallback) return detail::with_counters(std::move(*fallback), res);
   throw NumericalError(str(
       where, ": no capture configuration chosen by the search was reached (", res.goals_tried, " goals, ",
       res.goals_out_of_limits, " of them behind a joint limit, ", res.shooting_iterations, " reaching runs)",

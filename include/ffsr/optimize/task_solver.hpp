@@ -193,20 +193,10 @@ class TaskSolver {
   const TaskRates& factorize(bool with_projector) {
     svd_.compute(Jt_);
     const auto& sv = svd_.singularValues();
-    out_.sigma_min = sv(sv.size() - 1);
-    out_.lambda2 = 0;
-    out_.damped = false;
-    out_.null_scale = 1;
-    if (out_.sigma_min < threshold_) {
-      const double r = out_.sigma_min / threshold_;
-      out_.lambda2 = (1 - r * r) * max_damping_ * max_damping_;
-      out_.damped = true;
-    }
-    const double lambda2 = out_.lambda2;
+    set_damping(sv(sv.size() - 1));
     Jpinv_.setZero();
     for (Eigen::Index i = 0; i < sv.size(); ++i) {
-      const double sigma = sv(i);
-      const double g = lambda2 > 0 ? sigma / (sigma * sigma + lambda2) : (sigma > 1e-12 ? 1.0 / sigma : 0.0);
+      const double g = pinv_gain(sv(i));
       Jpinv_.noalias() += g * svd_.matrixV().col(i) * svd_.matrixU().col(i).transpose();
     }
     out_.theta_dot.noalias() = Jpinv_ * xdot_;

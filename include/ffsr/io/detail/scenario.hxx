@@ -23,13 +23,17 @@ inline std::string trimmed(const std::string& s) {
   return b == std::string::npos ? std::string() : s.substr(b, e - b + 1);
 }
 
-/// A number written as text; NaN and infinities pass (the validation names them).
+/// A number written as text; NaN and infinities written as such pass (the validation names them), a
+/// finite number too large for a double ("1e999") does not.
 inline double number_from_text(const std::string& text, const std::string& key, const std::string& in = "") {
   const std::string t = trimmed(text);
   char* end = nullptr;
+  errno = 0;
   const double x = std::strtod(t.c_str(), &end);
   if (t.empty() || end != t.c_str() + t.size())
     throw InputError(str(key, ": '", t, "' is not a number", in.empty() ? "" : " (in '" + in + "')"));
+  if (errno == ERANGE && std::isinf(x))
+    throw InputError(str(key, ": '", t, "' is out of the range of a double", in.empty() ? "" : " (in '" + in + "')"));
   return x;
 }
 

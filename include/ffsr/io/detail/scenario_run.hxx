@@ -319,6 +319,21 @@ inline void add_global_json(nlohmann::json& j, const Scenario& sc, const GlobalR
   j["global_exact_force_reduction_percent"] = reduction_percent(base_run.f_max_exact, r.run.f_max_exact);
 }
 
+/// A clearance report as JSON: the smallest distance {distance m, pair, time s, kind} with the
+/// smallest of each kind of pair ("arm_target", "arm_bus", "self"; null where there is no pair).
+inline nlohmann::json clearance_json(const ClearanceReport& c) {
+  auto entry = [](const ClearanceReport::Entry& e) {
+    if (e.pair.empty()) return nlohmann::json(nullptr);
+    return nlohmann::json{{"distance", e.distance}, {"pair", e.pair}, {"time", e.time}};
+  };
+  nlohmann::json x = entry(c.overall);
+  if (!x.is_null()) x["kind"] = c.kind;
+  x["arm_target"] = entry(c.arm_target);
+  x["arm_bus"] = entry(c.arm_bus);
+  x["self"] = entry(c.self);
+  return x;
+}
+
 /// Shapes and clearance: the keys in "scenario", each run's "min_clearance" (overall and per kind
 /// of pair: distance m, pair, time s), the global run's goals rejected by the path check.
 inline void add_clearance_json(nlohmann::json& j, const Scenario& sc, const ScenarioResult& r) {
@@ -330,18 +345,7 @@ inline void add_clearance_json(nlohmann::json& j, const Scenario& sc, const Scen
   j["scenario"]["bus-box"] = k.bus_box;
   j["scenario"]["clearance"] = k.clearance;
   j["scenario"]["contact-exemption"] = k.contact_exemption;
-  auto entry = [](const ClearanceReport::Entry& e) {
-    if (e.pair.empty()) return nlohmann::json(nullptr);
-    return nlohmann::json{{"distance", e.distance}, {"pair", e.pair}, {"time", e.time}};
-  };
-  for (const auto& [name, c] : r.clearances) {
-    nlohmann::json x = entry(c.overall);
-    if (!x.is_null()) x["kind"] = c.kind;
-    x["arm_target"] = entry(c.arm_target);
-    x["arm_bus"] = entry(c.arm_bus);
-    x["self"] = entry(c.self);
-    j[name]["min_clearance"] = x;
-  }
+  for (const auto& [name, c] : r.clearances) j[name]["min_clearance"] = clearance_json(c);
   if (r.global) j["global"]["goals_rejected_by_clearance"] = r.global->result.goals_rejected;
 }
 
