@@ -7,6 +7,7 @@
 #include <cmath>
 #include <iomanip>
 #include <sstream>
+#include <utility>
 
 namespace ffsr::cli::figures {
 namespace {
@@ -19,8 +20,9 @@ using plot::Panel3;
 
 constexpr int kInstants = 8;
 constexpr int kBlack = 6;
-constexpr int kTargetColor = 3;  // reddish purple: runs use 0, 1, 2
+constexpr int kTargetColor = 3;           // reddish purple: runs use 0, 1, 2
 constexpr int kReconfigurationColor = 4;  // orange: the end-effector's path in a reconfiguration
+constexpr int kClosestColor = 7;          // wine: the closest pair
 
 std::string fixed(double x, int digits) {
   std::ostringstream s;
@@ -43,10 +45,12 @@ struct Drawing {
   std::vector<Vector3> dots;
 };
 
-/// Adds the outline of a box (centre c, axes the columns of R, half side h) to a drawing: the square
-/// in its x-y plane when `planar`, else the twelve edges of the cube.
-void add_box(Drawing& d, const Vector3& c, const Matrix3& R, double h, bool planar) {
-  auto corner = [&](double a, double b, double z) { return Vector3(c + R * Vector3(a * h, b * h, z * h)); };
+/// Adds the outline of a box (centre c, axes the columns of R, half sides h) to a drawing: the
+/// rectangle in its x-y plane when `planar`, else its twelve edges.
+void add_box(Drawing& d, const Vector3& c, const Matrix3& R, const Vector3& h, bool planar) {
+  auto corner = [&](double a, double b, double z) {
+    return Vector3(c + R * Vector3(a * h.x(), b * h.y(), z * h.z()));
+  };
   auto square = [&](double z) {
     return std::vector<Vector3>{corner(-1, -1, z), corner(1, -1, z), corner(1, 1, z), corner(-1, 1, z),
                                 corner(-1, -1, z)};
@@ -60,16 +64,82 @@ void add_box(Drawing& d, const Vector3& c, const Matrix3& R, double h, bool plan
     for (int b : {-1, 1}) d.lines.push_back({corner(a, b, -1), corner(a, b, 1)});
 }
 
+/// The arc c + r (cos a e1 + sin a e2), a from `from` to `to` (a full circle: 48 segments).
+std::vector<Vector3> arc(const Vector3& c, const Vector3& e1, const Vector3& e2, double r, double from = 0,
+                         double to = 2 * M_PI) {
+  const int n = std::max(2, static_cast<int>(std::ceil(48 * (to - from) / (2 * M_PI))));
+  std::vector<Vector3> pts;
+  for (int i = 0; i <= n; ++i) {
+    const double a = from + (to - from) * double(i) / double(n);
+    pts.push_back(c + r * (std::cos(a) * e1 + std::sin(a) * e2));
+  }
+  return pts;
+}
+
+/// A collision shape's outlines: `top` as seen along z (its silhouette, for the x-y views) and
+/// `oblique` as a wireframe (for the 3-D view).
+struct ShapeDrawing {
+  Drawing top, oblique;
+};
+
+/// Adds shape `s` at world pose P (the carrying frame's pose times s.pose) to both outlines.
+void add_shape(ShapeDrawing& d, const Shape& s, const Pose& P) {
+  const Vector3 c = P.p, ex = Vector3::UnitX(), ey = Vector3::UnitY(), ez = Vector3::UnitZ();
+  if (s.kind == Shape::Kind::Box) {
+    add_box(d.top, c, P.R, 0.5 * s.size, false);
+    add_box(d.oblique, c, P.R, 0.5 * s.size, false);
+    return;
+  }
+  if (s.kind == Shape::Kind::Sphere) {
+    d.top.lines.push_back(arc(c, ex, ey, s.radius));
+    for (const auto& [e1, e2] : {std::pair{ex, ey}, std::pair{ey, ez}, std::pair{ez, ex}})
+      d.oblique.lines.push_back(arc(c, e1, e2, s.radius));
+    return;
+  }
+  // cylinder or capsule: the axis a (local z) from e0 to e1
+  const bool capsule = s.kind == Shape::Kind::Capsule;
+  const double r = s.radius;
+  const Vector3 a = P.R.col(2), e0 = c - 0.5 * s.length * a, e1 = c + 0.5 * s.length * a;
+  const Vector3 u = a.unitOrthogonal(), v = a.cross(u);
+  for (const Vector3& e : {e0, e1}) d.oblique.lines.push_back(arc(e, u, v, r));
+  for (const Vector3& w : {u, Vector3(-u), v, Vector3(-v)})
+    d.oblique.lines.push_back({e0 + r * w, e1 + r * w});
+  if (capsule)  // the caps: two half circles over each end
+    for (const Vector3& w : {u, v}) {
+      d.oblique.lines.push_back(arc(e1, a, w, r, -M_PI / 2, M_PI / 2));
+      d.oblique.lines.push_back(arc(e0, Vector3(-a), w, r, -M_PI / 2, M_PI / 2));
+    }
+  // silhouette along z: a capsule's end circles in the x-y plane, a cylinder's end circles (ellipses
+  // seen from above), and the two sides r from the axis, horizontal and normal to it
+  for (const Vector3& e : {e0, e1}) d.top.lines.push_back(capsule ? arc(e, ex, ey, r) : arc(e, u, v, r));
+  const Vector3 side = ez.cross(a);
+  if (side.norm() > 1e-9)
+    for (double k : {-1.0, 1.0}) {
+      const Vector3 w = k * r * side.normalized();
+      d.top.lines.push_back({e0 + w, e1 + w});
+    }
+}
+
+/// The shapes of every body at the kinematics of `data` (forward_kinematics run).
+ShapeDrawing body_shapes(const SceneShapes& shapes, const Data& data) {
+  ShapeDrawing d;
+  for (size_t b = 0; b < shapes.bodies.size() && b < data.p.size(); ++b)
+    for (const Shape& s : shapes.bodies[b]) add_shape(d, s, Pose{data.p[b], data.R[b]} * s.pose);
+  return d;
+}
+
 /// The robot at one recorded state: the base as a box around its frame origin (half side: the
-/// farthest joint mounted on it, so the mounts sit on the box), the links as segments between
-/// joint origins and to the end-effector, the joints as dots.
-Drawing robot_drawing(const Model& model, Data& data, int frame, const CaptureSample& s, bool planar) {
+/// farthest joint mounted on it, so the mounts sit on the box; none when `base_box` is false: the
+/// bus's own shape is drawn), the links as segments between joint origins and to the end-effector,
+/// the joints as dots.
+Drawing robot_drawing(const Model& model, Data& data, int frame, const CaptureSample& s, bool planar,
+                      bool base_box) {
   forward_kinematics(model, data, s.base, s.theta);
   Drawing d;
   double half = 0.05;
   for (int i = 1; i < model.nb(); ++i)
     if (model.body(i).parent == 0) half = std::max(half, model.body(i).tree.p.cwiseAbs().maxCoeff());
-  add_box(d, data.p[0], data.R[0], half, planar);
+  if (base_box) add_box(d, data.p[0], data.R[0], Vector3::Constant(half), planar);
   for (int i = 1; i < model.nb(); ++i) {
     const int parent = model.body(i).parent;
     if (parent > 0) d.lines.push_back({data.p[static_cast<size_t>(parent)], data.p[static_cast<size_t>(i)]});
@@ -80,23 +150,30 @@ Drawing robot_drawing(const Model& model, Data& data, int frame, const CaptureSa
   return d;
 }
 
-/// The target at T: its outline (a square, or a cube, of half side max |r_tp|, so that the contact
-/// point lies on its surface -- a schematic, the target's shape is not part of the model), the
-/// contact point and an arrow along the contact normal.
-Drawing target_drawing(const Target& t, bool planar, double arrow) {
-  Drawing d;
-  const double h = std::max(0.1, t.contact_offset.cwiseAbs().maxCoeff());
-  add_box(d, t.position, t.rotation(), h, planar);
+/// The target at T: its shape when the scenario has one, else a schematic box (a square, or a cube,
+/// of half side max |r_tp|, so that the contact point lies on its surface); the contact point and an
+/// arrow along the contact normal.
+ShapeDrawing target_drawing(const Target& t, bool planar, double arrow, const std::optional<Shape>& shape) {
+  ShapeDrawing d;
+  if (shape) {
+    add_shape(d, *shape, Pose{t.position, t.rotation()} * shape->pose);
+  } else {
+    const double h = std::max(0.1, t.contact_offset.cwiseAbs().maxCoeff());
+    add_box(d.top, t.position, t.rotation(), Vector3::Constant(h), planar);
+    add_box(d.oblique, t.position, t.rotation(), Vector3::Constant(h), planar);
+  }
   const Vector3 cp = t.contact_point(), u = t.normal_world();
   // the normal points from the end-effector into the target: draw it arriving at the contact point
   const Vector3 tail = cp - arrow * u;
   Vector3 side = u.cross(Vector3::UnitZ());
   if (side.norm() < 1e-6) side = u.cross(Vector3::UnitX());
   side.normalize();
-  d.lines.push_back({tail, cp});
-  d.lines.push_back(
-      {cp - 0.25 * arrow * u + 0.12 * arrow * side, cp, cp - 0.25 * arrow * u - 0.12 * arrow * side});
-  d.dots.push_back(cp);
+  for (Drawing* v : {&d.top, &d.oblique}) {
+    v->lines.push_back({tail, cp});
+    v->lines.push_back(
+        {cp - 0.25 * arrow * u + 0.12 * arrow * side, cp, cp - 0.25 * arrow * u - 0.12 * arrow * side});
+    v->dots.push_back(cp);
+  }
   return d;
 }
 
@@ -199,11 +276,19 @@ bool planar_motion(const Model& model, Data& data, double z0, const std::vector<
   return planar;
 }
 
-/// The drawings of one run: the arm at the instants, the end-effector path, the target at T.
+/// The drawings of one run: the arm at the instants, the end-effector path, the target at T; with
+/// shapes, the bodies' shapes at T and the closest pair along the path (nearest points joined,
+/// with every shape at that instant when it is not T).
 struct RunDrawings {
   std::vector<Drawing> arms;
-  Drawing path, target;
+  Drawing path;
+  ShapeDrawing target;
   Drawing reconfiguration_path;  ///< the end-effector during a reconfiguration (empty: none)
+  ShapeDrawing shapes;           ///< the bus's and the links' shapes at T (empty: no shapes)
+  Drawing closest;               ///< the closest pair's nearest points joined (empty: none)
+  ShapeDrawing closest_shapes;   ///< every shape at the closest pair's instant (empty: at T)
+  std::string closest_note;      ///< "closest: link3 - target at t = 177.8 s" (empty: none)
+  double closest_distance = 0;   ///< m
   int color = 0;
   double duration = 0;
   bool planar = true;
@@ -214,10 +299,11 @@ struct RunDrawings {
 };
 
 RunDrawings run_drawings(const Model& model, Data& data, int frame, const CaptureResult& res,
-                         const Drawing& target, bool planar, long reconfiguration_samples = 0) {
+                         const ShapeDrawing& target, bool planar, long reconfiguration_samples,
+                         bool base_box) {
   RunDrawings d;
   for (size_t k : instants(res.series.size()))
-    d.arms.push_back(robot_drawing(model, data, frame, res.series[k], planar));
+    d.arms.push_back(robot_drawing(model, data, frame, res.series[k], planar, base_box));
   d.target = target;
   d.planar = planar;
   d.path.lines.emplace_back();
@@ -228,6 +314,32 @@ RunDrawings run_drawings(const Model& model, Data& data, int frame, const Captur
     if (i + 1 >= k) d.path.lines.back().push_back(res.series[i].end_effector);  // joined at t_r
   }
   return d;
+}
+
+/// Adds the shapes of a run to its drawings: the bodies at T and, from the clearance report, the
+/// closest pair (and every shape at its instant, the recorded state nearest to it, when not T).
+void add_run_shapes(RunDrawings& d, const Model& model, Data& data, const CaptureResult& res,
+                    const SceneShapes& shapes, const Target& target_at_start,
+                    const ClearanceReport* clearance) {
+  if (res.series.empty()) return;
+  forward_kinematics(model, data, res.series.back().base, res.series.back().theta);
+  d.shapes = body_shapes(shapes, data);
+  if (!clearance || !std::isfinite(clearance->overall.distance)) return;
+  const ClearanceReport::Entry& c = clearance->overall;
+  d.closest.lines.push_back({c.p_a, c.p_b});
+  d.closest.dots = {c.p_a, c.p_b};
+  d.closest_note = str("closest: ", c.pair, " at t = ", fixed(c.time, 1), " s");
+  d.closest_distance = c.distance;
+  const auto nearest = std::min_element(
+      res.series.begin(), res.series.end(),
+      [&](const auto& a, const auto& b) { return std::abs(a.t - c.time) < std::abs(b.t - c.time); });
+  if (&*nearest == &res.series.back()) return;
+  forward_kinematics(model, data, nearest->base, nearest->theta);
+  d.closest_shapes = body_shapes(shapes, data);
+  if (shapes.target) {
+    const Target t = propagate_target(target_at_start, c.time);
+    add_shape(d.closest_shapes, *shapes.target, Pose{t.position, t.rotation()} * shapes.target->pose);
+  }
 }
 
 /// The x-y view: the arms (the first dashed with open joints), the path, the target.
@@ -256,7 +368,11 @@ void top_view(Panel& p, const RunDrawings& d) {
   add(p, d.path, 0, 1, kBlack, 1.0, 1.0,
       d.reconfiguration_path.lines.empty() ? "end-effector path" : "end-effector, approach", "", 1.0);
   p.curves.back().line_style = 2;
-  add(p, d.target, 0, 1, kTargetColor, 1.0, 1.5, "target at T, normal", "●", 0.9);
+  add(p, d.closest_shapes.top, 0, 1, d.color, 0.3, 1.0, "", "", 1.0);
+  add(p, d.shapes.top, 0, 1, d.color, 0.7, 1.0, "shapes at T", "", 1.0);
+  add(p, d.target.top, 0, 1, kTargetColor, 1.0, 1.5, "target at T, normal", "●", 0.9);
+  add(p, d.closest, 0, 1, kClosestColor, 1.0, 2.5, str("closest: ", fixed(d.closest_distance, 3), " m"), "■",
+      0.8);
 }
 
 /// The oblique 3-D view of a spatial run.
@@ -273,7 +389,10 @@ Panel3 oblique_view(const RunDrawings& d) {
   }
   add(q, d.path, kBlack, 1.0, 1.0, "", 1.0);
   q.curves.back().line_style = 2;
-  add(q, d.target, kTargetColor, 1.0, 1.5, "●", 0.8);
+  add(q, d.closest_shapes.oblique, d.color, 0.3, 1.0, "", 1.0);
+  add(q, d.shapes.oblique, d.color, 0.7, 1.0, "", 1.0);
+  add(q, d.target.oblique, kTargetColor, 1.0, 1.5, "●", 0.8);
+  add(q, d.closest, kClosestColor, 1.0, 2.5, "■", 0.8);
   return q;
 }
 
@@ -287,11 +406,13 @@ plot::Figure capture_figure(const std::string& label, const CaptureResult& res, 
   Panel p;
   top_view(p, d);
   if (d.planar) {
-    p.title = str("the arm at ", d.arms.size(), " instants (faint: early, dark: late)");
+    p.title = d.closest_note.empty()
+                  ? str("the arm at ", d.arms.size(), " instants (faint: early, dark: late)")
+                  : str("the arm at ", d.arms.size(), " instants; ", d.closest_note);
   } else {
     fig.cols = 2;
     fig.panels.emplace_back(oblique_view(d));
-    p.title = "top view (x-y)";
+    p.title = d.closest_note.empty() ? std::string("top view (x-y)") : "top view; " + d.closest_note;
     p.legend_outside = false;
   }
   fig.panels.emplace_back(std::move(p));
@@ -387,18 +508,22 @@ plot::Figure joints_figure(const Model& model, const std::vector<CaptureRun>& ru
 }  // namespace
 
 std::vector<plot::Figure> capture(const Model& model, int frame, const Target& target_at_start,
-                                  double duration, const std::vector<CaptureRun>& runs) {
+                                  double duration, const std::vector<CaptureRun>& runs,
+                                  const SceneShapes* shapes) {
   Data data(model);
   const Target target = propagate_target(target_at_start, duration);
   const bool planar = planar_motion(model, data, target.contact_point().z(), runs);
   double reach = 0;
   for (int i = 1; i < model.nb(); ++i) reach += model.body(i).tree.p.norm();
-  const Drawing target_at_T = target_drawing(target, planar, std::max(0.2, 0.12 * reach));
+  const ShapeDrawing target_at_T =
+      target_drawing(target, planar, std::max(0.2, 0.12 * reach), shapes ? shapes->target : std::nullopt);
 
   std::vector<plot::Figure> out;
   for (size_t r = 0; r < runs.size(); ++r) {
+    const bool bus_shape = shapes && !shapes->bodies.empty() && !shapes->bodies[0].empty();
     RunDrawings d = run_drawings(model, data, frame, *runs[r].result, target_at_T, planar,
-                                 runs[r].reconfiguration_samples);
+                                 runs[r].reconfiguration_samples, !bus_shape);
+    if (shapes) add_run_shapes(d, model, data, *runs[r].result, *shapes, target_at_start, runs[r].clearance);
     d.color = static_cast<int>(r);
     d.duration = duration;
     out.push_back(capture_figure(runs[r].label, *runs[r].result, d));
@@ -426,7 +551,8 @@ plot::Figure closed_loop(const ClosedLoopSeries& s) {
   }
   const bool micro = e_max < 1e-4;
   const bool limit_lines = s.torque_limit > 0 && tau_max > 0.3 * s.torque_limit;
-  Panel angles = labelled("joint angles: closed loop (solid), plan (dashed)", "time t (s)", "joint angle (deg)"),
+  Panel angles =
+            labelled("joint angles: closed loop (solid), plan (dashed)", "time t (s)", "joint angle (deg)"),
         track = labelled("end effector to the reference line", "time t (s)",
                          micro ? "|p#de#u - x#dd#u| (µm)" : "|p#de#u - x#dd#u| (mm)"),
         torque = labelled(limit_lines ? str("joint torques (limit ±", s.torque_limit, " N m: dashed)")

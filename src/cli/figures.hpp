@@ -4,8 +4,10 @@
 
 #include "plot.hpp"
 
+#include "ffsr/geometry/shape.hpp"
 #include "ffsr/optimize/capture.hpp"
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -18,6 +20,14 @@ struct CaptureRun {
   const CaptureResult* result = nullptr;
   CaptureTask task;
   long reconfiguration_samples = 0;  ///< the first samples of the series that are a reconfiguration
+  /// With shapes: the smallest distance along the path (its pair marked); null: none.
+  const ClearanceReport* clearance = nullptr;
+};
+
+/// The collision shapes of a scenario with geometry, drawn as they are in the capture pictures.
+struct SceneShapes {
+  std::vector<std::vector<Shape>> bodies;  ///< bodies[b]: the shapes of body b (body frame)
+  std::optional<Shape> target;             ///< the target's shape (target frame); none: a schematic box
 };
 
 /// Figures 10, 11, 13-15: for each run the arm at eight instants (links as segments, joints as
@@ -25,22 +35,26 @@ struct CaptureRun {
 /// with its contact point and normal -- in the plane for a planar robot, else an oblique view and a
 /// top view. Then "histories" (M_ie, closed-form F_max, base attitude drift and the task's smallest
 /// singular value against time, all runs on shared axes) and "joints" (the joint angles).
+/// With `shapes`: the target's shape at T instead of the schematic box, the bus and the links'
+/// shapes with the arm at T, and for a run with a clearance report its closest pair (the nearest
+/// points joined, with the bodies and the target at that instant, faint).
 /// Forward kinematics and the task Jacobian are recomputed from each recorded state.
 /// Reads the runs' series (record_series must have been on).
 std::vector<plot::Figure> capture(const Model& model, int frame, const Target& target_at_start,
-                                  double duration, const std::vector<CaptureRun>& runs);
+                                  double duration, const std::vector<CaptureRun>& runs,
+                                  const SceneShapes* shapes = nullptr);
 
 /// A closed-loop run of `closed-loop` (plain data: the command copies it from the simulation's
 /// recorded series) beside the open-loop plan it follows.
 struct ClosedLoopSeries {
   std::vector<std::string> joint_names;
-  std::vector<double> t;                      ///< s
-  std::vector<Eigen::VectorXd> theta;         ///< rad, one per t
-  std::vector<Eigen::VectorXd> lag;           ///< command - joint rate, rad/s, one per t
-  std::vector<Eigen::VectorXd> torque;        ///< N m, one per t
-  std::vector<double> reference_error;        ///< |p_e - x_d|, m, one per t
-  double torque_limit = 0;                    ///< N m
-  const CaptureResult* open_loop = nullptr;   ///< the plan, with its recorded series
+  std::vector<double> t;                     ///< s
+  std::vector<Eigen::VectorXd> theta;        ///< rad, one per t
+  std::vector<Eigen::VectorXd> lag;          ///< command - joint rate, rad/s, one per t
+  std::vector<Eigen::VectorXd> torque;       ///< N m, one per t
+  std::vector<double> reference_error;       ///< |p_e - x_d|, m, one per t
+  double torque_limit = 0;                   ///< N m
+  const CaptureResult* open_loop = nullptr;  ///< the plan, with its recorded series
   std::string title;
 };
 /// "closed_loop": the joint angles of the closed loop (solid) and of the open-loop plan (dashed),

@@ -13,6 +13,7 @@
 #include <iomanip>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <set>
 #include <sstream>
 
@@ -154,6 +155,17 @@ std::string series_csv(const Scenario& sc, const ScenarioResult& r) {
   return c.str();
 }
 
+/// The scenario's collision shapes for the pictures; none without geometry.
+std::optional<figures::SceneShapes> scene_shapes(const Scenario& sc) {
+#ifdef FFSR_HAVE_GEOMETRY
+  if (sc.geometry)
+    return figures::SceneShapes{sc.geometry->checker->geometry().shapes,
+                                sc.geometry->checker->target_shape()};
+#endif
+  (void)sc;
+  return std::nullopt;
+}
+
 /// JSON, CSV and figures, built first and written all or nothing.
 void write_outputs(const Scenario& sc, const ScenarioResult& r, const RunSettings& o, RunRequest& q,
                    const nlohmann::json& j) {
@@ -161,7 +173,12 @@ void write_outputs(const Scenario& sc, const ScenarioResult& r, const RunSetting
     std::vector<figures::CaptureRun> runs{{"plain", &r.plain, sc.baseline_task},
                                           {"optimized", &r.optimized, sc.task}};
     if (r.global) runs.push_back({"global", &r.global->result.run, sc.task, reconfiguration_samples(r)});
-    plot::render(figures::capture(*sc.model, sc.problem.frame, sc.problem.target, sc.capture.duration, runs),
+    const std::optional<figures::SceneShapes> shapes = scene_shapes(sc);
+    for (figures::CaptureRun& run : runs)  // the plain run's clearance is called "baseline"
+      for (const auto& [name, c] : r.clearances)
+        if (name == (run.label == "plain" ? "baseline" : run.label)) run.clearance = &c;
+    plot::render(figures::capture(*sc.model, sc.problem.frame, sc.problem.target, sc.capture.duration, runs,
+                                  shapes ? &*shapes : nullptr),
                  o.plot, q.plot_format);
   }
   q.outputs.set("--json", j.dump(2) + "\n");
@@ -257,8 +274,8 @@ void print_base_jump(std::ostream& out, const Scenario& sc, const ScenarioResult
   };
   const auto flags = out.flags();
   const auto precision = out.precision();
-  out << std::scientific << std::setprecision(3) << "base angular rate jump at the impact: plain " << rate(r.plain)
-      << " deg/s, optimized " << rate(r.optimized) << " deg/s";
+  out << std::scientific << std::setprecision(3) << "base angular rate jump at the impact: plain "
+      << rate(r.plain) << " deg/s, optimized " << rate(r.optimized) << " deg/s";
   if (r.global) out << ", global " << rate(r.global->result.run) << " deg/s";
   if (r.global && sc.keys.max_base_rate_deg > 0)
     out << std::defaultfloat << " (searched within max-base-rate-deg " << sc.keys.max_base_rate_deg << ")";
@@ -270,11 +287,13 @@ void print_base_jump(std::ostream& out, const Scenario& sc, const ScenarioResult
 /// With shapes: each run's smallest distance along its path and the pair (docs/geometry.md).
 void print_clearance(std::ostream& out, const Scenario& sc, const ScenarioResult& r) {
   if (r.clearances.empty()) return;
-  out << std::fixed << std::setprecision(4) << "smallest distance along the path (clearance " << sc.keys.clearance
-      << " m, last " << sc.keys.contact_exemption << " m of the end-effector link exempt at the target):";
+  out << std::fixed << std::setprecision(4) << "smallest distance along the path (clearance "
+      << sc.keys.clearance << " m, last " << sc.keys.contact_exemption
+      << " m of the end-effector link exempt at the target):";
   for (const auto& [name, c] : r.clearances)
-    out << (name == "baseline" ? " plain " : ", " + name + " ") << c.overall.distance << " m (" << c.overall.pair
-        << ", t = " << std::setprecision(1) << c.overall.time << " s)" << std::setprecision(4);
+    out << (name == "baseline" ? " plain " : ", " + name + " ") << c.overall.distance << " m ("
+        << c.overall.pair << ", t = " << std::setprecision(1) << c.overall.time << " s)"
+        << std::setprecision(4);
   out << "\n";
   if (r.global && r.global->result.goals_rejected > 0)
     out << "clearance: " << r.global->result.goals_rejected

@@ -15,6 +15,7 @@
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -202,6 +203,118 @@ TEST_CASE(
     check_png(dir / f, 1000, 700);
 }
 
+/// The distance in the x-y plane from (x, y) to the segment a-b projected on it.
+double planar_segment_distance(double x, double y, const Vector3& a, const Vector3& b) {
+  const Eigen::Vector2d p(x, y), a2 = a.head<2>(), d = b.head<2>() - a2;
+  const double t = d.squaredNorm() > 0 ? std::clamp((p - a2).dot(d) / d.squaredNorm(), 0.0, 1.0) : 0.0;
+  return (p - a2 - t * d).norm();
+}
+
+TEST_CASE("capture figures with shapes: the outlines lie on the shapes, the closest pair is marked",
+          "[plot]") {
+  const Paper3 p;
+  CaptureProblem pb;
+  pb.model = &p.model;
+  pb.frame = p.model.end_effector();
+  pb.theta = ffsr::test::deg({0, 150, -100});
+  pb.target = p.target;
+  CaptureTask task;
+  task.axes = {true, true, false};
+  CaptureOptions opt;
+  opt.duration = 180;
+  opt.step = 0.2;
+  opt.record_series = true;
+  const CaptureResult run = plan_capture(pb, task, opt);
+  const double r = 0.05;
+  const Vector3 bus(0.6, 0.5, 0.4), target_size(0.3, 0.4, 0.5);
+  figures::SceneShapes shapes;
+  shapes.bodies = robot_geometry(p.model, {}, {r}, {bus.x(), bus.y(), bus.z()}).shapes;
+  shapes.target = Shape::box(target_size, Pose{Vector3(0.02, -0.03, 0), Matrix3::Identity()});
+  ClearanceReport rep;  // a closest pair at t = 90 s (the marker is drawn from the report as given)
+  rep.overall.distance = 0.1234;
+  rep.overall.pair = "link2 - target";
+  rep.overall.time = 90;
+  rep.overall.p_a = Vector3(2.1, 1.2, 0);
+  rep.overall.p_b = Vector3(2.2, 1.25, 0);
+  figures::CaptureRun cr{"global", &run, task};
+  cr.clearance = &rep;
+  const auto figs = figures::capture(p.model, pb.frame, pb.target, opt.duration, {cr}, &shapes);
+  const auto& panel = std::get<plot::Panel>(figs.at(0).panels.at(0));
+
+  // the bodies at T, independently: the bus's corners and the links' centre lines (joint origins)
+  Data d(p.model);
+  forward_kinematics(p.model, d, run.series.back().base, run.series.back().theta);
+  std::vector<std::pair<Vector3, Vector3>> axes;  // each moving body's segment to its child / end-effector
+  for (int b = 1; b < p.model.nb(); ++b) {
+    const bool has_child = b + 1 < p.model.nb();
+    axes.emplace_back(d.p[size_t(b)], has_child ? d.p[size_t(b + 1)] : run.end_effector);
+  }
+  int shape_curves = 0, bus_curves = 0, capsule_curves = 0, faint = 0;
+  for (const plot::Curve& c : panel.curves) {
+    if (c.alpha == 0.3) ++faint;
+    if (c.alpha != 0.7) continue;
+    ++shape_curves;
+    // a bus edge: every point on the box's surface, two coordinates at their half side (an edge)
+    bool on_bus = true;
+    for (size_t i = 0; i < c.x.size(); ++i) {
+      const Vector3 local = d.R[0].transpose() * (Vector3(c.x[i], c.y[i], 0) - d.p[0]);
+      on_bus = on_bus && std::abs(local.x()) <= 0.5 * bus.x() + 1e-9 &&
+               std::abs(local.y()) <= 0.5 * bus.y() + 1e-9 &&
+               (std::abs(std::abs(local.x()) - 0.5 * bus.x()) < 1e-9 ||
+                std::abs(std::abs(local.y()) - 0.5 * bus.y()) < 1e-9);
+    }
+    if (on_bus) {
+      ++bus_curves;
+      continue;
+    }
+    // a capsule's silhouette: within r of one link's axis, and r from it at its farthest point
+    bool on_capsule = false;
+    for (const auto& [a, b] : axes) {
+      double far = 0;
+      bool inside = true;
+      for (size_t i = 0; i < c.x.size(); ++i) {
+        const double dist = planar_segment_distance(c.x[i], c.y[i], a, b);
+        far = std::max(far, dist);
+        inside = inside && dist <= r + 1e-9;
+      }
+      on_capsule = on_capsule || (inside && std::abs(far - r) < 1e-9);
+    }
+    CHECK(on_capsule);
+    capsule_curves += on_capsule;
+  }
+  CHECK(bus_curves == 6);  // its two faces as closed lines and four side edges, seen from above
+  CHECK(capsule_curves == 4 * int(axes.size()));  // two end circles and two sides per link
+  CHECK(shape_curves == bus_curves + capsule_curves);
+  CHECK(faint == shape_curves + 6);  // at t = 90 s: the same shapes and the target's box
+
+  // the target's box at T: its lines (before the normal's arrow) on its edges, in the target frame
+  const Target tT = propagate_target(p.target, opt.duration);
+  std::vector<const plot::Curve*> target_lines;
+  for (const plot::Curve& c : panel.curves)
+    if (c.color == 3 && c.symbol.empty()) target_lines.push_back(&c);
+  REQUIRE(target_lines.size() == 6 + 2);
+  for (size_t k = 0; k < 6; ++k)
+    for (size_t i = 0; i < target_lines[k]->x.size(); ++i) {
+      const Vector3 local =
+          tT.rotation().transpose() *
+              (Vector3(target_lines[k]->x[i], target_lines[k]->y[i], tT.position.z()) - tT.position) -
+          Vector3(0.02, -0.03, 0);
+      const Eigen::Array2d rel = local.head<2>().cwiseAbs().array() / (0.5 * target_size.head<2>().array());
+      CHECK(rel.maxCoeff() == Approx(1.0).epsilon(1e-9));
+    }
+  // the closest pair: its nearest points joined, the legend naming the pair, distance and time
+  const plot::Curve* marker = nullptr;
+  for (const plot::Curve& c : panel.curves)
+    if (c.label == "closest: 0.123 m") marker = &c;
+  REQUIRE(marker);
+  CHECK(panel.title == "the arm at 8 instants; closest: link2 - target at t = 90.0 s");
+  CHECK(marker->x == std::vector<double>{2.1, 2.2});
+  CHECK(marker->y == std::vector<double>{1.2, 1.25});
+  TempDir dir;
+  plot::render(figs, dir.str(), plot::Format::Png);
+  check_png(dir / "capture_global.png", 1000, 700);
+}
+
 TEST_CASE("main job with --plot: the 3-DOF scenario's figures as PNG and SVG", "[plot][cli]") {
   TempDir dir;
   fs::create_directory(dir / "png");
@@ -352,11 +465,12 @@ TEST_CASE("closed-loop --plot: the closed loop beside its plan, the JSON's numbe
   check_png(dir / "closed_loop.png", 1200, 900, 8);
   std::ifstream in(dir / "cl.json");
   const nlohmann::json j = nlohmann::json::parse(in);
-  CHECK(j["closed_loop"]["capture_error"].get<double>() < 1e-4);  // the exact target: tracked
+  CHECK(j["closed_loop"]["capture_error"].get<double>() < 1e-4);        // the exact target: tracked
   CHECK(j["closed_loop"]["max_torque"].get<double>() <= 100.0 + 1e-9);  // the default torque limit
 }
 
-TEST_CASE("closed-loop figure: one curve per joint and run, the limit lines, equal lengths required", "[plot]") {
+TEST_CASE("closed-loop figure: one curve per joint and run, the limit lines, equal lengths required",
+          "[plot]") {
   CaptureResult open;
   for (int i = 0; i <= 4; ++i) {
     CaptureSample x;
@@ -383,7 +497,7 @@ TEST_CASE("closed-loop figure: one curve per joint and run, the limit lines, equ
   CHECK(angles.curves[1].x.size() == 5);
   CHECK(std::get<plot::Panel>(f.panels[1]).curves.front().y.front() == Approx(2.0));  // mm
   CHECK(std::get<plot::Panel>(f.panels[2]).curves.size() == 4);  // two joints, +limit, -limit (60 > 0.3 x 50)
-  s.reference_error.assign(s.t.size(), 2e-6);  // small errors in micrometres
+  s.reference_error.assign(s.t.size(), 2e-6);                    // small errors in micrometres
   CHECK(std::get<plot::Panel>(figures::closed_loop(s).panels[1]).curves.front().y.front() == Approx(2.0));
   s.torque.assign(s.t.size(), Eigen::Vector2d(1.0, -1.0));  // far below the limit: no limit lines
   CHECK(std::get<plot::Panel>(figures::closed_loop(s).panels[2]).curves.size() == 2);
