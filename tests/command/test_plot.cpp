@@ -59,6 +59,29 @@ struct Paper3 {
     target.position = Vector3(2.75, 1.45, 0);
     target.angular_velocity = Vector3(0, 0, 2 * M_PI / 180);
   }
+  /// The capture from joint angles (0, 150, -100) deg.
+  CaptureProblem problem() const {
+    CaptureProblem pb;
+    pb.model = &model;
+    pb.frame = model.end_effector();
+    pb.theta = ffsr::test::deg({0, 150, -100});
+    pb.target = target;
+    return pb;
+  }
+  /// The planar position task.
+  static CaptureTask task() {
+    CaptureTask t;
+    t.axes = {true, true, false};
+    return t;
+  }
+  /// T = 180 s in steps of 0.2 s, the series recorded.
+  static CaptureOptions options() {
+    CaptureOptions o;
+    o.duration = 180;
+    o.step = 0.2;
+    o.record_series = true;
+    return o;
+  }
 };
 
 /// M_ie over a grid of joint angles (deg), last axis fastest, evaluated directly with Eq. 14.
@@ -147,17 +170,9 @@ TEST_CASE(
     "capture figures: the drawn arm at T meets the planner's end-effector and the drift curve its drift",
     "[plot]") {
   const Paper3 p;
-  CaptureProblem pb;
-  pb.model = &p.model;
-  pb.frame = p.model.end_effector();
-  pb.theta = ffsr::test::deg({0, 150, -100});
-  pb.target = p.target;
-  CaptureTask task;
-  task.axes = {true, true, false};
-  CaptureOptions opt;
-  opt.duration = 180;
-  opt.step = 0.2;
-  opt.record_series = true;
+  const CaptureProblem pb = p.problem();
+  const CaptureTask task = Paper3::task();
+  CaptureOptions opt = Paper3::options();
   const CaptureResult plain = plan_capture(pb, task, opt);
   opt.gain = -0.01;
   const CaptureResult optimized = plan_capture(pb, task, opt);
@@ -213,17 +228,9 @@ double planar_segment_distance(double x, double y, const Vector3& a, const Vecto
 TEST_CASE("capture figures with shapes: the outlines lie on the shapes, the closest pair is marked",
           "[plot]") {
   const Paper3 p;
-  CaptureProblem pb;
-  pb.model = &p.model;
-  pb.frame = p.model.end_effector();
-  pb.theta = ffsr::test::deg({0, 150, -100});
-  pb.target = p.target;
-  CaptureTask task;
-  task.axes = {true, true, false};
-  CaptureOptions opt;
-  opt.duration = 180;
-  opt.step = 0.2;
-  opt.record_series = true;
+  const CaptureProblem pb = p.problem();
+  const CaptureTask task = Paper3::task();
+  CaptureOptions opt = Paper3::options();
   const CaptureResult run = plan_capture(pb, task, opt);
   const double r = 0.05;
   const Vector3 bus(0.6, 0.5, 0.4), target_size(0.3, 0.4, 0.5);
