@@ -10,6 +10,7 @@
 #include "ffsr/optimize/reconfigure.hpp"
 
 #include <cmath>
+#include <optional>
 #include <string>
 
 namespace test_reconfigure {
@@ -200,6 +201,33 @@ TEST_CASE("reconfigure: global run on the 7-DOF pose scenario reaches the pose m
   REQUIRE(r.phases.size() == 2);
   CHECK(r.phases[0].max_joint_rate <= 3 * kDeg * (1 + 1e-9));
   CHECK(r.phases[1].max_joint_rate <= 3 * kDeg * (1 + 1e-9));
+}
+
+TEST_CASE("reconfigure: the run check learns when each checked run's approach begins", "[reconfigure]") {
+  const ffsr::Scenario sc = scenario("robots/paper_3dof.toml");
+  ffsr::CaptureOptions opt = sc.capture;
+  opt.gain = 0;
+  opt.max_joint_rate = sc.keys.max_joint_rate_deg * kDeg;
+  for (const ffsr::ReconfigureMode mode : {ffsr::ReconfigureMode::Never, ffsr::ReconfigureMode::Always}) {
+    ffsr::GlobalCaptureOptions g;
+    g.search.seed = sc.seed;
+    g.search.starts = sc.keys.global_starts;
+    g.reconfigure.mode = mode;
+    std::vector<double> begins;  // one per checked run
+    g.check_run = [&begins](const ffsr::CaptureResult& run,
+                            double approach_begin) -> std::optional<std::string> {
+      CHECK(!run.series.empty());  // the check sees the recorded path
+      begins.push_back(approach_begin);
+      return std::nullopt;
+    };
+    const ffsr::GlobalCaptureResult r = ffsr::plan_capture_global(sc.problem, sc.task, opt, g);
+    INFO(ffsr::reconfigure_mode_name(mode));
+    REQUIRE(!begins.empty());
+    CHECK(r.reconfigured == (mode == ffsr::ReconfigureMode::Always));
+    // the accepted run was the last one checked: its approach begins where its first phase ends
+    CHECK(begins.back() == (r.reconfigured ? r.phases.front().t_end : 0.0));
+    for (double b : begins) CHECK((mode == ffsr::ReconfigureMode::Always ? b > 0 : b == 0));
+  }
 }
 
 TEST_CASE("reconfigure: bad keys give one line naming the key", "[reconfigure]") {

@@ -57,8 +57,8 @@ inline std::vector<LinkShape> scenario_urdf_shapes(const ScenarioKeys& k, const 
 inline void check_contact_on_surface(const Shape& target, const Vector3& r_tp) {
   const double d = point_surface_distance(target, r_tp);
   if (std::abs(d) > 1e-6)
-    throw InputError(str("--contact-offset: the contact point is ", metres(std::abs(d)), " m ", d > 0 ? "outside" : "inside",
-                         " the target-shape's surface (it must lie on it)"));
+    throw InputError(str("--contact-offset: the contact point is ", metres(std::abs(d)), " m ",
+                         d > 0 ? "outside" : "inside", " the target-shape's surface (it must lie on it)"));
 }
 
 /// Checks that the start configuration keeps the clearance (the pair and its distance otherwise).
@@ -66,8 +66,8 @@ inline void check_start_clearance(const Scenario& sc, const SceneGeometry& g) {
   const ClearanceReport r = configuration_clearance(*sc.model, *g.checker, sc.problem.base, sc.problem.theta,
                                                     target_pose(sc.problem.target));
   if (!r.overall.pair.empty() && r.overall.distance < g.clearance)
-    throw InputError(str("--clearance: the start configuration is already closer than ", metres(g.clearance), " m: ",
-                         r.overall.pair, " (", r.kind, ") ", metres(r.overall.distance), " m"));
+    throw InputError(str("--clearance: the start configuration is already closer than ", metres(g.clearance),
+                         " m: ", r.overall.pair, " (", r.kind, ") ", metres(r.overall.distance), " m"));
 }
 
 }  // namespace detail
@@ -75,7 +75,8 @@ inline void check_start_clearance(const Scenario& sc, const SceneGeometry& g) {
 /// The shapes of the keys for `model` and a target with contact point `r_tp` (null when none of the
 /// keys is given), without the start configuration's check. InputError naming the key.
 inline std::shared_ptr<const SceneGeometry> scene_geometry(const ScenarioKeys& k, const Model& model,
-                                                           const Vector3& r_tp, const EmbeddedUrdf* embedded) {
+                                                           const Vector3& r_tp,
+                                                           const EmbeddedUrdf* embedded) {
   using detail::str;
   if (!scenario_uses_geometry(k)) return nullptr;
   if (!std::isfinite(k.clearance) || k.clearance < 0)
@@ -87,7 +88,8 @@ inline std::shared_ptr<const SceneGeometry> scene_geometry(const ScenarioKeys& k
   } else if (k.given.count("target-size") || k.given.count("target-shape-offset")) {
     throw InputError("--target-size: needs --target-shape");
   }
-  const RobotGeometry rg = robot_geometry(model, detail::scenario_urdf_shapes(k, embedded), k.link_radius, k.bus_box);
+  const RobotGeometry rg =
+      robot_geometry(model, detail::scenario_urdf_shapes(k, embedded), k.link_radius, k.bus_box);
   auto g = std::make_shared<SceneGeometry>();
   g->checker = std::make_shared<CollisionChecker>(model, rg, target, k.contact_exemption);
   g->clearance = k.clearance;
@@ -96,7 +98,8 @@ inline std::shared_ptr<const SceneGeometry> scene_geometry(const ScenarioKeys& k
 
 /// The scenario's geometry (null when it uses none of the keys); the start configuration must keep
 /// the clearance. InputError naming the key.
-inline std::shared_ptr<const SceneGeometry> scenario_geometry(const Scenario& sc, const EmbeddedUrdf* embedded) {
+inline std::shared_ptr<const SceneGeometry> scenario_geometry(const Scenario& sc,
+                                                              const EmbeddedUrdf* embedded) {
   std::shared_ptr<const SceneGeometry> g =
       scene_geometry(sc.keys, *sc.model, sc.problem.target.contact_offset, embedded);
   if (g && g->clearance > 0) detail::check_start_clearance(sc, *g);
@@ -126,9 +129,10 @@ inline std::vector<Pose> target_poses(const Target& t0, std::vector<double> time
 /// target at T and at the times of `sweep_times` before it (every 3 s over the last 30 s: the space the
 /// tumbling target sweeps while the arm, nearly at rest, closes in); each reaching run is checked
 /// along its path. When every reached goal fails that check, the target's poses 3 s before, at and
-/// 3 s after each violation (after the first round also every 10 s over the last 90 s) are added to
-/// the search's constraints and the plan is made again (up to 4 rounds); the last error is thrown
-/// when none keeps the clearance.
+/// 3 s after each arm-target violation of an approach (one during a reconfiguration, with the arm
+/// far from its capture configuration, only rejects its run), and after the first round also every
+/// 10 s over the last 90 s, are added to the search's constraints and the plan is made again (up
+/// to 4 rounds); the last error is thrown when none keeps the clearance.
 inline GlobalCaptureResult plan_global_with_clearance(const Scenario& sc, const CaptureOptions& opt,
                                                       GlobalCaptureOptions g) {
   const SceneGeometry* geo = sc.geometry.get();
@@ -142,14 +146,18 @@ inline GlobalCaptureResult plan_global_with_clearance(const Scenario& sc, const 
   const double c = geo->clearance;
   auto violations = std::make_shared<std::vector<double>>();
   const std::shared_ptr<const ManifoldInequalities> given = g.search.inequalities;  // e.g. the base rate
-  g.check_run = [m, t0, cc, c, violations](const CaptureResult& run) {
+  g.check_run = [m, t0, cc, c, violations](const CaptureResult& run, double approach_begin) {
     const ClearanceReport r = path_clearance(*m, *cc, t0, run);
     std::optional<std::string> why = clearance_violation(r, c);
-    if (why && r.kind == "arm-target") violations->push_back(r.overall.time);
+    // the target's pose at a violation constrains the capture configuration in the next round; a
+    // violation during a reconfiguration (the arm far from that configuration) rejects the run only
+    if (why && r.kind == "arm-target" && r.overall.time >= approach_begin)
+      violations->push_back(r.overall.time);
     return why;
   };
   for (int round = 1;; ++round) {
-    g.search.inequalities = combine_inequalities(given, clearance_constraints(*m, cc, detail::target_poses(t0, times), c));
+    g.search.inequalities =
+        combine_inequalities(given, clearance_constraints(*m, cc, detail::target_poses(t0, times), c));
     violations->clear();
     try {
       return plan_capture_global(sc.problem, sc.task, opt, g);
@@ -172,13 +180,14 @@ inline ClearanceReport run_clearance(const Scenario& sc, const CaptureResult& ru
 
 struct SceneGeometry {};
 
-inline std::shared_ptr<const SceneGeometry> scene_geometry(const ScenarioKeys& k, const Model&, const Vector3&,
-                                                           const EmbeddedUrdf*) {
+inline std::shared_ptr<const SceneGeometry> scene_geometry(const ScenarioKeys& k, const Model&,
+                                                           const Vector3&, const EmbeddedUrdf*) {
   if (scenario_uses_geometry(k))
     throw InputError("--clearance: this build has no geometry (ffsr::geometry needs FCL, Debian libfcl-dev)");
   return nullptr;
 }
-inline std::shared_ptr<const SceneGeometry> scenario_geometry(const Scenario& sc, const EmbeddedUrdf* embedded) {
+inline std::shared_ptr<const SceneGeometry> scenario_geometry(const Scenario& sc,
+                                                              const EmbeddedUrdf* embedded) {
   return scene_geometry(sc.keys, *sc.model, sc.problem.target.contact_offset, embedded);
 }
 inline GlobalCaptureResult plan_global_with_clearance(const Scenario& sc, const CaptureOptions& opt,

@@ -278,8 +278,8 @@ inline void slsqp_inequalities(unsigned m, double* result, unsigned n, const dou
 }
 
 /// True when every inequality of `so` (if any) is at most `tolerance` at theta (NaN is not).
-inline bool inequalities_within(const ManifoldSearchOptions& so, const BasePose& base, const Eigen::VectorXd& theta,
-                                double tolerance) {
+inline bool inequalities_within(const ManifoldSearchOptions& so, const BasePose& base,
+                                const Eigen::VectorXd& theta, double tolerance) {
   if (!so.inequalities || so.inequalities->count == 0) return true;
   std::vector<double> g(so.inequalities->count);
   so.inequalities->eval(base, theta, g.data(), nullptr);
@@ -660,9 +660,10 @@ struct GlobalCaptureOptions {
   /// A reconfiguration before the approach (reconfigure.hpp): never (the default), auto (only when
   /// the best goal is not reached by the approach alone) or always; its duration.
   ReconfigureOptions reconfigure;
-  /// Optional check of a reaching run (its series recorded): a message rejects the run, whose goal
-  /// is then given up (e.g. the clearance along the path, geometry/clearance.hpp).
-  std::function<std::optional<std::string>(const CaptureResult&)> check_run;
+  /// Optional check of a reaching run (its series recorded) and the time its approach begins (0, or
+  /// the end of its reconfiguration): a message rejects the run, whose goal is then given up (e.g.
+  /// the clearance along the path, geometry/clearance.hpp).
+  std::function<std::optional<std::string>(const CaptureResult&, double approach_begin)> check_run;
 };
 
 struct GlobalCaptureResult {
@@ -846,7 +847,8 @@ inline std::optional<GlobalCaptureResult> reach_goal(const CaptureProblem& pb, c
 /// InputError unless the reconfiguration duration is 0 (not set) or lies in (0, duration).
 inline void check_reconfiguration_duration(double t_r, double duration, const char* where) {
   if (!std::isfinite(t_r) || t_r < 0 || (t_r > 0 && t_r >= duration))
-    throw InputError(str(where, ": the reconfiguration duration must lie in (0, ", duration, ") s, got ", t_r));
+    throw InputError(
+        str(where, ": the reconfiguration duration must lie in (0, ", duration, ") s, got ", t_r));
 }
 
 /// The best reached goal's result with the counters of every goal tried (`counts`).
@@ -911,7 +913,8 @@ inline GlobalCaptureResult plan_capture_global(const CaptureProblem& pb, const C
   };
   auto reject = [&g, &res](std::optional<GlobalCaptureResult>& r) {  // the run's check (e.g. the clearance)
     if (!r || !g.check_run) return;
-    if (std::optional<std::string> why = g.check_run(r->run)) {
+    if (std::optional<std::string> why =
+            g.check_run(r->run, r->reconfigured ? r->phases.front().t_end : 0.0)) {
       ++res.goals_rejected;
       res.rejection = *why;
       r.reset();
