@@ -14,7 +14,6 @@
 #include "ffsr/io/scenario.hpp"
 #include "ffsr/simulate/closed_loop.hpp"
 
-
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -137,7 +136,8 @@ int main(int argc, char** argv) {
     const Run ex = run(exact);
     print("exact", ex, M_open);
     std::printf(
-        "exact: %ld ticks, %ld CVODE steps, %ld saturated ticks, %ld damped, %ld rate-limited, max |p_e - x_d| "
+        "exact: %ld ticks, %ld CVODE steps, %ld saturated ticks, %ld damped, %ld rate-limited, max |p_e - "
+        "x_d| "
         "%.2e m\n",
         ex.r.ticks, ex.r.cvode_steps, ex.r.saturated_ticks, ex.r.damped_ticks, ex.r.rate_limited_ticks,
         ex.r.max_reference_error);

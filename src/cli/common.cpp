@@ -86,12 +86,33 @@ namespace {
 /// The keys of a subject (SubjectOptions): the robot and its start state, the bus and the loader, the
 /// target and the contact law.
 const std::set<std::string>& subject_keys() {
-  static const std::set<std::string> keys = {
-      "urdf", "end-effector", "joints-deg", "base-position", "base-rpy-deg", "bus-mass", "bus-inertia",
-      "bus-com", "mount-xyz", "mount-rpy-deg", "lock-joints", "inertia-repair", "min-mass", "min-inertia",
-      "end-effector-offset", "target-mass", "target-inertia", "target-rpy-deg", "target-angular-velocity-deg",
-      "target-velocity", "contact-offset", "normal", "model", "stiffness", "exponent", "restitution",
-      "approach-speed"};
+  static const std::set<std::string> keys = {"urdf",
+                                             "end-effector",
+                                             "joints-deg",
+                                             "base-position",
+                                             "base-rpy-deg",
+                                             "bus-mass",
+                                             "bus-inertia",
+                                             "bus-com",
+                                             "mount-xyz",
+                                             "mount-rpy-deg",
+                                             "lock-joints",
+                                             "inertia-repair",
+                                             "min-mass",
+                                             "min-inertia",
+                                             "end-effector-offset",
+                                             "target-mass",
+                                             "target-inertia",
+                                             "target-rpy-deg",
+                                             "target-angular-velocity-deg",
+                                             "target-velocity",
+                                             "contact-offset",
+                                             "normal",
+                                             "model",
+                                             "stiffness",
+                                             "exponent",
+                                             "restitution",
+                                             "approach-speed"};
   return keys;
 }
 
@@ -102,7 +123,8 @@ void SubjectOptions::add_to(CLI::App& app, const std::set<std::string>& also) {
                  "Scenario file (TOML) whose robot, start state, target and contact law to take; flags "
                  "override its keys (default: the built-in paper 3-DOF scenario)")
       ->check(CLI::ExistingFile);
-  flags.add_to(app, [&also](const std::string& name) { return subject_keys().count(name) || also.count(name); });
+  flags.add_to(app,
+               [&also](const std::string& name) { return subject_keys().count(name) || also.count(name); });
 }
 
 Subject load_subject(const SubjectOptions& o) {
@@ -112,7 +134,8 @@ Subject load_subject(const SubjectOptions& o) {
   if (o.flags.given("urdf")) {  // another robot: its end-effector and joint angles from the flags alone
     if (!o.flags.given("end-effector")) k.end_effector.clear();
     if (!o.flags.given("joints-deg"))
-      throw InputError("--joints-deg: required with --urdf (the robot's joint angles in degrees, URDF tree order)");
+      throw InputError(
+          "--joints-deg: required with --urdf (the robot's joint angles in degrees, URDF tree order)");
   }
   const EmbeddedUrdf embedded = builtin_urdf();
   s.robot.model = std::move(*ffsr::detail::model_of(k, &embedded, s.robot.report));
@@ -135,7 +158,8 @@ Subject load_subject(const SubjectOptions& o) {
 }
 
 ContactJoints Subject::contact_joints() const {
-  const JointModel m = all_joint_models() ? JointModel::Free : parse_joint_model(keys.contact_joints, "--contact-joints");
+  const JointModel m =
+      all_joint_models() ? JointModel::Free : parse_joint_model(keys.contact_joints, "--contact-joints");
   return {m, per_joint_values(keys.armature, robot.model, "--armature")};
 }
 

@@ -65,10 +65,10 @@ struct Robot {
 struct Subject {
   ScenarioKeys keys;  ///< as resolved (the URDF path relative to the scenario file)
   Robot robot;
-  Target target;               ///< at t = 0, with its spin and velocity
-  ContactParams params;        ///< K, alpha, c_r, checked
-  std::string law;             ///< the damping law's name as given (contact also takes 'all')
-  double approach_speed = 0;   ///< m/s, finite (its sign is the subcommand's to judge)
+  Target target;              ///< at t = 0, with its spin and velocity
+  ContactParams params;       ///< K, alpha, c_r, checked
+  std::string law;            ///< the damping law's name as given (contact also takes 'all')
+  double approach_speed = 0;  ///< m/s, finite (its sign is the subcommand's to judge)
   /// The joint models of the contact (contact-joints, armature; algorithm/joint_models.hpp); 'all'
   /// (contact: each model in turn) gives free. InputError naming the key.
   ContactJoints contact_joints() const;
@@ -77,7 +77,6 @@ struct Subject {
 /// Builds the subject; warns about every repair of the model. InputError naming the key or the file,
 /// ModelError from the loader.
 Subject load_subject(const SubjectOptions& options);
-
 
 /// Output files, as people name them in a shell. Every subcommand writes its outputs through
 /// `Outputs` (or the two functions below, which use the same writer):

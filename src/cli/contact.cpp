@@ -63,8 +63,8 @@ Row evaluate(const Subject& s, const ContactOptions& o, const std::string& law_n
   mo.joint_stiffness = per_joint_values(s.keys.joint_stiffness, r.model, "--joint-stiffness");
   mo.joint_damping = per_joint_values(s.keys.joint_damping, r.model, "--joint-damping");
   mo.armature = per_joint_values(s.keys.armature, r.model, "--armature");
-  MultibodyContactResult mb = simulate_contact(r.model, r.base, r.theta, r.end_effector, target,
-                                               s.approach_speed, p, law_name, mo);
+  MultibodyContactResult mb =
+      simulate_contact(r.model, r.base, r.theta, r.end_effector, target, s.approach_speed, p, law_name, mo);
   const AnyContactLaw law = make_contact_law(law_name, p, mb.approach_velocity);
   auto predictions = joint_predictions(s, law, mb.integrated_effective_mass);
   const double M_ie = predictions.front().M_ie;  // the chosen model's (free for all)
@@ -174,12 +174,9 @@ nlohmann::json contact_json(const std::vector<Row>& rows, const Subject& s) {
     j["laws"] = nlohmann::json::array();
     for (const auto& row : rows) j["laws"].push_back(row_json(row));
   }
-  j["parameters"] = {{"stiffness", s.params.K},
-                     {"exponent", s.params.alpha},
-                     {"restitution", s.params.c_r},
-                     {"approach_speed", s.approach_speed},
-                     {"urdf", s.keys.urdf},
-                     {"joints_deg", s.keys.joints_deg}};
+  j["parameters"] = {{"stiffness", s.params.K},     {"exponent", s.params.alpha},
+                     {"restitution", s.params.c_r}, {"approach_speed", s.approach_speed},
+                     {"urdf", s.keys.urdf},         {"joints_deg", s.keys.joints_deg}};
   j["version"] = FFSR_VERSION;
   return j;
 }

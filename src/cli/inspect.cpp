@@ -56,7 +56,8 @@ std::optional<ClearanceReport> inspect_clearance(const Subject& s) {
       scene_geometry(s.keys, s.robot.model, s.target.contact_offset, &embedded);
 #ifdef FFSR_HAVE_GEOMETRY
   if (g)
-    return configuration_clearance(s.robot.model, *g->checker, s.robot.base, s.robot.theta, target_pose(s.target));
+    return configuration_clearance(s.robot.model, *g->checker, s.robot.base, s.robot.theta,
+                                   target_pose(s.target));
 #endif
   return std::nullopt;
 }
@@ -145,8 +146,9 @@ int run_inspect(const InspectOptions& o) {
   std::cout << "effective mass   m_e  = " << m_e << " kg   (Eq. 4)\n";
   std::cout << "integrated mass  M_ie = " << M_ie << " kg   (Eq. 14)\n";
   if (dist)
-    std::cout << "base jump        |dw_0| = " << dist->angular_rate() * 180.0 / M_PI << " deg/s, |dv_0| = "
-              << dist->linear.norm() << " m/s   (impulse " << dist->impulse << " N s, " << s.law << ")\n";
+    std::cout << "base jump        |dw_0| = " << dist->angular_rate() * 180.0 / M_PI
+              << " deg/s, |dv_0| = " << dist->linear.norm() << " m/s   (impulse " << dist->impulse << " N s, "
+              << s.law << ")\n";
   else
     std::cout << "base jump        none: the end-effector does not approach the target at --approach-speed\n";
   if (clearance) print_clearance(*clearance);
@@ -160,10 +162,11 @@ int run_inspect(const InspectOptions& o) {
 void register_inspect(CLI::App& app, Action& action) {
   auto opts = std::make_shared<InspectOptions>();
   CLI::App* sub =
-      app.add_subcommand("inspect", "Evaluate one configuration (a scenario's start state; flags override it): H, J_f, "
-                                    "effective mass, M_ie, the base's jump at the impact, distances between shapes");
-  opts->subject.add_to(*sub, {"target-position", "target-shape", "target-size", "target-shape-offset", "link-radius", "bus-box",
-                              "contact-exemption"});
+      app.add_subcommand("inspect",
+                         "Evaluate one configuration (a scenario's start state; flags override it): H, J_f, "
+                         "effective mass, M_ie, the base's jump at the impact, distances between shapes");
+  opts->subject.add_to(*sub, {"target-position", "target-shape", "target-size", "target-shape-offset",
+                              "link-radius", "bus-box", "contact-exemption"});
   sub->add_flag("--json", opts->json, "Print one JSON object on stdout");
   sub->callback([opts, &action] { action = [opts] { return run_inspect(*opts); }; });
 }

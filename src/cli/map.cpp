@@ -75,8 +75,8 @@ Grid parse_grid(const MapOptions& o, const std::string& urdf, int n_joints) {
   Grid g;
   for (double j : joints) {
     if (j != std::floor(j) || j < 1 || j > n_joints)
-      throw InputError(str("--vary: joint ", j, " is not one of 1..", n_joints, " (the robot in ",
-                           urdf, " has ", n_joints, " joints, numbered from 1 in URDF tree order)"));
+      throw InputError(str("--vary: joint ", j, " is not one of 1..", n_joints, " (the robot in ", urdf,
+                           " has ", n_joints, " joints, numbered from 1 in URDF tree order)"));
     for (const Axis& a : g.axes)
       if (a.joint == static_cast<int>(j) - 1) throw InputError(str("--vary: joint ", j, " is given twice"));
     g.axes.push_back({static_cast<int>(j) - 1, 0, 0, 0});
@@ -183,7 +183,7 @@ struct Worker {
                            ? integrated_effective_mass_fast(model, data, base, theta, frame, u,
                                                             target_inverse_mass)  // Eq. 14
                            : joint_model_M();
-      const double F = max_force_closed_form(law, M);                                               // Eq. 24
+      const double F = max_force_closed_form(law, M);  // Eq. 24
       if (values) values[idx - first_point] = M;
       if (M > max_M) max_M = M, argmax = idx;
       if (M < min_M) min_M = M, argmin = idx;
@@ -257,8 +257,7 @@ std::vector<plot::Figure> map_figures(const Grid& grid, const std::vector<std::s
 /// does not approach the target or the law is unknown.
 AnyContactLaw map_law(const Subject& s) {
   const Target& target = s.target;
-  if (s.law == "all")
-    throw InputError("--model: map evaluates one law; 'all' is for the contact subcommand");
+  if (s.law == "all") throw InputError("--model: map evaluates one law; 'all' is for the contact subcommand");
   const Vector3 u = target.normal_world();
   const double v_in = approach_velocity(u, Vector3(s.approach_speed * u), target.velocity,
                                         target.angular_velocity_world(), target.offset_world());  // Eq. 10-12

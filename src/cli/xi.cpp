@@ -76,8 +76,7 @@ XiSetup parse(const XiOptions& o) {
     return os.str();
   };
   const std::string fixed_k = "K = " + g(s.base.K) + " N/m^" + g(s.base.alpha),
-                    fixed_v = "δ̇⁻ = " + g(s.approach_speed) + " m/s",
-                    fixed_c = "c#dr#u = " + g(s.base.c_r);
+                    fixed_v = "δ̇⁻ = " + g(s.approach_speed) + " m/s", fixed_c = "c#dr#u = " + g(s.base.c_r);
   s.studies = {
       study(kColumns[0], "ξ against K (Figure 4): " + fixed_v + ", " + fixed_c, "contact stiffness K (N/m^α)",
             true, spaced(1e7, 1e11, o.points, true), laws),

@@ -106,8 +106,8 @@ TEST_CASE("inspect, contact and map evaluate a scenario's start state (--config)
   CHECK(cj.at("integrated_effective_mass").get<double>() == Approx(M_start).epsilon(1e-12));
   CHECK(cj.at("parameters").at("urdf").get<std::string>() == kSource + "/robots/paper_7dof.urdf");
   // one grid point of map at the start angle of joint 7
-  const auto g = cli({"map", "--config", file, "--vary", "7", "--range-deg", "0,1", "--step-deg", "1", "--csv", "-",
-                      "--quiet"});
+  const auto g = cli({"map", "--config", file, "--vary", "7", "--range-deg", "0,1", "--step-deg", "1",
+                      "--csv", "-", "--quiet"});
   INFO(g.err);
   REQUIRE(g.exit_code == 0);
   const std::string row = g.out.substr(g.out.find('\n') + 1);
@@ -152,15 +152,17 @@ TEST_CASE("xi holds a scenario's contact law fixed (--config), flags override it
   };
   for (const auto& [args, c_r, v] :
        {std::make_tuple(std::vector<std::string>{"xi", "--config", file, "--points", "2"}, 0.3, 0.2),
-        std::make_tuple(std::vector<std::string>{"xi", "--config", file, "--points", "2", "--restitution", "0.6",
-                                                 "--approach-speed", "0.5"},
+        std::make_tuple(std::vector<std::string>{"xi", "--config", file, "--points", "2", "--restitution",
+                                                 "0.6", "--approach-speed", "0.5"},
                         0.6, 0.5)}) {
     const auto [law, xi] = first_row(cli(args));
-    const double expected = ffsr::relative_error(ffsr::make_contact_law(law, ffsr::ContactParams{1e7, 1.5, c_r}, v));
+    const double expected =
+        ffsr::relative_error(ffsr::make_contact_law(law, ffsr::ContactParams{1e7, 1.5, c_r}, v));
     CHECK(xi == Approx(expected).epsilon(1e-9));
   }
   const auto plain = first_row(cli({"xi", "--points", "2"}));  // the built-in scenario: c_r = 0.9
-  CHECK(plain.second == Approx(ffsr::relative_error(ffsr::make_contact_law(plain.first, ffsr::ContactParams{1e7, 1.5, 0.9}, 0.2)))
+  CHECK(plain.second == Approx(ffsr::relative_error(ffsr::make_contact_law(
+                                   plain.first, ffsr::ContactParams{1e7, 1.5, 0.9}, 0.2)))
                             .epsilon(1e-9));
 }
 
@@ -258,10 +260,7 @@ TEST_CASE("contact --series writes F(t) and delta(t)", "[cli]") {
 // 3. the main job
 // ------------------------------------------------------------------------------------------------
 
-namespace {
-
-
-}  // namespace
+namespace {}  // namespace
 
 TEST_CASE("a flag on the command line overrides the scenario file", "[cli]") {
   TempDir tmp;
@@ -341,8 +340,12 @@ std::vector<BadCase> bad_cases() {
       {"missing URDF file",
        {"inspect", "--urdf", "{TMP}/no_such_robot.urdf", "--joints-deg", "0,90,-90"},
        {"no_such_robot.urdf", "cannot open"}},
-      {"missing scenario file", {"inspect", "--config", "{TMP}/no_such_scenario.toml"}, {"--config", "no_such_scenario.toml"}},
-      {"--urdf without --joints-deg", {"inspect", "--urdf", kUrdf7}, {"--joints-deg", "required with --urdf"}},
+      {"missing scenario file",
+       {"inspect", "--config", "{TMP}/no_such_scenario.toml"},
+       {"--config", "no_such_scenario.toml"}},
+      {"--urdf without --joints-deg",
+       {"inspect", "--urdf", kUrdf7},
+       {"--joints-deg", "required with --urdf"}},
       {"wrong joint count", inspect3({"--joints-deg", "0,90"}), {"--joints-deg", "3 joints"}},
       {"wrong joint count, 7-DOF",
        {"inspect", "--urdf", kUrdf7, "--joints-deg", "0,90,-90"},
@@ -436,7 +439,9 @@ std::vector<BadCase> bad_cases() {
       {"run: unknown end-effector", run_default({"--end-effector", "nope"}), {"'nope'", "link3, ee"}},
       {"run: missing URDF", run_default({"--urdf", "{TMP}/no_such_robot.urdf"}), {"no_such_robot.urdf"}},
       {"run: stray positional argument", run_default({"orbit"}), {"orbit"}},
-      {"xi: non-existent --config", {"xi", "--config", "{TMP}/no_such_scenario.toml"}, {"--config", "no_such_scenario.toml"}},
+      {"xi: non-existent --config",
+       {"xi", "--config", "{TMP}/no_such_scenario.toml"},
+       {"--config", "no_such_scenario.toml"}},
       {"run: non-existent --config",
        run_default({"--config", "{TMP}/no_such_scenario.toml"}),
        {"--config", "no_such_scenario.toml"}},

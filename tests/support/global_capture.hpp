@@ -67,7 +67,9 @@ const Shared& shared_runs(const char* urdf, bool planar, double T) {
 }
 
 inline const Shared& shared_3dof() { return shared_runs<problem_3dof>("paper_3dof.urdf", true, 180); }
-inline const Shared& shared_7dof_position() { return shared_runs<problem_7dof>("paper_7dof.urdf", false, 157); }
+inline const Shared& shared_7dof_position() {
+  return shared_runs<problem_7dof>("paper_7dof.urdf", false, 157);
+}
 
 /// The checks every global run must pass, against the run's own records and the paper's method.
 inline void check_run(const Shared& s, double bound_M_ie) {

@@ -11,7 +11,6 @@
 #include "ffsr/io/scenario.hpp"
 #include "ffsr/simulate/closed_loop.hpp"
 
-
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -352,7 +351,8 @@ TEST_CASE("closed loop: exact target, stiff rate loops: the global plan's captur
   CHECK(r.saturated_ticks == 0);
 }
 
-TEST_CASE("closed loop, 3-DOF paper scenario: the gradient controller through the dynamics reaches its plan") {
+TEST_CASE(
+    "closed loop, 3-DOF paper scenario: the gradient controller through the dynamics reaches its plan") {
   // the short companion of the 7-DOF case above (which the sanitizer stage leaves out: minutes
   // under ASan): the same checks on the planar robot with the paper's gradient policy
   const Scenario sc = load_scenario(kRobots + "paper_3dof.toml");

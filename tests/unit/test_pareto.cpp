@@ -139,11 +139,11 @@ TEST_CASE_METHOD(Paper7Position,
   for (const ManifoldPoint& p : r.local_optima)  // every optimum kept keeps the limit
     CHECK(base_disturbance(m, d, base, p.theta, pb.frame, s.capture_target, law).angular_rate() <=
           mid.base_rate * (1 + 1e-5));
-  INFO("front point " << mid.M_ie << " kg at " << mid.base_rate << " rad/s, constrained search " << r.best.M_ie
-                      << " kg");
+  INFO("front point " << mid.M_ie << " kg at " << mid.base_rate << " rad/s, constrained search "
+                      << r.best.M_ie << " kg");
   CHECK(r.best.M_ie >= f.min_mass.M_ie * (1 - 1e-9));  // the limit costs M_ie ...
-  CHECK(r.best.M_ie <= mid.M_ie * (1 + 1e-3));          // ... no more than the front says
-  CHECK(r.best.M_ie >= mid.M_ie * (1 - 1e-2));          // and the front's point is (near) optimal
+  CHECK(r.best.M_ie <= mid.M_ie * (1 + 1e-3));         // ... no more than the front says
+  CHECK(r.best.M_ie >= mid.M_ie * (1 - 1e-2));         // and the front's point is (near) optimal
   CHECK_THROWS_AS(base_rate_inequality(pb, s, -1.0), InputError);
   CHECK_THROWS_AS(base_rate_inequality(pb, s, std::nan("")), InputError);
 }

@@ -30,10 +30,11 @@ inline double number_from_text(const std::string& text, const std::string& key, 
   char* end = nullptr;
   errno = 0;
   const double x = std::strtod(t.c_str(), &end);
+  const std::string within = in.empty() ? "" : " (in '" + in + "')";
   if (t.empty() || end != t.c_str() + t.size())
-    throw InputError(str(key, ": '", t, "' is not a number", in.empty() ? "" : " (in '" + in + "')"));
+    throw InputError(str(key, ": '", t, "' is not a number", within));
   if (errno == ERANGE && std::isinf(x))
-    throw InputError(str(key, ": '", t, "' is out of the range of a double", in.empty() ? "" : " (in '" + in + "')"));
+    throw InputError(str(key, ": '", t, "' is out of the range of a double", within));
   return x;
 }
 
@@ -246,9 +247,10 @@ inline std::vector<ScenarioKey> build_scenario_keys() {
                "Global run: largest joint rate, deg/s (> 0; default: not limited; the paper's method is not "
                "limited)"),
       FFSR_KEY("global-starts", global_starts, "Global search: random starts (>= 1)", "32"),
-      FFSR_KEY("max-base-rate-deg", max_base_rate_deg,
-               "Global search: largest jump of the base's angular velocity at the impact, deg/s (a constraint; "
-               "> 0; default: not limited; `pareto` shows the trade-off against M_ie)"),
+      FFSR_KEY(
+          "max-base-rate-deg", max_base_rate_deg,
+          "Global search: largest jump of the base's angular velocity at the impact, deg/s (a constraint; "
+          "> 0; default: not limited; `pareto` shows the trade-off against M_ie)"),
       // the spacecraft's side: the reaction-null-space approach
       FFSR_KEY("base-attitude", base_attitude,
                "Optimized run: free, or hold (the base's angular velocity stays zero; the objective uses "
@@ -277,18 +279,23 @@ inline std::vector<ScenarioKey> build_scenario_keys() {
       FFSR_KEY("joint-damping", joint_damping,
                "Multibody reference: joint PD damping, N m s/rad (one or per joint)", "0"),
       // shapes and clearance (io/scenario_geometry.hpp, docs/geometry.md)
-      FFSR_KEY("target-shape", target_shape, "Target's collision shape: box, sphere or cylinder (default: none)"),
+      FFSR_KEY("target-shape", target_shape,
+               "Target's collision shape: box, sphere or cylinder (default: none)"),
       FFSR_KEY("target-size", target_size,
                "Target shape's size, m: box edge lengths; sphere radius; cylinder radius, length (along z)"),
-      FFSR_KEY("target-shape-offset", target_shape_offset, "Target shape's centre in the target frame, m", "0,0,0"),
+      FFSR_KEY("target-shape-offset", target_shape_offset, "Target shape's centre in the target frame, m",
+               "0,0,0"),
       FFSR_KEY("link-radius", link_radius,
-               "Capsule radius of links without URDF collision primitives, m (one, or one per moving body)", "0.05"),
-      FFSR_KEY("bus-box", bus_box, "The bus as a box centred on the base frame (edge lengths, m), when the URDF's "
-                                   "base has no collision primitive"),
-      FFSR_KEY("clearance", clearance, "Least distance the global run keeps between arm, bus and target, m (0: none)",
-               "0"),
+               "Capsule radius of links without URDF collision primitives, m (one, or one per moving body)",
+               "0.05"),
+      FFSR_KEY("bus-box", bus_box,
+               "The bus as a box centred on the base frame (edge lengths, m), when the URDF's "
+               "base has no collision primitive"),
+      FFSR_KEY("clearance", clearance,
+               "Least distance the global run keeps between arm, bus and target, m (0: none)", "0"),
       FFSR_KEY("contact-exemption", contact_exemption,
-               "Length of the end-effector link before the contact point not checked against the target, m", "0.2"),
+               "Length of the end-effector link before the contact point not checked against the target, m",
+               "0.2"),
   };
 }
 

@@ -75,13 +75,15 @@ inline GlobalRun run_global(const Scenario& sc, const CaptureResult& paper_run, 
     r.result = plan_global_with_clearance(sc, opt, g);  // as plan_capture_global without a clearance
   } catch (const ReconfigurationRateError& e) {
     throw InputError(str("--reconfigure-duration: a reconfiguration in ", e.duration, " s: joint '", e.joint,
-                         "' needs ", std::ceil(e.needed * 18000 / M_PI) / 100, " deg/s, max-joint-rate-deg is ",
-                         e.limit * 180 / M_PI));
+                         "' needs ", std::ceil(e.needed * 18000 / M_PI) / 100,
+                         " deg/s, max-joint-rate-deg is ", e.limit * 180 / M_PI));
   } catch (const InfeasibleInequalitiesError& e) {
     if (!(sc.keys.max_base_rate_deg > 0)) throw InputError(str("global run: ", e.what()));
-    throw InputError(str("--max-base-rate-deg: no capture configuration found keeps the impact's base-rate "
-                         "jump within ", std::setprecision(6), sc.keys.max_base_rate_deg, " deg/s",
-                         sc.geometry ? " and the clearance" : "", " (`ffsr-optimize pareto` shows the least)"));
+    throw InputError(
+        str("--max-base-rate-deg: no capture configuration found keeps the impact's base-rate "
+            "jump within ",
+            std::setprecision(6), sc.keys.max_base_rate_deg, " deg/s",
+            sc.geometry ? " and the clearance" : "", " (`ffsr-optimize pareto` shows the least)"));
   } catch (const InputError& e) {
     if (std::string(e.what()).find("max joint rate") != std::string::npos)
       throw InputError(str("--max-joint-rate-deg: ", e.what()));
