@@ -46,6 +46,26 @@ inline Eigen::MatrixXd base_attitude_directions(const Model& model, Data& data, 
   return svd.matrixU().leftCols(r) * sv.head(r).cwiseInverse().asDiagonal();
 }
 
+/// How the freedom left by the task rows `Jt` (m x n) and the held rows `A` (r x n) is shared among
+/// the joints: the diagonal of the projector on the null space of the stack [Jt; A], divided by its
+/// trace (the shares sum to 1; all zero when the stack has full column rank). A joint with a share
+/// near 1 is the only one the objective can move. On the paper's 7-DOF robot with a position task
+/// the share of joint 7 is ~1: it turns the end-effector about its own axis and reacts on the base
+/// only through the last link's axial inertia, so holding the base leaves joints 1-6 no freedom.
+inline Eigen::VectorXd held_freedom_shares(const Eigen::Ref<const Eigen::MatrixXd>& Jt,
+                                           const Eigen::Ref<const Eigen::MatrixXd>& A) {
+  const Eigen::Index n = Jt.cols();
+  Eigen::MatrixXd S(Jt.rows() + A.rows(), n);
+  S << Jt, A;
+  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(S, Eigen::ComputeFullV);
+  const auto& sv = svd.singularValues();
+  Eigen::Index rank = 0;
+  while (rank < sv.size() && sv(rank) > 1e-9 * sv(0)) ++rank;
+  Eigen::VectorXd shares = Eigen::VectorXd::Zero(n);
+  for (Eigen::Index i = rank; i < n; ++i) shares += svd.matrixV().col(i).cwiseAbs2();
+  return rank < n ? Eigen::VectorXd(shares / static_cast<double>(n - rank)) : shares;
+}
+
 /// The joints a task of `task_rows` rows needs with `attitude_rows` held base-attitude rows:
 /// task_rows + attitude_rows, plus one when the objective is optimized (gain != 0).
 inline int joints_needed_to_hold(int task_rows, int attitude_rows, bool optimize) {

@@ -44,8 +44,11 @@
 #include "ffsr/optimize/run_monitors.hpp"
 #include "ffsr/optimize/task_solver.hpp"
 
+#include <algorithm>
 #include <limits>
+#include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace ffsr {
@@ -98,8 +101,11 @@ inline void prepare_base_attitude_hold(const CaptureProblem& pb, const CaptureOp
                                        const char* where) {
   const Model& model = *pb.model;
   Data data(model);
-  s.attitude_basis = base_attitude_directions(model, data, pb.base, pb.theta, pb.frame);
+  s.attitude_basis = base_attitude_directions(model, data, pb.base, pb.theta, pb.frame);  // and data.Jf
   const int m = static_cast<int>(s.rows.size()), r = static_cast<int>(s.attitude_basis.cols());
+  Eigen::MatrixXd Jt(m, model.n());
+  for (int i = 0; i < m; ++i) Jt.row(i) = data.Jf.row(s.rows[static_cast<size_t>(i)]);
+  s.held_freedom = held_freedom_shares(Jt, s.attitude_basis.transpose() * base_angular_rows(data));
   const int needed = joints_needed_to_hold(m, r, opt.gain != 0.0);
   if (needed > model.n())
     throw InputError(str(where, ": holding the base attitude takes ", m, " task rows + ", r,
@@ -124,6 +130,7 @@ inline CaptureSetup prepare_capture(const CaptureProblem& pb, const CaptureTask&
                  0,
                  0,
                  make_contact_law("hunt-crossley", ContactParams{}, 1.0),
+                 {},
                  {},
                  {},
                  {},
@@ -175,6 +182,7 @@ struct CaptureRateField {
   Eigen::MatrixXd attitude_rows;  ///< hold_base_attitude: Q^T A (r x n), the held rows
   double min_singular_value = std::numeric_limits<double>::infinity();
   long damped_steps = 0;
+  double first_damped_time = -1;  ///< t of the first damped evaluation (-1: none)
   double max_joint_rate = 0;
 
   CaptureRateField(const CaptureProblem& pb_, const CaptureTask& task_, const CaptureOptions& opt_,
@@ -204,7 +212,7 @@ struct CaptureRateField {
     const TaskRates& r = solver.extra_rows() > 0 ? solver.solve(data.Jf, cmd, policy.active(), attitude_rows)
                                                  : solver.solve(data.Jf, cmd, policy.active());
     min_singular_value = std::min(min_singular_value, r.sigma_min);
-    if (r.damped) ++damped_steps;
+    if (r.damped && damped_steps++ == 0) first_damped_time = t;
     if (policy.active()) {
       policy(model, data, pb, setup, t, base, theta, solver.projector(), qd_null);
       solver.add_null_space(qd_null, opt.max_joint_rate);
@@ -267,6 +275,33 @@ inline void finish_capture(const Model& model, Data& data, const CaptureProblem&
                              " rad at the capture (tolerance ", opt.orientation_tolerance, " rad)"));
 }
 
+/// The error of a held approach (hold_base_attitude) that loses the line at an algorithmic
+/// singularity: J_t N_A rank-deficient from `t_singular` on, the tracking error `error` at `t`, and
+/// the joints that hold the freedom the task and the held rows leave (setup.held_freedom, shares of
+/// 10 % and more).
+inline std::string held_singularity_message(const Model& model, const CaptureOptions& opt,
+                                            const CaptureSetup& setup, const char* where, double t_singular,
+                                            double sigma_min, double t, double error) {
+  std::vector<std::pair<double, int>> shares;
+  for (Eigen::Index k = 0; k < setup.held_freedom.size(); ++k)
+    if (setup.held_freedom(k) >= 0.1) shares.emplace_back(setup.held_freedom(k), static_cast<int>(k));
+  std::sort(shares.rbegin(), shares.rend());
+  const std::vector<std::string> names = model.joint_names();
+  std::ostringstream m;
+  m.precision(3);
+  m << where << ": holding the base attitude, the arm meets an algorithmic singularity: from t = " << t_singular
+    << " s the task rows in the held rows' null space (J_t N_A) lose rank (smallest singular value " << sigma_min
+    << ", damped below " << opt.singular_value_threshold << ") and at t = " << t << " s the end-effector is "
+    << error << " m off the line, which it cannot follow without turning the base; the freedom the task and the "
+    << "held rows leave at t = 0 is in ";
+  if (shares.empty()) m << "no joint";
+  for (size_t i = 0; i < shares.size(); ++i)
+    m << (i == 0 ? "" : ", ") << names[static_cast<size_t>(shares[i].second)] << " (" << 100 * shares[i].first
+      << " %)";
+  m << " (base-attitude = free turns the base)";
+  return m.str();
+}
+
 /// The number of RK4 steps: at least one. The 1e-9 slack (a duration that is a whole number of steps
 /// up to rounding) must not round a duration shorter than 1e-9 steps down to none -- a run without
 /// a step would return the initial state with no Jacobian ever evaluated (min_singular_value = inf).
@@ -306,7 +341,14 @@ CaptureResult integrate_capture(const CaptureProblem& pb, const CaptureTask& tas
     const double t = static_cast<double>(k) * h;
     rk4.begin(field, t, base, theta);  // data holds the kinematics of the current state
     monitors.check_motion(model, data, rk4.k_base[0], rk4.k_theta[0]);
-    monitors.check_tracking(setup.line.position(t) - frame_pose(model, data, pb.frame).p, setup.rows, t);
+    try {
+      monitors.check_tracking(setup.line.position(t) - frame_pose(model, data, pb.frame).p, setup.rows, t);
+    } catch (const NumericalError&) {
+      if (setup.held_freedom.size() == 0 || field.first_damped_time < 0) throw;
+      throw NumericalError(detail::held_singularity_message(model, opt, setup, where, field.first_damped_time,
+                                                            field.min_singular_value, t,
+                                                            monitors.max_tracking_error));
+    }
     monitors.check_quaternion(rk4.finish(field, t, h, base, theta));
     monitors.check_state(model, base, theta, t + h);
     ++res.steps;

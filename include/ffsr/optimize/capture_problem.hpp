@@ -118,6 +118,9 @@ struct CaptureSetup {
   std::vector<int> rows;                ///< rows of J_f (and of the 6-D error) that the task constrains
   /// hold_base_attitude: Q (3 x r), the base angular velocities held at zero (base_attitude.hpp); else empty
   Eigen::MatrixXd attitude_basis;
+  /// hold_base_attitude: each joint's share of the freedom the task and the held rows leave at the
+  /// initial state (held_freedom_shares); else empty
+  Eigen::VectorXd held_freedom;
 };
 
 }  // namespace ffsr

@@ -29,7 +29,8 @@
 // so both phases aim at the same capture. The result joins both phases: one series (time from 0 to
 // T), the monitors' maxima over both, the drifts from the initial base pose, and a RunPhase per phase.
 //
-// Collisions are not checked in either phase (the robot has no shapes yet).
+// Neither phase looks at shapes: with a clearance the global run checks each joined run's path
+// (GlobalCaptureOptions::check_run) and rejects a run that comes closer than the clearance.
 #pragma once
 
 #include "ffsr/optimize/capture.hpp"
