@@ -289,7 +289,7 @@ void print_clearance(std::ostream& out, const Scenario& sc, const ScenarioResult
   if (r.clearances.empty()) return;
   out << std::fixed << std::setprecision(4) << "smallest distance along the path (clearance "
       << sc.keys.clearance << " m, last " << sc.keys.contact_exemption
-      << " m of the end-effector link exempt at the target):";
+      << " m of the arm before the contact point exempt at the target):";
   for (const auto& [name, c] : r.clearances)
     out << (name == "baseline" ? " plain " : ", " + name + " ") << c.overall.distance << " m ("
         << c.overall.pair << ", t = " << std::setprecision(1) << c.overall.time << " s)"

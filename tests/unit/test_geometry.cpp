@@ -139,6 +139,48 @@ TEST_CASE("geometry: FCL distances match closed forms on random configurations o
   CHECK(r3.checker.pairs().size() == 4 + 2 + 1);
 }
 
+TEST_CASE("geometry: a contact exemption longer than the end-effector link reaches back along the chain") {
+  // paper 3-DOF: link 3 runs 0.5 m from joint 3 to the end-effector point, link 2 1.6 m from joint 2
+  // to joint 3. With a 0.7 m exemption link 3 has no arm-target pair and link 2 is checked against
+  // the target with its centre-line capsule ending 0.2 m before joint 3.
+  const Robot rob = paper_robot("paper_3dof.urdf", 0.05, 0.7);
+  const Model& m = rob.model;
+  const CollisionChecker& cc = rob.checker;
+  CHECK(cc.exempt(3));
+  CHECK_FALSE(cc.exempt(2));
+  REQUIRE(cc.exempt_capsule(2).has_value());
+  CHECK(cc.exempt_capsule(2)->length == Approx(1.4).margin(1e-12));
+  int link2_target = -1;
+  for (size_t i = 0; i < cc.pairs().size(); ++i) {
+    const BodyPair& p = cc.pairs()[i];
+    CHECK_FALSE((p.b < 0 && p.a == 3));
+    if (p.b < 0 && p.a == 2) link2_target = static_cast<int>(i);
+  }
+  REQUIRE(link2_target >= 0);
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> U(-1, 1);
+  Data d(m);
+  int compared = 0;
+  for (int s = 0; s < 100; ++s) {
+    const Eigen::Vector3d th(M_PI * U(rng), M_PI * U(rng), M_PI * U(rng));
+    forward_kinematics(m, d, BasePose{}, th);
+    const Pose target{Vector3(U(rng), U(rng), U(rng)) * 2.5,
+                      Eigen::AngleAxisd(M_PI * U(rng), Vector3(U(rng), 1, U(rng)).normalized()).toRotationMatrix()};
+    const Vector3 a = d.p[2], b = d.p[2] + (d.p[3] - d.p[2]) * (1.4 / 1.6);
+    const double expected = capsule_box({a, b, 0.05}, target.p, target.R, Vector3::Constant(0.25));
+    if (expected < 1e-6) continue;
+    CHECK(std::abs(cc.pair_distance(d, target, link2_target).distance - expected) < 1e-9);
+    ++compared;
+  }
+  CHECK(compared > 50);
+  // the default 0.2 m ends on link 3 itself: link 2 keeps its whole capsule
+  const Robot def = paper_robot("paper_3dof.urdf", 0.05, 0.2);
+  CHECK_FALSE(def.checker.exempt(3));
+  REQUIRE(def.checker.exempt_capsule(3).has_value());
+  CHECK(def.checker.exempt_capsule(3)->length == Approx(0.3).margin(1e-12));
+  CHECK_FALSE(def.checker.exempt_capsule(2).has_value());
+}
+
 TEST_CASE("geometry: distance gradient equals central finite differences (base and target fixed)") {
   const Robot rob = paper_robot("paper_7dof.urdf", 0.05, 0.2);
   const Model& m = rob.model;

@@ -4,6 +4,9 @@
 
 #include <catch2/catch.hpp>
 
+#include <cstdlib>
+#include <filesystem>
+
 namespace test_geometry_scenario {
 
 using namespace ffsr;
@@ -59,6 +62,46 @@ TEST_CASE("geometry scenario: the 3-DOF global run keeps 5 cm along its whole pa
   // the same path re-checked independently of the run's own report: the capture configuration
   const nlohmann::json j = scenario_json(sc, r, "test");
   CHECK(j["global"]["min_clearance"]["distance"].get<double>() == Approx(g.overall.distance));
+}
+
+std::string samples_dir() {
+  if (const char* env = std::getenv("FFSR_URDF_SAMPLES")) return env;
+  return std::string(FFSR_SOURCE_DIR) + "/../shared/urdf-samples";
+}
+
+/// A reference arm's clearance scenario: its global run keeps the clearance along the whole path, by
+/// every kind of pair; without the clearance the global run comes closer (the bound was needed).
+void check_arm_clearance(const std::string& file) {
+  const std::string path = std::string(FFSR_SOURCE_DIR) + "/tests/data/" + file;
+  ScenarioKeys k = read_scenario_file(path);
+  if (std::getenv("FFSR_URDF_SAMPLES")) override_scenario_key(k, "urdf", samples_dir() + "/" +
+                                                               std::filesystem::path(k.urdf).filename().string());
+  const Scenario sc = build_scenario(k);
+  REQUIRE(sc.geometry);
+  const ScenarioResult r = run_scenario(sc);
+  REQUIRE(r.global);
+  REQUIRE(r.clearances.size() == 3);
+  const ClearanceReport& g = r.clearances[2].second;
+  INFO(file << ": global " << g.overall.distance << " m (" << g.overall.pair << ", t = " << g.overall.time << " s)");
+  CHECK(g.arm_target.distance >= 0.05 - 1e-6);
+  CHECK(g.arm_bus.distance >= 0.05 - 1e-6);
+  CHECK(g.self.distance >= 0.05 - 1e-6);
+  override_scenario_key(k, "clearance", "0");
+  const Scenario free_sc = build_scenario(k);
+  const ScenarioResult f = run_scenario(free_sc);
+  REQUIRE(f.global);
+  INFO("without the clearance: " << f.clearances[2].second.overall.distance << " m, M_ie " << f.global->result.run.M_ie
+                                 << " kg; with it " << r.global->result.run.M_ie << " kg");
+  CHECK(f.clearances[2].second.overall.distance < 0.05);
+}
+
+TEST_CASE("geometry scenario: Panda and UR5 with capsule links, the global run keeps 5 cm") {
+  if (!std::filesystem::exists(samples_dir() + "/panda.urdf")) {
+    WARN("skipped Panda and UR5: the URDF samples are not in " << samples_dir());
+    return;
+  }
+  check_arm_clearance("panda_clearance.toml");
+  check_arm_clearance("ur5_clearance.toml");
 }
 
 }  // namespace test_geometry_scenario

@@ -10,13 +10,17 @@
 // The distance of a pair is the least over its shapes (FCL's signed distance: negative when they
 // overlap), with the nearest points in the inertial frame.
 //
-// Contact exemption. The end-effector touches the target at the capture: its body is checked against
-// the target with its centre-line capsule cut short, from the body's joint origin to `exemption`
-// metres before the contact point (its own shapes are not used against the target), at every time
-// of the path. The last `exemption` metres of the end-effector link (and the capsule's round cap
-// beyond the contact point) are therefore never checked against the target; everything else is.
-// With a capsule of radius r the kept part stays at least `clearance` away from the target's face
-// when the link meets the face within acos((clearance + r) / exemption) of its normal.
+// Contact exemption. The end-effector touches the target at the capture, and the links just behind
+// it are close to the target then. The last `exemption` metres of the arm before the contact point,
+// measured along the chain's centre lines (the end-effector body's from its joint origin to the
+// contact point, then each parent's from its joint origin to its child's), are not checked against
+// the target, at every time of the path: a body wholly inside them has no arm-target pair; the
+// body where they end is checked with its centre-line capsule (radius link-radius) cut short there,
+// instead of its own shapes. On the paper's robots the end-effector link is longer than the default
+// 0.2 m, so only its last 0.2 m is exempt; on a wrist whose last links are short (UR5, Kinova) the
+// exemption reaches back across them. With a capsule of radius r a straight kept part stays at least
+// `clearance` away from the target's face when the arm meets the face within
+// acos((clearance + r) / exemption) of its normal.
 //
 // Gradient (distance_gradient). For a pair with nearest points p_a on body a and p_b on body b and
 // distance d != 0, n = (p_a - p_b) / d is the unit direction along which d grows when p_a moves
@@ -182,15 +186,18 @@ class CollisionChecker {
     for (int b = 0; b < nb; ++b)
       for (const Shape& s : g_.shapes[static_cast<size_t>(b)]) geoms_[static_cast<size_t>(b)].push_back(fcl_of(s));
     if (target_) target_geom_ = fcl_of(*target_);
-    make_ee_capsule();
+    make_exemption(model);
     make_pairs(model);
   }
 
   const std::vector<BodyPair>& pairs() const { return pairs_; }
   const RobotGeometry& geometry() const { return g_; }
   const std::optional<Shape>& target_shape() const { return target_; }
-  /// The trimmed end-effector capsule checked against the target (body frame), if any.
-  const std::optional<Shape>& exempt_capsule() const { return ee_capsule_; }
+  /// Body b's trimmed centre-line capsule checked against the target instead of its shapes (body
+  /// frame), if the contact exemption ends on b.
+  const std::optional<Shape>& exempt_capsule(int b) const { return trimmed_[static_cast<size_t>(b)]; }
+  /// Whether body b lies wholly inside the contact exemption (no arm-target pair).
+  bool exempt(int b) const { return exempt_[static_cast<size_t>(b)] != 0; }
   double exemption() const { return exemption_; }
 
   /// "link3 - target" for a pair.
@@ -216,8 +223,9 @@ class CollisionChecker {
     const auto& ga = geoms_[static_cast<size_t>(p.a)];
     const auto& sa = g_.shapes[static_cast<size_t>(p.a)];
     if (p.b < 0) {
-      if (p.a == g_.ee_body) {
-        closest(*ee_capsule_, ee_capsule_geom_.get(), A * ee_capsule_->pose, *target_, target_geom_.get(),
+      const std::optional<Shape>& cut = trimmed_[static_cast<size_t>(p.a)];
+      if (cut) {
+        closest(*cut, trimmed_geom_[static_cast<size_t>(p.a)].get(), A * cut->pose, *target_, target_geom_.get(),
                 target * target_->pose, best);
       } else {
         for (size_t k = 0; k < sa.size(); ++k)
@@ -318,14 +326,31 @@ class CollisionChecker {
 
   static bool round(const Shape& s) { return s.kind == Shape::Kind::Capsule || s.kind == Shape::Kind::Sphere; }
 
-  void make_ee_capsule() {
+  /// The contact exemption (see the top of the file): walks from the contact point back along the
+  /// chain's centre lines, marking the bodies it covers and cutting the capsule of the one it ends on.
+  void make_exemption(const Model& model) {
+    const size_t nb = static_cast<size_t>(model.nb());
+    trimmed_.assign(nb, std::nullopt);
+    trimmed_geom_.assign(nb, nullptr);
+    exempt_.assign(nb, 0);
     if (g_.ee_body < 0 || !target_) return;
-    const Vector3 a = g_.ee_line_start, e = g_.ee_line_end;
-    const double L = (e - a).norm();
-    if (L <= exemption_) return;  // the whole link is exempt
-    const Vector3 b = a + (e - a) * ((L - exemption_) / L);
-    ee_capsule_ = Shape::capsule_between(a, b, g_.ee_radius);
-    ee_capsule_geom_ = fcl_of(*ee_capsule_);
+    int b = g_.ee_body;
+    Vector3 a = g_.ee_line_start, e = g_.ee_line_end;  // body frame of b
+    double left = exemption_;
+    while (b > 0) {
+      const double L = (e - a).norm();
+      if (L > left) {
+        const double r = g_.line_radius.empty() ? g_.ee_radius : g_.line_radius[static_cast<size_t>(b)];
+        trimmed_[static_cast<size_t>(b)] = Shape::capsule_between(a, a + (e - a) * ((L - left) / L), r);
+        trimmed_geom_[static_cast<size_t>(b)] = fcl_of(*trimmed_[static_cast<size_t>(b)]);
+        return;
+      }
+      exempt_[static_cast<size_t>(b)] = 1;
+      left -= L;
+      e = model.body(b).tree.p;  // the parent's centre line: its joint origin to b's
+      a = Vector3::Zero();
+      b = model.body(b).parent;
+    }
   }
 
   /// Length along the tree between the joint origins of body a's child towards d and of d, when
@@ -345,7 +370,8 @@ class CollisionChecker {
     auto has = [&](int b) { return !g_.shapes[static_cast<size_t>(b)].empty(); };
     if (target_)
       for (int b = 0; b < nb; ++b)
-        if (b == g_.ee_body ? ee_capsule_.has_value() : has(b)) pairs_.push_back({b, -1, PairKind::ArmTarget});
+        if (!exempt(b) && (trimmed_[static_cast<size_t>(b)] || has(b)))
+          pairs_.push_back({b, -1, PairKind::ArmTarget});
     if (has(0))
       for (int b = 1; b < nb; ++b)
         if (has(b) && model.body(b).parent != 0) pairs_.push_back({b, 0, PairKind::ArmBus});
@@ -379,8 +405,10 @@ class CollisionChecker {
   std::optional<Shape> target_;
   double exemption_ = 0;
   std::vector<std::vector<Geom>> geoms_;
-  Geom target_geom_, ee_capsule_geom_;
-  std::optional<Shape> ee_capsule_;
+  Geom target_geom_;
+  std::vector<std::optional<Shape>> trimmed_;  ///< per body: the cut centre-line capsule, if the exemption ends there
+  std::vector<Geom> trimmed_geom_;
+  std::vector<char> exempt_;  ///< per body: 1 when wholly inside the exemption
   std::vector<BodyPair> pairs_;
 };
 

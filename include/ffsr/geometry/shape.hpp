@@ -140,7 +140,7 @@ inline double point_surface_distance(const Shape& s, const Vector3& point) {
 }
 
 /// The shapes of a robot: shapes[b] are those of body b (in its frame), names[b] its name.
-/// `origin[b]` tells where they came from: "urdf", "capsule", "bus-box" or "" (no shape).
+/// `origin[b]` tells where they came from: "urdf", "capsule", "urdf+capsule", "bus-box" or "" (no shape).
 struct RobotGeometry {
   std::vector<std::vector<Shape>> shapes;
   std::vector<std::string> names, origin;
@@ -149,12 +149,16 @@ struct RobotGeometry {
   Vector3 ee_line_start = Vector3::Zero(), ee_line_end = Vector3::Zero();
   double ee_radius = 0;
   int ee_body = -1;
+  /// The radius of each moving body's centre-line capsule (link-radius; 0 for the base), also for a
+  /// body with URDF shapes: the contact exemption trims the centre lines of the bodies it reaches.
+  std::vector<double> line_radius;
 };
 
 /// A URDF <collision> primitive of a link (io/urdf_collision.hpp reads them).
 struct LinkShape {
   std::string link;
-  Shape shape;  ///< pose in the link frame
+  Shape shape;        ///< pose in the link frame
+  bool mesh = false;  ///< a mesh (not read; shape unset): the link's body gets capsules too
 };
 
 namespace detail {
@@ -179,7 +183,8 @@ inline std::vector<Vector3> centre_line_ends(const Model& model, int b) {
 }  // namespace detail
 
 /// The robot's shapes: `urdf_shapes` (the <collision> primitives, mapped to bodies through the
-/// model's frames) where a body has some; otherwise capsules of radius link_radius[b - 1] (one
+/// model's frames) where a body has some, and capsules too where one of its links has a mesh;
+/// otherwise capsules of radius link_radius[b - 1] (one
 /// value: every link) along the body's centre lines. The base (body 0): its URDF primitives, else
 /// `bus_box` when given (edge lengths, centred on the base frame), else nothing. InputError
 /// naming `link-radius` or `bus-box` on a bad value.
@@ -196,8 +201,13 @@ inline RobotGeometry robot_geometry(const Model& model, const std::vector<LinkSh
   g.shapes.resize(static_cast<size_t>(nb));
   g.origin.assign(static_cast<size_t>(nb), "");
   for (int b = 0; b < nb; ++b) g.names.push_back(model.body(b).name);
+  std::vector<char> has_mesh(static_cast<size_t>(nb), 0);
   for (const LinkShape& ls : urdf_shapes) {
     const Frame& f = model.frame(model.frame_index(ls.link));
+    if (ls.mesh) {
+      has_mesh[static_cast<size_t>(f.body)] = 1;
+      continue;
+    }
     Shape s = ls.shape;
     s.pose = f.pose * s.pose;
     validate_shape(s, str(model.source, ": link '", ls.link, "' <collision>"));
@@ -212,17 +222,20 @@ inline RobotGeometry robot_geometry(const Model& model, const std::vector<LinkSh
     g.origin[0] = "bus-box";
   }
   const Frame& ee = model.frame(model.end_effector());
+  g.line_radius.assign(static_cast<size_t>(nb), 0.0);
   for (int b = 1; b < nb; ++b) {
     const double r = link_radius[link_radius.size() == 1 ? 0 : static_cast<size_t>(b - 1)];
+    g.line_radius[static_cast<size_t>(b)] = r;
     if (b == ee.body) {
       g.ee_body = b;
       g.ee_line_end = ee.pose.p;
       g.ee_radius = r;
     }
-    if (!g.shapes[static_cast<size_t>(b)].empty()) continue;
+    const bool primitives = !g.shapes[static_cast<size_t>(b)].empty();
+    if (primitives && !has_mesh[static_cast<size_t>(b)]) continue;
     for (const Vector3& e : detail::centre_line_ends(model, b))
       g.shapes[static_cast<size_t>(b)].push_back(Shape::capsule_between(Vector3::Zero(), e, r));
-    g.origin[static_cast<size_t>(b)] = "capsule";
+    g.origin[static_cast<size_t>(b)] = primitives ? "urdf+capsule" : "capsule";
   }
   return g;
 }

@@ -1,6 +1,7 @@
 // ffsr/io/urdf_collision.hpp -- the <collision> primitives of a URDF (box, sphere, cylinder), for
-// geometry/shape.hpp's robot_geometry. Meshes are skipped (the files do not ship them): a body with
-// none of the primitives gets capsules along its centre lines. Component ffsr::urdf.
+// geometry/shape.hpp's robot_geometry. Meshes are not read (the files do not ship them); each is
+// listed as a mesh, so that its body also gets capsules along its centre lines (a Panda's hand body
+// has the finger pads' boxes, and its meshes are the hand itself). Component ffsr::urdf.
 #pragma once
 
 #include "ffsr/geometry/shape.hpp"
@@ -13,8 +14,8 @@
 
 namespace ffsr {
 
-/// The primitive <collision> shapes of every link of URDF text, poses in the link frame, in the
-/// order of the file's links (urdfdom's map order: by name). `source` names the file in errors.
+/// The primitive <collision> shapes of every link of URDF text, poses in the link frame, and an
+/// entry with `mesh` set for each mesh, in the order of the file's links (urdfdom's map order: by name). `source` names the file in errors.
 inline std::vector<LinkShape> urdf_collision_shapes_from_string(const std::string& xml,
                                                                 const std::string& source) {
   const detail::UrdfDocument doc = detail::parse_urdf_document(xml, source);
@@ -38,8 +39,9 @@ inline std::vector<LinkShape> urdf_collision_shapes_from_string(const std::strin
           s = Shape::cylinder(y.radius, y.length, pose);
           break;
         }
-        default:
-          continue;  // mesh
+        default:  // a mesh: its body gets capsules too
+          out.push_back({name, Shape{}, true});
+          continue;
       }
       validate_shape(s, detail::str(source, ": link '", name, "' <collision>"));
       out.push_back({name, s});

@@ -294,7 +294,7 @@ inline std::vector<ScenarioKey> build_scenario_keys() {
       FFSR_KEY("clearance", clearance,
                "Least distance the global run keeps between arm, bus and target, m (0: none)", "0"),
       FFSR_KEY("contact-exemption", contact_exemption,
-               "Length of the end-effector link before the contact point not checked against the target, m",
+               "Length of the arm before the contact point (along the links' centre lines) not checked against the target, m",
                "0.2"),
   };
 }
