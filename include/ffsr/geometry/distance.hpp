@@ -42,6 +42,7 @@
 #include <fcl/geometry/shape/sphere.h>
 
 #include <algorithm>
+#include <array>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -141,11 +142,11 @@ inline double box_sdf(const Shape& box, const Pose& B, const Vector3& x, Vector3
   return d;
 }
 
-/// A capsule/sphere overlapping a box: the least signed distance of the box along the centre
-/// segment minus the radius (golden section: the signed distance of a convex set is convex along a
-/// segment), a depth that is continuous with the distance outside, and the nearest points: the
-/// deepest point of the capsule and its projection on the box's surface.
-inline void round_box_overlap(const Shape& s, const Pose& S, const Shape& box, const Pose& B, double& d,
+/// A capsule/sphere that reaches into a box: the least signed distance of the box along the centre
+/// segment minus the radius (golden section, 60 steps: the signed distance of a convex set is convex
+/// along a segment), a depth continuous with the distance outside, and the nearest points: the
+/// deepest point of the round shape and its centre point's projection on the box's surface.
+inline void round_box_depth(const Shape& s, const Pose& S, const Shape& box, const Pose& B, double& d,
                               Vector3& ps, Vector3& pbox) {
   Vector3 a, b;
   round_segment(s, S, a, b);
@@ -169,6 +170,61 @@ inline void round_box_overlap(const Shape& s, const Pose& S, const Shape& box, c
   d = sd - s.radius;
   ps = x - s.radius * n;  // deepest point of the round shape into the box
   pbox = x - sd * n;      // the box surface point nearest to the centre point
+}
+
+
+/// Signed distance of a capsule/sphere and a box, and the nearest points. Outside, exactly: in the
+/// box frame the squared distance of the centre segment's point q(t) to the box is a sum of squares
+/// of the coordinates beyond the box's half sizes, a quadratic in t between the t where a coordinate
+/// crosses a face plane; its least value over those pieces is the segment's distance (minus the
+/// radius: the capsule's). When the segment reaches the box, the depth of round_box_depth. Replaces
+/// FCL's GJK for these pairs: the global search evaluates them most.
+inline void round_box(const Shape& s, const Pose& S, const Shape& box, const Pose& B, double& d, Vector3& ps,
+                      Vector3& pbox) {
+  Vector3 a, b;
+  round_segment(s, S, a, b);
+  const Vector3 q0 = B.R.transpose() * (a - B.p), dq = B.R.transpose() * (b - a), h = 0.5 * box.size;
+  std::array<double, 8> ts{};
+  int m = 0;
+  ts[static_cast<size_t>(m++)] = 0;
+  for (int i = 0; i < 3; ++i)
+    if (dq(i) != 0)
+      for (double face : {-h(i), h(i)}) {
+        const double t = (face - q0(i)) / dq(i);
+        if (t > 0 && t < 1) ts[static_cast<size_t>(m++)] = t;
+      }
+  ts[static_cast<size_t>(m++)] = 1;
+  for (int i = 1; i < m; ++i)  // insertion sort of at most 8
+    for (int j = i; j > 0 && ts[static_cast<size_t>(j)] < ts[static_cast<size_t>(j - 1)]; --j)
+      std::swap(ts[static_cast<size_t>(j)], ts[static_cast<size_t>(j - 1)]);
+  auto outside2 = [&](double t) { return ((q0 + t * dq).cwiseAbs() - h).cwiseMax(0.0).squaredNorm(); };
+  double best_t = 0, best = outside2(0);
+  for (int k = 0; k + 1 < m; ++k) {
+    const double t0 = ts[static_cast<size_t>(k)], t1 = ts[static_cast<size_t>(k + 1)];
+    const Vector3 mid = q0 + 0.5 * (t0 + t1) * dq;
+    double num = 0, den = 0;  // the piece's quadratic: sum over the coordinates beyond a face
+    for (int i = 0; i < 3; ++i) {
+      if (std::abs(mid(i)) <= h(i)) continue;
+      const double c = q0(i) - (mid(i) > 0 ? h(i) : -h(i));
+      num -= c * dq(i);
+      den += dq(i) * dq(i);
+    }
+    const double t = den > 0 ? std::clamp(num / den, t0, t1) : t0;
+    for (double x : {t, t1}) {
+      const double g = outside2(x);
+      if (g < best) best = g, best_t = x;
+    }
+  }
+  if (!(best > 0)) {
+    round_box_depth(s, S, box, B, d, ps, pbox);
+    return;
+  }
+  const Vector3 x = a + best_t * (b - a);
+  Vector3 n;
+  const double sd = box_sdf(box, B, x, &n);
+  d = sd - s.radius;
+  ps = x - s.radius * n;
+  pbox = x - sd * n;
 }
 
 }  // namespace detail
@@ -300,6 +356,10 @@ class CollisionChecker {
     Vector3 pa, pb;
     if (round(sa) && round(sb)) {
       detail::round_round(sa, A, sb, B, d, pa, pb);
+    } else if (round(sa) && sb.kind == Shape::Kind::Box) {
+      detail::round_box(sa, A, sb, B, d, pa, pb);
+    } else if (round(sb) && sa.kind == Shape::Kind::Box) {
+      detail::round_box(sb, B, sa, A, d, pb, pa);
     } else {
       fcl::DistanceRequestd req(true);
       req.distance_tolerance = 1e-12;
@@ -309,13 +369,7 @@ class CollisionChecker {
       d = res.min_distance;
       pa = res.nearest_points[0];
       pb = res.nearest_points[1];
-      if (d <= 0) {  // overlapping: FCL gives no depth; a round shape in a box has one (below)
-        d = 0;
-        if (round(sa) && sb.kind == Shape::Kind::Box) detail::round_box_overlap(sa, A, sb, B, d, pa, pb);
-        if (round(sb) && sa.kind == Shape::Kind::Box) {
-          detail::round_box_overlap(sb, B, sa, A, d, pb, pa);
-        }
-      }
+      if (d <= 0) d = 0;  // overlapping: FCL gives no depth (round shapes in boxes have one, above)
     }
     if (d < best.distance) {
       best.distance = d;
