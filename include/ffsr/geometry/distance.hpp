@@ -112,8 +112,8 @@ inline void segment_segment(const Vector3& p1, const Vector3& q1, const Vector3&
 
 /// Signed distance of two capsules/spheres (exact, also when they overlap) and the nearest points
 /// (on each surface along the line between the closest centre points).
-inline void round_round(const Shape& sa, const Pose& A, const Shape& sb, const Pose& B, double& d, Vector3& pa,
-                        Vector3& pb) {
+inline void round_round(const Shape& sa, const Pose& A, const Shape& sb, const Pose& B, double& d,
+                        Vector3& pa, Vector3& pb) {
   Vector3 a0, a1, b0, b1, ca, cb;
   round_segment(sa, A, a0, a1);
   round_segment(sb, B, b0, b1);
@@ -147,7 +147,7 @@ inline double box_sdf(const Shape& box, const Pose& B, const Vector3& x, Vector3
 /// along a segment), a depth continuous with the distance outside, and the nearest points: the
 /// deepest point of the round shape and its centre point's projection on the box's surface.
 inline void round_box_depth(const Shape& s, const Pose& S, const Shape& box, const Pose& B, double& d,
-                              Vector3& ps, Vector3& pbox) {
+                            Vector3& ps, Vector3& pbox) {
   Vector3 a, b;
   round_segment(s, S, a, b);
   auto f = [&](double t) { return box_sdf(box, B, a + t * (b - a), nullptr); };
@@ -171,7 +171,6 @@ inline void round_box_depth(const Shape& s, const Pose& S, const Shape& box, con
   ps = x - s.radius * n;  // deepest point of the round shape into the box
   pbox = x - sd * n;      // the box surface point nearest to the centre point
 }
-
 
 /// Signed distance of a capsule/sphere and a box, and the nearest points. Outside, exactly: in the
 /// box frame the squared distance of the centre segment's point q(t) to the box is a sum of squares
@@ -240,7 +239,8 @@ class CollisionChecker {
     const int nb = model.nb();
     geoms_.resize(static_cast<size_t>(nb));
     for (int b = 0; b < nb; ++b)
-      for (const Shape& s : g_.shapes[static_cast<size_t>(b)]) geoms_[static_cast<size_t>(b)].push_back(fcl_of(s));
+      for (const Shape& s : g_.shapes[static_cast<size_t>(b)])
+        geoms_[static_cast<size_t>(b)].push_back(fcl_of(s));
     if (target_) target_geom_ = fcl_of(*target_);
     make_exemption(model);
     make_pairs(model);
@@ -281,11 +281,12 @@ class CollisionChecker {
     if (p.b < 0) {
       const std::optional<Shape>& cut = trimmed_[static_cast<size_t>(p.a)];
       if (cut) {
-        closest(*cut, trimmed_geom_[static_cast<size_t>(p.a)].get(), A * cut->pose, *target_, target_geom_.get(),
-                target * target_->pose, best);
+        closest(*cut, trimmed_geom_[static_cast<size_t>(p.a)].get(), A * cut->pose, *target_,
+                target_geom_.get(), target * target_->pose, best);
       } else {
         for (size_t k = 0; k < sa.size(); ++k)
-          closest(sa[k], ga[k].get(), A * sa[k].pose, *target_, target_geom_.get(), target * target_->pose, best);
+          closest(sa[k], ga[k].get(), A * sa[k].pose, *target_, target_geom_.get(), target * target_->pose,
+                  best);
       }
       return best;
     }
@@ -378,7 +379,9 @@ class CollisionChecker {
     }
   }
 
-  static bool round(const Shape& s) { return s.kind == Shape::Kind::Capsule || s.kind == Shape::Kind::Sphere; }
+  static bool round(const Shape& s) {
+    return s.kind == Shape::Kind::Capsule || s.kind == Shape::Kind::Sphere;
+  }
 
   /// The contact exemption (see the top of the file): walks from the contact point back along the
   /// chain's centre lines, marking the bodies it covers and cutting the capsule of the one it ends on.
@@ -394,7 +397,8 @@ class CollisionChecker {
     while (b > 0) {
       const double L = (e - a).norm();
       if (L > left) {
-        const double r = g_.line_radius.empty() ? g_.ee_radius : g_.line_radius[static_cast<size_t>(b)];
+        const double r =
+            static_cast<size_t>(b) < g_.line_radius.size() ? g_.line_radius[static_cast<size_t>(b)] : 0.0;
         trimmed_[static_cast<size_t>(b)] = Shape::capsule_between(a, a + (e - a) * ((L - left) / L), r);
         trimmed_geom_[static_cast<size_t>(b)] = fcl_of(*trimmed_[static_cast<size_t>(b)]);
         return;
@@ -460,7 +464,8 @@ class CollisionChecker {
   double exemption_ = 0;
   std::vector<std::vector<Geom>> geoms_;
   Geom target_geom_;
-  std::vector<std::optional<Shape>> trimmed_;  ///< per body: the cut centre-line capsule, if the exemption ends there
+  std::vector<std::optional<Shape>>
+      trimmed_;  ///< per body: the cut centre-line capsule, if the exemption ends there
   std::vector<Geom> trimmed_geom_;
   std::vector<char> exempt_;  ///< per body: 1 when wholly inside the exemption
   std::vector<BodyPair> pairs_;

@@ -144,10 +144,9 @@ inline double point_surface_distance(const Shape& s, const Vector3& point) {
 struct RobotGeometry {
   std::vector<std::vector<Shape>> shapes;
   std::vector<std::string> names, origin;
-  /// The end-effector body's centre line (body frame) from its joint origin to the contact point,
-  /// and the radius of its capsule: the contact exemption trims it (geometry/distance.hpp).
+  /// The end-effector body's centre line (body frame) from its joint origin to the contact point:
+  /// the contact exemption trims it (geometry/distance.hpp).
   Vector3 ee_line_start = Vector3::Zero(), ee_line_end = Vector3::Zero();
-  double ee_radius = 0;
   int ee_body = -1;
   /// The radius of each moving body's centre-line capsule (link-radius; 0 for the base), also for a
   /// body with URDF shapes: the contact exemption trims the centre lines of the bodies it reaches.
@@ -229,7 +228,6 @@ inline RobotGeometry robot_geometry(const Model& model, const std::vector<LinkSh
     if (b == ee.body) {
       g.ee_body = b;
       g.ee_line_end = ee.pose.p;
-      g.ee_radius = r;
     }
     const bool primitives = !g.shapes[static_cast<size_t>(b)].empty();
     if (primitives && !has_mesh[static_cast<size_t>(b)]) continue;

@@ -15,7 +15,8 @@
 namespace ffsr {
 
 /// The primitive <collision> shapes of every link of URDF text, poses in the link frame, and an
-/// entry with `mesh` set for each mesh, in the order of the file's links (urdfdom's map order: by name). `source` names the file in errors.
+/// entry with `mesh` set for each mesh, in the order of the file's links (urdfdom's map order: by
+/// name). `source` names the file in errors.
 inline std::vector<LinkShape> urdf_collision_shapes_from_string(const std::string& xml,
                                                                 const std::string& source) {
   const detail::UrdfDocument doc = detail::parse_urdf_document(xml, source);
