@@ -412,7 +412,9 @@ plot::Figure capture_figure(const std::string& label, const CaptureResult& res, 
   } else {
     fig.cols = 2;
     fig.panels.emplace_back(oblique_view(d));
-    p.title = d.closest_note.empty() ? std::string("top view (x-y)") : "top view; " + d.closest_note;
+    // with a closest pair the note alone (the x-y axes say which view it is): "top view; " before a
+    // long pair name ran past the panel's edge
+    p.title = d.closest_note.empty() ? std::string("top view (x-y)") : d.closest_note;
     p.legend_outside = false;
   }
   fig.panels.emplace_back(std::move(p));

@@ -74,7 +74,7 @@ Vector3 centre_of_mass(const Model& m, Data& d, const BasePose& b, const Eigen::
 /// A capture setup with nothing but what a policy reads filled in by the test.
 CaptureSetup bare_setup() {
   return CaptureSetup{Target{}, {}, {}, 0, 0, make_contact_law("hunt-crossley", ContactParams{}, 1.0),
-                      {},       {}, {}, {}};
+                      {},       {}, {}, {}, {}};
 }
 
 }  // namespace
