@@ -1,7 +1,9 @@
 // ffsr/geometry/clearance.hpp -- a clearance for capture plans: the smallest distance of a
 // configuration or along a recorded run, the search's inequality constraints
 // distance >= clearance (ManifoldInequalities of optimize/global.hpp), and the check of a reaching
-// run (GlobalCaptureOptions::check_run). Pairs and the contact exemption: geometry/distance.hpp.
+// run (GlobalCaptureOptions::check_run), and the clearance barrier, a joint-rate filter (RateGuard)
+// that keeps a capture run's distances >= the clearance through its null space. Pairs and the
+// contact exemption: geometry/distance.hpp.
 // Component ffsr::geometry.
 #pragma once
 
@@ -9,10 +11,14 @@
 #include "ffsr/model/target.hpp"
 #include "ffsr/optimize/global.hpp"
 
+#include <algorithm>
+#include <cmath>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <sstream>
 #include <string>
+#include <vector>
 
 namespace ffsr {
 
@@ -107,6 +113,126 @@ inline std::shared_ptr<ManifoldInequalities> clearance_constraints(const Model& 
     }
   };
   return q;
+}
+
+/// The free-floating rate of the distance of pair `d` (at the kinematics and data.H of `data`, crba
+/// run; the target in its state at that time): d_dot = g*^T theta_dot + b for joint rates theta_dot
+/// with zero momentum (see ClearanceBarrier). `hb`: the Cholesky factor of H_b (data.H's top-left
+/// 6 x 6). Writes g (n); returns b (the target's motion; 0 for a pair of two robot bodies).
+inline double free_floating_distance_rate(const Model& model, const Data& data, const CollisionChecker& cc,
+                                          const PairDistance& d, const Target& target,
+                                          const Eigen::LLT<Matrix6>& hb, Eigen::Ref<Eigen::VectorXd> g) {
+  cc.distance_gradient(model, data, d, g);
+  if (!std::isfinite(d.distance) || d.distance == 0 ||
+      cc.pairs()[static_cast<size_t>(d.pair)].kind != PairKind::ArmTarget)
+    return 0;
+  const Vector3 u = (d.p_a - d.p_b) / d.distance;
+  Vector6 w;
+  w << u, (d.p_a - data.p[0]).cross(u);
+  g.noalias() -= data.H.topRightCorner(6, model.n()).transpose() * hb.solve(w);
+  return -u.dot(target.velocity + target.angular_velocity_world().cross(d.p_b - target.position));
+}
+
+/// The clearance barrier of a capture run (a RateGuard, optimize/capture_problem.hpp): a joint-rate
+/// filter in the task's null space that keeps every pair's distance d above the clearance c.
+///
+/// Free-floating distance rate. With the nearest points p_a (on the arm) and p_b and n = (p_a - p_b)
+/// / d, d_dot = n^T (v(p_a) - v(p_b)). The arm's part is g^T theta_dot + n^T (v_0 + w_0 x (p_a -
+/// p_0)) with g the fixed-base gradient of distance.hpp; the base velocity of zero momentum is
+/// [v_0; w_0] = -H_b^-1 H_bm theta_dot, so d_dot = g*^T theta_dot - n^T v(p_b) with
+///   g* = g - H_bm^T H_b^-1 [n; (p_a - p_0) x n]
+/// for an arm-target pair, v(p_b) the target's point velocity (v_t + omega_t x (p_b - c_t), the
+/// target propagated to t). For a pair of two robot bodies (arm-bus, self) the base's rigid motion
+/// moves both points alike and n is parallel to p_a - p_b, so its terms cancel: g* = g, v(p_b) from
+/// the arm's chain as in g.
+///
+/// Barrier (a control barrier function on each pair): the rates must keep d_dot >= -lambda (d - c_b),
+/// c_b = (1 + margin) c, so that d approaches c_b at most exponentially and never crosses it in
+/// continuous time (the margin absorbs the integration step). Where the rates break it, the filter
+/// adds the least correction inside the null space, theta_dot += beta N g*, beta = (-lambda (d - c_b) -
+/// d_dot) / (g*^T N g*), pair by pair, in up to 8 sweeps over the pairs (Kaczmarz projections onto the
+/// half-spaces, which converge where they intersect). A pair whose g* has no component in the null
+/// space (g*^T N g* < 1e-12) cannot be kept: the run goes on and its path check reports it.
+/// clearance_barrier: lambda = min(100 / T, 0.5 / h) (a time constant of T / 100, and at least two
+/// RK4 steps), margin 2 %.
+class ClearanceBarrier : public RateGuard {
+ public:
+  ClearanceBarrier(std::shared_ptr<const CollisionChecker> cc, const Target& target0, double clearance,
+                   double lambda, double margin = 0.02)
+      : cc_(std::move(cc)), initial_(target0), target_(target0), c_b_((1 + margin) * clearance), lambda_(lambda) {
+    if (!cc_) throw InputError("ClearanceBarrier: no collision checker");
+    if (!std::isfinite(clearance) || clearance <= 0)
+      throw InputError(detail::str("ClearanceBarrier: the clearance must be positive and finite, got ", clearance));
+    if (!std::isfinite(lambda) || lambda <= 0)
+      throw InputError(detail::str("ClearanceBarrier: lambda must be positive and finite, got ", lambda));
+    if (!std::isfinite(margin) || margin < 0)
+      throw InputError(detail::str("ClearanceBarrier: the margin must be >= 0 and finite, got ", margin));
+  }
+
+  void filter(const Model& model, const Data& data, double t, const Eigen::MatrixXd& N,
+              Eigen::VectorXd& theta_dot) override {
+    if (t != t_target_) {  // the run's times increase (the RK4 stages too): propagate from the last
+      target_ = t > t_target_ ? propagate_target(target_, t - t_target_) : propagate_target(initial_, t);
+      t_target_ = t;
+    }
+    const auto n = static_cast<Eigen::Index>(model.n());
+    const Pose tp = target_pose(target_);
+    cc_->distances(data, tp, ds_);
+    const auto pairs = static_cast<Eigen::Index>(ds_.size());
+    G_.resize(pairs, n);
+    NG_.resize(pairs, n);
+    bias_.resize(pairs);
+    den_.resize(pairs);
+    grad_.resize(n);
+    hb_.compute(data.H.topLeftCorner<6, 6>());
+    for (Eigen::Index i = 0; i < pairs; ++i) {
+      bias_(i) = free_floating_distance_rate(model, data, *cc_, ds_[static_cast<size_t>(i)], target_, hb_, grad_);
+      G_.row(i) = grad_.transpose();
+    }
+    NG_.noalias() = G_ * N;  // rows (N g*_i)^T, N symmetric
+    for (Eigen::Index i = 0; i < pairs; ++i) den_(i) = NG_.row(i).dot(G_.row(i));
+    for (int sweep = 0; sweep < 8; ++sweep) {
+      bool changed = false;
+      for (Eigen::Index i = 0; i < pairs; ++i) {
+        const double d = ds_[static_cast<size_t>(i)].distance;
+        if (!std::isfinite(d) || !(den_(i) > 1e-12)) continue;
+        const double need = -lambda_ * (d - c_b_) - (G_.row(i).dot(theta_dot) + bias_(i));
+        if (need <= 1e-12) continue;
+        theta_dot.noalias() += (need / den_(i)) * NG_.row(i).transpose();
+        changed = true;
+        ++corrections_;
+      }
+      if (!changed) break;
+    }
+  }
+
+  /// The corrections made so far (pair by pair, every sweep).
+  long corrections() const { return corrections_; }
+
+ private:
+  std::shared_ptr<const CollisionChecker> cc_;
+  Target initial_, target_;  ///< the target at t = 0 and at t_target_
+  double t_target_ = 0;
+  double c_b_, lambda_;
+  long corrections_ = 0;
+  std::vector<PairDistance> ds_;
+  Eigen::MatrixXd G_, NG_;
+  Eigen::VectorXd bias_, den_, grad_;
+  Eigen::LLT<Matrix6> hb_;
+};
+
+/// The factory of CaptureOptions::rate_guard for a clearance barrier (ClearanceBarrier) on a run of
+/// duration T and RK4 step h (the options'): lambda = min(100 / T, 0.5 / h).
+inline std::function<std::unique_ptr<RateGuard>()> clearance_barrier(std::shared_ptr<const CollisionChecker> cc,
+                                                                    const Target& target0, double clearance,
+                                                                    const CaptureOptions& opt) {
+  if (!std::isfinite(opt.duration) || opt.duration <= 0 || !std::isfinite(opt.step) || opt.step <= 0)
+    throw InputError(detail::str("clearance_barrier: the duration and the step must be positive and finite, got ",
+                                 opt.duration, " and ", opt.step));
+  const double lambda = std::min(100.0 / opt.duration, 0.5 / opt.step);
+  return [cc, target0, clearance, lambda]() -> std::unique_ptr<RateGuard> {
+    return std::make_unique<ClearanceBarrier>(cc, target0, clearance, lambda);
+  };
 }
 
 /// "link3 - target 0.0321 m < clearance 0.05 m at t = 171.3 s", or nothing when the report keeps it

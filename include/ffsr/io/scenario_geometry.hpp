@@ -182,6 +182,14 @@ inline ClearanceReport run_clearance(const Scenario& sc, const CaptureResult& ru
   return path_clearance(*sc.model, *sc.geometry->checker, sc.problem.target, run);
 }
 
+/// With the scenario's clearance, the plain and the paper's-method runs keep it through the clearance
+/// barrier (ClearanceBarrier: a null-space filter of their joint rates); without one, nothing.
+inline void add_clearance_barrier(const Scenario& sc, CaptureOptions& opt) {
+  const SceneGeometry* geo = sc.geometry.get();
+  if (!geo || !(geo->clearance > 0)) return;
+  opt.rate_guard = clearance_barrier(geo->checker, sc.problem.target, geo->clearance, opt);
+}
+
 #else
 
 struct SceneGeometry {};
@@ -201,6 +209,7 @@ inline GlobalCaptureResult plan_global_with_clearance(const Scenario& sc, const 
   return plan_capture_global(sc.problem, sc.task, opt, g);
 }
 inline ClearanceReport run_clearance(const Scenario&, const CaptureResult&) { return {}; }
+inline void add_clearance_barrier(const Scenario&, CaptureOptions&) {}
 
 #endif
 

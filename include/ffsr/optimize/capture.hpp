@@ -164,7 +164,8 @@ inline CaptureSetup prepare_capture(const CaptureProblem& pb, const CaptureTask&
 namespace detail {
 
 /// The joint-rate field of a capture run: at (t, base, theta) it writes theta_dot from the task
-/// solver and the null-space policy (Eq. 30-31) and the base velocity xb from zero momentum (Eq. 2).
+/// solver and the null-space policy (Eq. 30-31), filtered by the options' rate guard if any, and the
+/// base velocity xb from zero momentum (Eq. 2).
 /// Runs crba, frame_jacobian and generalized_jacobian at (base, theta), then the policy; data then
 /// holds the kinematics and data.H of (base, theta). Records the smallest singular value, the damped
 /// evaluations and the largest |theta_dot_k|.
@@ -180,6 +181,7 @@ struct CaptureRateField {
   TaskSolver solver;
   Eigen::VectorXd qd_null;
   Eigen::MatrixXd attitude_rows;  ///< hold_base_attitude: Q^T A (r x n), the held rows
+  std::unique_ptr<RateGuard> guard;  ///< opt.rate_guard's filter (null: none)
   double min_singular_value = std::numeric_limits<double>::infinity();
   long damped_steps = 0;
   double first_damped_time = -1;  ///< t of the first damped evaluation (-1: none)
@@ -197,7 +199,8 @@ struct CaptureRateField {
         solver(model.n(), setup_.rows, static_cast<int>(setup_.attitude_basis.cols()),
                opt_.singular_value_threshold, opt_.max_damping),
         qd_null(model.n()),
-        attitude_rows(setup_.attitude_basis.cols(), model.n()) {}
+        attitude_rows(setup_.attitude_basis.cols(), model.n()),
+        guard(opt_.rate_guard ? opt_.rate_guard() : nullptr) {}
 
   void operator()(double t, const BasePose& base, const Eigen::VectorXd& theta, Eigen::VectorXd& theta_dot,
                   Vector6& xb) {
@@ -209,8 +212,9 @@ struct CaptureRateField {
         task_velocity_command(setup.line, t, ee, opt.feedback, task.kind == CaptureTask::Kind::Pose);
     if (solver.extra_rows() > 0)
       attitude_rows.noalias() = setup.attitude_basis.transpose() * base_angular_rows(data);
-    const TaskRates& r = solver.extra_rows() > 0 ? solver.solve(data.Jf, cmd, policy.active(), attitude_rows)
-                                                 : solver.solve(data.Jf, cmd, policy.active());
+    const bool projector = policy.active() || guard;
+    const TaskRates& r = solver.extra_rows() > 0 ? solver.solve(data.Jf, cmd, projector, attitude_rows)
+                                                 : solver.solve(data.Jf, cmd, projector);
     min_singular_value = std::min(min_singular_value, r.sigma_min);
     if (r.damped && damped_steps++ == 0) first_damped_time = t;
     if (policy.active()) {
@@ -218,6 +222,7 @@ struct CaptureRateField {
       solver.add_null_space(qd_null, opt.max_joint_rate);
     }
     theta_dot = r.theta_dot;
+    if (guard) guard->filter(model, data, t, solver.projector(), theta_dot);
     max_joint_rate = std::max(max_joint_rate, theta_dot.cwiseAbs().maxCoeff());
     xb = base_velocity_from_momentum(model, data, theta_dot);  // data.H is H(base, theta)
   }

@@ -12,6 +12,7 @@
 
 #include <array>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -35,6 +36,20 @@ struct CaptureTask {
 
 enum class CaptureObjective { IntegratedEffectiveMass, ExactMaxForce };
 
+/// A filter of a capture run's joint rates inside the task's null space, applied at every evaluation
+/// of the rate law after the null-space policy and the joint-rate scaling (for example the clearance
+/// barrier of geometry/clearance.hpp, which keeps the distances to obstacles). `filter` receives the
+/// kinematics and data.H of (base, theta) (crba, frame_jacobian, generalized_jacobian run), the time,
+/// the null-space projector N of the task (and of the held rows, with hold_base_attitude) and the
+/// joint rates, which it may change by adding N v only (the task rates stay). It keeps per-run state,
+/// so each run makes its own (CaptureOptions::rate_guard).
+class RateGuard {
+ public:
+  virtual ~RateGuard() = default;
+  virtual void filter(const Model& model, const Data& data, double t, const Eigen::MatrixXd& N,
+                      Eigen::VectorXd& theta_dot) = 0;
+};
+
 struct CaptureOptions {
   double duration = 180.0;              ///< T, s
   double step = 0.1;                    ///< RK4 step, s
@@ -51,6 +66,9 @@ struct CaptureOptions {
   double max_joint_rate = 0;  ///< rad/s; the null-space term is scaled down to respect it (0: not limited)
   /// Reaction-null-space approach: hold the base's angular velocity at zero (base_attitude.hpp)
   bool hold_base_attitude = false;
+  /// Makes the run's joint-rate filter (RateGuard), called once per run; empty: none. The filter's
+  /// correction is not scaled by max_joint_rate (the largest joint rate is still recorded).
+  std::function<std::unique_ptr<RateGuard>()> rate_guard;
 };
 
 /// The capture problem: robot, end-effector, initial state, target (its initial state at t = 0),

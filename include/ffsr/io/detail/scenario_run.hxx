@@ -12,6 +12,8 @@ inline std::pair<CaptureResult, CaptureResult> plan_plain_and_optimized(const Sc
   opt.hold_base_attitude = sc.hold_base_attitude;  // the optimized run only
   plain.progress = options.plain_progress;
   opt.progress = options.optimized_progress;
+  add_clearance_barrier(sc, plain);  // with a clearance: both runs keep it in their null space
+  add_clearance_barrier(sc, opt);
   auto labelled = [](const char* label, auto&& f) {
     try {
       return f();
