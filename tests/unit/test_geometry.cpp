@@ -266,6 +266,36 @@ TEST_CASE("geometry: URDF collision primitives are read and capsules fill the li
   CHECK(g.shapes[3][0].length == Approx(0.5));  // link 3 to the end-effector
 }
 
+TEST_CASE("geometry: a capsule sunk into a box gets the least signed distance along its segment") {
+  // random capsules through a rotated box: the depth against the signed point-box distance minimized
+  // along the segment by golden section (convex along a segment), written here
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> U(-1, 1);
+  const Shape box = Shape::box(Vector3(0.5, 0.3, 0.8));
+  const Pose B{Vector3(0.2, -0.1, 0.3), Eigen::AngleAxisd(0.7, Vector3(1, 2, 3).normalized()).toRotationMatrix()};
+  auto signed_box = [&](const Vector3& x) {
+    const Vector3 e = (B.R.transpose() * (x - B.p)).cwiseAbs() - 0.5 * box.size;
+    return e.maxCoeff() > 0 ? e.cwiseMax(0.0).norm() : e.maxCoeff();
+  };
+  int sunk = 0;
+  for (int s = 0; s < 400; ++s) {
+    const Shape cap = Shape::capsule(0.05 + 0.1 * std::abs(U(rng)), 0.2 + 0.8 * std::abs(U(rng)));
+    const Pose P{B.p + 0.4 * Vector3(U(rng), U(rng), U(rng)),
+                 Eigen::AngleAxisd(M_PI * U(rng), Vector3(U(rng), U(rng), U(rng)).normalized()).toRotationMatrix()};
+    const Vector3 a = P.p - 0.5 * cap.length * P.R.col(2), b = P.p + 0.5 * cap.length * P.R.col(2);
+    const double expected = convex_min([&](double t) { return signed_box(a + t * (b - a)); }) - cap.radius;
+    if (expected > -1e-3) continue;  // the segment well inside: the depth branch
+    double d;
+    Vector3 pa, pb;
+    detail::round_box(cap, P, box, B, d, pa, pb);
+    INFO("sample " << s);
+    CHECK(std::abs(d - expected) < 1e-9);
+    CHECK((pa - pb).norm() == Approx(std::abs(d)).margin(1e-9));
+    ++sunk;
+  }
+  CHECK(sunk > 100);
+}
+
 TEST_CASE("geometry: a capsule overlapping a box gets its depth, continuous with the distance") {
   // a capsule of radius 0.1 along x at height z above the top face (z = 0.25) of a 0.5 m cube:
   // signed distance z - 0.25 - 0.1 whether it is above the face or sunk into it (closed form)

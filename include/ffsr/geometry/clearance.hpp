@@ -95,15 +95,30 @@ inline std::shared_ptr<ManifoldInequalities> clearance_constraints(const Model& 
   q->count = count;
   auto data = std::make_shared<Data>(model);
   auto grad = std::make_shared<Eigen::VectorXd>(model.n());
+  // the bus-target pairs do not move with theta: their distances are kept for the last base pose
+  auto bus_base = std::make_shared<std::optional<BasePose>>();
+  auto bus_rows = std::make_shared<std::vector<double>>(count);
   const Model* m = &model;
-  q->eval = [m, cc, data, grad, targets, clearance](const BasePose& base, const Eigen::VectorXd& theta, double* g,
-                                                    double* G) {
+  q->eval = [m, cc, data, grad, targets, clearance, bus_base, bus_rows](const BasePose& base,
+                                                                        const Eigen::VectorXd& theta, double* g,
+                                                                        double* G) {
     forward_kinematics(*m, *data, base, theta);
     const auto n = static_cast<size_t>(m->n());
+    const bool same_base = bus_base->has_value() && (*bus_base)->position == base.position &&
+                           (*bus_base)->orientation.coeffs() == base.orientation.coeffs();
     size_t row = 0;
     for (size_t i = 0; i < cc->pairs().size(); ++i) {
-      const size_t poses = cc->pairs()[i].kind == PairKind::ArmTarget ? targets.size() : 1;
+      const BodyPair& p = cc->pairs()[i];
+      const size_t poses = p.kind == PairKind::ArmTarget ? targets.size() : 1;
+      const bool bus_target = p.a == 0 && p.b < 0;
       for (size_t t = 0; t < poses; ++t, ++row) {
+        if (bus_target) {  // zero gradient: the base pose is the search's, fixed
+          if (!same_base) (*bus_rows)[row] = cc->pair_distance(*data, targets[t], static_cast<int>(i)).distance;
+          g[row] = clearance - (*bus_rows)[row];
+          if (G)
+            for (size_t k = 0; k < n; ++k) G[row * n + k] = 0;
+          continue;
+        }
         const PairDistance d = cc->pair_distance(*data, targets[t], static_cast<int>(i));
         g[row] = clearance - d.distance;
         if (!G) continue;
@@ -111,6 +126,7 @@ inline std::shared_ptr<ManifoldInequalities> clearance_constraints(const Model& 
         for (size_t k = 0; k < n; ++k) G[row * n + k] = -(*grad)(static_cast<Eigen::Index>(k));
       }
     }
+    *bus_base = base;
   };
   return q;
 }

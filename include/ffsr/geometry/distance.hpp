@@ -143,28 +143,40 @@ inline double box_sdf(const Shape& box, const Pose& B, const Vector3& x, Vector3
 }
 
 /// A capsule/sphere that reaches into a box: the least signed distance of the box along the centre
-/// segment minus the radius (golden section, 60 steps: the signed distance of a convex set is convex
-/// along a segment), a depth continuous with the distance outside, and the nearest points: the
-/// deepest point of the round shape and its centre point's projection on the box's surface.
+/// segment minus the radius, a depth continuous with the distance outside, and the nearest points:
+/// the deepest point of the round shape and its centre point's projection on the box's surface.
+/// Exact: in the box frame, g(t) = max_i (|q_i(t)| - h_i) is the largest of six linear functions of
+/// the segment parameter, a lower bound of the signed distance equal to it inside the box; the
+/// segment reaches the box, so min g <= 0 is the least signed distance, and the minimum of a maximum
+/// of lines on [0, 1] lies at an end or where two of them cross (at most 15 points).
 inline void round_box_depth(const Shape& s, const Pose& S, const Shape& box, const Pose& B, double& d,
                             Vector3& ps, Vector3& pbox) {
   Vector3 a, b;
   round_segment(s, S, a, b);
-  auto f = [&](double t) { return box_sdf(box, B, a + t * (b - a), nullptr); };
-  double lo = 0, hi = 1;
-  const double g = (std::sqrt(5.0) - 1) / 2;
-  double c = hi - g, e = lo + g, fc = f(c), fe = f(e);
-  for (int i = 0; i < 60; ++i) {
-    if (fc < fe) {
-      hi = e, e = c, fe = fc, c = hi - g * (hi - lo), fc = f(c);
-    } else {
-      lo = c, c = e, fc = fe, e = lo + g * (hi - lo), fe = f(e);
-    }
+  const Vector3 q0 = B.R.transpose() * (a - B.p), dq = B.R.transpose() * (b - a), h = 0.5 * box.size;
+  std::array<double, 6> c{}, k{};  // the lines c_j + k_j t
+  for (int i = 0; i < 3; ++i) {
+    c[static_cast<size_t>(2 * i)] = q0(i) - h(i), k[static_cast<size_t>(2 * i)] = dq(i);
+    c[static_cast<size_t>(2 * i + 1)] = -q0(i) - h(i), k[static_cast<size_t>(2 * i + 1)] = -dq(i);
   }
-  double t = 0.5 * (lo + hi);
-  if (f(0.0) < f(t)) t = 0;
-  if (f(1.0) < f(t)) t = 1;
-  const Vector3 x = a + t * (b - a);
+  auto g = [&](double t) {
+    double m = c[0] + k[0] * t;
+    for (size_t j = 1; j < 6; ++j) m = std::max(m, c[j] + k[j] * t);
+    return m;
+  };
+  double best_t = 0, best = g(0.0);
+  auto consider = [&](double t) {
+    const double v = g(t);
+    if (v < best) best = v, best_t = t;
+  };
+  consider(1.0);
+  for (size_t j = 0; j < 6; ++j)
+    for (size_t l = j + 1; l < 6; ++l)
+      if (k[j] != k[l]) {
+        const double t = (c[l] - c[j]) / (k[j] - k[l]);
+        if (t > 0 && t < 1) consider(t);
+      }
+  const Vector3 x = a + best_t * (b - a);
   Vector3 n;
   const double sd = box_sdf(box, B, x, &n);
   d = sd - s.radius;
@@ -208,7 +220,11 @@ inline void round_box(const Shape& s, const Pose& S, const Shape& box, const Pos
       num -= c * dq(i);
       den += dq(i) * dq(i);
     }
-    const double t = den > 0 ? std::clamp(num / den, t0, t1) : t0;
+    if (den == 0) {  // every coordinate within the box on this piece: the segment is inside there
+      best = 0;      // (at the piece's ends the squared distance is 0 only up to rounding)
+      break;
+    }
+    const double t = std::clamp(num / den, t0, t1);
     for (double x : {t, t1}) {
       const double g = outside2(x);
       if (g < best) best = g, best_t = x;
@@ -218,12 +234,11 @@ inline void round_box(const Shape& s, const Pose& S, const Shape& box, const Pos
     round_box_depth(s, S, box, B, d, ps, pbox);
     return;
   }
-  const Vector3 x = a + best_t * (b - a);
-  Vector3 n;
-  const double sd = box_sdf(box, B, x, &n);
-  d = sd - s.radius;
-  ps = x - s.radius * n;
-  pbox = x - sd * n;
+  // outside: the nearest box point is the centre point clamped to the box (box frame)
+  const Vector3 xq = q0 + best_t * dq, cq = xq.cwiseMax(-h).cwiseMin(h), nq = (xq - cq) / std::sqrt(best);
+  d = std::sqrt(best) - s.radius;
+  pbox = B.p + B.R * cq;
+  ps = a + best_t * (b - a) - s.radius * (B.R * nq);
 }
 
 }  // namespace detail
