@@ -186,6 +186,15 @@ void write_outputs(const Scenario& sc, const ScenarioResult& r, const RunSetting
   q.outputs.write();
 }
 
+namespace {
+/// "0.0505 m": a distance with four decimals.
+std::string metres4(double x) {
+  std::ostringstream s;
+  s << std::fixed << std::setprecision(4) << x << " m";
+  return s.str();
+}
+}  // namespace
+
 void print_global_notes(std::ostream& out, const Scenario& sc, const GlobalRun& g,
                         const CaptureResult& opt_run) {
   const GlobalCaptureResult& r = g.result;
@@ -195,6 +204,7 @@ void print_global_notes(std::ostream& out, const Scenario& sc, const GlobalRun& 
   const char* u = unit == 1.0 ? " kg" : " kN";
   out << std::fixed << std::setprecision(3) << "global (" << o.objective << ", seed " << o.seed
       << "): reached " << r.objective / unit << u << ", manifold optimum at the reached base pose "
+      << (r.search_distance_bound > 0 ? "with distances >= " + metres4(r.search_distance_bound) + " " : "")
       << r.manifold_optimum / unit << u << " (gap " << r.optimality_gap_percent << " %), "
       << r.shooting_iterations << " reaching run(s), " << r.goals_tried << " goal(s) tried"
       << (r.goals_out_of_limits > 0 ? " (" + std::to_string(r.goals_out_of_limits) + " behind a joint limit)"
@@ -295,6 +305,14 @@ void print_clearance(std::ostream& out, const Scenario& sc, const ScenarioResult
         << c.overall.pair << ", t = " << std::setprecision(1) << c.overall.time << " s)"
         << std::setprecision(4);
   out << "\n";
+  for (const auto& [name, c] : r.clearances)  // the global run is rejected instead (below)
+    if (name != "global" && sc.keys.clearance > 0 && c.overall.distance < sc.keys.clearance - 1e-6)
+      out << "clearance: the " << (name == "baseline" ? "plain" : name)
+          << " run comes closer than the clearance (the clearance barrier could not keep it with the freedom "
+             "its task leaves): "
+          << c.overall.pair << " " << c.overall.distance << " m at t = " << std::setprecision(1) << c.overall.time
+          << " s\n"
+          << std::setprecision(4);
   if (r.global && r.global->result.goals_rejected > 0)
     out << "clearance: " << r.global->result.goals_rejected
         << " reached goal(s) rejected along the path; last: " << r.global->result.rejection << "\n";

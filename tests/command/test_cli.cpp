@@ -211,6 +211,27 @@ TEST_CASE("inspect: the distances of a configuration with shapes, against a clos
 // 2. contact
 // ------------------------------------------------------------------------------------------------
 
+TEST_CASE("the main job names a plain or paper's-method run that the clearance barrier could not keep", "[cli]") {
+  // robots/paper_7dof_position_clearance.toml with 9 cm: the plain run tracks the pose (one null-space
+  // direction) and its last link passes closer to the target; the paper's method (position task, four
+  // directions) keeps 9 cm. The distances come from the JSON, the line from the table.
+  const std::string file = kSource + "/robots/paper_7dof_position_clearance.toml";
+  const auto j = cli({"--config", file, "--clearance", "0.09", "--global", "false", "--quiet", "--json", "-"});
+  INFO(j.err);
+  REQUIRE(j.exit_code == 0);
+  const auto res = nlohmann::json::parse(j.out);
+  const double plain = res.at("baseline").at("min_clearance").at("distance").get<double>();
+  CHECK(plain < 0.09);
+  CHECK(res.at("optimized").at("min_clearance").at("distance").get<double>() >= 0.09 - 1e-6);
+  const auto t = cli({"--config", file, "--clearance", "0.09", "--global", "false"});
+  REQUIRE(t.exit_code == 0);
+  const std::string line = "clearance: the plain run comes closer than the clearance (the clearance barrier could "
+                           "not keep it with the freedom its task leaves): " +
+                           res.at("baseline").at("min_clearance").at("pair").get<std::string>() + " ";
+  CHECK(t.out.find(line) != std::string::npos);
+  CHECK(t.out.find("clearance: the optimized run") == std::string::npos);
+}
+
 TEST_CASE("contact --model all --json lists the eight laws", "[cli]") {
   const auto j =
       parse_json(cli({"contact", "--urdf", kUrdf3, "--joints-deg", "0,90,-90", "--model", "all", "--json"}));

@@ -219,7 +219,9 @@ template <class Policy>
 class CaptureController {
  public:
   /// The plan: prepare_capture(pb, task, opt) (its input errors, InputError naming
-  /// "CaptureController") and the policy. Allocates; step() then does not.
+  /// "CaptureController") and the policy. Allocates; step() then does not. opt.rate_guard is not
+  /// used (a joint-rate filter such as the clearance barrier may allocate and throw, and it models
+  /// the target of the plan, not the estimates of update_target).
   CaptureController(const CaptureProblem& pb, const CaptureTask& task, const CaptureOptions& opt,
                     Policy policy, const ControllerOptions& copt = {})
       : core_(std::make_unique<Core>(pb, task, opt, std::move(policy), copt)) {}
@@ -358,6 +360,7 @@ class CaptureController {
     static CaptureOptions without_callbacks(CaptureOptions o) {
       o.progress = nullptr;
       o.record_series = false;
+      o.rate_guard = nullptr;  // a filter may allocate and throw; the clearance barrier's target is the plan's
       return o;
     }
     static void presize(GradientPolicy& p, int n) { p.grad = Eigen::VectorXd::Zero(n); }

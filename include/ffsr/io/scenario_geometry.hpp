@@ -162,7 +162,9 @@ inline GlobalCaptureResult plan_global_with_clearance(const Scenario& sc, const 
         given, clearance_constraints(*m, cc, detail::target_poses(t0, times), c + margin));
     violations->clear();
     try {
-      return plan_capture_global(sc.problem, sc.task, opt, g);
+      GlobalCaptureResult r = plan_capture_global(sc.problem, sc.task, opt, g);
+      r.search_distance_bound = c + margin;
+      return r;
     } catch (const NumericalError&) {
       if (round == 4 || violations->empty()) throw;
     }

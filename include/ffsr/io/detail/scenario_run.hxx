@@ -285,6 +285,7 @@ inline void add_global_json(nlohmann::json& j, const Scenario& sc, const GlobalR
   x["objective_value"] = r.objective;
   x["manifold_optimum"] = r.manifold_optimum;
   x["optimality_gap_percent"] = r.optimality_gap_percent;
+  x["search_distance_bound"] = r.search_distance_bound;
   x["shooting_iterations"] = r.shooting_iterations;
   x["goals_tried"] = r.goals_tried;
   x["goals_out_of_limits"] = r.goals_out_of_limits;
