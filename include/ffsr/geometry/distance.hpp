@@ -148,12 +148,11 @@ inline double box_sdf(const Shape& box, const Pose& B, const Vector3& x, Vector3
 /// Exact: in the box frame, g(t) = max_i (|q_i(t)| - h_i) is the largest of six linear functions of
 /// the segment parameter, a lower bound of the signed distance equal to it inside the box; the
 /// segment reaches the box, so min g <= 0 is the least signed distance, and the minimum of a maximum
-/// of lines on [0, 1] lies at an end or where two of them cross (at most 15 points).
-inline void round_box_depth(const Shape& s, const Pose& S, const Shape& box, const Pose& B, double& d,
-                            Vector3& ps, Vector3& pbox) {
-  Vector3 a, b;
-  round_segment(s, S, a, b);
-  const Vector3 q0 = B.R.transpose() * (a - B.p), dq = B.R.transpose() * (b - a), h = 0.5 * box.size;
+/// of lines on [0, 1] lies at an end or where two of them cross (at most 15 points). The centre
+/// segment a-b, in the box frame q0 + t dq, comes from round_box.
+inline void round_box_depth(const Shape& s, const Vector3& a, const Vector3& b, const Shape& box, const Pose& B,
+                            const Vector3& q0, const Vector3& dq, double& d, Vector3& ps, Vector3& pbox) {
+  const Vector3 h = 0.5 * box.size;
   std::array<double, 6> c{}, k{};  // the lines c_j + k_j t
   for (int i = 0; i < 3; ++i) {
     c[static_cast<size_t>(2 * i)] = q0(i) - h(i), k[static_cast<size_t>(2 * i)] = dq(i);
@@ -231,7 +230,7 @@ inline void round_box(const Shape& s, const Pose& S, const Shape& box, const Pos
     }
   }
   if (!(best > 0)) {
-    round_box_depth(s, S, box, B, d, ps, pbox);
+    round_box_depth(s, a, b, box, B, q0, dq, d, ps, pbox);
     return;
   }
   // outside: the nearest box point is the centre point clamped to the box (box frame)
