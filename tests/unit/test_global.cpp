@@ -134,6 +134,26 @@ TEST_CASE("Global capture: bad inputs", "[global]") {
   BasePose far;
   far.position = Vector3(-5, 0, 0);
   CHECK_THROWS_WITH(search_capture_manifold(pb, task, s, far, g.search), Catch::Contains("out of reach"));
+  // a target 10 m away: the task alone cannot follow the line; with a reconfiguration allowed the
+  // search at the initial base pose finds nothing either, and the error (a NumericalError, as without
+  // a reconfiguration) names both
+  CaptureProblem away = pb;
+  away.target.position += Vector3(10, 0, 0);
+  for (const ReconfigureMode mode : {ReconfigureMode::Never, ReconfigureMode::Auto, ReconfigureMode::Always}) {
+    g.reconfigure.mode = mode;
+    INFO(reconfigure_mode_name(mode));
+    try {
+      plan_capture_global(away, task, o, g);
+      FAIL("no error");
+    } catch (const InputError& e) {
+      FAIL("an InputError: " << e.what());
+    } catch (const NumericalError& e) {
+      const std::string what = e.what();
+      CHECK_THAT(what, Catch::Contains("cannot follow the line"));
+      if (mode != ReconfigureMode::Never) CHECK_THAT(what, Catch::Contains("the search at the initial base pose"));
+      CHECK(what.find('\n') == std::string::npos);
+    }
+  }
 }
 
 namespace {

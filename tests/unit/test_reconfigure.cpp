@@ -165,42 +165,73 @@ TEST_CASE("reconfigure: both phases conserve zero momentum, keep the centre of m
   check_boundary_and_capture(rr, sc.problem.theta + delta, t_r, opt);
 }
 
-// Hidden ([.]): it needs an orientation residual whose only zero is the final orientation (the log
-// map); with vee(skew(R)) the search's optima below 15.66 kg are all turned half a turn, dropped as
-// goals, and the run stays on the start's component. Run it with `test_reconfigure "[pose-optimum]"`.
-TEST_CASE("reconfigure: global run on the 7-DOF pose scenario reaches the pose manifold's optimum",
-          "[.][pose-optimum]") {
-  const ffsr::Scenario sc = scenario("robots/paper_7dof_pose.toml");
-  const auto [plain, optimized] = ffsr::plan_plain_and_optimized(sc);
-  // the global run's options (run_global), with one more start: a configuration near the pose
-  // manifold's optimum on a component the approach alone cannot reach (found by an independent
-  // search with the orientation error as an angle), so that the goal does not hang on the search
-  ffsr::CaptureOptions opt = sc.capture;
-  opt.gain = 0;
-  opt.max_joint_rate = 3 * kDeg;
-  ffsr::GlobalCaptureOptions g;
-  g.search.seed = sc.seed;
-  g.search.starts = sc.keys.global_starts;
+// The gripper in the orientation of a configuration of very low M_ie (1.278 kg at the scenario's
+// capture point, [4.3, -14.8, -31.0, 2.5, -54.7, -8.3, 32.9] deg), 134 deg away from the initial
+// orientation the scenario keeps: the task alone cannot turn the gripper that far along the line (it
+// loses the line at t = 103 s), so without a reconfiguration there is no plan; with one, the global
+// run reaches the pose manifold's optimum in that orientation.
+TEST_CASE("reconfigure: a grasp orientation the task alone cannot reach, reached with a reconfiguration",
+          "[reconfigure]") {
+  const std::string file = "robots/paper_7dof_pose.toml";
+  const ffsr::Scenario start = scenario(file);
+  const ffsr::Model& model = *start.model;
+  ffsr::Data data(model);
   Eigen::VectorXd known(7);
   known << 4.3, -14.8, -31.0, 2.5, -54.7, -8.3, 32.9;
-  g.extra_starts = {optimized.theta, known * kDeg};
-  g.reconfigure.mode = ffsr::ReconfigureMode::Auto;
-  const ffsr::GlobalCaptureResult r = ffsr::plan_capture_global(sc.problem, sc.task, opt, g);
+  ffsr::crba(model, data, start.problem.base, known * kDeg);
+  const ffsr::Vector3 rpy = ffsr::rpy_from_rotation(ffsr::frame_pose(model, data, start.problem.frame).R) / kDeg;
+  const std::string final_rpy =
+      std::to_string(rpy.x()) + "," + std::to_string(rpy.y()) + "," + std::to_string(rpy.z());
+  INFO("final-rpy-deg = " << final_rpy);
+
+  ffsr::CaptureOptions opt = start.capture;
+  opt.gain = 0;
+  opt.max_joint_rate = 3 * kDeg;
+  auto options = [&](const ffsr::Scenario& sc, ffsr::ReconfigureMode mode) {
+    ffsr::GlobalCaptureOptions g;
+    g.search.seed = sc.seed;
+    g.search.starts = sc.keys.global_starts;
+    g.reconfigure.mode = mode;
+    return g;
+  };
+  const ffsr::Scenario sc = scenario(file, {{"final-rpy-deg", final_rpy}});
+  // without a reconfiguration: the task alone's error, as before
+  CHECK_THROWS_AS(ffsr::plan_capture_global(sc.problem, sc.task, opt, options(sc, ffsr::ReconfigureMode::Never)),
+                  ffsr::NumericalError);
+
+  opt.record_series = true;
+  const ffsr::GlobalCaptureResult r =
+      ffsr::plan_capture_global(sc.problem, sc.task, opt, options(sc, ffsr::ReconfigureMode::Auto));
   INFO("M_ie " << r.run.M_ie << " kg, manifold optimum " << r.manifold_optimum << " kg");
+  CHECK(r.task_alone_failure.find("cannot follow the line") != std::string::npos);
   CHECK(r.reconfigured);
   CHECK(r.run.M_ie <= 1.31);
   CHECK(std::abs(r.run.M_ie - r.manifold_optimum) <= 0.01 * r.run.M_ie);
   CHECK(r.reached_manifold_optimum);
-  // the orientation at T as an angle, from the reached configuration
-  ffsr::Data data(*sc.model);
-  ffsr::crba(*sc.model, data, r.run.base, r.run.theta);
-  const ffsr::Matrix3 R = ffsr::frame_pose(*sc.model, data, sc.problem.frame).R;
-  const ffsr::CaptureSetup setup = ffsr::prepare_capture(sc.problem, sc.task, opt);
-  const double angle = Eigen::AngleAxisd(setup.R_end * R.transpose()).angle();
-  CHECK(angle < sc.capture.orientation_tolerance);
+  // the capture at T from the reached state: the orientation as an angle, the capture point
+  ffsr::crba(model, data, r.run.base, r.run.theta);
+  const ffsr::Pose ee = ffsr::frame_pose(model, data, sc.problem.frame);
+  const ffsr::Matrix3 R_end = ffsr::rotation_from_rpy(rpy * kDeg);
+  CHECK(Eigen::AngleAxisd(R_end * ee.R.transpose()).angle() < sc.capture.orientation_tolerance);
+  CHECK((ee.p - r.run.capture_point).norm() < sc.capture.tolerance);
+  // both phases: joint rates within the limit, joint limits, zero momentum, the centre of mass kept
   REQUIRE(r.phases.size() == 2);
-  CHECK(r.phases[0].max_joint_rate <= 3 * kDeg * (1 + 1e-9));
-  CHECK(r.phases[1].max_joint_rate <= 3 * kDeg * (1 + 1e-9));
+  for (const ffsr::RunPhase& ph : r.phases) CHECK(ph.max_joint_rate <= 3 * kDeg * (1 + 1e-9));
+  const auto& s = r.run.series;
+  REQUIRE(s.size() > 2);
+  StateCheck check(model);
+  const ffsr::Vector3 c0 = check.com(s.front());
+  double worst_momentum = 0, worst_com = 0, worst_rate = 0;
+  for (size_t i = 1; i + 1 < s.size(); ++i) {
+    worst_momentum = std::max(worst_momentum, check.momentum(s[i - 1], s[i], s[i + 1]));
+    worst_com = std::max(worst_com, (check.com(s[i]) - c0).norm());
+    worst_rate = std::max(worst_rate, (s[i + 1].theta - s[i].theta).cwiseAbs().maxCoeff() / (s[i + 1].t - s[i].t));
+    CHECK(ffsr::detail::within_limits(model, s[i].theta));
+  }
+  INFO("momentum (central differences) " << worst_momentum << ", centre of mass " << worst_com << " m");
+  CHECK(worst_momentum < 1e-3 * r.run.max_body_momentum + 1e-6);
+  CHECK(worst_com < 1e-9);
+  CHECK(worst_rate <= 3 * kDeg * (1 + 1e-3));
 }
 
 TEST_CASE("reconfigure: the run check learns when each checked run's approach begins", "[reconfigure]") {

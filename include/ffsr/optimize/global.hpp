@@ -690,6 +690,10 @@ struct GlobalCaptureResult {
   /// clearance plus the margin of the round that planned the run); manifold_optimum is the optimum
   /// under it. 0: no distance bound.
   double search_distance_bound = 0;
+  /// Empty when the task alone (no null-space motion) followed the line and gave the first base pose
+  /// at T; otherwise its error (possible only with a reconfiguration allowed): the first search was at
+  /// the initial base pose.
+  std::string task_alone_failure;
 };
 
 namespace detail {
@@ -797,7 +801,9 @@ inline std::optional<GlobalCaptureResult> reach_goal(const CaptureProblem& pb, c
       ++res.goals_out_of_limits;
       return std::nullopt;
     } catch (const NumericalError&) {
-      if (t_r > 0) return std::nullopt;  // the approach after this reconfiguration fails: give it up
+      // the approach fails (after a reconfiguration, or alone where one may follow): give the goal
+      // up; the approach alone without a reconfiguration to fall back on: the run's error
+      if (t_r > 0 || g.reconfigure.mode != ReconfigureMode::Never) return std::nullopt;
       throw;
     }
     const ManifoldPoint reached = evaluate_capture(pb, setup, run.base, run.theta, g.search.objective,
@@ -883,7 +889,10 @@ inline GlobalCaptureResult with_counters(GlobalCaptureResult best, const GlobalC
 /// g.reconfigure (reconfigure.hpp): never, the approach alone; always, every goal reached with a
 /// reconfiguration first; auto, each goal with the approach alone first, then, unless reached,
 /// with a reconfiguration. A reconfiguration the joint-rate limit does not allow in its time throws
-/// ReconfigurationRateError (an InputError).
+/// ReconfigurationRateError (an InputError). With a reconfiguration allowed (auto, always), a task
+/// the arm cannot follow from its start is no error: the failure of the task alone goes into
+/// task_alone_failure, the first search is at the initial base pose, and an approach alone that fails
+/// gives its goal up to the reconfiguration.
 inline GlobalCaptureResult plan_capture_global(const CaptureProblem& pb, const CaptureTask& task,
                                                const CaptureOptions& opt, const GlobalCaptureOptions& g) {
   using detail::str;
@@ -899,15 +908,31 @@ inline GlobalCaptureResult plan_capture_global(const CaptureProblem& pb, const C
 
   // the task alone (no null-space motion): a first base pose at T, and the rate it needs
   ServoPolicy none;
-  const CaptureResult plain = integrate_capture(pb, task, quiet, setup, none, where);
-  if (o.max_joint_rate > 0 && plain.max_joint_rate > o.max_joint_rate)
-    throw InputError(str(where, ": max joint rate ", o.max_joint_rate * 180 / M_PI,
-                         " deg/s is below what the task alone needs (", plain.max_joint_rate * 180 / M_PI,
-                         " deg/s)"));
+  // With a reconfiguration allowed, a task the arm cannot follow from its start (a grasp orientation
+  // far from the initial one, an algorithmic singularity on the way) is no error: the search starts
+  // at the initial base pose instead, and the reconfiguration moves the arm to where the approach works.
   GlobalCaptureResult res;
   std::vector<Eigen::VectorXd> extra = g.extra_starts;
-  extra.push_back(plain.theta);
-  const std::vector<ManifoldPoint> goals = detail::capture_goals(pb, task, setup, plain.base, g, extra, res);
+  BasePose first_base = pb.base;
+  try {
+    const CaptureResult plain = integrate_capture(pb, task, quiet, setup, none, where);
+    if (o.max_joint_rate > 0 && plain.max_joint_rate > o.max_joint_rate)
+      throw InputError(str(where, ": max joint rate ", o.max_joint_rate * 180 / M_PI,
+                           " deg/s is below what the task alone needs (", plain.max_joint_rate * 180 / M_PI,
+                           " deg/s)"));
+    extra.push_back(plain.theta);
+    first_base = plain.base;
+  } catch (const NumericalError& e) {
+    if (g.reconfigure.mode == ReconfigureMode::Never) throw;
+    res.task_alone_failure = e.what();
+  }
+  std::vector<ManifoldPoint> goals;
+  try {
+    goals = detail::capture_goals(pb, task, setup, first_base, g, extra, res);
+  } catch (const InputError& e) {  // e.g. a capture point out of reach: the task alone's error first
+    if (res.task_alone_failure.empty()) throw;
+    throw NumericalError(str(res.task_alone_failure, "; the search at the initial base pose: ", e.what()));
+  }
 
   CaptureOptions run_opt = quiet;
   run_opt.record_series = opt.record_series || static_cast<bool>(g.check_run);
@@ -955,7 +980,8 @@ inline GlobalCaptureResult plan_capture_global(const CaptureProblem& pb, const C
   throw NumericalError(str(
       where, ": no capture configuration chosen by the search was reached (", res.goals_tried, " goals, ",
       res.goals_out_of_limits, " of them behind a joint limit, ", res.shooting_iterations, " reaching runs)",
-      res.goals_rejected ? str("; the last reached goal was rejected: ", res.rejection) : ""));
+      res.goals_rejected ? str("; the last reached goal was rejected: ", res.rejection) : "",
+      res.task_alone_failure.empty() ? "" : str("; the task alone failed: ", res.task_alone_failure)));
 }
 
 }  // namespace ffsr
