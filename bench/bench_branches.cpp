@@ -9,7 +9,7 @@
 //     (search_capture_manifold, the scenario's seed and starts; the task-only run's configuration
 //     as the extra start);
 //   - the whole global plan as the main job makes it (plan_capture_global, the paper's-method run's
-//     capture configuration as the extra start);
+//     capture configuration as the extra start, the scenario's reconfiguration mode: auto);
 //   - the branches' reachability (capture_branches: one reaching run for each of the best 6);
 // and the whole global plan with a reconfiguration for robots/paper_7dof_pose.toml in a grasp
 // orientation the task alone cannot reach.
@@ -76,6 +76,8 @@ void bench_scenario(const std::string& file, int runs) {
   GlobalCaptureOptions g;
   g.search = so;
   g.extra_starts = {paper.theta};
+  g.reconfigure.mode = reconfigure_mode_of(sc.keys.reconfigure, "reconfigure");  // the scenario's (auto)
+  g.reconfigure.duration = sc.keys.reconfigure_duration;
   GlobalCaptureResult global;
   const double t_plan = median_seconds(
       runs, [&] { global = plan_capture_global(sc.problem, sc.task, opt, g); }, c_plan);
@@ -88,8 +90,9 @@ void bench_scenario(const std::string& file, int runs) {
   std::printf("  branch search:        %8.3f s wall, %8.3f s CPU  (%zu local optima, best %.4f kg; %s)\n",
               t_search, c_search, search.local_optima.size(), search.best.M_ie, search.method.c_str());
   std::printf(
-      "  whole global plan:    %8.3f s wall, %8.3f s CPU  (reached %.4f kg, manifold optimum %.4f kg)\n",
-      t_plan, c_plan, global.objective, global.manifold_optimum);
+      "  whole global plan:    %8.3f s wall, %8.3f s CPU  (reached %.4f kg, manifold optimum %.4f kg, "
+      "reconfigured: %s)\n",
+      t_plan, c_plan, global.objective, global.manifold_optimum, global.reconfigured ? "yes" : "no");
   std::printf(
       "  branch reachability:  %8.3f s wall, %8.3f s CPU  (%zu branches, the best %zu tested, one run "
       "each)\n",
