@@ -694,6 +694,9 @@ struct GlobalCaptureResult {
   /// at T; otherwise its error (possible only with a reconfiguration allowed): the first search was at
   /// the initial base pose.
   std::string task_alone_failure;
+  /// The error of the last reaching run that failed and whose goal was given up for it (an approach
+  /// after a reconfiguration, or alone where a reconfiguration may follow); empty if none.
+  std::string run_failure;
 };
 
 namespace detail {
@@ -800,10 +803,13 @@ inline std::optional<GlobalCaptureResult> reach_goal(const CaptureProblem& pb, c
     } catch (const JointLimitError&) {
       ++res.goals_out_of_limits;
       return std::nullopt;
-    } catch (const NumericalError&) {
+    } catch (const NumericalError& e) {
       // the approach fails (after a reconfiguration, or alone where one may follow): give the goal
       // up; the approach alone without a reconfiguration to fall back on: the run's error
-      if (t_r > 0 || g.reconfigure.mode != ReconfigureMode::Never) return std::nullopt;
+      if (t_r > 0 || g.reconfigure.mode != ReconfigureMode::Never) {
+        res.run_failure = e.what();
+        return std::nullopt;
+      }
       throw;
     }
     const ManifoldPoint reached = evaluate_capture(pb, setup, run.base, run.theta, g.search.objective,
@@ -870,6 +876,7 @@ inline GlobalCaptureResult with_counters(GlobalCaptureResult best, const GlobalC
   best.objective_evaluations = counts.objective_evaluations;
   best.search_seconds = counts.search_seconds;
   best.goals_rejected = counts.goals_rejected;
+  best.run_failure = counts.run_failure;
   return best;
 }
 
@@ -981,7 +988,8 @@ inline GlobalCaptureResult plan_capture_global(const CaptureProblem& pb, const C
       where, ": no capture configuration chosen by the search was reached (", res.goals_tried, " goals, ",
       res.goals_out_of_limits, " of them behind a joint limit, ", res.shooting_iterations, " reaching runs)",
       res.goals_rejected ? str("; the last reached goal was rejected: ", res.rejection) : "",
-      res.task_alone_failure.empty() ? "" : str("; the task alone failed: ", res.task_alone_failure)));
+      res.task_alone_failure.empty() ? "" : str("; the task alone failed: ", res.task_alone_failure),
+      res.run_failure.empty() ? "" : str("; the last reaching run that failed: ", res.run_failure)));
 }
 
 }  // namespace ffsr
