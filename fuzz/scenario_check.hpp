@@ -9,14 +9,16 @@
 //    failure): 1 means an exception that is not an
 //    ffsr::Error or a CLI11 parse error reached main;
 //  - a failed run leaves no output file and no temporary file behind;
-//  - a successful run's JSON parses and has no null (nlohmann writes NaN and inf as null) and no
-//    non-finite number, its CSV and its terminal table contain no nan or inf.
+//  - a successful run's JSON parses and has no null (nlohmann writes NaN and inf as null; only the
+//    reductions against a run that failed, {"error": message}, are null) and no non-finite number,
+//    its CSV and its terminal table contain no nan or inf.
 #pragma once
 
 #include "fuzz_checks.hpp"
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <regex>
@@ -62,14 +64,17 @@ inline bool has_non_finite_token(const std::string& text) {
   return std::regex_search(text, re);
 }
 
-inline void check_json_finite(const nlohmann::json& j, const std::string& path) {
+/// `null_ok`: the paths where a null is documented (the reductions against a run that failed).
+inline void check_json_finite(const nlohmann::json& j, const std::string& path,
+                              const std::vector<std::string>& null_ok = {}) {
+  if (j.is_null() && std::find(null_ok.begin(), null_ok.end(), path) != null_ok.end()) return;
   if (j.is_null()) fail("JSON output: null (a NaN or inf) at " + path);
   if (j.is_number_float() && !std::isfinite(j.get<double>()))
     fail("JSON output: non-finite number at " + path);
   if (j.is_object())
-    for (auto it = j.begin(); it != j.end(); ++it) check_json_finite(it.value(), path + "/" + it.key());
+    for (auto it = j.begin(); it != j.end(); ++it) check_json_finite(it.value(), path + "/" + it.key(), null_ok);
   if (j.is_array())
-    for (size_t i = 0; i < j.size(); ++i) check_json_finite(j[i], path + "/" + std::to_string(i));
+    for (size_t i = 0; i < j.size(); ++i) check_json_finite(j[i], path + "/" + std::to_string(i), null_ok);
 }
 
 /// The checks after one run of the scenario in `dir` (see the top of this file). `terminal` is what
@@ -99,7 +104,22 @@ inline void check_scenario_outputs(const std::string& dir, int exit_code, const 
   } catch (const std::exception& e) {
     fail(std::string("the JSON output does not parse: ") + e.what());
   }
-  check_json_finite(j, "");
+  // a plain or paper's-method run that failed while the global row ran: {"error": text} in its place,
+  // and the reductions against it null
+  std::vector<std::string> null_ok;
+  for (const char* row : {"baseline", "optimized"})
+    if (j.contains(row) && j[row].contains("error")) {
+      if (!j[row]["error"].is_string() || j[row]["error"].get<std::string>().empty())
+        fail(std::string("JSON output: /") + row + "/error is not a message");
+      if (!j.contains("global")) fail(std::string("JSON output: /") + row + " failed without a global row");
+      for (const char* k : {"/mass_reduction_percent", "/force_reduction_percent", "/exact_force_reduction_percent"})
+        null_ok.push_back(k);
+      if (std::string(row) == "baseline")
+        for (const char* k : {"/global_mass_reduction_percent", "/global_force_reduction_percent",
+                              "/global_exact_force_reduction_percent"})
+          null_ok.push_back(k);
+    }
+  check_json_finite(j, "", null_ok);
   if (has_non_finite_token(read_text(dir + "/out.csv"))) fail("the CSV output has nan or inf");
 }
 

@@ -110,6 +110,7 @@ ScenarioResult compute(Scenario& sc, const RunSettings& o) {
   sc.capture.record_series = !o.csv.empty() || !o.plot.empty();
   Progress p1{"plain"}, p2{"optimized"};
   ScenarioRunOptions run;
+  run.keep_going = true;  // a plain or paper's-method row that fails is reported; the global row decides
   if (!o.quiet) {
     run.plain_progress = std::ref(p1);
     run.optimized_progress = std::ref(p2);
@@ -137,8 +138,9 @@ std::string series_csv(const Scenario& sc, const ScenarioResult& r) {
   c << std::setprecision(12) << "run,t";
   for (const auto& name : sc.model->joint_names()) c << "," << name << "_deg";
   c << ",base_x,base_y,base_z,base_qw,base_qx,base_qy,base_qz,ee_x,ee_y,ee_z,M_ie,F_max_estimate,phase\n";
-  std::vector<std::pair<const char*, const CaptureResult*>> runs{{"baseline", &r.plain},
-                                                                 {"optimized", &r.optimized}};
+  std::vector<std::pair<const char*, const CaptureResult*>> runs;
+  if (r.plain_ok()) runs.emplace_back("baseline", &r.plain);
+  if (r.optimized_ok()) runs.emplace_back("optimized", &r.optimized);
   if (r.global) runs.emplace_back("global", &r.global->result.run);
   for (const auto& [label, run] : runs) {
     const long reconfiguring = r.global && run == &r.global->result.run ? reconfiguration_samples(r) : 0;
@@ -170,8 +172,9 @@ std::optional<figures::SceneShapes> scene_shapes(const Scenario& sc) {
 void write_outputs(const Scenario& sc, const ScenarioResult& r, const RunSettings& o, RunRequest& q,
                    const nlohmann::json& j) {
   if (!o.plot.empty()) {  // the pictures of the same result structs; the runs are one vector entry each
-    std::vector<figures::CaptureRun> runs{{"plain", &r.plain, sc.baseline_task},
-                                          {"optimized", &r.optimized, sc.task}};
+    std::vector<figures::CaptureRun> runs;
+    if (r.plain_ok()) runs.push_back({"plain", &r.plain, sc.baseline_task});
+    if (r.optimized_ok()) runs.push_back({"optimized", &r.optimized, sc.task});
     if (r.global) runs.push_back({"global", &r.global->result.run, sc.task, reconfiguration_samples(r)});
     const std::optional<figures::SceneShapes> shapes = scene_shapes(sc);
     for (figures::CaptureRun& run : runs)  // the plain run's clearance is called "baseline"
@@ -195,8 +198,8 @@ std::string metres4(double x) {
 }
 }  // namespace
 
-void print_global_notes(std::ostream& out, const Scenario& sc, const GlobalRun& g,
-                        const CaptureResult& opt_run) {
+/// The global row's notes; `opt_run`: the paper's-method run (null when it failed).
+void print_global_notes(std::ostream& out, const Scenario& sc, const GlobalRun& g, const CaptureResult* opt_run) {
   const GlobalCaptureResult& r = g.result;
   const ScenarioKeys& o = sc.keys;
   const bool mb = o.objective == "multibody-force";
@@ -222,10 +225,14 @@ void print_global_notes(std::ostream& out, const Scenario& sc, const GlobalRun& 
            "manifold; "
            "the servo reached none of them\n";
   if (mb)
-    out << "CVODE multibody F_max: optimization " << g.paper_objective / 1e3 << " kN, global "
-        << r.objective / 1e3 << " kN\n";
-  out << "largest joint rate: optimization " << opt_run.max_joint_rate * 180.0 / M_PI
-      << " deg/s (not limited), global " << r.run.max_joint_rate * 180.0 / M_PI << " deg/s ("
+    out << "CVODE multibody F_max: "
+        << (opt_run ? "optimization " + std::to_string(g.paper_objective / 1e3) + " kN, " : std::string())
+        << "global " << r.objective / 1e3 << " kN\n";
+  out << "largest joint rate: "
+      << (opt_run ? "optimization " + std::to_string(opt_run->max_joint_rate * 180.0 / M_PI) +
+                        " deg/s (not limited), "
+                  : std::string())
+      << "global " << r.run.max_joint_rate * 180.0 / M_PI << " deg/s ("
       << (o.max_joint_rate_deg > 0 ? "limit " + std::to_string(o.max_joint_rate_deg) + " deg/s"
                                    : std::string("not limited"))
       << ")\n";
@@ -253,7 +260,11 @@ void print_rows(std::ostream& out, const Scenario& sc, const ScenarioResult& r) 
       << std::setw(11) << "M_ie (kg)" << std::setw(14) << "F_max (kN)" << std::setw(14) << "exact (kN)"
       << std::setw(15) << "tracking (m)"
       << "\n";
-  auto row = [&](const char* label, const CaptureResult& x) {
+  auto row = [&](const char* label, const CaptureResult& x, const std::string& failure = {}) {
+    if (!failure.empty()) {  // the message follows the table
+      out << std::left << std::setw(24) << label << "failed (below)\n";
+      return;
+    }
     out << std::left << std::setw(24) << label << std::setw(w) << deg_list(x.theta) << std::right
         << std::fixed << std::setprecision(3) << std::setw(11) << x.M_ie << std::setw(14)
         << x.f_max_closed_form / 1e3 << std::setw(14) << x.f_max_exact / 1e3 << std::setw(15)
@@ -265,13 +276,15 @@ void print_rows(std::ostream& out, const Scenario& sc, const ScenarioResult& r) 
         << reduction_percent(r.plain.f_max_closed_form, x.f_max_closed_form) << "%" << std::setw(13)
         << reduction_percent(r.plain.f_max_exact, x.f_max_exact) << "%\n";
   };
-  row("Without optimization", r.plain);
-  row("With optimization", r.optimized);
+  row("Without optimization", r.plain, r.plain_failure);
+  row("With optimization", r.optimized, r.optimized_failure);
   if (r.global) row("Global", r.global->result.run);
-  reduction("Reduction (optimization)", r.optimized);
+  if (r.plain_ok() && r.optimized_ok()) reduction("Reduction (optimization)", r.optimized);
+  if (r.global && r.plain_ok()) reduction("Reduction (global)", r.global->result.run);
+  for (const std::string* f : {&r.plain_failure, &r.optimized_failure})
+    if (!f->empty()) out << "failed: " << *f << "\n";
   if (r.global) {
-    reduction("Reduction (global)", r.global->result.run);
-    print_global_notes(out, sc, *r.global, r.optimized);
+    print_global_notes(out, sc, *r.global, r.optimized_ok() ? &r.optimized : nullptr);
     print_robust_note(out, r);
   }
 }
@@ -284,9 +297,15 @@ void print_base_jump(std::ostream& out, const Scenario& sc, const ScenarioResult
   };
   const auto flags = out.flags();
   const auto precision = out.precision();
-  out << std::scientific << std::setprecision(3) << "base angular rate jump at the impact: plain "
-      << rate(r.plain) << " deg/s, optimized " << rate(r.optimized) << " deg/s";
-  if (r.global) out << ", global " << rate(r.global->result.run) << " deg/s";
+  out << std::scientific << std::setprecision(3) << "base angular rate jump at the impact:";
+  const char* sep = " ";
+  for (const auto& [name, run] : {std::pair<const char*, const CaptureResult*>{"plain", r.plain_ok() ? &r.plain : nullptr},
+                                  {"optimized", r.optimized_ok() ? &r.optimized : nullptr},
+                                  {"global", r.global ? &r.global->result.run : nullptr}})
+    if (run) {
+      out << sep << name << " " << rate(*run) << " deg/s";
+      sep = ", ";
+    }
   if (r.global && sc.keys.max_base_rate_deg > 0)
     out << std::defaultfloat << " (searched within max-base-rate-deg " << sc.keys.max_base_rate_deg << ")";
   out << "\n";
@@ -319,27 +338,37 @@ void print_clearance(std::ostream& out, const Scenario& sc, const ScenarioResult
 }
 
 void print_table(std::ostream& out, const Scenario& sc, const ScenarioResult& r) {
-  const CaptureResult &base_run = r.plain, &opt_run = r.optimized;
   out << "ffsr-optimize " << FFSR_VERSION << ": " << sc.where << " (" << sc.model->n() << " joints, "
       << sc.keys.model << ", T = " << sc.capture.duration << " s, step " << sc.capture.step
       << " s, rho = " << sc.capture.gain << ")\n\n";
   print_rows(out, sc, r);
   out << "\n";
+  const CaptureResult& first = r.first_run();
   out << std::setprecision(4) << "capture point ["
-      << base_run.capture_point.transpose().format(Eigen::IOFormat(4, 0, ", "))
-      << "] m, approach velocity delta_dot^- = " << base_run.approach_velocity << " m/s\n"
-      << "base drift: plain " << base_run.base_position_drift * 1e3 << " mm / "
-      << base_run.base_attitude_drift * 180.0 / M_PI << " deg, optimized "
-      << opt_run.base_position_drift * 1e3 << " mm / " << opt_run.base_attitude_drift * 180.0 / M_PI
-      << " deg\n";
+      << first.capture_point.transpose().format(Eigen::IOFormat(4, 0, ", "))
+      << "] m, approach velocity delta_dot^- = " << first.approach_velocity << " m/s\n";
+  if (r.plain_ok() || r.optimized_ok()) {
+    out << "base drift:";
+    if (r.plain_ok())
+      out << " plain " << r.plain.base_position_drift * 1e3 << " mm / "
+          << r.plain.base_attitude_drift * 180.0 / M_PI << " deg";
+    if (r.optimized_ok())
+      out << (r.plain_ok() ? "," : "") << " optimized " << r.optimized.base_position_drift * 1e3 << " mm / "
+          << r.optimized.base_attitude_drift * 180.0 / M_PI << " deg";
+    out << "\n";
+  }
   print_base_jump(out, sc, r);
   out << "tasks: plain " << (sc.baseline_task.kind == CaptureTask::Kind::Pose ? "pose" : "position")
       << ", optimized " << (sc.task.kind == CaptureTask::Kind::Pose ? "pose" : "position")
       << "; F_max: Eq. 24 closed form; exact: peak of the single-body model (Eq. 16)\n";
-  if (base_run.damped_steps + opt_run.damped_steps > 0)
-    out << "note: near a singularity the pseudo-inverse was damped in "
-        << base_run.damped_steps + opt_run.damped_steps << " evaluations (smallest singular value "
-        << std::min(base_run.min_singular_value, opt_run.min_singular_value) << ")\n";
+  // a failed run's CaptureResult is empty: no damped evaluations, its smallest singular value not counted
+  const long damped = r.plain.damped_steps + r.optimized.damped_steps;
+  if (damped > 0)
+    out << "note: near a singularity the pseudo-inverse was damped in " << damped
+        << " evaluations (smallest singular value "
+        << std::min(r.plain_ok() ? r.plain.min_singular_value : INFINITY,
+                    r.optimized_ok() ? r.optimized.min_singular_value : INFINITY)
+        << ")\n";
   print_clearance(out, sc, r);
 }
 

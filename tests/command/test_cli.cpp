@@ -232,6 +232,43 @@ TEST_CASE("the main job names a plain or paper's-method run that the clearance b
   CHECK(t.out.find("clearance: the optimized run") == std::string::npos);
 }
 
+TEST_CASE("the main job reports a plain and a paper's-method row that fail and goes on to the global row", "[cli]") {
+  // robots/paper_7dof_grasp.toml: a grasp orientation 134 deg from the initial one; the straight line
+  // alone loses it, the global run reconfigures first. Exit 0, the failed rows' errors in the JSON,
+  // table and no CSV rows for them; the global row's series has both phases.
+  TempDir tmp;
+  const auto r = cli({"--config", kSource + "/robots/paper_7dof_grasp.toml", "--quiet", "--json", "out.json", "--csv",
+                      "out.csv"},
+                     tmp.str());
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  const json j = read_json_file(tmp.str() + "/out.json");
+  const std::string plain_error = j.at("baseline").at("error").get<std::string>();
+  CHECK(plain_error.rfind("plain run: ", 0) == 0);
+  CHECK(j.at("optimized").at("error").get<std::string>().rfind("optimized run: ", 0) == 0);
+  CHECK(j.at("mass_reduction_percent").is_null());
+  CHECK(j.at("global_mass_reduction_percent").is_null());
+  const json& g = j.at("global");
+  CHECK(g.at("reconfigured").get<bool>());
+  CHECK(g.at("reached_manifold_optimum").get<bool>());
+  CHECK(g.at("integrated_effective_mass").get<double>() <= 1.31);
+  CHECK(g.at("orientation_error_deg").get<double>() < 1e-3);
+  CHECK(r.out.find("Without optimization    failed (below)") != std::string::npos);
+  CHECK(r.out.find("failed: " + plain_error + "\n") != std::string::npos);
+  CHECK(r.out.find("nan") == std::string::npos);
+  const std::string csv = read_file(tmp.str() + "/out.csv");
+  CHECK(csv.find("\nbaseline,") == std::string::npos);
+  CHECK(csv.find("\noptimized,") == std::string::npos);
+  CHECK(csv.find(",reconfiguration\n") != std::string::npos);
+  CHECK(csv.find(",approach\n") != std::string::npos);
+
+  // without the global row the first failure is the job's error (exit 3, as a point out of reach)
+  const auto off = cli({"--config", kSource + "/robots/paper_7dof_grasp.toml", "--global", "false", "--quiet"});
+  CHECK(off.exit_code == 3);
+  CHECK(off.err.rfind(kErrorPrefix + " plain run: ", 0) == 0);
+  CHECK(off.out.empty());
+}
+
 TEST_CASE("contact --model all --json lists the eight laws", "[cli]") {
   const auto j =
       parse_json(cli({"contact", "--urdf", kUrdf3, "--joints-deg", "0,90,-90", "--model", "all", "--json"}));

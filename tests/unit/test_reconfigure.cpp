@@ -287,4 +287,54 @@ TEST_CASE("reconfigure: bad keys give one line naming the key", "[reconfigure]")
   CHECK(msg.find('\n') == std::string::npos);
 }
 
+TEST_CASE("main job: a grasp orientation only the global run reaches, the failed rows reported",
+          "[reconfigure]") {
+  // robots/paper_7dof_grasp.toml: the plain and paper's-method rows cannot turn the gripper to the
+  // grasp orientation along the line; by default the main job stops at the first; with keep_going
+  // their errors are recorded and the global run (reconfiguration first) gives the answer
+  const ffsr::Scenario sc = scenario("robots/paper_7dof_grasp.toml");
+  try {
+    ffsr::run_scenario(sc);
+    FAIL("expected the plain run to lose the line");
+  } catch (const ffsr::NumericalError& e) {
+    CHECK(std::string(e.what()).rfind("plain run: ", 0) == 0);
+  }
+  ffsr::ScenarioRunOptions keep;
+  keep.keep_going = true;
+  const ffsr::ScenarioResult r = ffsr::run_scenario(sc, keep);
+  INFO("plain: " << r.plain_failure << "\noptimized: " << r.optimized_failure);
+  CHECK(r.plain_failure.rfind("plain run: ", 0) == 0);
+  CHECK(r.plain_failure.find("cannot follow the line") != std::string::npos);
+  CHECK(r.optimized_failure.rfind("optimized run: ", 0) == 0);
+  REQUIRE(r.global);
+  const ffsr::GlobalCaptureResult& g = r.global->result;
+  CHECK(g.reconfigured);
+  CHECK(g.run.M_ie <= 1.31);
+  CHECK(std::abs(g.run.M_ie - g.manifold_optimum) <= 0.01 * g.run.M_ie);
+  CHECK(g.reached_manifold_optimum);
+  CHECK(std::isnan(r.global->paper_objective));  // no paper's-method run to compare with
+  CHECK(&r.first_run() == &g.run);
+  // the gripper at T in the file's orientation, as an angle from forward kinematics
+  const ffsr::Model& model = *sc.model;
+  ffsr::Data data(model);
+  ffsr::crba(model, data, g.run.base, g.run.theta);
+  const ffsr::Pose ee = ffsr::frame_pose(model, data, sc.problem.frame);
+  const ffsr::Matrix3 R_end = ffsr::rotation_from_rpy(ffsr::Vector3(-16.39, -6.94, -46.07) * kDeg);
+  CHECK(Eigen::AngleAxisd(R_end * ee.R.transpose()).angle() < sc.capture.orientation_tolerance);
+  CHECK((ee.p - g.run.capture_point).norm() < sc.capture.tolerance);
+
+  // the JSON: each failed row's error in place of its numbers, the reductions against it null
+  const nlohmann::json j = ffsr::scenario_json(sc, r, "test");
+  CHECK(j.at("baseline").at("error") == r.plain_failure);
+  CHECK(j.at("optimized").at("error") == r.optimized_failure);
+  CHECK_FALSE(j.at("baseline").contains("integrated_effective_mass"));
+  for (const char* key : {"mass_reduction_percent", "global_mass_reduction_percent",
+                          "global_exact_force_reduction_percent"})
+    CHECK(j.at(key).is_null());
+  CHECK(j.at("global").at("integrated_effective_mass") == g.run.M_ie);
+  CHECK(j.at("global").contains("base_disturbance"));
+  CHECK(j.at("capture_point") == nlohmann::json(std::vector<double>(g.run.capture_point.data(),
+                                                                     g.run.capture_point.data() + 3)));
+}
+
 }  // namespace test_reconfigure

@@ -10,6 +10,7 @@
 #include "ffsr/uncertainty/robust_objective.hpp"
 
 #include <functional>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -22,7 +23,8 @@ namespace ffsr {
 /// The global run and what the outputs need beside it.
 struct GlobalRun {
   GlobalCaptureResult result;
-  double paper_objective = 0;  ///< the objective at the paper's-method run's capture configuration
+  /// the objective at the paper's-method run's capture configuration (NaN without that run)
+  double paper_objective = 0;
   /// the distinct local optima of the last search (at the reached base pose), sorted by objective
   std::vector<CaptureBranch> branches;
 };
@@ -35,6 +37,16 @@ struct RobustRow {
 
 struct ScenarioResult {
   CaptureResult plain, optimized;
+  /// With ScenarioRunOptions::keep_going: the error of the plain or the optimized run when it failed
+  /// (its CaptureResult is then empty and is not reported); empty when the run succeeded.
+  std::string plain_failure, optimized_failure;
+  bool plain_ok() const { return plain_failure.empty(); }
+  bool optimized_ok() const { return optimized_failure.empty(); }
+  /// The first run that succeeded (plain, optimized, global): the capture point and the approach
+  /// velocity are the same in every run.
+  const CaptureResult& first_run() const {
+    return plain_ok() ? plain : optimized_ok() || !global ? optimized : global->result.run;
+  }
   std::optional<GlobalRun> global;  ///< unless the scenario's global = false
   /// objective = robust-force: the search's sample set, its table and each row's tail measure
   std::shared_ptr<RobustForceObjective> robust;
@@ -47,6 +59,13 @@ struct ScenarioResult {
 struct ScenarioRunOptions {
   bool record_series = false;  ///< keep the time series of every run (CaptureResult::series)
   std::function<void(double)> plain_progress, optimized_progress;  ///< fraction done, optional
+  /// When the global run follows (global = true): a plain or optimized run that fails (a
+  /// NumericalError: the line cannot be followed, a joint limit) is recorded in
+  /// ScenarioResult::plain_failure / optimized_failure and the job goes on, so that a capture only
+  /// the global run reaches (a grasp orientation that needs a reconfiguration) is still planned. The
+  /// global run then has no paper's-method start; when it fails too, the error names both failures.
+  /// Default: the first failure is thrown (plan_plain_and_optimized).
+  bool keep_going = false;
 };
 
 /// The plain and the optimized run. A NumericalError names the run ("plain run: ...").
@@ -66,6 +85,9 @@ std::shared_ptr<RobustForceObjective> scenario_robust_objective(const Scenario& 
 /// the sample set of the robust-force objective (null otherwise). The reaching runs stop within
 /// 1 % of the manifold optimum, 0.01 % for robust-force or with `tight_reaching`. Errors name the run.
 GlobalRun run_global(const Scenario& sc, const CaptureResult& paper_run, GlobalObjective objective,
+                     std::shared_ptr<RobustForceObjective> robust = nullptr, bool tight_reaching = false);
+/// As above without a paper's-method run (it failed): no extra start, GlobalRun::paper_objective NaN.
+GlobalRun run_global(const Scenario& sc, GlobalObjective objective,
                      std::shared_ptr<RobustForceObjective> robust = nullptr, bool tight_reaching = false);
 
 /// The main job: plain, optimized and (unless global = false) global runs; robust-force reads the

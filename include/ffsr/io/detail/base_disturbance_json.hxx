@@ -23,11 +23,13 @@ inline nlohmann::json base_disturbance_json(const BaseDisturbance& d) {
           {"linear_velocity_jump", vector_json(d.linear)}};
 }
 
-/// Adds "base_disturbance" to the baseline, optimized and (when present) global rows of `j`.
+/// Adds "base_disturbance" to the baseline, optimized and global rows of `j` that hold a run.
 inline void add_base_disturbance_json(nlohmann::json& j, const Scenario& sc, const ScenarioResult& r) {
   Data data(*sc.model);
-  j["baseline"]["base_disturbance"] = base_disturbance_json(run_base_disturbance(sc, data, r.plain));
-  j["optimized"]["base_disturbance"] = base_disturbance_json(run_base_disturbance(sc, data, r.optimized));
+  if (r.plain_ok())
+    j["baseline"]["base_disturbance"] = base_disturbance_json(run_base_disturbance(sc, data, r.plain));
+  if (r.optimized_ok())
+    j["optimized"]["base_disturbance"] = base_disturbance_json(run_base_disturbance(sc, data, r.optimized));
   if (r.global)
     j["global"]["base_disturbance"] =
         base_disturbance_json(run_base_disturbance(sc, data, r.global->result.run));

@@ -3,27 +3,39 @@
 
 namespace ffsr {
 
-inline std::pair<CaptureResult, CaptureResult> plan_plain_and_optimized(const Scenario& sc,
-                                                                        const ScenarioRunOptions& options) {
+namespace detail {
+
+/// The options of the plain (`plain` true: gain 0, the baseline task) or the optimized run.
+inline CaptureOptions row_options(const Scenario& sc, const ScenarioRunOptions& options, bool plain) {
   CaptureOptions opt = sc.capture;
   opt.record_series = opt.record_series || options.record_series || sc.geometry;  // distances along the path
-  CaptureOptions plain = opt;
-  plain.gain = 0.0;
-  opt.hold_base_attitude = sc.hold_base_attitude;  // the optimized run only
-  plain.progress = options.plain_progress;
-  opt.progress = options.optimized_progress;
-  add_clearance_barrier(sc, plain);  // with a clearance: both runs keep it in their null space
-  add_clearance_barrier(sc, opt);
-  auto labelled = [](const char* label, auto&& f) {
-    try {
-      return f();
-    } catch (const NumericalError& e) {
-      throw NumericalError(detail::str(label, " run: ", e.what()));
-    }
-  };
-  CaptureResult base_run =
-      labelled("plain", [&] { return plan_capture(sc.problem, sc.baseline_task, plain); });
-  CaptureResult opt_run = labelled("optimized", [&] { return plan_capture(sc.problem, sc.task, opt); });
+  if (plain) {
+    opt.gain = 0.0;
+    opt.progress = options.plain_progress;
+  } else {
+    opt.hold_base_attitude = sc.hold_base_attitude;  // the optimized run only
+    opt.progress = options.optimized_progress;
+  }
+  add_clearance_barrier(sc, opt);  // with a clearance: both runs keep it in their null space
+  return opt;
+}
+
+/// The plain or the optimized run; a NumericalError names it ("plain run: ...").
+inline CaptureResult plan_row(const Scenario& sc, const ScenarioRunOptions& options, bool plain) {
+  const CaptureOptions opt = row_options(sc, options, plain);
+  try {
+    return plan_capture(sc.problem, plain ? sc.baseline_task : sc.task, opt);
+  } catch (const NumericalError& e) {
+    throw NumericalError(str(plain ? "plain" : "optimized", " run: ", e.what()));
+  }
+}
+
+}  // namespace detail
+
+inline std::pair<CaptureResult, CaptureResult> plan_plain_and_optimized(const Scenario& sc,
+                                                                        const ScenarioRunOptions& options) {
+  CaptureResult base_run = detail::plan_row(sc, options, true);
+  CaptureResult opt_run = detail::plan_row(sc, options, false);
   return {std::move(base_run), std::move(opt_run)};
 }
 
@@ -41,9 +53,11 @@ inline std::shared_ptr<RobustForceObjective> scenario_robust_objective(const Sce
   return std::make_shared<RobustForceObjective>(std::move(samples), sc.problem.law);
 }
 
-inline GlobalRun run_global(const Scenario& sc, const CaptureResult& paper_run, GlobalObjective objective,
+namespace detail {
+
+/// run_global with the paper's-method run, or without it (null).
+inline GlobalRun run_global(const Scenario& sc, const CaptureResult* paper_run, GlobalObjective objective,
                             std::shared_ptr<RobustForceObjective> robust, bool tight_reaching) {
-  using detail::str;
   CaptureOptions opt = sc.capture;
   opt.gain = 0.0;
   opt.max_joint_rate = sc.keys.max_joint_rate_deg * M_PI / 180.0;
@@ -65,7 +79,7 @@ inline GlobalRun run_global(const Scenario& sc, const CaptureResult& paper_run, 
     g.gap_percent = 0.01;
     g.max_iterations = 16;
   }
-  g.extra_starts = {paper_run.theta};
+  if (paper_run) g.extra_starts = {paper_run->theta};
   if (sc.keys.max_base_rate_deg > 0)  // the impact's base-rate jump as a constraint of every search
     g.search.inequalities = base_rate_inequality(sc.problem, prepare_capture(sc.problem, sc.task, opt),
                                                  sc.keys.max_base_rate_deg * M_PI / 180.0);
@@ -95,11 +109,25 @@ inline GlobalRun run_global(const Scenario& sc, const CaptureResult& paper_run, 
   }
   const CaptureSetup setup = prepare_capture(sc.problem, sc.task, opt);
   r.paper_objective =
-      evaluate_capture(sc.problem, setup, paper_run.base, paper_run.theta, objective, {}, robust.get())
-          .objective;
+      paper_run ? evaluate_capture(sc.problem, setup, paper_run->base, paper_run->theta, objective, {},
+                                   robust.get())
+                      .objective
+                : std::numeric_limits<double>::quiet_NaN();
   r.branches = capture_branches(sc.problem, sc.task, opt, setup, r.result.search, r.result.run.base, 6,
                                 std::max(1u, std::thread::hardware_concurrency()));
   return r;
+}
+
+}  // namespace detail
+
+inline GlobalRun run_global(const Scenario& sc, const CaptureResult& paper_run, GlobalObjective objective,
+                            std::shared_ptr<RobustForceObjective> robust, bool tight_reaching) {
+  return detail::run_global(sc, &paper_run, objective, std::move(robust), tight_reaching);
+}
+
+inline GlobalRun run_global(const Scenario& sc, GlobalObjective objective,
+                            std::shared_ptr<RobustForceObjective> robust, bool tight_reaching) {
+  return detail::run_global(sc, nullptr, objective, std::move(robust), tight_reaching);
 }
 
 namespace detail {
@@ -119,24 +147,41 @@ inline UncertaintySpec robust_force_spec(const Scenario& sc) {
 
 inline ScenarioResult run_scenario(const Scenario& sc, const ScenarioRunOptions& options) {
   ScenarioResult r;
-  std::tie(r.plain, r.optimized) = plan_plain_and_optimized(sc, options);
+  if (!options.keep_going || !sc.keys.global) {
+    std::tie(r.plain, r.optimized) = plan_plain_and_optimized(sc, options);
+  } else {  // a failed row is recorded; the global run decides
+    for (const bool plain : {true, false}) try {
+        (plain ? r.plain : r.optimized) = detail::plan_row(sc, options, plain);
+      } catch (const NumericalError& e) {
+        (plain ? r.plain_failure : r.optimized_failure) = e.what();
+      }
+  }
   if (sc.geometry) {
-    r.clearances.emplace_back("baseline", run_clearance(sc, r.plain));
-    r.clearances.emplace_back("optimized", run_clearance(sc, r.optimized));
+    if (r.plain_ok()) r.clearances.emplace_back("baseline", run_clearance(sc, r.plain));
+    if (r.optimized_ok()) r.clearances.emplace_back("optimized", run_clearance(sc, r.optimized));
   }
   if (!sc.keys.global) return r;
   if (sc.objective == GlobalObjective::RobustForce) {
     r.robust_spec = detail::robust_force_spec(sc);
     r.robust = scenario_robust_objective(sc, r.robust_spec);
   }
-  r.global = run_global(sc, r.optimized, sc.objective, r.robust);
+  try {
+    r.global = detail::run_global(sc, r.optimized_ok() ? &r.optimized : nullptr, sc.objective, r.robust, false);
+  } catch (const NumericalError& e) {
+    if (r.plain_ok() && r.optimized_ok()) throw;
+    throw NumericalError(detail::str(r.plain_ok() ? r.optimized_failure : r.plain_failure,
+                                     "; the global run failed too: ", e.what()));
+  }
   if (sc.geometry) r.clearances.emplace_back("global", run_clearance(sc, r.global->result.run));
   if (r.robust) {
     const Model& model = *sc.model;
     Data data(model);
     const std::pair<const char*, const CaptureResult*> rows[] = {
-        {"baseline", &r.plain}, {"optimized", &r.optimized}, {"global", &r.global->result.run}};
+        {"baseline", r.plain_ok() ? &r.plain : nullptr},
+        {"optimized", r.optimized_ok() ? &r.optimized : nullptr},
+        {"global", &r.global->result.run}};
     for (const auto& [name, run] : rows) {
+      if (!run) continue;
       const auto v =
           r.robust->value(robot_inverse_inertia(model, data, run->base, run->theta, sc.problem.frame));
       r.robust_rows.push_back({name, v.cvar95, v.p95});
@@ -277,8 +322,9 @@ inline nlohmann::json branches_json(const std::vector<CaptureBranch>& branches) 
   return a;
 }
 
+/// The global row; its reductions against `base_run` (null: the plain run failed, null reductions).
 inline void add_global_json(nlohmann::json& j, const Scenario& sc, const GlobalRun& g,
-                            const CaptureResult& base_run) {
+                            const CaptureResult* base_run) {
   const GlobalCaptureResult& r = g.result;
   nlohmann::json x = run_json(r.run, sc.task, 0.0);
   x["objective"] = sc.keys.objective;
@@ -314,14 +360,17 @@ inline void add_global_json(nlohmann::json& j, const Scenario& sc, const GlobalR
         ranked.push_back({{"integrated_effective_mass", p.M_ie}, {"f_max_multibody", p.objective}});
     x["search"]["ranked_local_optima"] = ranked;
     x["f_max_multibody"] = r.objective;
-    j["optimized"]["f_max_multibody"] = g.paper_objective;
+    if (std::isfinite(g.paper_objective)) j["optimized"]["f_max_multibody"] = g.paper_objective;
   }
   x["branches"] = branches_json(g.branches);
   j["global"] = x;
-  j["global_mass_reduction_percent"] = reduction_percent(base_run.M_ie, r.run.M_ie);
-  j["global_force_reduction_percent"] =
-      reduction_percent(base_run.f_max_closed_form, r.run.f_max_closed_form);
-  j["global_exact_force_reduction_percent"] = reduction_percent(base_run.f_max_exact, r.run.f_max_exact);
+  auto reduction = [&](double before, double after) {
+    return base_run ? nlohmann::json(reduction_percent(before, after)) : nlohmann::json(nullptr);
+  };
+  const CaptureResult& b = base_run ? *base_run : r.run;
+  j["global_mass_reduction_percent"] = reduction(b.M_ie, r.run.M_ie);
+  j["global_force_reduction_percent"] = reduction(b.f_max_closed_form, r.run.f_max_closed_form);
+  j["global_exact_force_reduction_percent"] = reduction(b.f_max_exact, r.run.f_max_exact);
 }
 
 /// A clearance report as JSON: the smallest distance {distance m, pair, time s, kind} with the
@@ -367,13 +416,19 @@ inline nlohmann::json scenario_json(const Scenario& sc, const ScenarioResult& r,
   j["scenario"] = detail::resolved_json(sc);
   j["model_repairs"] = repairs_json(sc.report);
   j["model_load"] = report_json(sc.report);
-  j["capture_point"] = detail::vector_json(r.plain.capture_point);
-  j["baseline"] = detail::run_json(r.plain, sc.baseline_task, 0.0);
-  j["optimized"] = detail::run_json(r.optimized, sc.task, sc.capture.gain);
-  j["mass_reduction_percent"] = reduction_percent(r.plain.M_ie, r.optimized.M_ie);
-  j["force_reduction_percent"] = reduction_percent(r.plain.f_max_closed_form, r.optimized.f_max_closed_form);
-  j["exact_force_reduction_percent"] = reduction_percent(r.plain.f_max_exact, r.optimized.f_max_exact);
-  if (r.global) detail::add_global_json(j, sc, *r.global, r.plain);
+  j["capture_point"] = detail::vector_json(r.first_run().capture_point);
+  // a run that failed (ScenarioRunOptions::keep_going): {"error": its message}, its reductions null
+  j["baseline"] = r.plain_ok() ? detail::run_json(r.plain, sc.baseline_task, 0.0)
+                               : nlohmann::json{{"error", r.plain_failure}};
+  j["optimized"] = r.optimized_ok() ? detail::run_json(r.optimized, sc.task, sc.capture.gain)
+                                    : nlohmann::json{{"error", r.optimized_failure}};
+  const bool both = r.plain_ok() && r.optimized_ok();
+  j["mass_reduction_percent"] = both ? nlohmann::json(reduction_percent(r.plain.M_ie, r.optimized.M_ie)) : nullptr;
+  j["force_reduction_percent"] =
+      both ? nlohmann::json(reduction_percent(r.plain.f_max_closed_form, r.optimized.f_max_closed_form)) : nullptr;
+  j["exact_force_reduction_percent"] =
+      both ? nlohmann::json(reduction_percent(r.plain.f_max_exact, r.optimized.f_max_exact)) : nullptr;
+  if (r.global) detail::add_global_json(j, sc, *r.global, r.plain_ok() ? &r.plain : nullptr);
   detail::add_base_disturbance_json(j, sc, r);
   if (sc.geometry) detail::add_clearance_json(j, sc, r);
   if (r.robust) {
