@@ -57,12 +57,11 @@ inline void plan_both(Shared& r) {
 /// position task over T seconds), made once per process.
 template <CaptureProblem (*Problem)(const Model&)>
 const Shared& shared_runs(const char* urdf, bool planar, double T) {
-  static const Shared s = [&] {
-    Shared r{model_from_urdf_file(kRobots + urdf), {}, position_task(planar), options(T), {}, {}};
-    r.pb = Problem(r.model);
-    plan_both(r);
-    return r;
-  }();
+  // built in place: pb.model points to s.model (a Shared built in a local and returned would leave it
+  // pointing into a dead stack frame unless the compiler elides the copy)
+  static Shared s{model_from_urdf_file(kRobots + urdf), {}, position_task(planar), options(T), {}, {}};
+  static const bool planned = (s.pb = Problem(s.model), plan_both(s), true);
+  (void)planned;
   return s;
 }
 
