@@ -126,6 +126,15 @@ std::string deg_list(const Eigen::VectorXd& theta, int precision = 2) {
   return os.str();
 }
 
+/// The runs that hold a result, in the table's order: "plain", "optimized" (unless they failed), "global".
+std::vector<std::pair<const char*, const CaptureResult*>> reported_runs(const ScenarioResult& r) {
+  std::vector<std::pair<const char*, const CaptureResult*>> runs;
+  if (r.plain_ok()) runs.emplace_back("plain", &r.plain);
+  if (r.optimized_ok()) runs.emplace_back("optimized", &r.optimized);
+  if (r.global) runs.emplace_back("global", &r.global->result.run);
+  return runs;
+}
+
 /// The number of the global run's first samples that belong to its reconfiguration (0: none).
 long reconfiguration_samples(const ScenarioResult& r) {
   if (!r.global || !r.global->result.reconfigured) return 0;
@@ -138,11 +147,8 @@ std::string series_csv(const Scenario& sc, const ScenarioResult& r) {
   c << std::setprecision(12) << "run,t";
   for (const auto& name : sc.model->joint_names()) c << "," << name << "_deg";
   c << ",base_x,base_y,base_z,base_qw,base_qx,base_qy,base_qz,ee_x,ee_y,ee_z,M_ie,F_max_estimate,phase\n";
-  std::vector<std::pair<const char*, const CaptureResult*>> runs;
-  if (r.plain_ok()) runs.emplace_back("baseline", &r.plain);
-  if (r.optimized_ok()) runs.emplace_back("optimized", &r.optimized);
-  if (r.global) runs.emplace_back("global", &r.global->result.run);
-  for (const auto& [label, run] : runs) {
+  for (auto [label, run] : reported_runs(r)) {
+    if (run == &r.plain) label = "baseline";  // the CSV's name of the plain run
     const long reconfiguring = r.global && run == &r.global->result.run ? reconfiguration_samples(r) : 0;
     for (const CaptureSample& s : run->series) {
       c << label << "," << s.t;
@@ -224,15 +230,14 @@ void print_global_notes(std::ostream& out, const Scenario& sc, const GlobalRun& 
     out << "note: the better optima at the reached base pose lie on other components of the self-motion "
            "manifold; "
            "the servo reached none of them\n";
-  if (mb)
-    out << "CVODE multibody F_max: "
-        << (opt_run ? "optimization " + std::to_string(g.paper_objective / 1e3) + " kN, " : std::string())
-        << "global " << r.objective / 1e3 << " kN\n";
-  out << "largest joint rate: "
-      << (opt_run ? "optimization " + std::to_string(opt_run->max_joint_rate * 180.0 / M_PI) +
-                        " deg/s (not limited), "
-                  : std::string())
-      << "global " << r.run.max_joint_rate * 180.0 / M_PI << " deg/s ("
+  if (mb) {
+    out << "CVODE multibody F_max: ";
+    if (opt_run) out << "optimization " << g.paper_objective / 1e3 << " kN, ";
+    out << "global " << r.objective / 1e3 << " kN\n";
+  }
+  out << "largest joint rate: ";
+  if (opt_run) out << "optimization " << opt_run->max_joint_rate * 180.0 / M_PI << " deg/s (not limited), ";
+  out << "global " << r.run.max_joint_rate * 180.0 / M_PI << " deg/s ("
       << (o.max_joint_rate_deg > 0 ? "limit " + std::to_string(o.max_joint_rate_deg) + " deg/s"
                                    : std::string("not limited"))
       << ")\n";
@@ -299,13 +304,10 @@ void print_base_jump(std::ostream& out, const Scenario& sc, const ScenarioResult
   const auto precision = out.precision();
   out << std::scientific << std::setprecision(3) << "base angular rate jump at the impact:";
   const char* sep = " ";
-  for (const auto& [name, run] : {std::pair<const char*, const CaptureResult*>{"plain", r.plain_ok() ? &r.plain : nullptr},
-                                  {"optimized", r.optimized_ok() ? &r.optimized : nullptr},
-                                  {"global", r.global ? &r.global->result.run : nullptr}})
-    if (run) {
-      out << sep << name << " " << rate(*run) << " deg/s";
-      sep = ", ";
-    }
+  for (const auto& [name, run] : reported_runs(r)) {
+    out << sep << name << " " << rate(*run) << " deg/s";
+    sep = ", ";
+  }
   if (r.global && sc.keys.max_base_rate_deg > 0)
     out << std::defaultfloat << " (searched within max-base-rate-deg " << sc.keys.max_base_rate_deg << ")";
   out << "\n";
@@ -347,21 +349,19 @@ void print_table(std::ostream& out, const Scenario& sc, const ScenarioResult& r)
   out << std::setprecision(4) << "capture point ["
       << first.capture_point.transpose().format(Eigen::IOFormat(4, 0, ", "))
       << "] m, approach velocity delta_dot^- = " << first.approach_velocity << " m/s\n";
-  if (r.plain_ok() || r.optimized_ok()) {
-    out << "base drift:";
-    if (r.plain_ok())
-      out << " plain " << r.plain.base_position_drift * 1e3 << " mm / "
-          << r.plain.base_attitude_drift * 180.0 / M_PI << " deg";
-    if (r.optimized_ok())
-      out << (r.plain_ok() ? "," : "") << " optimized " << r.optimized.base_position_drift * 1e3 << " mm / "
-          << r.optimized.base_attitude_drift * 180.0 / M_PI << " deg";
-    out << "\n";
+  const char* sep = "base drift: ";  // of the plain and optimized runs that hold a result
+  for (const auto& [name, run] : reported_runs(r)) {
+    if (std::string(name) == "global") continue;
+    out << sep << name << " " << run->base_position_drift * 1e3 << " mm / "
+        << run->base_attitude_drift * 180.0 / M_PI << " deg";
+    sep = ", ";
   }
+  if (r.plain_ok() || r.optimized_ok()) out << "\n";
   print_base_jump(out, sc, r);
   out << "tasks: plain " << (sc.baseline_task.kind == CaptureTask::Kind::Pose ? "pose" : "position")
       << ", optimized " << (sc.task.kind == CaptureTask::Kind::Pose ? "pose" : "position")
       << "; F_max: Eq. 24 closed form; exact: peak of the single-body model (Eq. 16)\n";
-  // a failed run's CaptureResult is empty: no damped evaluations, its smallest singular value not counted
+  // a failed run's CaptureResult is empty: no damped evaluations, and its smallest singular value (0) is not one
   const long damped = r.plain.damped_steps + r.optimized.damped_steps;
   if (damped > 0)
     out << "note: near a singularity the pseudo-inverse was damped in " << damped

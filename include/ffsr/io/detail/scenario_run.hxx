@@ -322,6 +322,19 @@ inline nlohmann::json branches_json(const std::vector<CaptureBranch>& branches) 
   return a;
 }
 
+/// "<prefix>mass_reduction_percent", "<prefix>force_reduction_percent" and
+/// "<prefix>exact_force_reduction_percent" of `after` against `before`; null when either run failed (null).
+inline void add_reductions_json(nlohmann::json& j, const std::string& prefix, const CaptureResult* before,
+                                const CaptureResult* after) {
+  auto reduction = [&](double CaptureResult::*value) {
+    return before && after ? nlohmann::json(reduction_percent(before->*value, after->*value))
+                           : nlohmann::json(nullptr);
+  };
+  j[prefix + "mass_reduction_percent"] = reduction(&CaptureResult::M_ie);
+  j[prefix + "force_reduction_percent"] = reduction(&CaptureResult::f_max_closed_form);
+  j[prefix + "exact_force_reduction_percent"] = reduction(&CaptureResult::f_max_exact);
+}
+
 /// The global row; its reductions against `base_run` (null: the plain run failed, null reductions).
 inline void add_global_json(nlohmann::json& j, const Scenario& sc, const GlobalRun& g,
                             const CaptureResult* base_run) {
@@ -364,13 +377,7 @@ inline void add_global_json(nlohmann::json& j, const Scenario& sc, const GlobalR
   }
   x["branches"] = branches_json(g.branches);
   j["global"] = x;
-  auto reduction = [&](double before, double after) {
-    return base_run ? nlohmann::json(reduction_percent(before, after)) : nlohmann::json(nullptr);
-  };
-  const CaptureResult& b = base_run ? *base_run : r.run;
-  j["global_mass_reduction_percent"] = reduction(b.M_ie, r.run.M_ie);
-  j["global_force_reduction_percent"] = reduction(b.f_max_closed_form, r.run.f_max_closed_form);
-  j["global_exact_force_reduction_percent"] = reduction(b.f_max_exact, r.run.f_max_exact);
+  add_reductions_json(j, "global_", base_run, &r.run);
 }
 
 /// A clearance report as JSON: the smallest distance {distance m, pair, time s, kind} with the
@@ -422,13 +429,9 @@ inline nlohmann::json scenario_json(const Scenario& sc, const ScenarioResult& r,
                                : nlohmann::json{{"error", r.plain_failure}};
   j["optimized"] = r.optimized_ok() ? detail::run_json(r.optimized, sc.task, sc.capture.gain)
                                     : nlohmann::json{{"error", r.optimized_failure}};
-  const bool both = r.plain_ok() && r.optimized_ok();
-  j["mass_reduction_percent"] = both ? nlohmann::json(reduction_percent(r.plain.M_ie, r.optimized.M_ie)) : nullptr;
-  j["force_reduction_percent"] =
-      both ? nlohmann::json(reduction_percent(r.plain.f_max_closed_form, r.optimized.f_max_closed_form)) : nullptr;
-  j["exact_force_reduction_percent"] =
-      both ? nlohmann::json(reduction_percent(r.plain.f_max_exact, r.optimized.f_max_exact)) : nullptr;
-  if (r.global) detail::add_global_json(j, sc, *r.global, r.plain_ok() ? &r.plain : nullptr);
+  const CaptureResult* plain = r.plain_ok() ? &r.plain : nullptr;
+  detail::add_reductions_json(j, "", plain, r.optimized_ok() ? &r.optimized : nullptr);
+  if (r.global) detail::add_global_json(j, sc, *r.global, plain);
   detail::add_base_disturbance_json(j, sc, r);
   if (sc.geometry) detail::add_clearance_json(j, sc, r);
   if (r.robust) {
