@@ -8,7 +8,7 @@ cli="${1:-$root/build/src/cli/ffsr-optimize}"
 out="$root/docs/figures"
 tmp="$(mktemp -d)"
 trap 'rm -rf "$tmp"' EXIT
-mkdir -p "$out" "$tmp/3dof" "$tmp/7dof" "$tmp/contact" "$tmp/xi" "$tmp/map" "$tmp/robust"
+mkdir -p "$out" "$tmp/3dof" "$tmp/7dof" "$tmp/contact" "$tmp/xi" "$tmp/map" "$tmp/robust" "$tmp/pareto"
 
 # Figures 10 and 11: the 3-DOF robot, plain and optimized (Table 4)
 "$cli" --config "$root/robots/paper_3dof.toml" --plot "$tmp/3dof" --quiet > /dev/null
@@ -40,4 +40,7 @@ cp "$tmp/map/map_cloud.png" "$out/3dof_map_cloud.png"
 # beyond the paper: F_max over the uncertain target of the example (1000 samples, exact model)
 "$cli" robust --config "$root/robots/paper_7dof_position_uncertain.toml" --plot "$tmp/robust" --quiet > /dev/null
 cp "$tmp/robust/robust.png" "$out/7dof_robust.png"
+# beyond the paper: M_ie against the base's angular rate jump at the impact, the three runs marked
+"$cli" pareto --config "$root/robots/paper_7dof_position.toml" --plot "$tmp/pareto" > /dev/null
+cp "$tmp/pareto/pareto.png" "$out/7dof_pareto.png"
 ls -l "$out"

@@ -682,6 +682,98 @@ plot::Figure xi(const XiStudy& s) {
   return fig;
 }
 
+namespace {
+std::string scientific(double x, int digits) {
+  std::ostringstream s;
+  s << std::scientific << std::setprecision(digits) << x;
+  return s.str();
+}
+
+/// "1.2866 kg, 1.72e-03 deg/s"
+std::string mass_rate(double mass, double rate) {
+  return fixed(mass, 4) + " kg, " + scientific(rate, 2) + " deg/s";
+}
+
+Curve marker(std::string label, std::vector<double> x, std::vector<double> y, int color, const char* symbol,
+             double scale) {
+  Curve c;
+  c.label = std::move(label);
+  c.x = std::move(x);
+  c.y = std::move(y);
+  c.color = color;
+  c.line_style = 0;
+  c.symbol = symbol;
+  c.symbol_scale = scale;
+  return c;
+}
+}  // namespace
+
+plot::Figure pareto(const ParetoSeries& s) {
+  const size_t n = s.mass.size();
+  if (n == 0 || s.rate.size() != n)
+    throw InputError(str("pareto plot: ", n, " masses and ", s.rate.size(), " rates (equal, at least 1)"));
+  if (s.knee >= n) throw InputError(str("pareto plot: knee index ", s.knee, " out of 0..", n - 1));
+  auto bad = [](double m, double r) { return !std::isfinite(m) || !std::isfinite(r) || m <= 0 || r < 0; };
+  for (size_t i = 0; i < n; ++i)
+    if (bad(s.mass[i], s.rate[i]))
+      throw InputError(str("pareto plot: front point ", i, " is (", s.mass[i], ", ", s.rate[i], ")"));
+  for (const auto& r : s.runs)
+    if (bad(r.mass, r.rate)) throw InputError(str("pareto plot: ", r.label, " is (", r.mass, ", ", r.rate, ")"));
+
+  // the front's extent grown by a quarter on every side: the runs inside are drawn beside the front
+  const auto [m0, m1] = std::minmax_element(s.mass.begin(), s.mass.end());
+  const auto [r0, r1] = std::minmax_element(s.rate.begin(), s.rate.end());
+  const double dm = 0.25 * std::max(*m1 - *m0, 1e-6 * *m1), dr = 0.25 * std::max(*r1 - *r0, 1e-6 * (*r1 + 1e-12));
+  auto near = [&](const ParetoSeries::Run& r) {
+    return r.mass >= *m0 - dm && r.mass <= *m1 + dm && r.rate >= *r0 - dr && r.rate <= *r1 + dr;
+  };
+  const bool wide = std::any_of(s.runs.begin(), s.runs.end(), [&](const auto& r) { return !near(r); });
+
+  constexpr int kRunColors[] = {2, 3, 4, 5, 7};
+  auto run_marker = [&](size_t i) {
+    const auto& r = s.runs[i];
+    return marker(r.label + ": " + mass_rate(r.mass, r.rate), {r.mass}, {r.rate},
+                  kRunColors[i % std::size(kRunColors)], "▲", 1.0);
+  };
+  Curve line;
+  line.x = s.mass;
+  line.y = s.rate;
+  line.color = 0;
+  line.width = 1.5;
+  line.symbol = "●";
+
+  const std::string ylabel = "base angular rate jump |Δω#d0#u| (deg/s)";
+  Panel front = labelled("the front at the global run's base pose, the runs at their own", "M_ie (kg)", ylabel);
+  line.label = str("front (", n, " points)");
+  line.symbol_scale = 0.55;
+  front.curves.push_back(line);
+  front.curves.push_back(marker("least M_ie: " + mass_rate(s.mass.front(), s.rate.front()), {s.mass.front()},
+                                {s.rate.front()}, kBlack, "■", 0.9));
+  front.curves.push_back(marker("least rate: " + mass_rate(s.mass.back(), s.rate.back()), {s.mass.back()},
+                                {s.rate.back()}, kBlack, "□", 0.9));
+  front.curves.push_back(marker("knee: " + mass_rate(s.mass[s.knee], s.rate[s.knee]), {s.mass[s.knee]},
+                                {s.rate[s.knee]}, 1, "◆", 1.2));
+  for (size_t i = 0; i < s.runs.size(); ++i)
+    if (near(s.runs[i])) front.curves.push_back(run_marker(i));
+
+  plot::Figure fig;
+  fig.name = "pareto";
+  fig.title = s.title.empty() ? "Pareto front" : "Pareto front: " + s.title;
+  fig.width = 1200;
+  fig.panels.emplace_back(std::move(front));
+  if (wide) {  // below: the front as one line and every run, on the scale of the runs
+    Panel all = labelled("", "M_ie (kg)", ylabel);
+    line.label = "front (above)";
+    line.symbol_scale = 0.3;
+    all.curves.push_back(line);
+    for (size_t i = 0; i < s.runs.size(); ++i) all.curves.push_back(run_marker(i));
+    fig.panels.emplace_back(std::move(all));
+    fig.rows = 2;
+    fig.height = 1100;
+  }
+  return fig;
+}
+
 void Grid::validate(size_t dims) const {
   if (axes.size() != dims || axis_labels.size() != dims)
     throw InputError(str("map plot: expected ", dims, " varied joints, got ", axes.size()));

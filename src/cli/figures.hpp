@@ -82,6 +82,25 @@ struct XiStudy {
 };
 plot::Figure xi(const XiStudy& study);
 
+/// A Pareto front of (M_ie, base angular rate jump) with the runs of the main job (plain data:
+/// the command copies it from ParetoFront).
+struct ParetoSeries {
+  std::string title;               ///< names the scenario in the figure's title (may be empty)
+  std::vector<double> mass, rate;  ///< the front, kg and deg/s, M_ie increasing
+  size_t knee = 0;                 ///< index in mass/rate
+  struct Run {
+    std::string label;  ///< e.g. "plain run"
+    double mass = 0, rate = 0;
+  };
+  std::vector<Run> runs;
+};
+/// "pareto": the front as a line with markers, its two ends (the single-objective optima) and its
+/// knee marked, the runs as points with their values in the legend. When a run lies far from the
+/// front (outside its extent grown by a quarter on every side), a second panel below holds the front
+/// as one line and every run; with none, one panel. InputError on an empty front, unequal
+/// lengths, a knee out of range or a value that is not finite.
+plot::Figure pareto(const ParetoSeries& s);
+
 /// Values over a grid of joint angles: values[i0 * n1 * n2 + i1 * n2 + i2] (last axis fastest).
 struct Grid {
   std::vector<std::string> axis_labels;   ///< e.g. "θ1 (deg)"

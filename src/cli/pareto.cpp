@@ -1,6 +1,8 @@
 // ffsr-optimize pareto: the front of (M_ie, base angular rate jump at the impact) on the capture
 // manifold at the global run's base pose (ffsr/optimize/pareto.hpp), for a scenario as the main job.
 #include "common.hpp"
+#include "figures.hpp"
+#include "plot.hpp"
 #include "scenario.hpp"
 #include "subcommands.hpp"
 
@@ -16,12 +18,13 @@ namespace {
 
 struct ParetoCliOptions {
   ScenarioFlags flags;
-  std::string config, json, csv;
+  std::string config, json, csv, plot, plot_format = "png";
   int levels = 30, starts = 16;
   bool quiet = false;
 };
 
 constexpr double kDeg = 180.0 / M_PI;
+const char* const kRunNames[] = {"plain run", "paper's method", "global run"};
 
 nlohmann::json point_json(const ParetoPoint& p) {
   return {{"integrated_effective_mass", p.M_ie},
@@ -82,11 +85,23 @@ void print_front(std::ostream& out, const Scenario& sc, const ParetoFront& f,
   row("least M_ie (end)", f.min_mass);
   row("knee", f.points[f.knee]);
   row("least base rate (end)", f.min_rate);
-  const char* names[] = {"plain run", "paper's method", "global run"};
-  for (size_t i = 0; i < runs.size(); ++i) row(names[i], runs[i]);
+  for (size_t i = 0; i < runs.size(); ++i) row(kRunNames[i], runs[i]);
   out << "\nhypervolume " << f.hypervolume * kDeg << " kg deg/s up to the nadir of the ends (normalized "
       << f.hypervolume_normalized << "); " << f.evaluations << " evaluations, " << f.seconds << " s\n"
       << "|dw_0|: jump of the base's angular velocity from the contact impulse (single-body model)\n";
+}
+
+/// The picture's data: the front and the runs, in the units of the table.
+plot::Figure pareto_figure(const Scenario& sc, const ParetoFront& f, const std::vector<ParetoPoint>& runs) {
+  figures::ParetoSeries s;
+  s.title = sc.where;
+  for (const ParetoPoint& p : f.points) {
+    s.mass.push_back(p.M_ie);
+    s.rate.push_back(p.base_rate * kDeg);
+  }
+  s.knee = f.knee;
+  for (size_t i = 0; i < runs.size(); ++i) s.runs.push_back({kRunNames[i], runs[i].M_ie, runs[i].base_rate * kDeg});
+  return figures::pareto(s);
 }
 
 int run_pareto(const ParetoCliOptions& o) {
@@ -95,6 +110,7 @@ int run_pareto(const ParetoCliOptions& o) {
   outputs.add("--csv", o.csv);
   if (o.levels < 1) throw InputError(detail::str("--levels: must be >= 1, got ", o.levels));
   if (o.starts < 1) throw InputError(detail::str("--starts: must be >= 1, got ", o.starts));
+  const plot::Format plot_format = plot::check_request(o.plot, o.plot_format);
   Scenario sc = command_scenario(command_scenario_keys(o.config, o.flags));
   if (!sc.keys.global) throw InputError("--global: pareto needs the global run's base pose (global = true)");
   ScenarioRunOptions ro;
@@ -113,8 +129,12 @@ int run_pareto(const ParetoCliOptions& o) {
     runs.push_back(detail::pareto_point(*sc.model, data, sc.problem, setup, x->base, x->theta, e));
   outputs.set("--json", front_json(sc, f, runs, g.base).dump(2) + "\n");
   outputs.set("--csv", front_csv(f));
+  std::vector<std::string> drawn;
+  if (!o.plot.empty()) drawn = plot::render({pareto_figure(sc, f, runs)}, o.plot, plot_format);
   outputs.write();
-  print_front(outputs.table(), sc, f, runs);
+  std::ostream& out = outputs.table();
+  print_front(out, sc, f, runs);
+  for (const std::string& d : drawn) out << "wrote " << d << "\n";
   return 0;
 }
 
@@ -134,6 +154,9 @@ void register_pareto(CLI::App& app, Action& action) {
   sub->add_option("--json", o->json,
                   "Write the front (configurations, ends, knee, hypervolume) to this JSON file");
   sub->add_option("--csv", o->csv, "Write the front, one configuration per row, to this CSV file");
+  sub->add_option("--plot", o->plot,
+                  "Draw the front (knee, ends and the three runs marked) into this (existing) folder");
+  sub->add_option("--plot-format", o->plot_format, "Figure format: png, svg or pdf")->capture_default_str();
   sub->callback([o, &action] { action = [o] { return run_pareto(*o); }; });
 }
 

@@ -513,6 +513,90 @@ TEST_CASE("closed-loop figure: one curve per joint and run, the limit lines, equ
   CHECK_THROWS_AS(figures::closed_loop(s), InputError);
 }
 
+TEST_CASE("pareto figure: the front, its ends and knee, the runs near it beside it and every run below",
+          "[plot][pareto]") {
+  figures::ParetoSeries s;
+  s.mass = {1.0, 1.1, 1.2, 1.4};
+  s.rate = {4e-3, 2e-3, 1e-3, 0.0};
+  s.knee = 2;
+  s.runs = {{"near", 1.05, 3e-3}, {"far", 9.0, 5e-2}};
+  const plot::Figure f = figures::pareto(s);
+  CHECK(f.name == "pareto");
+  REQUIRE(f.panels.size() == 2);
+  const auto& front = std::get<plot::Panel>(f.panels[0]);
+  const auto& wide = std::get<plot::Panel>(f.panels[1]);
+  // front, the two ends, the knee, then the runs: only the near one beside the front; below, the
+  // front as one line and every run
+  REQUIRE(front.curves.size() == 5);
+  REQUIRE(wide.curves.size() == 3);
+  CHECK(wide.curves[0].x == s.mass);
+  CHECK(front.curves[0].x == s.mass);
+  CHECK(front.curves[0].y == s.rate);
+  CHECK(front.curves[1].x == std::vector<double>{1.0});
+  CHECK(front.curves[2].y == std::vector<double>{0.0});
+  CHECK(front.curves[3].x == std::vector<double>{1.2});
+  CHECK(front.curves[3].label.rfind("knee: 1.2000 kg, 1.00e-03 deg/s", 0) == 0);
+  CHECK(front.curves[4].label.rfind("near: 1.0500 kg", 0) == 0);
+  CHECK(wide.curves[1].label.rfind("near: 1.0500 kg", 0) == 0);
+  CHECK(wide.curves[2].label.rfind("far: 9.0000 kg, 5.00e-02 deg/s", 0) == 0);
+  for (const auto& c : front.curves) CHECK(c.label.find("far") == std::string::npos);
+
+  s.runs.pop_back();  // every run near the front: one panel
+  CHECK(figures::pareto(s).panels.size() == 1);
+  s.runs.push_back({"a quarter beyond the front's rate", 1.2, 5.01e-3});
+  CHECK(figures::pareto(s).panels.size() == 2);
+
+  auto bad = s;
+  bad.knee = 4;
+  CHECK_THROWS_WITH(figures::pareto(bad), Catch::Contains("knee index 4"));
+  bad = s;
+  bad.rate.pop_back();
+  CHECK_THROWS_AS(figures::pareto(bad), InputError);
+  bad = s;
+  bad.mass = {};
+  bad.rate = {};
+  CHECK_THROWS_AS(figures::pareto(bad), InputError);
+  bad = s;
+  bad.rate[1] = std::nan("");
+  CHECK_THROWS_WITH(figures::pareto(bad), Catch::Contains("front point 1"));
+  bad = s;
+  bad.runs[0].mass = -1;
+  CHECK_THROWS_WITH(figures::pareto(bad), Catch::Contains("near"));
+}
+
+TEST_CASE("pareto --plot: the 7-DOF front with its knee and the three runs drawn, the JSON beside it",
+          "[plot][cli][pareto]") {
+  TempDir dir;
+  const auto r = run_command({kCli, "pareto", "--config", ffsr::test::kRobots + "paper_7dof_position.toml",
+                              "--plot", dir.str(), "--json", dir / "front.json"});
+  REQUIRE(r.exit_code == 0);
+  CHECK(r.err.empty());
+  CHECK(r.out.find("wrote " + (dir / "pareto.png")) != std::string::npos);
+  // the plain run (17 kg) is far from the front (1.28 to 1.31 kg): two panels, one above the other
+  check_png(dir / "pareto.png", 1200, 1100, 8);
+  const auto img = ffsr::test::decode_png(dir / "pareto.png");
+  // the knee (vermillion) and the three runs (green, purple, orange) are drawn as filled markers
+  for (int colour : {1, 2, 3, 4}) {
+    const auto c = plot::palette(colour);
+    const uint32_t want = uint32_t(c[0]) << 16 | uint32_t(c[1]) << 8 | uint32_t(c[2]);
+    long pixels = 0;
+    for (uint32_t y = 0; y < img.height; ++y)
+      for (uint32_t x = 0; x < img.width; ++x) pixels += img.rgb(x, y) == want;
+    INFO("palette colour " << colour);
+    CHECK(pixels >= 30);
+  }
+  std::ifstream in(dir / "front.json");
+  const nlohmann::json j = nlohmann::json::parse(in);
+  CHECK(j["front"].size() >= 20);
+  CHECK(j["runs"]["baseline"]["integrated_effective_mass"].get<double>() > 10.0);
+
+  // SVG of the built-in 3-DOF scenario
+  fs::create_directory(dir / "svg");
+  const auto s = run_command({kCli, "pareto", "--plot", dir / "svg", "--plot-format", "svg"});
+  REQUIRE(s.exit_code == 0);
+  check_svg(dir / "svg/pareto.svg");
+}
+
 TEST_CASE("plot bad inputs: a missing folder or an unknown format give one error line and no output",
           "[plot][cli]") {
   TempDir dir;
@@ -532,6 +616,8 @@ TEST_CASE("plot bad inputs: a missing folder or an unknown format give one error
        "--plot-format: unknown format 'bmp'"},
       {{kCli, "xi", "--plot", missing}, "--plot: folder '" + missing},
       {{kCli, "closed-loop", "--plot", missing, "--quiet"}, "--plot: folder '" + missing},
+      {{kCli, "pareto", "--plot", missing, "--json", dir / "front.json"}, "--plot: folder '" + missing},
+      {{kCli, "pareto", "--plot", dir.str(), "--plot-format", "gif"}, "--plot-format: unknown format 'gif'"},
       {{kCli, "xi", "--points", "1"}, "--points: expected 2 to 100000, got 1"},
   };
   for (const auto& c : cases) {
