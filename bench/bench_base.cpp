@@ -15,7 +15,9 @@
 #include <fstream>
 #include <string>
 
-int main(int argc, char** argv) {
+namespace {
+
+int run(int argc, char** argv) {
   using namespace ffsr;
   std::string file = std::string(FFSR_SOURCE_DIR) + "/robots/paper_7dof_position.toml", csv;
   for (int i = 1; i < argc; ++i) {
@@ -71,4 +73,15 @@ int main(int argc, char** argv) {
     std::printf("%-28s %10.4f %14.6f %16.3g %14.3g\n", name, x->M_ie, x->base_attitude_drift * deg,
                 x->max_momentum, x->tracking_error);
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "ffsr-bench-base: error: %s\n", e.what());
+    return 1;
+  }
 }

@@ -237,10 +237,11 @@ void print_global_notes(std::ostream& out, const Scenario& sc, const GlobalRun& 
   }
   out << "largest joint rate: ";
   if (opt_run) out << "optimization " << opt_run->max_joint_rate * 180.0 / M_PI << " deg/s (not limited), ";
-  out << "global " << r.run.max_joint_rate * 180.0 / M_PI << " deg/s ("
-      << (o.max_joint_rate_deg > 0 ? "limit " + std::to_string(o.max_joint_rate_deg) + " deg/s"
-                                   : std::string("not limited"))
-      << ")\n";
+  out << "global " << r.run.max_joint_rate * 180.0 / M_PI << " deg/s (";
+  if (o.max_joint_rate_deg > 0)
+    out << "limit " << o.max_joint_rate_deg << " deg/s)\n";
+  else
+    out << "not limited)\n";
 }
 
 /// robust-force: the tail measure of every row over the search's sample set.

@@ -126,6 +126,22 @@ TEST_CASE("scenario: every robots/*.toml loads through the library", "[scenario]
   CHECK(ffsr::uncertainty_spec(keys).samples >= 1);
 }
 
+TEST_CASE("scenario: a variant built again from the resolved keys of a relative file finds the same URDF",
+          "[scenario]") {
+  // a scenario file named by a relative path: its urdf key is joined to the file's folder once
+  const std::string rel =
+      fs::relative(fs::path(kSource) / "robots" / "paper_7dof_position.toml", fs::current_path()).string();
+  REQUIRE(rel.find('/') != std::string::npos);
+  REQUIRE(rel.front() != '/');
+  const ffsr::Scenario sc = ffsr::load_scenario(rel);
+  CHECK(fs::equivalent(sc.keys.urdf, fs::path(kSource) / "robots" / "paper_7dof.urdf"));
+  ffsr::ScenarioKeys keys = sc.keys;
+  keys.base_attitude = "hold";
+  const ffsr::Scenario held = ffsr::build_scenario(std::move(keys));
+  CHECK(held.keys.urdf == sc.keys.urdf);
+  CHECK(held.model->n() == sc.model->n());
+}
+
 TEST_CASE("scenario: bad keys and values name the file or the key", "[scenario]") {
   TempDir tmp;
   const std::string base = read_text(kSource + "/robots/paper_3dof.toml");

@@ -76,6 +76,9 @@ struct ScenarioKeys {
   std::string where;                 ///< "scenario FILE" or "built-in scenario", for messages
   std::set<std::string> given;       ///< keys set by the file or an override
   std::set<std::string> overridden;  ///< keys set by an override (paths not resolved against the file)
+  /// True once build_scenario has joined `urdf` to the scenario file's folder: building a scenario
+  /// again from these keys (a variant of it) does not join it a second time.
+  bool urdf_resolved = false;
   std::map<std::string, std::string> extra;     ///< keys of the caller (read_scenario_file), as text
   std::shared_ptr<const toml::table> document;  ///< the file as read (its [uncertainty] table)
   // the spacecraft's side: the reaction-null-space approach

@@ -333,6 +333,10 @@ CaptureResult integrate_capture(const CaptureProblem& pb, const CaptureTask& tas
   Data& data = field.data;
   FreeFloatingRK4 rk4(model.n());
   RunMonitors monitors(model, where, std::max(10.0 * opt.tolerance, 1e-2));
+  if (task.kind == CaptureTask::Kind::Pose)
+    monitors.hint =
+        "the point may be out of reach, or the gripper's turn to the final orientation cannot be followed "
+        "along the line from this configuration";
   CaptureResult res;
   res.capture_point = setup.x_cap;
   BasePose base = pb.base;

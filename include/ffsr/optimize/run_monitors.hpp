@@ -21,6 +21,8 @@ namespace ffsr {
 
 struct RunMonitors {
   const char* where = "plan_capture";
+  /// The likely causes named when the line is lost (check_tracking).
+  const char* hint = "the point may be out of reach";
   double divergence = 1e-2;  ///< m: the tracking error beyond which the line is lost
   double max_momentum = 0, max_body_momentum = 0, max_com_drift = 0, max_tracking_error = 0;
   double max_quaternion_error = 0;
@@ -63,7 +65,7 @@ struct RunMonitors {
       throw NumericalError(detail::str(where,
                                        ": the end-effector cannot follow the line to the capture point "
                                        "(tracking error ",
-                                       err, " m at t = ", t, " s); the point may be out of reach"));
+                                       err, " m at t = ", t, " s); ", hint));
     return err;
   }
 

@@ -569,9 +569,11 @@ inline std::unique_ptr<Model> model_of(ScenarioKeys& k, const EmbeddedUrdf* embe
   if (k.file.empty() && embedded && !from_command_line && k.urdf == embedded->name)
     return std::make_unique<Model>(model_from_urdf_string(embedded->xml, embedded->source, options, &report));
   const size_t slash = k.file.find_last_of('/');
-  if (!k.file.empty() && !from_command_line && !k.urdf.empty() && k.urdf.front() != '/' &&
-      slash != std::string::npos)
+  if (!k.file.empty() && !from_command_line && !k.urdf_resolved && !k.urdf.empty() && k.urdf.front() != '/' &&
+      slash != std::string::npos) {
     k.urdf = k.file.substr(0, slash + 1) + k.urdf;
+    k.urdf_resolved = true;
+  }
   return std::make_unique<Model>(model_from_urdf_file(k.urdf, options, &report));
 }
 
