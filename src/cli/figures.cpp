@@ -721,11 +721,12 @@ plot::Figure pareto(const ParetoSeries& s) {
     if (bad(r.mass, r.rate)) throw InputError(str("pareto plot: ", r.label, " is (", r.mass, ", ", r.rate, ")"));
 
   // the front's extent grown by a quarter on every side: the runs inside are drawn beside the front
-  const auto [m0, m1] = std::minmax_element(s.mass.begin(), s.mass.end());
-  const auto [r0, r1] = std::minmax_element(s.rate.begin(), s.rate.end());
-  const double dm = 0.25 * std::max(*m1 - *m0, 1e-6 * *m1), dr = 0.25 * std::max(*r1 - *r0, 1e-6 * (*r1 + 1e-12));
+  const auto mass = std::minmax_element(s.mass.begin(), s.mass.end());
+  const auto rate = std::minmax_element(s.rate.begin(), s.rate.end());
+  const double m0 = *mass.first, m1 = *mass.second, r0 = *rate.first, r1 = *rate.second;
+  const double dm = 0.25 * std::max(m1 - m0, 1e-6 * m1), dr = 0.25 * std::max(r1 - r0, 1e-6 * (r1 + 1e-12));
   auto near = [&](const ParetoSeries::Run& r) {
-    return r.mass >= *m0 - dm && r.mass <= *m1 + dm && r.rate >= *r0 - dr && r.rate <= *r1 + dr;
+    return r.mass >= m0 - dm && r.mass <= m1 + dm && r.rate >= r0 - dr && r.rate <= r1 + dr;
   };
   const bool wide = std::any_of(s.runs.begin(), s.runs.end(), [&](const auto& r) { return !near(r); });
 
