@@ -169,7 +169,7 @@ class Renderer {
   /// The viewport of a 2-D panel inside its cell: room for tick labels, axis labels and the title.
   void viewport(const Cell& c, double right_extra, double& vx0, double& vx1, double& vy0, double& vy1) {
     const double px = 1.0 / fig_.width, py = 1.0 / fig_.height;
-    vx0 = c.x0 + 82 * px;
+    vx0 = c.x0 + 96 * px;  // room for the y label and PLplot's "(x10^k)" scale label
     vx1 = c.x1 - (18 + right_extra) * px;
     vy0 = c.y0 + (c.bottom ? 62 : 50) * py;  // the page edge clips descenders of the last row's x label
     vy1 = c.y1 - 30 * py;
