@@ -67,52 +67,15 @@ inline nlohmann::json report_json(const UrdfReport& report) {
 
 namespace detail {
 
-/// The resolved scenario (inputs, recorded for reproducibility).
+/// The resolved scenario (inputs, recorded for reproducibility): the source, the end-effector frame
+/// and the joints as loaded, then the echo of every key of the table (ScenarioKey::echo).
 inline nlohmann::json resolved_json(const Scenario& sc) {
-  const ScenarioKeys& o = sc.keys;
   const Model& model = *sc.model;
-  nlohmann::json j = {{"source", sc.builtin ? "built-in paper_3dof" : o.file},
-                      {"urdf", o.urdf},
+  nlohmann::json j = {{"source", sc.builtin ? "built-in paper_3dof" : sc.keys.file},
                       {"end_effector", model.frame(sc.problem.frame).name},
-                      {"joint_names", model.joint_names()},
-                      {"joints-deg", o.joints_deg},
-                      {"base-position", o.base_position},
-                      {"base-rpy-deg", o.base_rpy_deg},
-                      {"target-mass", o.target_mass},
-                      {"target-inertia", o.target_inertia},
-                      {"target-position", o.target_position},
-                      {"target-rpy-deg", o.target_rpy_deg},
-                      {"target-angular-velocity-deg", o.target_angular_velocity_deg},
-                      {"target-velocity", o.target_velocity},
-                      {"contact-offset", o.contact_offset},
-                      {"normal", o.normal},
-                      {"model", o.model},
-                      {"stiffness", o.stiffness},
-                      {"exponent", o.exponent},
-                      {"restitution", o.restitution},
-                      {"approach-speed", o.approach_speed},
-                      {"task", o.task},
-                      {"task-axes", o.task_axes},
-                      {"baseline-task", o.baseline_task.empty() ? o.task : o.baseline_task},
-                      {"duration", o.duration},
-                      {"step", o.step},
-                      {"gain", o.gain},
-                      {"feedback", o.feedback},
-                      {"tolerance", o.tolerance},
-                      {"objective", o.objective}};
-  j.update(o.load.to_json());
-  j["global"] = o.global;
-  j["seed"] = o.seed;
-  j["max-joint-rate-deg"] = o.max_joint_rate_deg;
-  j["global-starts"] = o.global_starts;
-  j["base-attitude"] = o.base_attitude;
-  j["reconfigure"] = o.reconfigure;
-  if (o.given.count("reconfigure-duration")) j["reconfigure-duration"] = o.reconfigure_duration;
-  if (o.given.count("max-base-rate-deg")) j["max-base-rate-deg"] = o.max_base_rate_deg;
-  if (o.contact_joints != "free") {  // joint models of the contact: absent means free (the paper's)
-    j["contact-joints"] = o.contact_joints;
-    j["armature"] = vector_json(sc.problem.joints.armature);
-  }
+                      {"joint_names", model.joint_names()}};
+  for (const ScenarioKey& key : scenario_keys())
+    if (key.echo) key.echo(sc, j);
   return j;
 }
 
@@ -207,17 +170,10 @@ inline nlohmann::json clearance_json(const ClearanceReport& c) {
   return x;
 }
 
-/// Shapes and clearance: the keys in "scenario", each run's "min_clearance" (overall and per kind
-/// of pair: distance m, pair, time s), the global run's goals rejected by the path check.
-inline void add_clearance_json(nlohmann::json& j, const Scenario& sc, const ScenarioResult& r) {
-  const ScenarioKeys& k = sc.keys;
-  j["scenario"]["target-shape"] = k.target_shape;
-  j["scenario"]["target-size"] = k.target_size;
-  j["scenario"]["target-shape-offset"] = k.target_shape_offset;
-  j["scenario"]["link-radius"] = k.link_radius;
-  j["scenario"]["bus-box"] = k.bus_box;
-  j["scenario"]["clearance"] = k.clearance;
-  j["scenario"]["contact-exemption"] = k.contact_exemption;
+/// Shapes and clearance (the keys are echoed in "scenario" by the key table): each run's
+/// "min_clearance" (overall and per kind of pair: distance m, pair, time s), the global run's goals
+/// rejected by the path check.
+inline void add_clearance_json(nlohmann::json& j, const ScenarioResult& r) {
   for (const auto& [name, c] : r.clearances) j[name]["min_clearance"] = clearance_json(c);
   if (r.global) j["global"]["goals_rejected_by_clearance"] = r.global->result.goals_rejected;
 }
@@ -245,7 +201,7 @@ inline nlohmann::json scenario_json(const Scenario& sc, const ScenarioResult& r,
   detail::add_reductions_json(j, "", plain, r.optimized_ok() ? &r.optimized : nullptr);
   if (r.global) detail::add_global_json(j, sc, *r.global, plain);
   detail::add_base_disturbance_json(j, sc, r);
-  if (sc.geometry) detail::add_clearance_json(j, sc, r);
+  if (sc.geometry) detail::add_clearance_json(j, r);
   if (r.robust) {
     nlohmann::json rj = {
         {"measure", "CVaR_95 (mean of the largest 5 %) and p95 (nearest rank) of the exact F_max, N"},

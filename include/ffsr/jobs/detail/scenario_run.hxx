@@ -108,11 +108,10 @@ inline GlobalRun run_global(const Scenario& sc, const CaptureResult* paper_run, 
     throw NumericalError(str("global run: ", e.what()));
   }
   const CaptureSetup setup = prepare_capture(sc.problem, sc.task, opt);
-  r.paper_objective =
-      paper_run ? evaluate_capture(sc.problem, setup, paper_run->base, paper_run->theta, objective, {},
-                                   robust.get())
-                      .objective
-                : std::numeric_limits<double>::quiet_NaN();
+  r.paper_objective = paper_run ? evaluate_capture(sc.problem, setup, paper_run->base, paper_run->theta,
+                                                   objective, {}, robust.get())
+                                      .objective
+                                : std::numeric_limits<double>::quiet_NaN();
   r.branches = capture_branches(sc.problem, sc.task, opt, setup, r.result.search, r.result.run.base, 6,
                                 std::max(1u, std::thread::hardware_concurrency()));
   return r;
@@ -166,7 +165,8 @@ inline ScenarioResult run_scenario(const Scenario& sc, const ScenarioRunOptions&
     r.robust = scenario_robust_objective(sc, r.robust_spec);
   }
   try {
-    r.global = detail::run_global(sc, r.optimized_ok() ? &r.optimized : nullptr, sc.objective, r.robust, false);
+    r.global =
+        detail::run_global(sc, r.optimized_ok() ? &r.optimized : nullptr, sc.objective, r.robust, false);
   } catch (const NumericalError& e) {
     if (r.plain_ok() && r.optimized_ok()) throw;
     throw NumericalError(detail::str(r.plain_ok() ? r.optimized_failure : r.plain_failure,
