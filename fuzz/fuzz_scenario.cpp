@@ -1,9 +1,10 @@
 // fuzz_scenario: arbitrary bytes as a scenario file of the main job of ffsr-optimize, run in-process
-// through the command's own code (src/cli: common.cpp, inspect.cpp, contact.cpp, robust.cpp, run.cpp; the CLI11
+// through the command's own code (src/cli: support/, inspect, contact, robust and run of commands/; the CLI11
 // app is set up as in main.cpp, and the same exceptions are caught). Checks: scenario_check.hpp.
 #include "scenario_check.hpp"
-#include "common.hpp"
-#include "subcommands.hpp"
+#include "commands/subcommands.hpp"
+#include "support/parse.hpp"
+#include "support/output.hpp"
 
 #include "ffsr/errors.hpp"
 

@@ -2,8 +2,11 @@
 // Parses the command line, runs the chosen action and maps exceptions to one error line and an exit
 // code (2: bad input or an output that cannot be written, 3: numerical failure, 4: the result moved
 // away from the --expect baseline). The library itself never prints.
-#include "common.hpp"
-#include "subcommands.hpp"
+#include "support/output.hpp"
+#include "support/parse.hpp"
+#include "support/progress.hpp"
+#include "support/subject.hpp"
+#include "commands/subcommands.hpp"
 
 #include <csignal>
 #include <iostream>
@@ -28,6 +31,25 @@ int exit_code_of_current_exception(bool parsing) {
     std::cerr << "ffsr-optimize: error: " << e.what() << "\n";
     return 1;
   }
+}
+
+/// "(did you mean --x?)" for the first flag of `argv` that the chosen subcommand (or the main job)
+/// does not know and that is close to one it knows; "" otherwise.
+std::string flag_suggestion(const CLI::App& app, int argc, char** argv) {
+  const auto subs = app.get_subcommands();
+  const CLI::App& chosen = subs.empty() ? app : *subs.front();
+  std::vector<std::string> names;
+  for (const CLI::Option* opt : chosen.get_options())
+    for (const std::string& n : opt->get_lnames()) names.push_back("--" + n);
+  for (int i = 1; i < argc; ++i) {
+    std::string a = argv[i];
+    if (a.rfind("--", 0) != 0) continue;
+    a = a.substr(0, a.find('='));
+    if (chosen.get_option_no_throw(a)) continue;
+    const std::string near = ffsr::detail::nearest_name(a, names);
+    if (!near.empty()) return " (did you mean " + near + "?)";
+  }
+  return "";
 }
 
 }  // namespace
@@ -58,7 +80,7 @@ int main(int argc, char** argv) {
   } catch (const CLI::Success& e) {  // --help, --help-all, --version
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    std::cerr << "ffsr-optimize: error: " << e.what() << "\n";
+    std::cerr << "ffsr-optimize: error: " << e.what() << flag_suggestion(app, argc, argv) << "\n";
     return kExitInput;
   } catch (...) {
     return exit_code_of_current_exception(true);

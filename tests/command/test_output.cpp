@@ -1,5 +1,5 @@
 // End-to-end tests of ffsr-optimize's output files as people use them from a shell
-// (src/cli/common.hpp, Outputs): '-' is standard output (the table then goes to standard error),
+// (src/cli/support/output.hpp, Outputs): '-' is standard output (the table then goes to standard error),
 // FIFOs and devices are written directly and never replaced, a symbolic link is followed and its
 // target replaced atomically, and every write error -- a full disk, a reader that closed the pipe --
 // is one error line naming the output, exit 2 and no partial regular file.

@@ -4,8 +4,8 @@
 // T ends where the planner's end-effector is, the attitude-drift curve ends at the planner's drift,
 // the map's maximum sits at the stretched arm (Section 5.1), xi from the closed form against the
 // exact peak. Bad inputs: a missing plot folder and an unknown format, one error line each.
-#include "cli/figures.hpp"
-#include "cli/plot.hpp"
+#include "cli/figures/figures.hpp"
+#include "cli/figures/plot.hpp"
 #include "support/image_check.hpp"
 #include "support/paper.hpp"
 #include "support/run_command.hpp"

@@ -1,6 +1,6 @@
-// A build without plotting: src/cli/plot.cpp compiled without FFSR_WITH_PLOT (as when PLplot is
+// A build without plotting: src/cli/figures/plot.cpp compiled without FFSR_WITH_PLOT (as when PLplot is
 // not found) must refuse every --plot with one error naming the flag.
-#include "cli/plot.hpp"
+#include "cli/figures/plot.hpp"
 
 #include "ffsr/errors.hpp"
 

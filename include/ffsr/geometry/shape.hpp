@@ -213,6 +213,9 @@ inline RobotGeometry robot_geometry(const Model& model, const std::vector<LinkSh
     g.shapes[static_cast<size_t>(f.body)].push_back(s);
     g.origin[static_cast<size_t>(f.body)] = "urdf";
   }
+  if (!g.shapes[0].empty() && !bus_box.empty())  // a key that would change nothing is refused
+    throw InputError(str("--bus-box: the URDF's base '", g.names[0],
+                         "' has <collision> primitives already (bus-box stands for a base without any)"));
   if (g.shapes[0].empty() && !bus_box.empty()) {
     if (bus_box.size() != 3) throw InputError(str("--bus-box: expected 3 numbers, got ", bus_box.size()));
     const Shape s = Shape::box(Vector3(bus_box[0], bus_box[1], bus_box[2]));

@@ -157,6 +157,9 @@ inline void start_of(const ScenarioKeys& k, const Model& model, CaptureProblem& 
   if (static_cast<int>(k.joints_deg.size()) != model.n()) {
     std::string names;
     for (const auto& n : model.joint_names()) names += (names.empty() ? "" : ", ") + n;
+    if (k.joints_deg.empty() && k.overridden.count("urdf"))  // a robot given by its URDF alone
+      throw InputError(str("--joints-deg: required with --urdf (the robot's ", model.n(),
+                           " joint angles in degrees, URDF tree order: ", names, ")"));
     throw InputError(str("--joints-deg: got ", k.joints_deg.size(), " angles, the robot has ", model.n(),
                          " joints (", names, ")"));
   }

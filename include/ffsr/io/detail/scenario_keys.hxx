@@ -487,10 +487,29 @@ inline void override_scenario_key(ScenarioKeys& keys, const std::string& name, c
   keys.overridden.insert(name);
 }
 
-/// Runs the check of every key of the table (ScenarioKey::check). InputError naming the key.
+/// Runs the check of every key of the table (ScenarioKey::check), then refuses a flag that would
+/// change nothing (a key given as an override, not by the file: a file may hold keys for other
+/// jobs): a key of the global run without one, the multibody reference's servo gains without the
+/// objective that runs it. InputError naming the key.
 inline void check_scenario_keys(const ScenarioKeys& keys) {
+  using detail::str;
   for (const ScenarioKey& key : scenario_keys())
     if (key.check) key.check(keys);
+  for (const ScenarioKey& key : scenario_keys()) {
+    if (!keys.overridden.count(key.name)) continue;
+    if (key.group == KeyGroup::Global && key.name != "global" && !keys.global)
+      throw InputError(str("--", key.name, ": acts on the global run only, and this run has none (global = false)"));
+    if ((key.name == "joint-stiffness" || key.name == "joint-damping") &&
+        !(keys.global && keys.objective == "multibody-force"))
+      throw InputError(str("--", key.name,
+                           ": acts on the multibody reference only: the global run's objective multibody-force "
+                           "(or the contact subcommand)"));
+  }
+  if (keys.overridden.count("objective") && !keys.global &&
+      (keys.objective == "multibody-force" || keys.objective == "robust-force"))
+    throw InputError(str("--objective: ", keys.objective,
+                         " acts on the global run only (the paper's method descends M_ie), and this run has "
+                         "none (global = false)"));
 }
 
 }  // namespace ffsr

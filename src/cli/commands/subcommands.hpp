@@ -1,4 +1,4 @@
-// src/cli/subcommands.hpp -- each subcommand registers its options and the action to run.
+// src/cli/commands/subcommands.hpp -- each subcommand registers its options and the action to run.
 #pragma once
 
 #include <CLI/CLI.hpp>

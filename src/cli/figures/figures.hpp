@@ -1,8 +1,8 @@
-// src/cli/figures.hpp -- the paper's figures as plot::Figure descriptions, built from the result
+// src/cli/figures/figures.hpp -- every figure of the command: the paper's figures as plot::Figure descriptions, built from the result
 // structs the JSON and CSV are written from (CaptureResult, the contact rows, a map grid).
 #pragma once
 
-#include "plot.hpp"
+#include "figures/plot.hpp"
 
 #include "ffsr/geometry/shape.hpp"
 #include "ffsr/optimize/capture.hpp"
@@ -119,5 +119,19 @@ plot::Figure map_slices(const Grid& grid, const std::vector<double>& point, cons
 /// Figure 8: the grid as coloured points in 3-D (at most `max_points`, evenly strided).
 plot::Figure map_cloud(const Grid& grid, const std::string& name, const std::string& title,
                        size_t max_points = 12000);
+
+/// The Monte Carlo of `robust`: every configuration's F_max over the samples and its 95th percentile
+/// (the estimator's), drawn as empirical CDFs and histograms ("robust").
+struct RobustSeries {
+  std::string title;
+  bool stiffness_conditional = false;  ///< the p95 is the law's conditional on the stiffness
+  struct Configuration {
+    std::string name;
+    std::vector<double> f_max;  ///< N, by sample
+    double p95 = 0;             ///< N
+  };
+  std::vector<Configuration> configurations;
+};
+plot::Figure robust(const RobustSeries& s);
 
 }  // namespace ffsr::cli::figures

@@ -3,12 +3,16 @@
 // global = false, globally; reports how much the capture configuration lowers M_ie and the maximum
 // contact force (Tables 4 and 7). The scenario and the runs are the library's (ffsr/io/scenario.hpp,
 // ffsr/jobs/scenario_run.hpp); this file turns flags into overrides and writes the outputs.
-#include "baseline.hpp"
-#include "common.hpp"
+#include "support/baseline.hpp"
+#include "support/output.hpp"
+#include "support/parse.hpp"
+#include "support/progress.hpp"
+#include "support/subject.hpp"
 #include "embedded.hpp"
-#include "figures.hpp"
-#include "scenario.hpp"
-#include "subcommands.hpp"
+#include "figures/figures.hpp"
+#include "commands/subcommands.hpp"
+
+#include "ffsr/jobs/scenario_run.hpp"
 
 #include <iomanip>
 #include <iostream>
@@ -19,25 +23,6 @@
 
 namespace ffsr::cli {
 
-// --- the scenario of a command ----------------------------------------------------------------------
-
-ScenarioKeys command_scenario_keys(const std::string& config, const ScenarioFlags& flags,
-                                   const std::set<std::string>& command_keys) {
-  ScenarioKeys keys = config.empty() ? read_scenario_text(kPaper3dofScenario, "built-in scenario")
-                                     : read_scenario_file(config, command_keys);
-  flags.apply(keys);
-  return keys;
-}
-
-EmbeddedUrdf builtin_urdf() { return {"paper_3dof.urdf", "built-in paper_3dof.urdf", kPaper3dofUrdf}; }
-
-Scenario command_scenario(ScenarioKeys keys) {
-  const EmbeddedUrdf embedded = builtin_urdf();
-  Scenario sc = build_scenario(std::move(keys), &embedded);
-  warn_repairs(sc.report);
-  return sc;
-}
-
 namespace {
 
 using detail::str;
@@ -47,7 +32,6 @@ using detail::str;
 struct RunSettings : OutputKeys {
   std::string expect;  ///< a stored result to compare with (regression run)
   double rtol = 1e-6, atol = 1e-9;
-  bool quiet = false;
 };
 
 const std::set<std::string> kCommandKeys = {"json",   "csv",  "plot", "plot-format",
@@ -93,8 +77,7 @@ struct RunRequest {
 
 RunRequest prepare_outputs(const RunSettings& o) {
   RunRequest q;
-  q.outputs.add("--json", o.json);
-  q.outputs.add("--csv", o.csv);
+  q.outputs = o.outputs();
   q.tol = {o.rtol, o.atol};
   if (!std::isfinite(o.rtol) || o.rtol < 0)
     throw InputError(str("--rtol: must be finite and >= 0, got ", o.rtol));
@@ -395,6 +378,7 @@ int report(const Scenario& sc, const ScenarioResult& r, const RunSettings& o, Ru
 int run_main(const RunOptions& o, const CLI::App& app) {
   ScenarioKeys keys = command_scenario_keys(o.config, o.flags, kCommandKeys);
   const RunSettings settings = settings_of(o.settings, keys, app);
+  set_quiet(settings.quiet);  // the flag, or the file's quiet key
   Scenario sc = command_scenario(std::move(keys));
   RunRequest request =
       prepare_outputs(settings);  // a conflict or an unreadable baseline is found before the work
@@ -410,22 +394,16 @@ void register_run(CLI::App& app, Action& action) {
                  "Scenario file (TOML); every key is also a flag. Default: the built-in paper 3-DOF scenario")
       ->check(CLI::ExistingFile);
   o->flags.add_to(app);
-  app.add_option("--json", o->settings.json,
-                 "Write the result (with the resolved scenario and the version) to this JSON file ('-': "
-                 "standard output)");
-  app.add_option("--csv", o->settings.csv,
-                 "Write the time series of both runs to this CSV file ('-': standard output)");
+  add_output_flags(app, o->settings,
+                   {"Write the result (with the resolved scenario and the version) as JSON to FILE",
+                    "Write the time series of the runs as CSV to FILE",
+                    "Draw the capture process and time histories"});
   app.add_option("--expect", o->settings.expect,
                  "Regression run: compare every number of the result with this stored --json result; exit 4 "
                  "when one moved (relative to the scenario file)");
   app.add_option("--rtol", o->settings.rtol, "--expect: relative tolerance")->capture_default_str();
   app.add_option("--atol", o->settings.atol, "--expect: absolute floor for values near zero")
       ->capture_default_str();
-  app.add_option("--plot", o->settings.plot,
-                 "Draw the capture process and time histories into this (existing) folder");
-  app.add_option("--plot-format", o->settings.plot_format, "Figure format: png, svg or pdf")
-      ->capture_default_str();
-  app.add_flag("--quiet", o->settings.quiet, "No progress line");
   app.callback([o, &app, &action] {
     if (app.get_subcommands().empty()) action = [o, &app] { return run_main(*o, app); };
   });

@@ -1,6 +1,4 @@
-#include "model_options.hpp"
-
-#include <cstdio>
+#include "support/scenario_flags.hpp"
 
 namespace ffsr::cli {
 
@@ -21,6 +19,12 @@ void ScenarioFlags::add_to(CLI::App& app, const std::function<bool(const std::st
   }
 }
 
+void ScenarioFlags::add_groups(CLI::App& app, std::initializer_list<KeyGroup> groups,
+                               const std::set<std::string>& except) {
+  const std::set<std::string> names = scenario_key_names(groups);
+  add_to(app, [&](const std::string& name) { return names.count(name) && !except.count(name); });
+}
+
 bool ScenarioFlags::given(const std::string& name) const {
   for (const auto& [key, opt] : options_)
     if (key->name == name) return opt->count() > 0;
@@ -38,17 +42,6 @@ void ScenarioFlags::apply(ScenarioKeys& keys) const {
     }
     override_scenario_key(keys, key->name, text);
   }
-}
-
-void warn_repairs(const UrdfReport& report) {
-  auto list = [](const std::vector<double>& v) {
-    std::string s;
-    for (double x : v) s += (s.empty() ? "" : ", ") + str(x);
-    return v.size() == 1 ? s : "(" + s + ")";
-  };
-  for (const ModelRepair& r : report.repairs)
-    std::fprintf(stderr, "ffsr-optimize: warning: link '%s': %s: %s -> %s\n", r.link.c_str(), r.what.c_str(),
-                 list(r.before).c_str(), list(r.after).c_str());
 }
 
 }  // namespace ffsr::cli

@@ -3,10 +3,14 @@
 // Figures 4-6. The parameters held fixed in each study are a scenario's contact law (--config, or the
 // built-in scenario: the paper's), flags override them. CSV always (a file, or stdout), pictures on
 // request.
-#include "common.hpp"
-#include "figures.hpp"
-#include "scenario.hpp"
-#include "subcommands.hpp"
+#include "support/output.hpp"
+#include "support/parse.hpp"
+#include "support/progress.hpp"
+#include "support/subject.hpp"
+#include "figures/figures.hpp"
+#include "commands/subcommands.hpp"
+
+#include "ffsr/jobs/scenario_run.hpp"
 
 #include <iomanip>
 #include <iostream>
@@ -20,7 +24,7 @@ struct XiOptions {
   std::string config;
   ScenarioFlags flags;  ///< stiffness, exponent, restitution, approach-speed
   int points = 41;
-  std::string csv, plot, plot_format = "png";
+  OutputKeys out;  ///< --json, --csv, --plot, --quiet
 };
 
 /// n values from a to b, evenly spaced (on a log scale when `log`).
@@ -67,7 +71,7 @@ XiSetup parse(const XiOptions& o) {
   if (!std::isfinite(k.approach_speed) || k.approach_speed <= 0)
     throw InputError(str("--approach-speed: must be positive and finite, got ", k.approach_speed));
   s.approach_speed = k.approach_speed;
-  s.plot_format = plot::check_request(o.plot, o.plot_format);
+  s.plot_format = plot::check_request(o.out.plot, o.out.plot_format);
   std::vector<std::string> laws;
   for (auto n : contact_law_names()) laws.emplace_back(n);
   auto g = [](double x) {
@@ -104,13 +108,8 @@ void compute(XiSetup& s) {
   }
 }
 
-/// The figures (when asked), then the CSV study,parameter,law,xi_percent to its file or stdout.
-int report(const XiOptions& o, const XiSetup& s) {
-  if (!o.plot.empty()) {
-    std::vector<plot::Figure> figs;
-    for (const auto& st : s.studies) figs.push_back(figures::xi(st));
-    plot::render(figs, o.plot, s.plot_format);
-  }
+/// study,parameter,law,xi_percent: one row per study, law and value.
+std::string xi_csv(const XiSetup& s) {
   std::ostringstream csv;
   csv << std::setprecision(12) << "study,parameter,law,xi_percent\n";
   for (size_t k = 0; k < s.studies.size(); ++k) {
@@ -119,14 +118,46 @@ int report(const XiOptions& o, const XiSetup& s) {
       for (size_t i = 0; i < st.x.size(); ++i)
         csv << kColumns[k] << "," << st.x[i] << "," << st.laws[l] << "," << st.xi[l][i] << "\n";
   }
-  if (o.csv.empty())
-    std::cout << csv.str();
-  else
-    write_file_atomic(o.csv, csv.str());
+  return csv.str();
+}
+
+/// The fixed parameters and, per study, the varied values and xi (percent) of each law.
+nlohmann::json xi_json(const XiSetup& s) {
+  nlohmann::json j;
+  j["parameters"] = {{"stiffness", s.base.K},
+                     {"exponent", s.base.alpha},
+                     {"restitution", s.base.c_r},
+                     {"approach_speed", s.approach_speed}};
+  j["studies"] = nlohmann::json::array();
+  for (size_t k = 0; k < s.studies.size(); ++k) {
+    const auto& st = s.studies[k];
+    nlohmann::json laws = nlohmann::json::object();
+    for (size_t l = 0; l < st.laws.size(); ++l) laws[st.laws[l]] = st.xi[l];
+    j["studies"].push_back({{"study", kColumns[k]}, {"parameter", st.x}, {"xi_percent", laws}});
+  }
+  j["version"] = FFSR_VERSION;
+  return j;
+}
+
+/// The figures (when asked), the JSON and the CSV; without --csv the CSV is the table (standard
+/// output, or standard error when the JSON goes there).
+int report(const XiOptions& o, const XiSetup& s) {
+  Outputs outputs = o.out.outputs();
+  if (!o.out.plot.empty()) {
+    std::vector<plot::Figure> figs;
+    for (const auto& st : s.studies) figs.push_back(figures::xi(st));
+    plot::render(figs, o.out.plot, s.plot_format);
+  }
+  const std::string csv = xi_csv(s);
+  outputs.set("--json", xi_json(s).dump(2) + "\n");
+  outputs.set("--csv", csv);
+  outputs.write();
+  if (o.out.csv.empty()) outputs.table() << csv;
   return 0;
 }
 
 int run_xi(const XiOptions& o) {
+  set_quiet(o.out.quiet);
   XiSetup s = parse(o);
   compute(s);
   return report(o, s);
@@ -147,9 +178,10 @@ void register_xi(CLI::App& app, Action& action) {
     return name == "stiffness" || name == "exponent" || name == "restitution" || name == "approach-speed";
   });
   sub->add_option("--points", o->points, "Values per study")->capture_default_str();
-  sub->add_option("--csv", o->csv, "Write study,parameter,law,xi_percent to this file (default: stdout)");
-  sub->add_option("--plot", o->plot, "Draw the three studies into this (existing) folder");
-  sub->add_option("--plot-format", o->plot_format, "Figure format: png, svg or pdf")->capture_default_str();
+  add_output_flags(*sub, o->out,
+                   {"Write the studies (the fixed parameters, xi of each law against each value) as JSON to FILE",
+                    "Write study,parameter,law,xi_percent as CSV to FILE (default: the table, on standard output)",
+                    "Draw the three studies"});
   sub->callback([o, &action] { action = [o] { return run_xi(*o); }; });
 }
 

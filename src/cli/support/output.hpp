@@ -1,82 +1,19 @@
-// src/cli/common.hpp -- options shared by the subcommands, parsing helpers and output files.
+// src/cli/support/output.hpp -- the command's outputs: the output flags every subcommand takes, and
+// the one writer of files and standard output (atomic, all or nothing).
 #pragma once
 
-#include "ffsr/algorithm/joint_models.hpp"
-#include "ffsr/contact/contact_law.hpp"
-#include "ffsr/ffsr.hpp"
-#include "model_options.hpp"
+#include "ffsr/io/scenario.hpp"
 
-#include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
-#include <chrono>
+#include <CLI/CLI.hpp>
+
 #include <ostream>
-#include <set>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace ffsr::cli {
-
-/// Exit codes: 2 for bad input (arguments, files, models) and for an output that cannot be written
-/// (including a reader that closed the pipe), 3 for a numerical failure, 4 when the result moved away
-/// from the --expect baseline.
-constexpr int kExitInput = 2;
-constexpr int kExitNumerical = 3;
-constexpr int kExitRegression = 4;
-
-/// Parses "a,b,c" into numbers; throws InputError naming `flag` on a bad or non-finite number or
-/// when the count is not one of `counts` (empty: any count >= 1).
-std::vector<double> parse_list(const std::string& text, const std::string& flag,
-                               std::vector<size_t> counts = {});
-Vector3 parse_vec3(const std::string& text, const std::string& flag);
-/// A non-negative integer written in decimal digits (no sign, no exponent), or InputError naming `flag`.
-std::uint64_t parse_count(const std::string& text, const std::string& flag);
-/// --shard K/N: part K (counting from 0) of N.
-struct Shard {
-  std::uint64_t k = 0, n = 1;
-};
-/// Parses K/N (0 <= K < N); InputError naming --shard.
-Shard parse_shard(const std::string& text);
-double deg2rad(double deg);
-double rad2deg(double rad);
-
-/// The robot at one configuration, the target and the contact law that inspect, contact and map
-/// evaluate: the keys of a scenario file (--config) or of the built-in scenario, then the scenario
-/// keys given as flags (the robot and its start state, the bus, the target, the contact law), read,
-/// checked and built by the library (ffsr/io/scenario.hpp) as for the main job. --urdf replaces the
-/// robot: its joint angles (--joints-deg, then required) and end-effector come from the flags alone.
-struct SubjectOptions {
-  std::string config;
-  ScenarioFlags flags;
-  /// --config and the flags of the subject's keys; `also` adds keys of the key table (their flags).
-  void add_to(CLI::App& app, const std::set<std::string>& also = {});
-};
-
-/// A robot at one configuration.
-struct Robot {
-  Model model;
-  int end_effector = 0;
-  BasePose base;
-  Eigen::VectorXd theta;
-  UrdfReport report;  ///< what the loader did to the file
-};
-
-/// What SubjectOptions describe, built.
-struct Subject {
-  ScenarioKeys keys;  ///< as resolved (the URDF path relative to the scenario file)
-  Robot robot;
-  Target target;              ///< at t = 0, with its spin and velocity
-  ContactParams params;       ///< K, alpha, c_r, checked
-  std::string law;            ///< the damping law's name as given (contact also takes 'all')
-  double approach_speed = 0;  ///< m/s, finite (its sign is the subcommand's to judge)
-  /// The joint models of the contact (contact-joints, armature; algorithm/joint_models.hpp); 'all'
-  /// (contact: each model in turn) gives free. InputError naming the key.
-  ContactJoints contact_joints() const;
-  bool all_joint_models() const { return keys.contact_joints == "all"; }
-};
-/// Builds the subject; warns about every repair of the model. InputError naming the key or the file,
-/// ModelError from the loader.
-Subject load_subject(const SubjectOptions& options);
 
 /// Output files, as people name them in a shell. Every subcommand writes its outputs through
 /// `Outputs` (or the two functions below, which use the same writer):
@@ -154,31 +91,14 @@ class StreamingOutput {
 /// it failed (a closed pipe, a full disk). main calls it after every successful action.
 void flush_stdout();
 
-/// A progress line on stderr when it is a terminal, shown once a run has lasted a second
-/// (`label` names the run). Call from one thread only.
-struct Progress {
-  explicit Progress(std::string label_, bool quiet = false, std::string unit_ = "points");
-  /// "label run  42%".
-  void operator()(double fraction);
-  /// "label 1234/5678 points, 1.2e+06/s, 3 s left" (`unit` instead of "points").
-  void operator()(unsigned long long done, unsigned long long total);
-
- private:
-  std::string label, unit;
-  std::chrono::steady_clock::time_point start;
-  bool shown = false;
-  bool enabled;
-};
-
-/// Matrix -> JSON array of rows.
-nlohmann::json to_json(const Eigen::MatrixXd& m);
-nlohmann::json to_json(const Eigen::VectorXd& v);
-
-/// The output keys of the subcommands that run a scenario (the main job, robust): where the JSON,
-/// the CSV and the figures go, and whether progress is shown. A flag or the scenario file sets them.
+/// The output flags every subcommand takes (docs/command.md, "Conventions"): `--json [FILE]` (no FILE
+/// or '-': standard output), `--csv FILE` where the subcommand has series, `--plot DIR` and
+/// `--plot-format` where it draws, and `--quiet`. The subcommands that run a scenario file also take
+/// them as keys of the file (a flag overrides the file).
 struct OutputKeys {
   std::string json, csv, plot, plot_format = "png";
   bool quiet = false;
+  std::string csv_flag = "--csv";  ///< the name the CSV was asked for by (contact also takes --series)
   /// Sets output key `name` from the scenario file's text (`flag` names it in errors); false when
   /// `name` is not an output key.
   bool set_from_file(const std::string& name, const std::string& text, const std::string& flag) {
@@ -196,7 +116,21 @@ struct OutputKeys {
       return false;
     return true;
   }
+  /// The files of --json and --csv (Outputs::add: two outputs on standard output are refused here,
+  /// before any work).
+  Outputs outputs() const;
 };
+
+/// What a subcommand writes, for the help of its output flags: --json always; --csv and --plot when
+/// the text is not null. `csv_alias`: a second name of --csv (contact's --series).
+struct OutputHelp {
+  const char* json;
+  const char* csv = nullptr;
+  const char* plot = nullptr;
+  const char* csv_alias = nullptr;
+};
+/// Registers the output flags of OutputKeys on `app`.
+void add_output_flags(CLI::App& app, OutputKeys& keys, const OutputHelp& help);
 
 /// Calls set(name, text, flag) for every command key the scenario file holds (ScenarioKeys::extra:
 /// json, csv, plot, ...) whose flag was not given on the command line: a flag overrides the file.

@@ -1,5 +1,5 @@
-// src/cli/plot.cpp -- the PLplot renderer of plot.hpp (and the stub of a build without PLplot).
-#include "plot.hpp"
+// src/cli/figures/plot.cpp -- the PLplot renderer of plot.hpp (and the stub of a build without PLplot).
+#include "figures/plot.hpp"
 
 #include "ffsr/errors.hpp"
 
@@ -175,12 +175,8 @@ class Renderer {
     vy1 = c.y1 - 30 * py;
   }
 
-  void draw(const Panel& p, const Cell& cell) {
-    const bool has_legend =
-        std::any_of(p.curves.begin(), p.curves.end(), [](const Curve& c) { return !c.label.empty(); });
-    double vx0, vx1, vy0, vy1;
-    viewport(cell, p.legend_outside && has_legend ? 250 : 0, vx0, vx1, vy0, vy1);
-    double xmin, xmax, ymin, ymax;
+  /// The data window of a panel: its limits, or the range of its curves with a margin.
+  static void data_window(const Panel& p, double& xmin, double& xmax, double& ymin, double& ymax) {
     if (p.limits.size() == 4) {
       xmin = p.limits[0], xmax = p.limits[1], ymin = p.limits[2], ymax = p.limits[3];
     } else {
@@ -192,37 +188,31 @@ class Renderer {
       range(xs, p.log_x ? 0.0 : 0.03, xmin, xmax);
       range(ys, 0.06, ymin, ymax);
     }
-    auto tx = [&](double x) { return p.log_x ? std::log10(x) : x; };
     if (p.log_x) {
       xmin = std::log10(xmin);
       xmax = std::log10(xmax);
     }
-    // an inside legend goes to the corner where its box hides the fewest curve points; when every
-    // corner would hide some, the y range grows upwards until the box fits above the curves
-    int corner = 0;
-    if (has_legend && !p.legend_outside) {
-      const long entries =
-          std::count_if(p.curves.begin(), p.curves.end(), [](const Curve& c) { return !c.label.empty(); });
-      const double box_w = 0.34, box_h = std::min(0.6, 0.03 + 0.085 * static_cast<double>(entries));
-      long hidden = 0;
+  }
+
+  /// The corner of an inside legend: where its box hides the fewest curve points; when every corner
+  /// would hide some, the y range grows upwards until the box fits above the curves.
+  template <class Tx>
+  static int legend_corner(const Panel& p, Tx tx, double xmin, double xmax, double ymin, double& ymax) {
+    const long entries =
+        std::count_if(p.curves.begin(), p.curves.end(), [](const Curve& c) { return !c.label.empty(); });
+    const double box_w = 0.34, box_h = std::min(0.6, 0.03 + 0.085 * static_cast<double>(entries));
+    long hidden = 0;
+    int corner = emptiest_corner(p.curves, tx, xmin, xmax, ymin, ymax, box_w, box_h, hidden);
+    if (hidden > 0 && p.limits.size() != 4 && !p.equal_aspect) {
+      ymax = ymin + (ymax - ymin) / (1.0 - box_h - 0.02);
       corner = emptiest_corner(p.curves, tx, xmin, xmax, ymin, ymax, box_w, box_h, hidden);
-      if (hidden > 0 && p.limits.size() != 4 && !p.equal_aspect) {
-        ymax = ymin + (ymax - ymin) / (1.0 - box_h - 0.02);
-        corner = emptiest_corner(p.curves, tx, xmin, xmax, ymin, ymax, box_w, box_h, hidden);
-      }
     }
-    if (p.equal_aspect) {
-      const double w = (vx1 - vx0) * fig_.width, h = (vy1 - vy0) * fig_.height;
-      const double s = std::max((xmax - xmin) / w, (ymax - ymin) / h);
-      const double cx = 0.5 * (xmin + xmax), cy = 0.5 * (ymin + ymax);
-      xmin = cx - 0.5 * s * w, xmax = cx + 0.5 * s * w;
-      ymin = cy - 0.5 * s * h, ymax = cy + 0.5 * s * h;
-    }
-    pls_.vpor(vx0, vx1, vy0, vy1);
-    pls_.wind(xmin, xmax, ymin, ymax);
-    pls_.col0(kGrey);
-    pls_.width(0.5);
-    pls_.box(p.log_x ? "ghl" : "g", 0, 0, "g", 0, 0);  // light grid first, under the curves
+    return corner;
+  }
+
+  /// The curves of a panel: fills, lines and symbols, in the window set.
+  template <class Tx>
+  void draw_curves(const Panel& p, Tx tx) {
     for (const auto& c : p.curves) {
       std::vector<double> x(c.x.size());
       std::transform(c.x.begin(), c.x.end(), x.begin(), tx);
@@ -242,6 +232,30 @@ class Renderer {
         pls_.schr(0, kScale);
       }
     }
+  }
+
+  void draw(const Panel& p, const Cell& cell) {
+    const bool has_legend =
+        std::any_of(p.curves.begin(), p.curves.end(), [](const Curve& c) { return !c.label.empty(); });
+    double vx0, vx1, vy0, vy1;
+    viewport(cell, p.legend_outside && has_legend ? 250 : 0, vx0, vx1, vy0, vy1);
+    double xmin, xmax, ymin, ymax;
+    data_window(p, xmin, xmax, ymin, ymax);
+    auto tx = [&](double x) { return p.log_x ? std::log10(x) : x; };
+    const int corner = has_legend && !p.legend_outside ? legend_corner(p, tx, xmin, xmax, ymin, ymax) : 0;
+    if (p.equal_aspect) {
+      const double w = (vx1 - vx0) * fig_.width, h = (vy1 - vy0) * fig_.height;
+      const double s = std::max((xmax - xmin) / w, (ymax - ymin) / h);
+      const double cx = 0.5 * (xmin + xmax), cy = 0.5 * (ymin + ymax);
+      xmin = cx - 0.5 * s * w, xmax = cx + 0.5 * s * w;
+      ymin = cy - 0.5 * s * h, ymax = cy + 0.5 * s * h;
+    }
+    pls_.vpor(vx0, vx1, vy0, vy1);
+    pls_.wind(xmin, xmax, ymin, ymax);
+    pls_.col0(kGrey);
+    pls_.width(0.5);
+    pls_.box(p.log_x ? "ghl" : "g", 0, 0, "g", 0, 0);  // light grid first, under the curves
+    draw_curves(p, tx);
     pls_.col0(kText);
     pls_.width(1.0);
     pls_.box(p.log_x ? "bcnstl" : "bcnst", 0, 0, "bcnstv", 0, 0);

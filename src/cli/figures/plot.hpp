@@ -1,4 +1,4 @@
-// src/cli/plot.hpp -- figures: a small description of what to draw (panels of curves, 3-D curves,
+// src/cli/figures/plot.hpp -- figures: a small description of what to draw (panels of curves, 3-D curves,
 // heat maps, 3-D point clouds) and a renderer that hands it to PLplot.
 //
 // The description is plain data, built by figures.cpp from the same result structs the JSON and CSV

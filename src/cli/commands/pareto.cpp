@@ -1,10 +1,14 @@
 // ffsr-optimize pareto: the front of (M_ie, base angular rate jump at the impact) on the capture
 // manifold at the global run's base pose (ffsr/optimize/pareto.hpp), for a scenario as the main job.
-#include "common.hpp"
-#include "figures.hpp"
-#include "plot.hpp"
-#include "scenario.hpp"
-#include "subcommands.hpp"
+#include "support/output.hpp"
+#include "support/parse.hpp"
+#include "support/progress.hpp"
+#include "support/subject.hpp"
+#include "figures/figures.hpp"
+#include "figures/plot.hpp"
+#include "commands/subcommands.hpp"
+
+#include "ffsr/jobs/scenario_run.hpp"
 
 #include "ffsr/optimize/pareto.hpp"
 
@@ -18,9 +22,9 @@ namespace {
 
 struct ParetoCliOptions {
   ScenarioFlags flags;
-  std::string config, json, csv, plot, plot_format = "png";
+  std::string config;
   int levels = 30, starts = 16;
-  bool quiet = false;
+  OutputKeys out;  ///< --json, --csv, --plot, --quiet
 };
 
 constexpr double kDeg = 180.0 / M_PI;
@@ -105,12 +109,11 @@ plot::Figure pareto_figure(const Scenario& sc, const ParetoFront& f, const std::
 }
 
 int run_pareto(const ParetoCliOptions& o) {
-  Outputs outputs;
-  outputs.add("--json", o.json);
-  outputs.add("--csv", o.csv);
+  set_quiet(o.out.quiet);
+  Outputs outputs = o.out.outputs();
   if (o.levels < 1) throw InputError(detail::str("--levels: must be >= 1, got ", o.levels));
   if (o.starts < 1) throw InputError(detail::str("--starts: must be >= 1, got ", o.starts));
-  const plot::Format plot_format = plot::check_request(o.plot, o.plot_format);
+  const plot::Format plot_format = plot::check_request(o.out.plot, o.out.plot_format);
   Scenario sc = command_scenario(command_scenario_keys(o.config, o.flags));
   if (!sc.keys.global) throw InputError("--global: pareto needs the global run's base pose (global = true)");
   ScenarioRunOptions ro;
@@ -130,7 +133,7 @@ int run_pareto(const ParetoCliOptions& o) {
   outputs.set("--json", front_json(sc, f, runs, g.base).dump(2) + "\n");
   outputs.set("--csv", front_csv(f));
   std::vector<std::string> drawn;
-  if (!o.plot.empty()) drawn = plot::render({pareto_figure(sc, f, runs)}, o.plot, plot_format);
+  if (!o.out.plot.empty()) drawn = plot::render({pareto_figure(sc, f, runs)}, o.out.plot, plot_format);
   outputs.write();
   std::ostream& out = outputs.table();
   print_front(out, sc, f, runs);
@@ -146,17 +149,17 @@ void register_pareto(CLI::App& app, Action& action) {
       "pareto", "Front of M_ie against the base's angular rate jump at the impact, on the capture manifold");
   sub->add_option("--config", o->config, "Scenario file (TOML); default: the built-in paper 3-DOF scenario")
       ->check(CLI::ExistingFile);
-  o->flags.add_to(*sub);
+  // the front is of M_ie with free joints during the contact: no joint-model keys
+  o->flags.add_groups(*sub, {KeyGroup::Robot, KeyGroup::Start, KeyGroup::Target, KeyGroup::TargetPlace,
+                             KeyGroup::Contact, KeyGroup::Planner, KeyGroup::Global, KeyGroup::Shapes});
   sub->add_option("--levels", o->levels, "Epsilon levels of the sweep between the two ends")
       ->capture_default_str();
   sub->add_option("--starts", o->starts, "Random starts of the two single-objective searches")
       ->capture_default_str();
-  sub->add_option("--json", o->json,
-                  "Write the front (configurations, ends, knee, hypervolume) to this JSON file");
-  sub->add_option("--csv", o->csv, "Write the front, one configuration per row, to this CSV file");
-  sub->add_option("--plot", o->plot,
-                  "Draw the front (knee, ends and the three runs marked) into this (existing) folder");
-  sub->add_option("--plot-format", o->plot_format, "Figure format: png, svg or pdf")->capture_default_str();
+  add_output_flags(*sub, o->out,
+                   {"Write the front (configurations, ends, knee, hypervolume) as JSON to FILE",
+                    "Write the front, one configuration per row, as CSV to FILE",
+                    "Draw the front (knee, ends and the three runs marked)"});
   sub->callback([o, &action] { action = [o] { return run_pareto(*o); }; });
 }
 

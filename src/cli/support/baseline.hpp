@@ -1,4 +1,4 @@
-// src/cli/baseline.hpp -- regression runs: compare a JSON result with a stored one (--expect).
+// src/cli/support/baseline.hpp -- regression runs: compare a JSON result with a stored one (--expect).
 // Header-only: the CLI's source files are also compiled, by name, into fuzz/fuzz_scenario.
 #pragma once
 

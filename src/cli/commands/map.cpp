@@ -23,9 +23,14 @@
 // theta_i = 0 slices) and the grid as coloured points in 3-D (Figure 8). The values are kept in memory
 // for that (8 bytes a point), so a plotted grid is limited to kMaxPlotPoints; a shard holds part of
 // the grid only and is not plotted.
-#include "common.hpp"
-#include "figures.hpp"
-#include "subcommands.hpp"
+#include "support/output.hpp"
+#include "support/parse.hpp"
+#include "support/progress.hpp"
+#include "support/subject.hpp"
+#include "figures/figures.hpp"
+#include "commands/subcommands.hpp"
+
+#include "ffsr/jobs/scenario_run.hpp"
 
 #include "ffsr/detail/parallel.hpp"
 
@@ -48,12 +53,11 @@ struct MapOptions {
   std::string vary;
   std::string range_deg = "-180,180";
   std::string step_deg = "2";
-  std::string csv;
   std::string shard = "0/1";
-  std::string plot, plot_format = "png", slice_deg;
+  std::string slice_deg;
   unsigned threads = 0;
   std::uint64_t max_points = 1000000000ULL;
-  bool quiet = false;
+  OutputKeys out;  ///< --csv (required: the map), --json (its summary), --plot, --quiet
 };
 
 /// One varied joint: angles lo + i step (degrees), i = 0..count-1.
@@ -195,12 +199,18 @@ struct Worker {
   }
 };
 
-std::string point_deg(const Grid& g, std::uint64_t idx) {
+/// The angles of point `idx`, deg, one per varied joint.
+std::vector<double> point_angles(const Grid& g, std::uint64_t idx) {
   std::vector<double> a(g.axes.size());
   for (size_t i = g.axes.size(); i-- > 0;) {
     a[i] = g.axes[i].angle_deg(idx % g.axes[i].count);
     idx /= g.axes[i].count;
   }
+  return a;
+}
+
+std::string point_deg(const Grid& g, std::uint64_t idx) {
+  const std::vector<double> a = point_angles(g, idx);
   std::ostringstream os;
   os << "[";
   for (size_t i = 0; i < a.size(); ++i) os << (i ? ", " : "") << a[i];
@@ -278,9 +288,9 @@ std::vector<double> check_map_plot(const MapOptions& o, const Grid& grid, const 
     slice_deg = parse_list(o.slice_deg, "--slice-deg", {grid.axes.size()});
     if (grid.axes.size() != 3) throw InputError("--slice-deg: slices are drawn for three varied joints only");
   }
-  if (o.plot.empty()) return slice_deg;
+  if (o.out.plot.empty()) return slice_deg;
   plot::require_available("--plot");
-  plot::check_folder(o.plot, "--plot");
+  plot::check_folder(o.out.plot, "--plot");
   if (grid.axes.size() > 3)
     throw InputError(str("--plot: pictures are drawn for 1 to 3 varied joints, got ", grid.axes.size(),
                          " (the CSV holds every point)"));
@@ -321,25 +331,71 @@ void run_workers(GridRun& g, StreamingOutput& out, std::uint64_t first, std::uin
       opt);
 }
 
+/// The largest and the smallest M_ie of the evaluated points (the first point of a tie).
+struct Extremes {
+  double max_M = 0, min_M = 0;
+  std::uint64_t argmax = 0, argmin = 0;
+};
+
+Extremes extremes(const GridRun& g) {
+  const Worker* hi = g.workers[0].get();
+  const Worker* lo = g.workers[0].get();
+  for (const auto& w : g.workers) {
+    if (w->max_M > hi->max_M || (w->max_M == hi->max_M && w->argmax < hi->argmax)) hi = w.get();
+    if (w->min_M < lo->min_M || (w->min_M == lo->min_M && w->argmin < lo->argmin)) lo = w.get();
+  }
+  return {hi->max_M, lo->min_M, hi->argmax, lo->argmin};
+}
+
 void print_map_summary(std::ostream& os, const MapOptions& o, const Grid& grid, const Shard& shard,
                        const GridRun& g, std::uint64_t count, double seconds) {
   os << "map: " << count << " of " << grid.size << " points (shard " << shard.k << "/" << shard.n << ") in "
      << seconds << " s, " << (seconds > 0 ? static_cast<double>(count) / seconds : 0.0) << " points/s on "
      << g.threads << " thread" << (g.threads > 1 ? "s" : "") << "\n";
   if (count > 0) {
-    const Worker* hi = g.workers[0].get();
-    const Worker* lo = g.workers[0].get();
-    for (const auto& w : g.workers) {
-      if (w->max_M > hi->max_M || (w->max_M == hi->max_M && w->argmax < hi->argmax)) hi = w.get();
-      if (w->min_M < lo->min_M || (w->min_M == lo->min_M && w->argmin < lo->argmin)) lo = w.get();
-    }
-    os << "max M_ie = " << hi->max_M << " kg at " << point_deg(grid, hi->argmax)
-       << " deg; min M_ie = " << lo->min_M << " kg at " << point_deg(grid, lo->argmin) << " deg\n";
+    const Extremes e = extremes(g);
+    os << "max M_ie = " << e.max_M << " kg at " << point_deg(grid, e.argmax) << " deg; min M_ie = " << e.min_M
+       << " kg at " << point_deg(grid, e.argmin) << " deg\n";
   }
-  if (o.csv != "-") os << "wrote " << o.csv << "\n";
+  if (!is_stdout_name(o.out.csv)) os << "wrote " << o.out.csv << "\n";
+}
+
+/// The map's summary: the grid, this shard's points and the extremes of M_ie with their closed-form
+/// F_max (the CSV holds every point).
+nlohmann::json map_json(const Subject& subject, const Grid& grid, const Shard& shard, const GridRun& g,
+                        std::uint64_t first, std::uint64_t count, JointModel joints, const AnyContactLaw& law) {
+  const auto names = subject.robot.model.joint_names();
+  nlohmann::json axes = nlohmann::json::array();
+  for (const Axis& a : grid.axes)
+    axes.push_back({{"joint", names[static_cast<size_t>(a.joint)]},
+                    {"from_deg", a.lo},
+                    {"step_deg", a.step},
+                    {"count", a.count}});
+  nlohmann::json j = {{"urdf", subject.keys.urdf},
+                      {"joints_deg", subject.keys.joints_deg},
+                      {"contact_joints", joint_model_name(joints)},
+                      {"axes", axes},
+                      {"points", grid.size},
+                      {"shard", {{"k", shard.k}, {"n", shard.n}, {"first", first}, {"end", first + count}}},
+                      {"version", FFSR_VERSION}};
+  if (count > 0) {
+    const Extremes e = extremes(g);
+    // F_max (Eq. 24) grows with M_ie: its extremes are at the same points
+    j["max"] = {{"integrated_effective_mass", e.max_M},
+                {"f_max_closed_form", max_force_closed_form(law, e.max_M)},
+                {"angles_deg", point_angles(grid, e.argmax)}};
+    j["min"] = {{"integrated_effective_mass", e.min_M},
+                {"f_max_closed_form", max_force_closed_form(law, e.min_M)},
+                {"angles_deg", point_angles(grid, e.argmin)}};
+  }
+  return j;
 }
 
 int run_map(const MapOptions& o) {
+  set_quiet(o.out.quiet);
+  Outputs outputs;  // the JSON summary; the CSV is streamed (below)
+  outputs.add("--json", o.out.json);
+  if (is_stdout_name(o.out.csv)) outputs.claim_stdout("--csv " + o.out.csv);
   const Subject subject = load_subject(o.subject);
   const Robot& r = subject.robot;
   const Target& target = subject.target;
@@ -349,15 +405,15 @@ int run_map(const MapOptions& o) {
   const std::uint64_t first = shard_begin(shard, grid.size, shard.k),
                       last = shard_begin(shard, grid.size, shard.k + 1);
   const std::uint64_t count = last - first;
-  const bool plotting = !o.plot.empty();
-  const plot::Format plot_format = plot::parse_format(o.plot_format, "--plot-format");
+  const bool plotting = !o.out.plot.empty();
+  const plot::Format plot_format = plot::parse_format(o.out.plot_format, "--plot-format");
   const std::vector<double> slice_deg = check_map_plot(o, grid, shard);
   std::vector<double> values(plotting ? count : 0);
 
   if (subject.all_joint_models())
     throw InputError("--contact-joints: map evaluates one joint model; 'all' is for the contact subcommand");
   const ContactJoints joints = subject.contact_joints();  // checked before any output
-  StreamingOutput out("--csv", o.csv);
+  StreamingOutput out("--csv", o.out.csv);
   if (shard.k == 0) {
     std::string header;
     const auto names = r.model.joint_names();
@@ -381,15 +437,17 @@ int run_map(const MapOptions& o) {
     g.workers.back()->first_point = first;
   }
   const auto t0 = std::chrono::steady_clock::now();
-  run_workers(g, out, first, last, kBlock, o.quiet);
+  run_workers(g, out, first, last, kBlock, o.out.quiet);
   // the pictures before the CSV is committed: a failed drawing leaves no CSV behind
   std::vector<std::string> drawn;
   if (plotting)
-    drawn = plot::render(map_figures(grid, r.model.joint_names(), std::move(values), slice_deg), o.plot,
+    drawn = plot::render(map_figures(grid, r.model.joint_names(), std::move(values), slice_deg), o.out.plot,
                          plot_format);
-  out.commit();
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  std::ostream& os = o.csv == "-" ? std::cerr : std::cout;
+  outputs.set("--json", map_json(subject, grid, shard, g, first, count, joints.model, law).dump(2) + "\n");
+  outputs.write();  // the summary first: a failed JSON leaves no CSV behind
+  out.commit();
+  std::ostream& os = outputs.table();  // standard error when the CSV or the JSON goes to standard output
   print_map_summary(os, o, grid, shard, g, count, seconds);
   for (const std::string& f : drawn) os << "wrote " << f << "\n";
   return 0;
@@ -402,7 +460,8 @@ void register_map(CLI::App& app, Action& action) {
   auto o = std::make_shared<MapOptions>();
   CLI::App* sub =
       app.add_subcommand("map", "M_ie (Eq. 14) and closed-form F_max (Eq. 24) over a grid of joint angles");
-  o->subject.add_to(*sub, {"contact-joints", "armature"});
+  // M_ie and F_max do not depend on where the base is, only on its attitude: no --base-position
+  o->subject.add_to(*sub, {"contact-joints", "armature"}, {"base-position"});
   sub->add_option("--vary", o->vary,
                   "Joints to vary, 1-based in URDF tree order, e.g. 1,2,3; the others stay at --joints-deg")
       ->required();
@@ -412,9 +471,6 @@ void register_map(CLI::App& app, Action& action) {
       ->capture_default_str();
   sub->add_option("--step-deg", o->step_deg, "Grid step, one for all or one per varied joint, deg")
       ->capture_default_str();
-  sub->add_option("--csv", o->csv,
-                  "Output CSV (one row per point: varied angles deg, M_ie kg, F_max N); '-' for stdout")
-      ->required();
   sub->add_option("--shard", o->shard,
                   "Evaluate the K-th of N contiguous parts of the grid (K/N, 0 <= K < N); only part 0 writes "
                   "the header, "
@@ -425,15 +481,16 @@ void register_map(CLI::App& app, Action& action) {
       ->capture_default_str();
   sub->add_option("--max-points", o->max_points, "Refuse grids with more points than this")
       ->capture_default_str();
-  sub->add_option(
-      "--plot", o->plot,
-      "Draw the map into this (existing) folder: M_ie against one joint, a heat map for two (Figure 9), "
-      "slices and a 3-D view for three (Figures 8, 9)");
-  sub->add_option("--plot-format", o->plot_format, "Figure format: png, svg or pdf")->capture_default_str();
+  add_output_flags(
+      *sub, o->out,
+      {"Write the map's summary (the grid, the points of this shard, the extremes of M_ie) as JSON to FILE",
+       "Write the map (one row per point: varied angles deg, M_ie kg, F_max N) as CSV to FILE",
+       "Draw the map: M_ie against one joint, a heat map for two (Figure 9), slices and a 3-D view for "
+       "three (Figures 8, 9)"});
+  sub->get_option("--csv")->required();
   sub->add_option("--slice-deg", o->slice_deg,
                   "Three varied joints: the point the slices go through, one angle per varied joint, deg "
                   "(default 0,0,0)");
-  sub->add_flag("--quiet", o->quiet, "No progress line");
   sub->callback([o, &action] { action = [o] { return run_map(*o); }; });
 }
 

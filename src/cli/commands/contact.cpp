@@ -1,7 +1,12 @@
 // ffsr-optimize contact: closed-form, exact and multibody (CVODE) maximum contact force.
-#include "common.hpp"
-#include "figures.hpp"
-#include "subcommands.hpp"
+#include "support/output.hpp"
+#include "support/parse.hpp"
+#include "support/progress.hpp"
+#include "support/subject.hpp"
+#include "figures/figures.hpp"
+#include "commands/subcommands.hpp"
+
+#include "ffsr/jobs/scenario_run.hpp"
 
 #include "ffsr/algorithm/base_disturbance.hpp"
 #include "ffsr/simulate/multibody.hpp"
@@ -16,8 +21,7 @@ namespace {
 
 struct ContactOptions {
   SubjectOptions subject;
-  std::string series, plot, plot_format = "png";
-  bool json = false;
+  OutputKeys out;  ///< --json, --csv (also --series: F(t), delta(t)), --plot, --quiet
 };
 
 struct Row {
@@ -59,7 +63,7 @@ Row evaluate(const Subject& s, const ContactOptions& o, const std::string& law_n
   const Target& target = s.target;
   const ContactParams& p = s.params;
   MultibodyContactOptions mo;
-  mo.record_series = !o.series.empty() || !o.plot.empty();
+  mo.record_series = !o.out.csv.empty() || !o.out.plot.empty();
   mo.joint_stiffness = per_joint_values(s.keys.joint_stiffness, r.model, "--joint-stiffness");
   mo.joint_damping = per_joint_values(s.keys.joint_damping, r.model, "--joint-damping");
   mo.armature = per_joint_values(s.keys.armature, r.model, "--armature");
@@ -163,7 +167,7 @@ void plot_contact(const std::vector<Row>& rows, const ContactParams& params, con
     c.f_max = row.f_multibody;
     curves.push_back(std::move(c));
   }
-  plot::render({figures::contact(curves, rows.front().M_ie, rows.front().v_in)}, o.plot, plot_format);
+  plot::render({figures::contact(curves, rows.front().M_ie, rows.front().v_in)}, o.out.plot, plot_format);
 }
 
 nlohmann::json contact_json(const std::vector<Row>& rows, const Subject& s) {
@@ -220,30 +224,27 @@ void print_contact_table(std::ostream& out, const std::vector<Row>& rows) {
          "multibody.\n";
 }
 
+/// F(t), delta(t) of the multibody run(s).
+std::string series_csv(const std::vector<Row>& rows) {
+  std::ostringstream csv;
+  csv << std::setprecision(12) << "model,t_s,force_N,delta_m\n";
+  for (const auto& row : rows)
+    for (const auto& s : row.series) csv << row.model << "," << s.t << "," << s.force << "," << s.delta << "\n";
+  return csv.str();
+}
+
 int run_contact(const ContactOptions& o) {
-  Outputs outputs;  // --series '-' and --json both print on standard output: one of them only
-  if (o.json) outputs.claim_stdout("--json");
-  outputs.add("--series", o.series);
+  set_quiet(o.out.quiet);
+  Outputs outputs = o.out.outputs();  // an output on standard output: the table goes to standard error
   const Subject subject = load_subject(o.subject);
-  const plot::Format plot_format = plot::check_request(o.plot, o.plot_format);
+  const plot::Format plot_format = plot::check_request(o.out.plot, o.out.plot_format);
   std::vector<Row> rows;
   for (const auto& n : contact_laws(subject)) rows.push_back(evaluate(subject, o, n));
-
-  if (!o.plot.empty()) plot_contact(rows, subject.params, o, plot_format);
-  if (!o.series.empty()) {
-    std::ostringstream csv;
-    csv << std::setprecision(12) << "model,t_s,force_N,delta_m\n";
-    for (const auto& row : rows)
-      for (const auto& s : row.series)
-        csv << row.model << "," << s.t << "," << s.force << "," << s.delta << "\n";
-    outputs.set("--series", csv.str());
-    outputs.write();
-  }
-  if (o.json) {
-    std::cout << contact_json(rows, subject).dump(2) << "\n";
-    return 0;
-  }
-  print_contact_table(outputs.table(), rows);  // standard error when --series is '-'
+  if (!o.out.plot.empty()) plot_contact(rows, subject.params, o, plot_format);
+  outputs.set("--json", contact_json(rows, subject).dump(2) + "\n");
+  if (!o.out.csv.empty()) outputs.set("--csv", series_csv(rows));
+  outputs.write();
+  print_contact_table(outputs.table(), rows);
   return 0;
 }
 
@@ -255,12 +256,10 @@ void register_contact(CLI::App& app, Action& action) {
       "contact", "Maximum contact force: closed form, exact, and CVODE multibody reference");
   // --model and --contact-joints also take 'all': every law of Table 1, every joint model
   o->subject.add_to(*sub, {"contact-joints", "armature", "joint-stiffness", "joint-damping"});
-  sub->add_option("--series", o->series,
-                  "Write F(t), delta(t) of the multibody run(s) to this CSV file ('-': standard output)");
-  sub->add_flag("--json", o->json, "Print one JSON object on stdout");
-  sub->add_option("--plot", o->plot,
-                  "Draw the F-delta loop(s) and F(t) (Figure 3) into this (existing) folder");
-  sub->add_option("--plot-format", o->plot_format, "Figure format: png, svg or pdf")->capture_default_str();
+  add_output_flags(*sub, o->out,
+                   {"Write the forces (every law asked for, the joint models, the base's jump) as JSON to FILE",
+                    "Write F(t), delta(t) of the multibody run(s) as CSV to FILE",
+                    "Draw the F-delta loop(s) and F(t) (Figure 3)", "--series"});
   sub->callback([o, &action] { action = [o] { return run_contact(*o); }; });
 }
 

@@ -1,0 +1,68 @@
+// src/cli/support/subject.hpp -- loading what a subcommand evaluates: the scenario of a command (the
+// file or the built-in one, then the given flags as overrides) and the subject of inspect, contact and
+// map (a robot at one configuration, the target, the contact law).
+#pragma once
+
+#include "support/scenario_flags.hpp"
+
+#include "ffsr/algorithm/joint_models.hpp"
+#include "ffsr/contact/contact_law.hpp"
+#include "ffsr/ffsr.hpp"
+#include "ffsr/io/scenario.hpp"
+
+#include <CLI/CLI.hpp>
+
+#include <set>
+#include <string>
+
+namespace ffsr::cli {
+
+/// The keys of a command's scenario: `config` (empty: the built-in paper 3-DOF scenario), then the
+/// given flags. `command_keys`: the command's own keys a file may hold (ScenarioKeys::extra).
+ScenarioKeys command_scenario_keys(const std::string& config, const ScenarioFlags& flags,
+                                   const std::set<std::string>& command_keys = {});
+/// The robot of the built-in scenario, compiled into the command.
+EmbeddedUrdf builtin_urdf();
+/// Builds the scenario (the built-in one from the robot compiled into the command) and warns about
+/// every repair of the model.
+Scenario command_scenario(ScenarioKeys keys);
+
+/// The robot at one configuration, the target and the contact law that inspect, contact and map
+/// evaluate: the keys of a scenario file (--config) or of the built-in scenario, then the scenario
+/// keys given as flags (the robot and its start state, the bus, the target, the contact law), read,
+/// checked and built by the library (ffsr/io/scenario.hpp) as for the main job. --urdf replaces the
+/// robot: its joint angles (--joints-deg, then required) and end-effector come from the flags alone.
+struct SubjectOptions {
+  std::string config;
+  ScenarioFlags flags;
+  /// --config and the flags of the subject's keys; `also` adds keys of the key table (their flags).
+  void add_to(CLI::App& app, const std::set<std::string>& also = {}, const std::set<std::string>& except = {});
+};
+
+/// A robot at one configuration.
+struct Robot {
+  Model model;
+  int end_effector = 0;
+  BasePose base;
+  Eigen::VectorXd theta;
+  UrdfReport report;  ///< what the loader did to the file
+};
+
+/// What SubjectOptions describe, built.
+struct Subject {
+  ScenarioKeys keys;  ///< as resolved (the URDF path relative to the scenario file)
+  Robot robot;
+  Target target;              ///< at t = 0, with its spin and velocity
+  ContactParams params;       ///< K, alpha, c_r, checked
+  std::string law;            ///< the damping law's name as given (contact also takes 'all')
+  double approach_speed = 0;  ///< m/s, finite (its sign is the subcommand's to judge)
+  /// The joint models of the contact (contact-joints, armature; algorithm/joint_models.hpp); 'all'
+  /// (contact: each model in turn) gives free. InputError naming the key.
+  ContactJoints contact_joints() const;
+  bool all_joint_models() const { return keys.contact_joints == "all"; }
+};
+/// Builds the subject; warns about every repair of the model. InputError naming the key or the file,
+/// ModelError from the loader.
+Subject load_subject(const SubjectOptions& options);
+
+}  // namespace ffsr::cli

@@ -1,0 +1,409 @@
+// The command-line conventions over every subcommand (docs/command.md, "Conventions"): each key of
+// the library's key table that a subcommand accepts changes its result or is refused; --quiet,
+// --json FILE and --json - everywhere (standard output then holds one JSON document and nothing
+// else); a bad value in a scenario file names the file, the key and its line; an unknown key names
+// the nearest known one; --config with --urdf keeps the file's other keys in every subcommand.
+// Small runs only (the built-in 3-DOF scenario, a few samples, coarse grids): the cases run in CI.
+#include "support/command.hpp"
+
+#include "ffsr/io/scenario.hpp"
+
+#include <catch2/catch.hpp>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <atomic>
+#include <fstream>
+#include <functional>
+#include <map>
+#include <regex>
+#include <set>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace test_conventions {
+
+using ffsr::test::Args;
+using ffsr::test::cli;
+using ffsr::test::CommandResult;
+using ffsr::test::kSource;
+using ffsr::test::kUrdf3;
+using nlohmann::json;
+
+/// A subcommand ("" for the main job) and the arguments of a small run of it.
+struct Sub {
+  std::string name;
+  Args base;
+};
+
+/// Files the cases use, written once into a scratch folder that lives for the test run.
+struct Files {
+  ffsr::test::TempDir dir;
+  std::string heavy_urdf, bad_inertia_urdf, uncertain_toml;
+  Files() {
+    const std::string urdf = ffsr::test::read_file(kUrdf3);
+    // the same robot with a heavier first link: another URDF for the urdf key
+    heavy_urdf = dir.str() + "/heavy.urdf";
+    std::ofstream(heavy_urdf) << std::regex_replace(urdf, std::regex("<mass value=\"5\"/>"),
+                                                    "<mass value=\"10\"/>");
+    // link1's moments break the triangle inequality (0.01 + 0.82 < 1.0): the inertia-repair key's case
+    bad_inertia_urdf = dir.str() + "/bad_inertia.urdf";
+    std::ofstream(bad_inertia_urdf) << std::regex_replace(
+        urdf, std::regex("ixx=\"0.01\" ixy=\"0\" ixz=\"0\" iyy=\"0.82\" iyz=\"0\" izz=\"0.82\""),
+        "ixx=\"0.01\" ixy=\"0\" ixz=\"0\" iyy=\"0.82\" iyz=\"0\" izz=\"1.0\"");
+    // the built-in scenario with an [uncertainty] table: robust's input
+    std::string toml = ffsr::test::read_file(kSource + "/robots/paper_3dof.toml");
+    toml = std::regex_replace(toml, std::regex("urdf = \"paper_3dof.urdf\""), "urdf = \"" + kUrdf3 + "\"");
+    uncertain_toml = dir.str() + "/uncertain.toml";
+    std::ofstream(uncertain_toml) << toml
+                                  << "\n[uncertainty]\nsamples = 8\nseed = 3\n"
+                                     "target-mass = { law = \"uniform\", relative = 0.1 }\n";
+  }
+};
+
+const Files& files() {
+  static const Files f;
+  return f;
+}
+
+const std::string kPosition7 = kSource + "/robots/paper_7dof_position.toml";
+const std::string kUncertain7 = kSource + "/robots/paper_7dof_position_uncertain.toml";
+
+/// Every subcommand with a small run of it: on the built-in 3-DOF scenario, or (`seven_dof`) on the
+/// paper's 7-DOF position scenario, whose plain run tracks the pose.
+std::vector<Sub> subcommands(bool seven_dof = false) {
+  if (seven_dof)
+    return {{"", {"--config", kPosition7, "--global", "false"}},
+            {"inspect", {"--config", kPosition7}},
+            {"contact", {"--config", kPosition7}},
+            {"xi", {"--config", kPosition7, "--points", "3"}},
+            {"map", {"--config", kPosition7, "--vary", "1", "--step-deg", "90", "--csv", "map.csv"}},
+            {"robust", {"--config", kUncertain7, "--global", "false", "--samples", "4"}},
+            {"pareto", {"--config", kPosition7, "--levels", "2", "--starts", "2", "--global-starts", "2"}},
+            {"closed-loop", {"--config", kPosition7, "--control-rate", "5", "--estimate-rate", "1"}}};
+  return {{"", {"--global", "false"}},
+          {"inspect", {}},
+          {"contact", {}},
+          {"xi", {"--points", "3"}},
+          {"map", {"--vary", "1", "--step-deg", "90", "--csv", "map.csv"}},
+          {"robust", {"--config", files().uncertain_toml, "--global", "false"}},
+          {"pareto", {"--levels", "2", "--starts", "2", "--global-starts", "2"}},
+          {"closed-loop", {"--control-rate", "5", "--estimate-rate", "1"}}};
+}
+
+/// The arguments that set a key to another value (`alt`, with the other keys it needs) and what the
+/// base run needs for the key to matter (`context`: global keys need the global run, shape keys a
+/// shape, and so on). Built-in 3-DOF scenario.
+struct KeyCase {
+  Args alt;
+  Args context;
+  bool seven_dof = false;  ///< on the 7-DOF position scenario (tasks, orientations)
+  bool limit = false;      ///< a tolerance: the alternative value makes the run fail, which is its effect
+};
+
+/// The end-effector's attitude of the 7-DOF scenario's start, turned by 2 deg about z: a final
+/// orientation of the pose task the arm can reach.
+std::string turned_final_rpy() {
+  const json j = ffsr::test::parse_json(cli({"inspect", "--config", kPosition7, "--json", "-"}));
+  const std::vector<double> rpy = j.at("end_effector_rpy_deg").get<std::vector<double>>();
+  return std::to_string(rpy[0]) + "," + std::to_string(rpy[1]) + "," + std::to_string(rpy[2] + 2.0);
+}
+
+const std::map<std::string, KeyCase>& key_cases() {
+  const Args bus{"--bus-mass", "500", "--bus-inertia", "200,200,200"};
+  const Args global{"--global", "true", "--global-starts", "2"};
+  const Args sphere{"--target-shape", "sphere", "--target-size", "0.29154759474226504"};
+  static const std::map<std::string, KeyCase> cases = {
+      {"urdf", {{"--urdf", files().heavy_urdf, "--joints-deg", "0,150,-100"}, {}}},
+      {"end-effector", {{"--end-effector", "link3"}, {}}},
+      {"bus-mass", {bus, {}}},
+      {"bus-inertia", {{"--bus-inertia", "300,300,300"}, bus}},
+      {"bus-com", {{"--bus-com", "0.1,0,0"}, bus}},
+      {"mount-xyz", {{"--mount-xyz", "0.1,0,0"}, bus}},
+      {"mount-rpy-deg", {{"--mount-rpy-deg", "0,0,5"}, bus}},
+      {"lock-joints", {{"--lock-joints", "joint3=-1.7453292519943295", "--joints-deg", "0,150"}, {"--gain", "0"}}},
+      {"inertia-repair", {{"--inertia-repair", "balance"}, {"--urdf", files().bad_inertia_urdf, "--joints-deg", "0,150,-100"}}},
+      {"min-mass", {{"--min-mass", "1000"}, {}}},
+      {"min-inertia", {{"--min-inertia", "1000"}, {}}},
+      {"end-effector-offset", {{"--end-effector-offset", "0.05,0,0"}, {}}},
+      {"joints-deg", {{"--joints-deg", "0,140,-100"}, {}}},
+      {"base-position", {{"--base-position", "0.05,0,0"}, {}}},
+      {"base-rpy-deg", {{"--base-rpy-deg", "0,0,3"}, {}}},
+      {"target-mass", {{"--target-mass", "150"}, {}}},
+      {"target-inertia", {{"--target-inertia", "50,100,100"}, {}}},
+      {"target-position", {{"--target-position", "2.7,1.45,0"}, sphere}},
+      {"target-rpy-deg", {{"--target-rpy-deg", "0,0,3"}, {}}},
+      {"target-angular-velocity-deg", {{"--target-angular-velocity-deg", "0,0,3"}, {}}},
+      {"target-velocity", {{"--target-velocity", "0.01,0,0"}, {}}},
+      {"contact-offset", {{"--contact-offset", "-0.25,0.1,0"}, {}}},
+      {"normal", {{"--normal", "1,0.1,0"}, {}}},
+      {"model", {{"--model", "hunt-crossley"}, {}}},
+      {"stiffness", {{"--stiffness", "2e9"}, {}}},
+      {"exponent", {{"--exponent", "1.2"}, {}}},
+      {"restitution", {{"--restitution", "0.5"}, {}}},
+      {"approach-speed", {{"--approach-speed", "0.3"}, {}}},
+      {"task", {{"--task", "pose"}, {}, true}},
+      {"task-axes", {{"--task-axes", "xyz"}, {}}},
+      {"baseline-task", {{"--baseline-task", "position"}, {}, true}},
+      {"final-rpy-deg", {{"--final-rpy-deg", turned_final_rpy()}, {}, true}},
+      {"duration", {{"--duration", "170"}, {}}},
+      {"step", {{"--step", "0.2"}, {}}},
+      {"gain", {{"--gain", "-0.02"}, {}}},
+      {"feedback", {{"--feedback", "2"}, {}}},
+      {"tolerance", {{"--tolerance", "1e-15"}, {}, false, true}},
+      {"orientation-tolerance-deg", {{"--orientation-tolerance-deg", "1e-14"}, {}, true, true}},
+      {"objective", {{"--objective", "exact-force"}, global}},
+      {"base-attitude", {{"--base-attitude", "hold", "--task-axes", "x"}, {"--task-axes", "x"}}},
+      {"global", {{"--global", "true", "--global-starts", "2"}, {}}},
+      {"seed", {{"--seed", "7"}, global}},
+      {"max-joint-rate-deg", {{"--max-joint-rate-deg", "5"}, global}},
+      {"global-starts", {{"--global-starts", "3"}, global}},
+      {"max-base-rate-deg", {{"--max-base-rate-deg", "0.01"}, global}},
+      {"reconfigure", {{"--reconfigure", "always"}, global}},
+      {"reconfigure-duration", {{"--reconfigure-duration", "30"}, {"--global", "true", "--global-starts", "2", "--reconfigure", "always"}}},
+      {"contact-joints", {{"--contact-joints", "locked"}, {}}},
+      {"armature", {{"--armature", "0.5"}, {"--contact-joints", "armature"}}},
+      {"joint-stiffness", {{"--joint-stiffness", "1000"}, {}}},
+      {"joint-damping", {{"--joint-damping", "100"}, {}}},
+      {"target-shape", {sphere, {}}},
+      {"target-size", {{"--target-size", "0.29154759474226504,0.1"}, {"--target-shape", "cylinder", "--target-size", "0.29154759474226504,0.2"}}},
+      // the sphere's centre moved so that the contact point stays on its surface
+      {"target-shape-offset", {{"--target-shape-offset", "-0.5,0,0"}, sphere}},
+      {"link-radius", {{"--link-radius", "0.08"}, sphere}},
+      {"bus-box", {{"--bus-box", "1,1,1"}, sphere}},
+      {"clearance", {{"--clearance", "0.09"}, sphere}},
+      {"contact-exemption", {{"--contact-exemption", "0.5"}, sphere}},
+  };
+  return cases;
+}
+
+/// The flags `sub` lists in its --help.
+std::set<std::string> accepted_flags(const std::string& sub) {
+  const CommandResult r = sub.empty() ? cli({"--help"}) : cli({sub, "--help"});
+  REQUIRE(r.exit_code == 0);
+  std::set<std::string> flags;
+  const std::regex flag("(--[a-z][a-z0-9-]*)");
+  for (std::sregex_iterator it(r.out.begin(), r.out.end(), flag), end; it != end; ++it) flags.insert((*it)[1]);
+  return flags;
+}
+
+/// `args` without the flags `sub` does not accept (each flag takes one value here).
+Args only_accepted(const Args& args, const std::set<std::string>& accepted) {
+  Args out;
+  for (size_t i = 0; i + 1 < args.size(); i += 2)
+    if (accepted.count(args[i])) {
+      out.push_back(args[i]);
+      out.push_back(args[i + 1]);
+    }
+  return out;
+}
+
+/// The command line of `sub` with `args` and --json - --quiet.
+Args command_line(const Sub& sub, const Args& args) {
+  Args a;
+  if (!sub.name.empty()) a.push_back(sub.name);
+  a.insert(a.end(), sub.base.begin(), sub.base.end());
+  a.insert(a.end(), args.begin(), args.end());
+  a.insert(a.end(), {"--json", "-", "--quiet"});
+  return a;
+}
+
+/// Runs every command line of `results` (the keys), two at a time, each in a scratch folder.
+void run_all(std::map<Args, CommandResult>& results) {
+  std::vector<std::pair<const Args*, CommandResult*>> jobs;
+  for (auto& [args, r] : results) jobs.emplace_back(&args, &r);
+  std::atomic<size_t> next{0};
+  auto worker = [&] {
+    for (size_t i = next++; i < jobs.size(); i = next++) *jobs[i].second = cli(*jobs[i].first);
+  };
+  std::thread other(worker);
+  worker();
+  other.join();
+}
+
+/// The result of a run without what echoes the inputs (the resolved scenario, the parameters, the
+/// version) or measures the machine (wall-clock seconds): what the key must change.
+json result_of(const CommandResult& r) {
+  json j = json::parse(r.out);
+  for (const char* echo : {"version", "scenario", "parameters", "urdf", "joints_deg"}) j.erase(echo);
+  std::function<void(json&)> strip = [&](json& x) {
+    if (x.is_object()) {
+      x.erase("seconds");
+      for (auto& [k, v] : x.items()) strip(v);
+    } else if (x.is_array()) {
+      for (auto& v : x) strip(v);
+    }
+  };
+  strip(j);
+  return j;
+}
+
+bool refused(const CommandResult& r, const std::string& flag) {
+  return r.exit_code == 2 && r.err.find(flag) != std::string::npos &&
+         std::count(r.err.begin(), r.err.end(), '\n') == 1;
+}
+
+}  // namespace test_conventions
+
+using namespace test_conventions;
+
+TEST_CASE("every key of the table has a case in this test", "[cli][conventions]") {
+  for (const ffsr::ScenarioKey& key : ffsr::scenario_keys()) {
+    INFO("key '" << key.name << "': add an alternative value to key_cases()");
+    CHECK(key_cases().count(key.name) == 1);
+  }
+}
+
+TEST_CASE("each key a subcommand accepts changes its result, or the subcommand refuses it",
+          "[cli][conventions]") {
+  // the runs first (two at a time, each distinct run once), then the verdicts
+  struct Check {
+    std::string where, flag;
+    bool accepted, limit;
+    Args before, after;
+  };
+  std::vector<Check> checks;
+  std::map<Args, CommandResult> results;
+  for (const bool seven : {false, true})
+    for (const Sub& sub : subcommands(seven)) {
+      const std::set<std::string> accepted = accepted_flags(sub.name);
+      for (const ffsr::ScenarioKey& key : ffsr::scenario_keys()) {
+        const auto it = key_cases().find(key.name);
+        if (it == key_cases().end() || it->second.seven_dof != seven) continue;
+        const KeyCase& c = it->second;
+        Check k{(sub.name.empty() ? "main job" : sub.name) + " --" + key.name, "--" + key.name,
+                accepted.count("--" + key.name) > 0, c.limit, {}, {}};
+        const Args context = k.accepted ? only_accepted(c.context, accepted) : Args{};
+        k.before = command_line(sub, context);
+        Args changed = context;
+        changed.insert(changed.end(), c.alt.begin(), c.alt.end());
+        k.after = command_line(sub, changed);
+        if (k.accepted) results[k.before];
+        results[k.after];
+        checks.push_back(std::move(k));
+      }
+    }
+  run_all(results);
+  std::string problems;
+  for (const Check& k : checks) {
+    const CommandResult& after = results.at(k.after);
+    if (!k.accepted) {  // refused by the parser, naming the flag
+      if (!refused(after, k.flag)) problems += k.where + ": not accepted, but not refused either: " + after.err + "\n";
+      continue;
+    }
+    const CommandResult& before = results.at(k.before);
+    if (refused(after, k.flag)) continue;                          // refused by the library, naming the key
+    if (before.exit_code != 0 && after.exit_code == 0) continue;  // the key makes the run work
+    if (k.limit && before.exit_code == 0 && after.exit_code != 0) continue;  // a tolerance the run misses
+    if (before.exit_code != 0 || after.exit_code != 0)
+      problems += k.where + ": exit " + std::to_string(before.exit_code) + " -> " + std::to_string(after.exit_code) +
+                  ": " + before.err + " / " + after.err + "\n";
+    else if (result_of(before) == result_of(after))
+      problems += k.where + ": accepted and ignored\n";
+  }
+  INFO(problems);
+  CHECK(problems.empty());
+}
+
+TEST_CASE("--quiet, --json FILE and --json - on every subcommand", "[cli][conventions]") {
+  for (const Sub& sub : subcommands()) {
+    INFO(sub.name);
+    ffsr::test::TempDir tmp;
+    Args a;
+    if (!sub.name.empty()) a.push_back(sub.name);
+    a.insert(a.end(), sub.base.begin(), sub.base.end());
+    Args to_file = a, to_stdout = a;
+    to_file.insert(to_file.end(), {"--quiet", "--json", "out.json"});
+    to_stdout.insert(to_stdout.end(), {"--quiet", "--json", "-"});
+    const CommandResult f = cli(to_file, tmp.str());
+    INFO(f.err);
+    REQUIRE(f.exit_code == 0);
+    CHECK(f.err.empty());  // --quiet: nothing on standard error
+    const json written = ffsr::test::read_json_file(tmp.str() + "/out.json");
+    CHECK(written.is_object());
+    const CommandResult s = cli(to_stdout, tmp.str());
+    REQUIRE(s.exit_code == 0);
+    json j;
+    REQUIRE_NOTHROW(j = json::parse(s.out));  // one JSON document and nothing else
+    CHECK(j.is_object());
+    CHECK(j.contains("version"));
+  }
+}
+
+TEST_CASE("--csv - is the only thing on standard output, where a subcommand has series", "[cli][conventions]") {
+  for (const Sub& sub : subcommands()) {
+    if (sub.name == "inspect") continue;  // one configuration: no series
+    INFO(sub.name);
+    ffsr::test::TempDir tmp;
+    Args a;
+    if (!sub.name.empty()) a.push_back(sub.name);
+    for (size_t i = 0; i < sub.base.size(); ++i) {  // the map's --csv replaced by '-'
+      if (sub.base[i] == "--csv") {
+        ++i;
+        continue;
+      }
+      a.push_back(sub.base[i]);
+    }
+    a.insert(a.end(), {"--quiet", "--csv", "-", "--json", "out.json"});
+    const CommandResult r = cli(a, tmp.str());
+    INFO(r.err);
+    REQUIRE(r.exit_code == 0);
+    REQUIRE_FALSE(r.out.empty());
+    CHECK(r.out.find('{') == std::string::npos);  // no JSON, no table: the CSV's lines only
+    CHECK(std::count(r.out.begin(), r.out.end(), ',') > 0);
+  }
+}
+
+TEST_CASE("a bad value in a scenario file names the file, the key and its line", "[cli][conventions]") {
+  ffsr::test::TempDir tmp;
+  std::string toml = ffsr::test::read_file(kSource + "/robots/paper_3dof.toml");
+  toml = std::regex_replace(toml, std::regex("urdf = \"paper_3dof.urdf\""), "urdf = \"" + kUrdf3 + "\"");
+  const std::string file = tmp.str() + "/s.toml";
+  SECTION("a value of the wrong type") {
+    std::ofstream(file) << std::regex_replace(toml, std::regex("duration = 180"), "duration = \"long\"");
+    const CommandResult r = cli({"--config", file, "--global", "false", "--quiet"});
+    CHECK(r.exit_code == 2);
+    CHECK(r.err.find("scenario " + file + ":27: --duration: 'long' is not a number") != std::string::npos);
+  }
+  SECTION("a value out of range, found when the scenario is built") {
+    std::ofstream(file) << std::regex_replace(toml, std::regex("duration = 180"), "duration = -5");
+    for (const Args& a : {Args{"--config", file, "--global", "false", "--quiet"}, Args{"pareto", "--config", file}}) {
+      const CommandResult r = cli(a);
+      CHECK(r.exit_code == 2);
+      CHECK(r.err.find("scenario " + file + ":27: --duration: must be positive") != std::string::npos);
+    }
+  }
+  SECTION("a flag's bad value names the flag only") {
+    const CommandResult r = cli({"--config", file, "--duration", "-5", "--global", "false", "--quiet"});
+    CHECK(r.exit_code == 2);
+    CHECK(r.err.find("error: --duration: must be positive") != std::string::npos);
+  }
+  SECTION("an unknown key names the nearest known one") {
+    std::ofstream(file) << toml << "clearence = 0.1\n";
+    const CommandResult r = cli({"--config", file, "--global", "false", "--quiet"});
+    CHECK(r.exit_code == 2);
+    CHECK(r.err.find("unknown key 'clearence' (did you mean 'clearance'?)") != std::string::npos);
+    const CommandResult f = cli({"--clearence", "0.1"});
+    CHECK(f.exit_code == 2);
+    CHECK(f.err.find("did you mean --clearance?") != std::string::npos);
+  }
+}
+
+TEST_CASE("--config with --urdf keeps the file's end-effector and joints in every subcommand", "[cli][conventions]") {
+  // the file names end-effector = "ee" and its joints; --urdf gives the same robot under another
+  // path: every subcommand evaluates the file's end-effector, as the main job does
+  ffsr::test::TempDir tmp;
+  const std::string copy = tmp.str() + "/copy.urdf";
+  std::ofstream(copy) << ffsr::test::read_file(kUrdf3);
+  const std::string scenario = kSource + "/robots/paper_3dof.toml";
+  const json a = ffsr::test::parse_json(cli({"inspect", "--config", scenario, "--json"}));
+  const json b = ffsr::test::parse_json(cli({"inspect", "--config", scenario, "--urdf", copy, "--json"}));
+  CHECK(b.at("end_effector") == a.at("end_effector"));
+  CHECK(b.at("integrated_effective_mass") == a.at("integrated_effective_mass"));
+  const json c = ffsr::test::parse_json(cli({"contact", "--config", scenario, "--urdf", copy, "--json", "-"}));
+  CHECK(c.at("integrated_effective_mass").get<double>() == a.at("integrated_effective_mass").get<double>());
+  const json m = ffsr::test::parse_json(
+      cli({"--config", scenario, "--urdf", copy, "--global", "false", "--quiet", "--json", "-"}));
+  CHECK(m.at("scenario").at("end_effector") == a.at("end_effector"));
+}
