@@ -5,6 +5,7 @@
 #include "subcommands.hpp"
 
 #include "ffsr/algorithm/base_disturbance.hpp"
+#include "ffsr/optimize/objective.hpp"
 
 #include <iomanip>
 #include <iostream>
@@ -19,23 +20,19 @@ struct InspectOptions {
   bool json = false;
 };
 
-/// The impact disturbance of the base at the configuration (single-body impulse), or nothing when the
-/// end-effector moving at the approach speed along u does not approach the target's contact point.
-std::optional<BaseDisturbance> inspect_disturbance(const Subject& s) {
-  const Robot& r = s.robot;
+/// The contact law at the approach velocity of the configuration, or nothing when the end-effector
+/// moving at the approach speed along u does not approach the target's contact point.
+std::optional<AnyContactLaw> inspect_law(const Subject& s) {
   const Target& target = s.target;
   const Vector3 u = target.normal_world();
   const double vin = approach_velocity(u, Vector3(s.approach_speed * u), target.velocity,
                                        target.angular_velocity_world(), target.offset_world());
   if (!(vin > 0)) return std::nullopt;
-  AnyContactLaw law = make_contact_law("hunt-crossley", s.params, vin);
   try {
-    law = make_contact_law(s.law, s.params, vin);
+    return make_contact_law(s.law, s.params, vin);
   } catch (const InputError& e) {
     throw InputError(std::string("--model: ") + e.what());
   }
-  Data data(r.model);
-  return base_disturbance(r.model, data, r.base, r.theta, r.end_effector, target, law);
 }
 
 nlohmann::json disturbance_json(const std::optional<BaseDisturbance>& d) {
@@ -95,16 +92,23 @@ void print_load_report(const UrdfReport& rep) {
 
 int run_inspect(const InspectOptions& o) {
   const Subject s = load_subject(o.subject);
+  if (s.all_joint_models())
+    throw InputError("--contact-joints: inspect evaluates one joint model; 'all' is for the contact subcommand");
+  const ContactJoints joints = s.contact_joints();
   const Robot& r = s.robot;
   const Target& target = s.target;
+  const std::optional<AnyContactLaw> law = inspect_law(s);
+  // M_ie and the base's jump (single-body impulse) of the joint model: the capture objective's
+  const CaptureEvaluator objective(r.model, r.end_effector, target, law ? &*law : nullptr, joints);
+  std::optional<BaseDisturbance> dist;
   Data data(r.model);
+  if (law) dist = objective.disturbance(data, r.base, r.theta);
   const Vector3 u = target.normal_world();
-  const double M_ie = integrated_effective_mass(r.model, data, r.base, r.theta, r.end_effector, target);
-  const double m_e = 1.0 / inverse_effective_mass(r.model, data, r.end_effector, u);
+  const double M_ie = objective.mass(data, r.base, r.theta);
+  const double m_e = 1.0 / inverse_effective_mass(r.model, data, r.end_effector, u, joints);
   frame_jacobian(r.model, data, r.end_effector);
   const Eigen::MatrixXd Jf = generalized_jacobian(r.model, data);
   const Pose ee = frame_pose(r.model, data, r.end_effector);
-  const std::optional<BaseDisturbance> dist = inspect_disturbance(s);
   const std::optional<ClearanceReport> clearance = inspect_clearance(s);
 
   if (o.json) {
@@ -121,6 +125,8 @@ int run_inspect(const InspectOptions& o) {
     j["J_bm"] = to_json(data.J);
     j["J_f"] = to_json(Jf);
     j["total_mass"] = r.model.total_mass();
+    j["contact_joints"] = joint_model_name(joints.model);
+    if (joints.model == JointModel::Armature) j["armature"] = to_json(joints.armature);
     j["effective_mass"] = m_e;
     j["integrated_effective_mass"] = M_ie;
     j["base_disturbance"] = disturbance_json(dist);
@@ -143,6 +149,8 @@ int run_inspect(const InspectOptions& o) {
               << (i + 1 < names.size() ? ", " : " deg\n");
   print_load_report(r.report);
   std::cout << "direction u      [" << u.transpose().format(Eigen::IOFormat(6, 0, ", ")) << "]\n";
+  if (joints.model != JointModel::Free)
+    std::cout << "contact joints   " << joint_model_name(joints.model) << " (M_ie, m_e and the base jump)\n";
   std::cout << "effective mass   m_e  = " << m_e << " kg   (Eq. 4)\n";
   std::cout << "integrated mass  M_ie = " << M_ie << " kg   (Eq. 14)\n";
   if (dist)
@@ -166,7 +174,7 @@ void register_inspect(CLI::App& app, Action& action) {
                          "Evaluate one configuration (a scenario's start state; flags override it): H, J_f, "
                          "effective mass, M_ie, the base's jump at the impact, distances between shapes");
   opts->subject.add_to(*sub, {"target-position", "target-shape", "target-size", "target-shape-offset",
-                              "link-radius", "bus-box", "contact-exemption"});
+                              "link-radius", "bus-box", "contact-exemption", "contact-joints", "armature"});
   sub->add_flag("--json", opts->json, "Print one JSON object on stdout");
   sub->callback([opts, &action] { action = [opts] { return run_inspect(*opts); }; });
 }

@@ -41,6 +41,7 @@
 #include "ffsr/optimize/free_floating_step.hpp"
 #include "ffsr/optimize/line_reference.hpp"
 #include "ffsr/optimize/null_space.hpp"
+#include "ffsr/optimize/objective.hpp"
 #include "ffsr/optimize/run_monitors.hpp"
 #include "ffsr/optimize/task_solver.hpp"
 
@@ -238,8 +239,9 @@ inline CaptureSample capture_sample(const Model& model, Data& data, const Captur
   c.base = base;
   crba(model, data, base, theta);
   c.end_effector = frame_pose(model, data, pb.frame).p;
-  c.M_ie = 1.0 / (inverse_effective_mass(model, data, pb.frame, s.u_cap, pb.joints) + s.target_inv_mass);
-  c.f_max_estimate = max_force_closed_form(s.law, c.M_ie);
+  const CaptureEvaluator objective(pb, s);
+  c.M_ie = objective.mass_at(data);
+  c.f_max_estimate = objective.f_max_closed_form(c.M_ie);
   return c;
 }
 
@@ -265,11 +267,11 @@ inline void finish_capture(const Model& model, Data& data, const CaptureProblem&
   res.base_position_drift = (base.position - pb.base.position).norm();
   res.base_attitude_drift = rotation_angle(base.orientation.toRotationMatrix() *
                                            pb.base.orientation.normalized().toRotationMatrix().transpose());
-  res.M_ie =
-      1.0 / (inverse_effective_mass(model, data, pb.frame, setup.u_cap, pb.joints) + setup.target_inv_mass);
+  const CaptureEvaluator objective(pb, setup);
+  res.M_ie = objective.mass_at(data);
   res.approach_velocity = setup.v_in;
-  res.f_max_closed_form = max_force_closed_form(setup.law, res.M_ie);
-  res.f_max_exact = max_force_exact(setup.law, res.M_ie);
+  res.f_max_closed_form = objective.f_max_closed_form(res.M_ie);
+  res.f_max_exact = objective.f_max_exact(res.M_ie);
   if (!std::isfinite(res.M_ie) || !std::isfinite(res.f_max_exact) || !std::isfinite(res.f_max_closed_form))
     throw NumericalError(str(where, ": the capture configuration gives a non-finite M_ie or F_max"));
   if (res.tracking_error > opt.tolerance)

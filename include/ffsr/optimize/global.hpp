@@ -41,9 +41,8 @@
 
 #include "ffsr/optimize/capture.hpp"
 #include "ffsr/optimize/detail/manifold_sampling.hxx"
+#include "ffsr/optimize/multibody_objective.hpp"
 #include "ffsr/optimize/reconfigure.hpp"
-#include "ffsr/simulate/multibody.hpp"
-#include "ffsr/uncertainty/robust_objective.hpp"
 
 #include <nlopt.hpp>
 
@@ -55,23 +54,6 @@
 #include <random>
 
 namespace ffsr {
-
-enum class GlobalObjective { Mass, ExactForce, MultibodyForce, RobustForce };
-
-/// The objective's name as the command spells it.
-inline const char* objective_name(GlobalObjective o) {
-  switch (o) {
-    case GlobalObjective::Mass:
-      return "mass";
-    case GlobalObjective::ExactForce:
-      return "exact-force";
-    case GlobalObjective::MultibodyForce:
-      return "multibody-force";
-    case GlobalObjective::RobustForce:
-      return "robust-force";
-  }
-  return "?";
-}
 
 /// Optional inequality constraints g(theta) <= 0 of the search at a fixed base pose (the clearance of
 /// geometry/clearance.hpp): `eval` writes the `count` values and, when grad is not null, their
@@ -126,13 +108,6 @@ struct ManifoldSearchOptions {
   double branch_radius = 0.5;
   int branch_local_searches = 24;
   std::shared_ptr<const ManifoldInequalities> inequalities;  ///< none: equality constraints only
-};
-
-/// A configuration on the capture manifold with its M_ie and objective value.
-struct ManifoldPoint {
-  Eigen::VectorXd theta;
-  double M_ie = 0;
-  double objective = 0;  ///< kg (mass) or N (exact-force, multibody-force, robust-force: CVaR_95)
 };
 
 struct ManifoldSearchResult {
@@ -234,7 +209,7 @@ struct SlsqpContext {
   const CaptureTask* task;
   const CaptureSetup* setup;
   const BasePose* base;
-  RobustForceObjective* robust = nullptr;  ///< robust-force: the objective (else M_ie)
+  const CaptureEvaluator* objective = nullptr;  ///< its search_value is minimized
   long evaluations = 0;
   Eigen::VectorXd theta, g, r;
   Eigen::MatrixXd J;
@@ -246,16 +221,9 @@ inline double slsqp_objective(unsigned n, const double* x, double* grad, void* p
   ++c.evaluations;
   c.theta = Eigen::Map<const Eigen::VectorXd>(x, n);
   c.g.resize(n);
-  if (c.robust) {
-    const double f = c.robust->value_and_gradient(*c.model, *c.data, *c.base, c.theta, c.pb->frame, c.g);
-    if (grad) Eigen::Map<Eigen::VectorXd>(grad, n) = c.g;
-    return f;
-  }
-  const double M =
-      integrated_effective_mass_gradient(*c.model, *c.data, *c.base, c.theta, c.pb->frame, c.setup->u_cap,
-                                         c.setup->target_inv_mass, c.pb->joints, c.g);
+  const double f = c.objective->search_value_gradient(*c.data, *c.base, c.theta, c.g);
   if (grad) Eigen::Map<Eigen::VectorXd>(grad, n) = c.g;
-  return M;
+  return f;
 }
 
 inline void slsqp_constraints(unsigned m, double* result, unsigned n, const double* x, double* grad,
@@ -302,39 +270,6 @@ inline bool exceeds_reach_tolerance(const ManifoldSearchOptions& so, const BaseP
 }
 
 }  // namespace detail
-
-/// Value of the objective at a capture configuration (base at T). Mass: M_ie (kg); exact-force:
-/// the single-body peak (Eq. 16) at M_ie; multibody-force: the CVODE multibody peak; robust-force:
-/// CVaR_95 of `robust` (required then). Runs crba (and CVODE for the multibody objective).
-inline ManifoldPoint evaluate_capture(const CaptureProblem& pb, const CaptureSetup& s, const BasePose& base,
-                                      const Eigen::VectorXd& theta, GlobalObjective objective,
-                                      const MultibodyContactOptions& mo = {},
-                                      RobustForceObjective* robust = nullptr) {
-  const Model& model = *pb.model;
-  Data data(model);
-  crba(model, data, base, theta);
-  ManifoldPoint p{
-      theta, 1.0 / (inverse_effective_mass(model, data, pb.frame, s.u_cap, pb.joints) + s.target_inv_mass),
-      0};
-  switch (objective) {
-    case GlobalObjective::Mass:
-      p.objective = p.M_ie;
-      break;
-    case GlobalObjective::ExactForce:
-      p.objective = max_force_exact(s.law, p.M_ie);
-      break;
-    case GlobalObjective::MultibodyForce:
-      p.objective = simulate_contact(model, base, theta, pb.frame, s.capture_target, pb.approach_speed,
-                                     pb.contact, pb.law, mo)
-                        .f_max;
-      break;
-    case GlobalObjective::RobustForce:
-      if (!robust) throw InputError("evaluate_capture: the robust-force objective needs its sample set");
-      p.objective = robust->value(robot_inverse_inertia(model, data, base, theta, pb.frame)).cvar95;
-      break;
-  }
-  return p;
-}
 
 /// Searches the capture manifold C(base) for the configuration of least objective (see the top of
 /// this file). `extra_starts` are tried first (projected like the random ones). Throws InputError
@@ -425,8 +360,9 @@ inline void configure_slsqp(nlopt::opt& local, const Model& model, int m, SlsqpC
 /// projected start in res.projected_starts.
 inline bool local_capture_optimum(const Model& model, Data& data, const CaptureProblem& pb,
                                   const CaptureTask& task, const CaptureSetup& s, const BasePose& base,
-                                  const ManifoldSearchOptions& so, nlopt::opt& local, Eigen::VectorXd q,
-                                  ManifoldSearchResult& res, ManifoldPoint& out) {
+                                  const ManifoldSearchOptions& so, const CaptureEvaluator& objective,
+                                  nlopt::opt& local, Eigen::VectorXd q, ManifoldSearchResult& res,
+                                  ManifoldPoint& out) {
   const int n = model.n();
   if (q.size() != n || !q.allFinite())
     throw InputError("search_capture_manifold: an extra start has the wrong size or is not finite");
@@ -447,13 +383,9 @@ inline bool local_capture_optimum(const Model& model, Data& data, const CaptureP
   if (!detail::nearest_representative(model, pb.theta, th) || !detail::within_limits(model, th) ||
       !detail::satisfies_inequalities(so, base, th))
     return false;
-  crba(model, data, base, th);
-  const double M =
-      1.0 / (inverse_effective_mass(model, data, pb.frame, s.u_cap, pb.joints) + s.target_inv_mass);
+  double M = 0;
+  const double v = objective.search_value(data, base, th, M);
   if (!std::isfinite(M)) return false;
-  const double v = so.objective == GlobalObjective::RobustForce
-                       ? so.robust->value(robot_inverse_inertia(model, data, base, th, pb.frame)).cvar95
-                       : M;
   out = {th, M, v};
   return true;
 }
@@ -470,18 +402,6 @@ inline void keep_distinct(const Model& model, std::vector<ManifoldPoint>& found,
   if (!duplicate) found.push_back(p);
 }
 
-/// The value the optima are compared by at a configuration on C(base): M_ie, or CVaR_95 for
-/// robust-force. Writes M. Runs crba.
-inline double manifold_value(const Model& model, Data& data, const CaptureProblem& pb, const CaptureSetup& s,
-                             const BasePose& base, const ManifoldSearchOptions& so, const Eigen::VectorXd& th,
-                             double& M) {
-  crba(model, data, base, th);
-  M = 1.0 / (inverse_effective_mass(model, data, pb.frame, s.u_cap) + s.target_inv_mass);
-  return so.objective == GlobalObjective::RobustForce
-             ? so.robust->value(robot_inverse_inertia(model, data, base, th, pb.frame)).cvar95
-             : M;
-}
-
 /// Without a null space (as many task rows as joints) C(base) is a set of points, the
 /// inverse-kinematics solutions: every start is projected (damped Newton to |c| <= 1e-12, or the
 /// search's tolerance when roundoff stops it first), moved to the representative of its posture,
@@ -489,8 +409,9 @@ inline double manifold_value(const Model& model, Data& data, const CaptureProble
 /// kept. No SLSQP: each solution is its own local optimum. Appends to `found`; counts into res.
 inline void enumerate_solutions(const Model& model, Data& data, const CaptureProblem& pb,
                                 const CaptureTask& task, const CaptureSetup& s, const BasePose& base,
-                                const ManifoldSearchOptions& so, const std::vector<Eigen::VectorXd>& starts,
-                                ManifoldSearchResult& res, std::vector<ManifoldPoint>& found) {
+                                const ManifoldSearchOptions& so, const CaptureEvaluator& objective,
+                                const std::vector<Eigen::VectorXd>& starts, ManifoldSearchResult& res,
+                                std::vector<ManifoldPoint>& found) {
   Eigen::VectorXd r;
   for (Eigen::VectorXd q : starts) {
     if (q.size() != model.n() || !q.allFinite())
@@ -505,7 +426,7 @@ inline void enumerate_solutions(const Model& model, Data& data, const CapturePro
     for (const ManifoldPoint& f : found) known = known || posture_distance(model, f.theta, q) < 1e-6;
     if (known) continue;
     double M = 0;
-    const double v = manifold_value(model, data, pb, s, base, so, q, M);
+    const double v = objective.search_value(data, base, q, M);
     if (std::isfinite(M)) found.push_back({q, M, v});
   }
 }
@@ -528,14 +449,13 @@ inline double posture_distance2(const Model& model, const Eigen::VectorXd& a, co
 /// distinct optima to `found`; counts into res.
 inline void branch_stage(const Model& model, Data& data, const CaptureProblem& pb, const CaptureTask& task,
                          const CaptureSetup& s, const BasePose& base, const ManifoldSearchOptions& so,
-                         nlopt::opt& local, ManifoldSearchResult& res, std::vector<ManifoldPoint>& found) {
+                         const CaptureEvaluator& objective, nlopt::opt& local, ManifoldSearchResult& res,
+                         std::vector<ManifoldPoint>& found) {
   std::vector<ManifoldPoint> samples;
   for (Eigen::VectorXd q : halton_starts(model, so.branch_starts)) {
     if (!project_to_manifold(model, data, pb, task, s, base, q, so.constraint_tolerance)) continue;
     if (!nearest_representative(model, pb.theta, q) || !within_limits(model, q)) continue;
-    double M = 0;
-    crba(model, data, base, q);
-    M = 1.0 / (inverse_effective_mass(model, data, pb.frame, s.u_cap) + s.target_inv_mass);
+    const double M = objective.mass(data, base, q);
     if (std::isfinite(M)) samples.push_back({q, M, M});
   }
   std::stable_sort(samples.begin(), samples.end(),
@@ -552,7 +472,7 @@ inline void branch_stage(const Model& model, Data& data, const CaptureProblem& p
     for (size_t j = 0; j < found.size() && !linked; ++j) linked = near(found[j], samples[i]);
     if (linked) continue;
     ++runs;
-    if (local_capture_optimum(model, data, pb, task, s, base, so, local, samples[i].theta, res, p))
+    if (local_capture_optimum(model, data, pb, task, s, base, so, objective, local, samples[i].theta, res, p))
       keep_distinct(model, found, p);
   }
 }
@@ -560,7 +480,7 @@ inline void branch_stage(const Model& model, Data& data, const CaptureProblem& p
 /// Fills res.best and the objective of res.local_optima (sorted by the compared value): the CVODE
 /// peak at the best max_ranked optima for multibody-force (0 for those not ranked), CVaR_95 as
 /// compared for robust-force, M_ie or the exact F_max at it otherwise.
-inline void rank_local_optima(const CaptureProblem& pb, const CaptureSetup& s, const BasePose& base,
+inline void rank_local_optima(const CaptureEvaluator& objective, Data& data, const BasePose& base,
                               const ManifoldSearchOptions& so, ManifoldSearchResult& res) {
   std::vector<ManifoldPoint>& found = res.local_optima;
   if (so.objective == GlobalObjective::MultibodyForce) {
@@ -568,7 +488,7 @@ inline void rank_local_optima(const CaptureProblem& pb, const CaptureSetup& s, c
     double best = std::numeric_limits<double>::infinity();
     const size_t k = std::min(found.size(), static_cast<size_t>(so.max_ranked));
     for (size_t i = 0; i < k; ++i) {
-      ManifoldPoint p = evaluate_capture(pb, s, base, found[i].theta, so.objective, so.multibody);
+      ManifoldPoint p = objective.evaluate(data, base, found[i].theta);
       ++res.objective_evaluations;
       found[i].objective = p.objective;
       if (p.objective < best) {
@@ -580,9 +500,8 @@ inline void rank_local_optima(const CaptureProblem& pb, const CaptureSetup& s, c
   } else if (so.objective == GlobalObjective::RobustForce) {
     res.best = found.front();  // sorted by CVaR_95, evaluated by local_capture_optimum
   } else {
-    res.best = evaluate_capture(pb, s, base, found.front().theta, so.objective);
-    for (ManifoldPoint& p : found)
-      p.objective = so.objective == GlobalObjective::ExactForce ? max_force_exact(s.law, p.M_ie) : p.M_ie;
+    res.best = objective.evaluate(data, base, found.front().theta);
+    for (ManifoldPoint& p : found) p.objective = objective.of_mass(p.M_ie);
   }
 }
 
@@ -608,8 +527,9 @@ inline ManifoldSearchResult detail::search_manifold(const CaptureProblem& pb, co
   const std::vector<Eigen::VectorXd> starts = manifold_starts(model, so.seed, extra_starts, random_starts);
   res.starts = static_cast<int>(starts.size());
 
-  detail::SlsqpContext ctx{&model, &data, &pb, &task, &s, &base, robust ? so.robust.get() : nullptr,
-                           0,      {},    {},  {},    {}};
+  const CvodeMultibodyPeak peak(pb, s.capture_target, so.multibody);
+  const CaptureEvaluator objective(pb, s, so.objective, &peak, so.robust.get());
+  detail::SlsqpContext ctx{&model, &data, &pb, &task, &s, &base, &objective, 0, {}, {}, {}, {}};
   nlopt::opt local(nlopt::LD_SLSQP, static_cast<unsigned>(model.n()));
   configure_slsqp(local, model, task.rows(), ctx, so);
   std::vector<ManifoldPoint> found;
@@ -620,16 +540,16 @@ inline ManifoldSearchResult detail::search_manifold(const CaptureProblem& pb, co
       for (Eigen::VectorXd& q : halton_starts(model, so.branch_starts)) all.push_back(std::move(q));
     res.starts = static_cast<int>(all.size());
     res.method = "all inverse-kinematics solutions from random and Halton starts (damped Newton)";
-    enumerate_solutions(model, data, pb, task, s, base, so, all, res, found);
+    enumerate_solutions(model, data, pb, task, s, base, so, objective, all, res, found);
   } else {
     ManifoldPoint p;
     for (const Eigen::VectorXd& q : starts)
-      if (local_capture_optimum(model, data, pb, task, s, base, so, local, q, res, p))
+      if (local_capture_optimum(model, data, pb, task, s, base, so, objective, local, q, res, p))
         keep_distinct(model, found, p);
     if (branch_stage_on) {
       res.starts += so.branch_starts;
       res.method += ", then multi-level single linkage over Halton starts";
-      branch_stage(model, data, pb, task, s, base, so, local, res, found);
+      branch_stage(model, data, pb, task, s, base, so, objective, local, res, found);
     }
   }
   res.evaluations = ctx.evaluations;
@@ -646,7 +566,7 @@ inline ManifoldSearchResult detail::search_manifold(const CaptureProblem& pb, co
   std::sort(found.begin(), found.end(),
             [](const ManifoldPoint& a, const ManifoldPoint& b) { return a.objective < b.objective; });
   res.local_optima = std::move(found);
-  rank_local_optima(pb, s, base, so, res);
+  rank_local_optima(objective, data, base, so, res);
   res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return res;
 }

@@ -63,14 +63,14 @@ struct ParetoFront {
 
 namespace detail {
 
-/// The two objectives at theta (base fixed): M_ie and |Delta w_0| with the restitution e of the law.
-/// Runs crba. Writes data.
+/// The two objectives at theta (base fixed): M_ie and |Delta w_0| with the restitution e of the law,
+/// under the problem's joint model (CaptureEvaluator). Runs crba. Writes data.
 inline ParetoPoint pareto_point(const Model& model, Data& data, const CaptureProblem& pb,
                                 const CaptureSetup& s, const BasePose& base, const Eigen::VectorXd& theta,
                                 double restitution) {
   crba(model, data, base, theta);
-  const Vector6 b = base_velocity_per_unit_impulse(model, data, pb.frame, s.u_cap);
-  const double M = 1.0 / (data.w.dot(data.y) + s.target_inv_mass);
+  Vector6 b;
+  const double M = CaptureEvaluator(pb, s).mass_and_base_response_at(data, b);
   const double P = M * approach_velocity(s.law) * (1.0 + restitution);
   return {theta, M, P * b.tail<3>().norm()};
 }
@@ -118,8 +118,7 @@ inline double pareto_mass(unsigned n, const double* x, double* grad, void* p) {
   const SlsqpContext& m = c.manifold;
   c.theta = Eigen::Map<const Eigen::VectorXd>(x, n);
   c.g.resize(n);
-  const double M = integrated_effective_mass_gradient(*m.model, *m.data, *m.base, c.theta, m.pb->frame,
-                                                      m.setup->u_cap, m.setup->target_inv_mass, c.g);
+  const double M = CaptureEvaluator(*m.pb, *m.setup).mass_gradient(*m.data, *m.base, c.theta, c.g);
   if (grad) Eigen::Map<Eigen::VectorXd>(grad, n) = c.g;
   return M;
 }
