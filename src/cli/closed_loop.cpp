@@ -189,8 +189,8 @@ plot::Figure closed_loop_figure(const Scenario& sc, const Plan& p, const ClosedL
   f.open_loop = &p.open;
   const std::string plan = p.name == "paper" || p.name == "global" ? p.name : "servo";  // fits the title
   f.title = str("Closed loop, ", plan, " plan, control ", o.control_rate, " Hz: capture error ",
-                std::setprecision(3), r.capture_error * 1e3, " mm, M#die#u ", r.M_ie, " kg (plan ", p.open.M_ie,
-                ")");
+                std::setprecision(3), r.capture_error * 1e3, " mm, M#die#u ", r.M_ie, " kg (plan ",
+                p.open.M_ie, ")");
   return figures::closed_loop(f);
 }
 

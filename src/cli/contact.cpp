@@ -93,7 +93,8 @@ Row evaluate(const Subject& s, const ContactOptions& o, const std::string& law_n
   row.mb_delta_at_f_max = mb.delta_at_f_max;
   row.base_jump_multibody = mb.base_velocity_end - mb.base_velocity_start;
   Data data(r.model);  // the target's position does not enter (only its attitude, inertia and offset)
-  row.base_jump = CaptureEvaluator(r.model, r.end_effector, target, &law, joints).disturbance(data, r.base, r.theta);
+  row.base_jump =
+      CaptureEvaluator(r.model, r.end_effector, target, &law, joints).disturbance(data, r.base, r.theta);
   return row;
 }
 

@@ -93,7 +93,8 @@ void print_load_report(const UrdfReport& rep) {
 int run_inspect(const InspectOptions& o) {
   const Subject s = load_subject(o.subject);
   if (s.all_joint_models())
-    throw InputError("--contact-joints: inspect evaluates one joint model; 'all' is for the contact subcommand");
+    throw InputError(
+        "--contact-joints: inspect evaluates one joint model; 'all' is for the contact subcommand");
   const ContactJoints joints = s.contact_joints();
   const Robot& r = s.robot;
   const Target& target = s.target;

@@ -525,8 +525,9 @@ RobustRun parse_robust(const RobustOptions& o, ScenarioKeys keys) {
     throw InputError(str("--threads: must be in [1, 1024], got ", o.threads));
   run.sc = robust_scenario(std::move(keys), o);
   if (run.force_model == ForceModel::Multibody && run.sc.problem.joints.model != JointModel::Free)
-    throw InputError(str("--contact-joints: the multibody force model simulates the joints free (servoed by "
-                         "joint-stiffness and joint-damping); use it with --force-model exact or closed"));
+    throw InputError(
+        str("--contact-joints: the multibody force model simulates the joints free (servoed by "
+            "joint-stiffness and joint-damping); use it with --force-model exact or closed"));
   run.first = run.spec.samples * run.shard_k / run.shard_n;
   run.end = run.spec.samples * (run.shard_k + 1) / run.shard_n;
   return run;
@@ -570,8 +571,8 @@ void evaluate_samples(RobustRun& run, const RobustOptions& o) {
       each([&](std::uint64_t i) { c.forces[i] = force(run.samples[i]); });
     } else {
       // Lambda^-1 of the scenario's joint model (the capture objective's); each sample its own target and law
-      const Matrix6 G =
-          CaptureEvaluator(model, pb.frame, run.nominal.target, nullptr, pb.joints).inverse_inertia(data, c.base, c.theta);
+      const Matrix6 G = CaptureEvaluator(model, pb.frame, run.nominal.target, nullptr, pb.joints)
+                            .inverse_inertia(data, c.base, c.theta);
       c.nominal = sample_force(G, nominal_sample, pb.law, run.force_model);
       each([&](std::uint64_t i) { c.forces[i] = sample_force(G, run.samples[i], pb.law, run.force_model); });
     }

@@ -23,7 +23,7 @@ namespace {
 
 struct JointCase {
   std::string name;
-  Args flags;  ///< the command's flags
+  Args flags;                                             ///< the command's flags
   std::vector<std::pair<std::string, std::string>> keys;  ///< the same as scenario keys
 };
 
@@ -58,8 +58,8 @@ Eigen::VectorXd radians(const nlohmann::json& deg) {
 BasePose pose(const nlohmann::json& position, const nlohmann::json& wxyz) {
   BasePose b;
   b.position = Vector3(position[0].get<double>(), position[1].get<double>(), position[2].get<double>());
-  b.orientation = Quaternion(wxyz[0].get<double>(), wxyz[1].get<double>(), wxyz[2].get<double>(),
-                             wxyz[3].get<double>());
+  b.orientation =
+      Quaternion(wxyz[0].get<double>(), wxyz[1].get<double>(), wxyz[2].get<double>(), wxyz[3].get<double>());
   return b;
 }
 
@@ -72,7 +72,8 @@ const std::string kPaper3 = kSource + "/robots/paper_3dof.toml";
 
 }  // namespace
 
-TEST_CASE("Joint models through the main job: every row, branch and base jump is the model's", "[objective][cli]") {
+TEST_CASE("Joint models through the main job: every row, branch and base jump is the model's",
+          "[objective][cli]") {
   for (const JointCase& c : joint_cases()) {
     INFO(c.name);
     TempDir dir;
@@ -91,7 +92,8 @@ TEST_CASE("Joint models through the main job: every row, branch and base jump is
       same(x["integrated_effective_mass"], M);
       same(x["f_max_closed_form"], f.f_max_closed_form(M));
       same(x["f_max_exact"], f.f_max_exact(M));
-      same(x["base_disturbance"]["impulse"], f.disturbance(data, base, radians(x["capture_configuration_deg"])).impulse);
+      same(x["base_disturbance"]["impulse"],
+           f.disturbance(data, base, radians(x["capture_configuration_deg"])).impulse);
     }
     const nlohmann::json& g = j["global"];
     same(g["objective_value"], g["integrated_effective_mass"].get<double>());
@@ -102,18 +104,21 @@ TEST_CASE("Joint models through the main job: every row, branch and base jump is
   }
 }
 
-TEST_CASE("Joint models through inspect and contact: M_ie and the peaks are the model's", "[objective][cli]") {
+TEST_CASE("Joint models through inspect and contact: M_ie and the peaks are the model's",
+          "[objective][cli]") {
   for (const JointCase& c : joint_cases()) {
     INFO(c.name);
     const Scenario sc = scenario_of(kPaper3, c);
     const Model& model = *sc.model;
     Data data(model);
-    const nlohmann::json ins = parse_json(cli_sub("inspect", with({"--config", kPaper3, "--json"}, c.flags), {}));
+    const nlohmann::json ins =
+        parse_json(cli_sub("inspect", with({"--config", kPaper3, "--json"}, c.flags), {}));
     CHECK(ins["contact_joints"] == c.name);
     const CaptureEvaluator at_start(model, sc.problem.frame, sc.problem.target, nullptr, sc.problem.joints);
     same(ins["integrated_effective_mass"], at_start.mass(data, sc.problem.base, radians(ins["joints_deg"])));
 
-    const nlohmann::json con = parse_json(cli_sub("contact", with({"--config", kPaper3, "--json"}, c.flags), {}));
+    const nlohmann::json con =
+        parse_json(cli_sub("contact", with({"--config", kPaper3, "--json"}, c.flags), {}));
     const AnyContactLaw law =
         make_contact_law(sc.problem.law, sc.problem.contact, con["approach_velocity"].get<double>());
     const CaptureEvaluator f(model, sc.problem.frame, sc.problem.target, &law, sc.problem.joints);
@@ -128,9 +133,10 @@ TEST_CASE("Joint models through inspect and contact: M_ie and the peaks are the 
 TEST_CASE("Joint models through map: each row's M_ie and F_max are the model's", "[objective][cli]") {
   for (const JointCase& c : joint_cases()) {
     INFO(c.name);
-    const auto r = cli_sub("map", with({"--config", kPaper3, "--vary", "1,3", "--step-deg", "90", "--csv", "-", "--quiet"},
-                                       c.flags),
-                           {});
+    const auto r = cli_sub(
+        "map",
+        with({"--config", kPaper3, "--vary", "1,3", "--step-deg", "90", "--csv", "-", "--quiet"}, c.flags),
+        {});
     REQUIRE(r.exit_code == 0);
     const Scenario sc = scenario_of(kPaper3, c);
     const Target& t = sc.problem.target;
@@ -165,8 +171,8 @@ TEST_CASE("Joint models through pareto and closed-loop: the front's and the loop
     INFO(c.name);
     TempDir dir;
     const Args common = with({"--config", kPaper3, "--duration", "60", "--quiet"}, c.flags);
-    const auto p = cli_sub("pareto", with(common, {"--levels", "3", "--starts", "4", "--json", dir / "p.json"}),
-                           dir.str());
+    const auto p = cli_sub(
+        "pareto", with(common, {"--levels", "3", "--starts", "4", "--json", dir / "p.json"}), dir.str());
     INFO(p.err);
     REQUIRE(p.exit_code == 0);
     const nlohmann::json pj = read_json_file(dir / "p.json");
@@ -180,17 +186,17 @@ TEST_CASE("Joint models through pareto and closed-loop: the front's and the loop
     same(pj["knee"]["integrated_effective_mass"],
          f.mass(data, base, radians(pj["knee"]["capture_configuration_deg"])));
 
-    const auto l = cli_sub("closed-loop", with(common, {"--control-rate", "10", "--estimate-rate", "1", "--json",
-                                                        dir / "l.json"}),
-                           dir.str());
+    const auto l = cli_sub(
+        "closed-loop",
+        with(common, {"--control-rate", "10", "--estimate-rate", "1", "--json", dir / "l.json"}), dir.str());
     INFO(l.err);
     REQUIRE(l.exit_code == 0);
     const nlohmann::json lj = read_json_file(dir / "l.json");
     for (const char* run : {"open_loop", "closed_loop"}) {
       INFO(run);
       const nlohmann::json& x = lj[run];
-      const double M =
-          f.mass(data, pose(x["base_position"], x["base_quaternion_wxyz"]), radians(x["capture_configuration_deg"]));
+      const double M = f.mass(data, pose(x["base_position"], x["base_quaternion_wxyz"]),
+                              radians(x["capture_configuration_deg"]));
       same(x["integrated_effective_mass"], M);
       same(x["f_max_closed_form"], f.f_max_closed_form(M));
     }
@@ -213,9 +219,10 @@ TEST_CASE("Joint models through robust: the nominal and the tail samples' M_ie a
   }
   for (const JointCase& c : joint_cases()) {
     INFO(c.name);
-    const auto r = cli_sub("robust", with({"--config", dir / "robust.toml", "--capture-joints-deg", "10,80,-60",
-                                           "--json", dir / "r.json", "--quiet"},
-                                          c.flags),
+    const auto r = cli_sub("robust",
+                           with({"--config", dir / "robust.toml", "--capture-joints-deg", "10,80,-60",
+                                 "--json", dir / "r.json", "--quiet"},
+                                c.flags),
                            dir.str());
     INFO(r.err);
     REQUIRE(r.exit_code == 0);
@@ -235,16 +242,16 @@ TEST_CASE("Joint models through robust: the nominal and the tail samples' M_ie a
     const UncertaintySpec spec = uncertainty_spec(sc.keys);
     REQUIRE(!cj["tail"].empty());
     for (const nlohmann::json& t : cj["tail"]) {
-      const SampleForce s =
-          sample_force(Linv, draw_sample(spec, nominal, t["index"].get<std::uint64_t>()), sc.problem.law,
-                       ForceModel::Exact);
+      const SampleForce s = sample_force(Linv, draw_sample(spec, nominal, t["index"].get<std::uint64_t>()),
+                                         sc.problem.law, ForceModel::Exact);
       same(t["M_ie"], s.M_ie);
       same(t["f_max"], s.f_max);
     }
   }
   // the multibody force model simulates the joints free: another joint model is refused in one line
-  const auto bad = cli_sub("robust", {"--config", dir / "robust.toml", "--capture-joints-deg", "10,80,-60",
-                                      "--force-model", "multibody", "--contact-joints", "locked", "--quiet"},
+  const auto bad = cli_sub("robust",
+                           {"--config", dir / "robust.toml", "--capture-joints-deg", "10,80,-60",
+                            "--force-model", "multibody", "--contact-joints", "locked", "--quiet"},
                            dir.str());
   CHECK(bad.exit_code == 2);
   CHECK(bad.err.rfind(kErrorPrefix + " --contact-joints:", 0) == 0);

@@ -89,7 +89,8 @@ double armature_M_ie(const Model& model, int frame, const BasePose& base, const 
   return 1.0 / (w.dot(H.fullPivLu().solve(w)) + target_inverse_mass(t));
 }
 
-Scenario scenario_with(const std::string& file, const std::vector<std::pair<std::string, std::string>>& keys) {
+Scenario scenario_with(const std::string& file,
+                       const std::vector<std::pair<std::string, std::string>>& keys) {
   ScenarioKeys k = read_scenario_file(file);
   for (const auto& [name, value] : keys) override_scenario_key(k, name, value);
   return build_scenario(std::move(k));
@@ -136,10 +137,12 @@ TEST_CASE("Capture objective: M_ie of each joint model against independent compu
           Approx(locked_M_ie(model, pb.frame, base, theta, s.capture_target)).epsilon(1e-10));
     pb.joints = {JointModel::Armature, Eigen::VectorXd::LinSpaced(model.n(), 0.1, 2.0)};
     CHECK(CaptureEvaluator(pb, s).mass(data, base, theta) ==
-          Approx(armature_M_ie(model, pb.frame, base, theta, pb.joints.armature, s.capture_target)).epsilon(1e-10));
+          Approx(armature_M_ie(model, pb.frame, base, theta, pb.joints.armature, s.capture_target))
+              .epsilon(1e-10));
     pb.joints = {};
     CHECK(CaptureEvaluator(pb, s).mass(data, base, theta) ==
-          Approx(armature_M_ie(model, pb.frame, base, theta, Eigen::VectorXd::Zero(model.n()), s.capture_target))
+          Approx(
+              armature_M_ie(model, pb.frame, base, theta, Eigen::VectorXd::Zero(model.n()), s.capture_target))
               .epsilon(1e-10));
     // the map's fast path is the same M_ie
     CHECK(CaptureEvaluator(pb, s).mass_fast(data, base, theta) ==
@@ -179,19 +182,22 @@ TEST_CASE("Capture objective: Lambda^-1 and the base's jump of the locked robot 
   CHECK(inverse_mass == Approx(1.0 / k.m + r.cross(u).dot(k.I.inverse() * r.cross(u))).epsilon(1e-10));
 }
 
-TEST_CASE("Capture objective: the gradients of every joint model and of robust-force equal central differences",
-          "[objective]") {
+TEST_CASE(
+    "Capture objective: the gradients of every joint model and of robust-force equal central differences",
+    "[objective]") {
   ScenarioKeys keys = read_scenario_file(kSource + "/robots/paper_7dof_position_uncertain.toml");
   const Scenario sc = build_scenario(keys);
   const Model& model = *sc.model;
   const CaptureSetup s = prepare_capture(sc.problem, sc.task, sc.capture);
-  const auto robust = scenario_robust_objective(sc, uncertainty_spec(sc.keys, std::uint64_t{40}, std::nullopt));
+  const auto robust =
+      scenario_robust_objective(sc, uncertainty_spec(sc.keys, std::uint64_t{40}, std::nullopt));
   const Eigen::VectorXd theta = (Eigen::VectorXd(7) << 0.2, 1.4, 1.1, -1.2, 1.3, 1.5, 0.1).finished();
   const BasePose base;
   Data data(model);
   Eigen::VectorXd grad(model.n());
-  const std::vector<ContactJoints> models{
-      {JointModel::Free, {}}, {JointModel::Locked, {}}, {JointModel::Armature, Eigen::VectorXd::Constant(7, 0.5)}};
+  const std::vector<ContactJoints> models{{JointModel::Free, {}},
+                                          {JointModel::Locked, {}},
+                                          {JointModel::Armature, Eigen::VectorXd::Constant(7, 0.5)}};
   for (const ContactJoints& joints : models) {
     CaptureProblem pb = sc.problem;
     pb.joints = joints;
@@ -212,13 +218,15 @@ TEST_CASE("Capture objective: the gradients of every joint model and of robust-f
   }
 }
 
-TEST_CASE("UR5 pose task under locked and armature joints: the branches carry that model's M_ie, ranked by it",
-          "[objective][branches]") {
+TEST_CASE(
+    "UR5 pose task under locked and armature joints: the branches carry that model's M_ie, ranked by it",
+    "[objective][branches]") {
   if (!have_ur5()) return;
   const std::string file = kSource + "/tests/data/ur5_pose.toml";
   for (const std::vector<std::pair<std::string, std::string>>& keys :
        {std::vector<std::pair<std::string, std::string>>{{"contact-joints", "locked"}},
-        std::vector<std::pair<std::string, std::string>>{{"contact-joints", "armature"}, {"armature", "0.3"}}}) {
+        std::vector<std::pair<std::string, std::string>>{{"contact-joints", "armature"},
+                                                         {"armature", "0.3"}}}) {
     const Scenario sc = scenario_with(file, keys);
     INFO(sc.keys.contact_joints);
     const ScenarioResult r = run_scenario(sc, {});
@@ -231,9 +239,9 @@ TEST_CASE("UR5 pose task under locked and armature joints: the branches carry th
     const bool locked = sc.problem.joints.model == JointModel::Locked;
     for (size_t i = 0; i < branches.size(); ++i) {
       const CaptureBranch& b = branches[i];
-      const double expected = locked ? locked_M_ie(model, sc.problem.frame, base, b.theta, at_T)
-                                     : armature_M_ie(model, sc.problem.frame, base, b.theta,
-                                                     sc.problem.joints.armature, at_T);
+      const double expected =
+          locked ? locked_M_ie(model, sc.problem.frame, base, b.theta, at_T)
+                 : armature_M_ie(model, sc.problem.frame, base, b.theta, sc.problem.joints.armature, at_T);
       CHECK(b.M_ie == Approx(expected).epsilon(1e-10));
       CHECK(b.objective == b.M_ie);  // the mass objective
       if (i > 0) CHECK(branches[i - 1].M_ie <= b.M_ie);

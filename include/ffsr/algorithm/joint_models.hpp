@@ -93,8 +93,8 @@ inline void factor_with_armature(Data& data, const Eigen::VectorXd& armature, co
 /// The locked system's inverse form s_b^T H_bb^-1 s_b for the wrench [f; m] at the origin of
 /// `frame` (a force f at the point and a couple m), s_b = J_b^T [f; m] = [f; (p_e - p_0) x f + m];
 /// writes y_b = H_bb^-1 s_b. Reads data.H, the kinematics. Writes data.w.
-inline double locked_wrench_form(const Model& model, Data& data, int frame, const Vector3& f, const Vector3& m,
-                                 Vector6& yb) {
+inline double locked_wrench_form(const Model& model, Data& data, int frame, const Vector3& f,
+                                 const Vector3& m, Vector6& yb) {
   jacobian_transpose_times(model, data, frame, f, m);
   const Vector6 sb = data.w.head<6>();
   const Matrix6 Hbb = data.H.topLeftCorner<6, 6>();
@@ -219,7 +219,8 @@ inline double integrated_effective_mass_gradient(const Model& model, Data& data,
 /// Y = L_a^-1 J^T. Locked: X^T H_bb^-1 X with X = [E 0; [p_e - p_0]x E], which maps the wrench to the
 /// base wrench s_b = J_b^T s. Exactly symmetric. Reads data.H and the kinematics. Writes data.L (the
 /// factor of H, or of H + diag(0, a)), data.w and data.y.
-inline Matrix6 inverse_inertia_matrix(const Model& model, Data& data, int frame, const ContactJoints& joints) {
+inline Matrix6 inverse_inertia_matrix(const Model& model, Data& data, int frame,
+                                      const ContactJoints& joints) {
   if (joints.model == JointModel::Free) return inverse_inertia_matrix(model, data, frame);
   detail::check_frame(model, frame, "inverse_inertia_matrix");
   Matrix6 Linv;
@@ -251,8 +252,8 @@ namespace detail {
 /// The gradient of q = s^T Lambda^-1 s under the joint model with the factor already in data.L: that
 /// of H (Free) or of H + diag(0, a) (Armature), as inverse_inertia_matrix(joints) leaves it; Locked
 /// reads data.H alone. No argument checks. Writes data.w, data.y, data.V, data.F and grad. Returns q.
-inline double inverse_inertia_form_gradient_prepared(const Model& model, Data& data, int frame, const Vector6& s,
-                                                     const ContactJoints& joints,
+inline double inverse_inertia_form_gradient_prepared(const Model& model, Data& data, int frame,
+                                                     const Vector6& s, const ContactJoints& joints,
                                                      Eigen::Ref<Eigen::VectorXd> grad) {
   if (joints.model != JointModel::Locked)  // the armature is constant: dH/dtheta is that of H
     return inverse_inertia_form_gradient_factored(model, data, frame, s, grad);

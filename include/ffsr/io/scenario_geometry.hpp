@@ -10,7 +10,8 @@
 #include "ffsr/io/scenario.hpp"
 
 #ifdef FFSR_HAVE_GEOMETRY
-#include "ffsr/geometry/clearance.hpp"
+#include "ffsr/optimize/clearance.hpp"
+#include "ffsr/optimize/global.hpp"
 #include "ffsr/io/urdf_collision.hpp"
 #endif
 

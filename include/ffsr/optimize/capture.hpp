@@ -110,9 +110,10 @@ inline void prepare_base_attitude_hold(const CaptureProblem& pb, const CaptureOp
   const int needed = joints_needed_to_hold(m, r, opt.gain != 0.0);
   if (needed > model.n())
     throw InputError(str(where, ": holding the base attitude takes ", m, " task rows + ", r,
-                         r == 1 ? " base-attitude row = " : " base-attitude rows = ", m + r, " of the robot's ", model.n(), " joints",
-                         opt.gain != 0.0 ? ": no freedom left for the objective" : "", " (it needs ",
-                         needed, " joints)"));
+                         r == 1 ? " base-attitude row = " : " base-attitude rows = ", m + r,
+                         " of the robot's ", model.n(), " joints",
+                         opt.gain != 0.0 ? ": no freedom left for the objective" : "", " (it needs ", needed,
+                         " joints)"));
 }
 
 }  // namespace detail
@@ -181,7 +182,7 @@ struct CaptureRateField {
   Data data;
   TaskSolver solver;
   Eigen::VectorXd qd_null;
-  Eigen::MatrixXd attitude_rows;  ///< hold_base_attitude: Q^T A (r x n), the held rows
+  Eigen::MatrixXd attitude_rows;     ///< hold_base_attitude: Q^T A (r x n), the held rows
   std::unique_ptr<RateGuard> guard;  ///< opt.rate_guard's filter (null: none)
   double min_singular_value = std::numeric_limits<double>::infinity();
   long damped_steps = 0;
@@ -296,10 +297,12 @@ inline std::string held_singularity_message(const Model& model, const CaptureOpt
   const std::vector<std::string> names = model.joint_names();
   std::ostringstream m;
   m.precision(3);
-  m << where << ": holding the base attitude, the arm meets an algorithmic singularity: from t = " << t_singular
-    << " s the task rows in the held rows' null space (J_t N_A) lose rank (smallest singular value " << sigma_min
-    << ", damped below " << opt.singular_value_threshold << ") and at t = " << t << " s the end-effector is "
-    << error << " m off the line, which it cannot follow without turning the base; the freedom the task and the "
+  m << where
+    << ": holding the base attitude, the arm meets an algorithmic singularity: from t = " << t_singular
+    << " s the task rows in the held rows' null space (J_t N_A) lose rank (smallest singular value "
+    << sigma_min << ", damped below " << opt.singular_value_threshold << ") and at t = " << t
+    << " s the end-effector is " << error
+    << " m off the line, which it cannot follow without turning the base; the freedom the task and the "
     << "held rows leave at t = 0 is in ";
   if (shares.empty()) m << "no joint";
   for (size_t i = 0; i < shares.size(); ++i)

@@ -13,11 +13,12 @@ namespace ffsr {
 /// armature). A view: pb, the target and the options must outlive it.
 class CvodeMultibodyPeak final : public MultibodyPeak {
  public:
-  CvodeMultibodyPeak(const CaptureProblem& pb, const Target& target_at_capture, const MultibodyContactOptions& o)
+  CvodeMultibodyPeak(const CaptureProblem& pb, const Target& target_at_capture,
+                     const MultibodyContactOptions& o)
       : pb_(pb), target_(target_at_capture), options_(o) {}
   double operator()(const BasePose& base, const Eigen::VectorXd& theta) const override {
-    return simulate_contact(*pb_.model, base, theta, pb_.frame, target_, pb_.approach_speed, pb_.contact, pb_.law,
-                            options_)
+    return simulate_contact(*pb_.model, base, theta, pb_.frame, target_, pb_.approach_speed, pb_.contact,
+                            pb_.law, options_)
         .f_max;
   }
 

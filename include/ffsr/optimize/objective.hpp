@@ -72,8 +72,9 @@ class CaptureEvaluator {
   /// the setup (the target at T, the law at the capture's approach velocity). multibody-force needs
   /// `peak`, robust-force `robust` (InputError at their first use otherwise). pb, s, peak and robust
   /// must outlive the evaluator.
-  CaptureEvaluator(const CaptureProblem& pb, const CaptureSetup& s, GlobalObjective kind = GlobalObjective::Mass,
-                   const MultibodyPeak* peak = nullptr, RobustForceObjective* robust = nullptr)
+  CaptureEvaluator(const CaptureProblem& pb, const CaptureSetup& s,
+                   GlobalObjective kind = GlobalObjective::Mass, const MultibodyPeak* peak = nullptr,
+                   RobustForceObjective* robust = nullptr)
       : model_(pb.model),
         frame_(pb.frame),
         u_(s.u_cap),
@@ -150,16 +151,19 @@ class CaptureEvaluator {
   double of_mass(double M_ie) const {
     if (kind_ == GlobalObjective::Mass) return M_ie;
     if (kind_ == GlobalObjective::ExactForce) return f_max_exact(M_ie);
-    throw InputError(detail::str("CaptureEvaluator: the ", objective_name(kind_),
-                                 " objective is no function of M_ie"));
+    throw InputError(
+        detail::str("CaptureEvaluator: the ", objective_name(kind_), " objective is no function of M_ie"));
   }
 
   /// The robot's 6x6 inverse inertia at the contact frame under the joint model (Lambda^-1 of
   /// inverse_inertia_matrix), at the configuration of the last crba. Writes data.L, data.w, data.y.
-  Matrix6 inverse_inertia_at(Data& data) const { return inverse_inertia_matrix(*model_, data, frame_, *joints_); }
+  Matrix6 inverse_inertia_at(Data& data) const {
+    return inverse_inertia_matrix(*model_, data, frame_, *joints_);
+  }
 
   /// The same at (base, theta). Runs crba.
-  Matrix6 inverse_inertia(Data& data, const BasePose& base, const Eigen::Ref<const Eigen::VectorXd>& theta) const {
+  Matrix6 inverse_inertia(Data& data, const BasePose& base,
+                          const Eigen::Ref<const Eigen::VectorXd>& theta) const {
     crba(*model_, data, base, theta);
     return inverse_inertia_at(data);
   }
@@ -181,7 +185,8 @@ class CaptureEvaluator {
   }
 
   /// search_value with its analytic gradient in theta (size n) at a fixed base pose. Runs crba.
-  double search_value_gradient(Data& data, const BasePose& base, const Eigen::Ref<const Eigen::VectorXd>& theta,
+  double search_value_gradient(Data& data, const BasePose& base,
+                               const Eigen::Ref<const Eigen::VectorXd>& theta,
                                Eigen::Ref<Eigen::VectorXd> grad) const {
     if (kind_ == GlobalObjective::RobustForce)
       return robust().value_and_gradient(*model_, data, base, theta, frame_, *joints_, grad);
@@ -220,7 +225,8 @@ class CaptureEvaluator {
 
   /// The impact disturbance of the base at (base, theta) under the joint model (its M_ie and the
   /// base's jump; algorithm/base_disturbance.hpp). Runs crba.
-  BaseDisturbance disturbance(Data& data, const BasePose& base, const Eigen::Ref<const Eigen::VectorXd>& theta) const {
+  BaseDisturbance disturbance(Data& data, const BasePose& base,
+                              const Eigen::Ref<const Eigen::VectorXd>& theta) const {
     crba(*model_, data, base, theta);
     return base_disturbance_at(*model_, data, frame_, u_, b_, law(), *joints_);
   }

@@ -94,8 +94,8 @@ class RobustForceObjective {
   /// The same under the joint model of the contact: Lambda^-1 and its form gradients of that model
   /// (inverse_inertia_matrix and inverse_inertia_form_gradient of joint_models.hpp).
   double value_and_gradient(const Model& model, Data& data, const BasePose& base,
-                            const Eigen::Ref<const Eigen::VectorXd>& theta, int frame, const ContactJoints& joints,
-                            Eigen::Ref<Eigen::VectorXd> grad) {
+                            const Eigen::Ref<const Eigen::VectorXd>& theta, int frame,
+                            const ContactJoints& joints, Eigen::Ref<Eigen::VectorXd> grad) {
     const int n = model.n();
     detail::require_size(grad.size(), n, "RobustForceObjective", "grad");
     g_.resize(n);
@@ -119,7 +119,8 @@ class RobustForceObjective {
       const double l = es.eigenvalues()(k);
       if (!(std::abs(l) > 1e-15 * scale)) continue;  // rank-deficient W (no contact-point: rank <= 3)
       // data.L is the factor from inverse_inertia_matrix above: not factorized again
-      detail::inverse_inertia_form_gradient_prepared(model, data, frame, es.eigenvectors().col(k), joints, g_);
+      detail::inverse_inertia_form_gradient_prepared(model, data, frame, es.eigenvectors().col(k), joints,
+                                                     g_);
       grad += l * g_;
     }
     return cvar;

@@ -108,11 +108,10 @@ inline GlobalRun run_global(const Scenario& sc, const CaptureResult* paper_run, 
     throw NumericalError(str("global run: ", e.what()));
   }
   const CaptureSetup setup = prepare_capture(sc.problem, sc.task, opt);
-  r.paper_objective =
-      paper_run ? evaluate_capture(sc.problem, setup, paper_run->base, paper_run->theta, objective,
-                                   g.search.multibody, robust.get())
-                      .objective
-                : std::numeric_limits<double>::quiet_NaN();
+  r.paper_objective = paper_run ? evaluate_capture(sc.problem, setup, paper_run->base, paper_run->theta,
+                                                   objective, g.search.multibody, robust.get())
+                                      .objective
+                                : std::numeric_limits<double>::quiet_NaN();
   r.branches = capture_branches(sc.problem, sc.task, opt, setup, r.result.search, r.result.run.base, 6,
                                 std::max(1u, std::thread::hardware_concurrency()));
   return r;
@@ -145,6 +144,27 @@ inline UncertaintySpec robust_force_spec(const Scenario& sc) {
 
 }  // namespace detail
 
+namespace detail {
+
+/// The robust-force measure (CVaR_95 and p95 of the exact F_max over the sample set, the scenario's
+/// joint model) of each run that holds a configuration, into r.robust_rows.
+inline void add_robust_rows(const Scenario& sc, ScenarioResult& r) {
+  Data data(*sc.model);
+  const CaptureSetup setup = prepare_capture(sc.problem, sc.task, sc.capture);
+  const CaptureEvaluator objective(sc.problem, setup, GlobalObjective::RobustForce, nullptr, r.robust.get());
+  const std::pair<const char*, const CaptureResult*> rows[] = {
+      {"baseline", r.plain_ok() ? &r.plain : nullptr},
+      {"optimized", r.optimized_ok() ? &r.optimized : nullptr},
+      {"global", &r.global->result.run}};
+  for (const auto& [name, run] : rows) {
+    if (!run) continue;
+    const auto v = objective.robust_value(data, run->base, run->theta);
+    r.robust_rows.push_back({name, v.cvar95, v.p95});
+  }
+}
+
+}  // namespace detail
+
 inline ScenarioResult run_scenario(const Scenario& sc, const ScenarioRunOptions& options) {
   ScenarioResult r;
   if (!options.keep_going || !sc.keys.global) {
@@ -166,27 +186,15 @@ inline ScenarioResult run_scenario(const Scenario& sc, const ScenarioRunOptions&
     r.robust = scenario_robust_objective(sc, r.robust_spec);
   }
   try {
-    r.global = detail::run_global(sc, r.optimized_ok() ? &r.optimized : nullptr, sc.objective, r.robust, false);
+    r.global =
+        detail::run_global(sc, r.optimized_ok() ? &r.optimized : nullptr, sc.objective, r.robust, false);
   } catch (const NumericalError& e) {
     if (r.plain_ok() && r.optimized_ok()) throw;
     throw NumericalError(detail::str(r.plain_ok() ? r.optimized_failure : r.plain_failure,
                                      "; the global run failed too: ", e.what()));
   }
   if (sc.geometry) r.clearances.emplace_back("global", run_clearance(sc, r.global->result.run));
-  if (r.robust) {
-    Data data(*sc.model);
-    const CaptureSetup setup = prepare_capture(sc.problem, sc.task, sc.capture);
-    const CaptureEvaluator objective(sc.problem, setup, GlobalObjective::RobustForce, nullptr, r.robust.get());
-    const std::pair<const char*, const CaptureResult*> rows[] = {
-        {"baseline", r.plain_ok() ? &r.plain : nullptr},
-        {"optimized", r.optimized_ok() ? &r.optimized : nullptr},
-        {"global", &r.global->result.run}};
-    for (const auto& [name, run] : rows) {
-      if (!run) continue;
-      const auto v = objective.robust_value(data, run->base, run->theta);
-      r.robust_rows.push_back({name, v.cvar95, v.p95});
-    }
-  }
+  if (r.robust) detail::add_robust_rows(sc, r);
   return r;
 }
 
