@@ -8,7 +8,7 @@
 #include "support/command.hpp"
 
 #include "ffsr/io/scenario.hpp"
-#include "ffsr/io/scenario_run.hpp"
+#include "ffsr/jobs/scenario_run.hpp"
 #include "ffsr/optimize/objective.hpp"
 
 #include <fstream>

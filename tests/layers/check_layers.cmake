@@ -21,6 +21,7 @@ set(FFSR_LAYERS
   "optimize"
   "control"
   "io"
+  "jobs"
   "ffsr"
 )
 # "<regex on the path relative to include/ffsr>=<folder whose layer the files keep to>"

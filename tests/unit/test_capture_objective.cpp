@@ -8,7 +8,7 @@
 #include <catch2/catch.hpp>
 
 #include "ffsr/io/scenario.hpp"
-#include "ffsr/io/scenario_run.hpp"
+#include "ffsr/jobs/scenario_run.hpp"
 #include "ffsr/optimize/pareto.hpp"
 
 #include <filesystem>

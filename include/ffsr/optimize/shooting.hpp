@@ -267,7 +267,7 @@ inline BasePose task_alone_base(const CaptureProblem& pb, const CaptureTask& tas
   try {
     const CaptureResult plain = integrate_capture(pb, task, quiet, setup, none, where);
     if (quiet.max_joint_rate > 0 && plain.max_joint_rate > quiet.max_joint_rate)
-      throw InputError(str(where, ": max joint rate ", quiet.max_joint_rate * 180 / M_PI,
+      throw JointRateLimitError(str(where, ": max joint rate ", quiet.max_joint_rate * 180 / M_PI,
                            " deg/s is below what the task alone needs (", plain.max_joint_rate * 180 / M_PI,
                            " deg/s)"));
     extra.push_back(plain.theta);
