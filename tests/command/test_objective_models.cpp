@@ -161,7 +161,7 @@ TEST_CASE("Joint models through map: each row's M_ie and F_max are the model's",
       CHECK(F == Approx(f.f_max_closed_form(expected)).epsilon(1e-10));
       ++rows;
     }
-    CHECK(rows == 25);
+    CHECK(rows == 16);  // 4 x 4 angles: -180, -90, 0, 90
   }
 }
 
@@ -170,13 +170,13 @@ TEST_CASE("Joint models through pareto and closed-loop: the front's and the loop
   for (const JointCase& c : joint_cases()) {
     INFO(c.name);
     TempDir dir;
-    const Args common = with({"--config", kPaper3, "--duration", "60", "--quiet"}, c.flags);
+    const Args common = with({"--config", kPaper3}, c.flags);
     const auto p = cli_sub(
         "pareto", with(common, {"--levels", "3", "--starts", "4", "--json", dir / "p.json"}), dir.str());
     INFO(p.err);
     REQUIRE(p.exit_code == 0);
     const nlohmann::json pj = read_json_file(dir / "p.json");
-    const Scenario sc = scenario_of(kPaper3, c, {{"duration", "60"}});
+    const Scenario sc = scenario_of(kPaper3, c);
     const CaptureSetup setup = prepare_capture(sc.problem, sc.task, sc.capture);
     const CaptureEvaluator f(sc.problem, setup);
     Data data(*sc.model);
@@ -188,7 +188,7 @@ TEST_CASE("Joint models through pareto and closed-loop: the front's and the loop
 
     const auto l = cli_sub(
         "closed-loop",
-        with(common, {"--control-rate", "10", "--estimate-rate", "1", "--json", dir / "l.json"}), dir.str());
+        with(common, {"--control-rate", "10", "--estimate-rate", "1", "--quiet", "--json", dir / "l.json"}), dir.str());
     INFO(l.err);
     REQUIRE(l.exit_code == 0);
     const nlohmann::json lj = read_json_file(dir / "l.json");

@@ -226,7 +226,7 @@ TEST_CASE(
   for (const std::vector<std::pair<std::string, std::string>>& keys :
        {std::vector<std::pair<std::string, std::string>>{{"contact-joints", "locked"}},
         std::vector<std::pair<std::string, std::string>>{{"contact-joints", "armature"},
-                                                         {"armature", "0.3"}}}) {
+                                                         {"armature", "0.5"}}}) {
     const Scenario sc = scenario_with(file, keys);
     INFO(sc.keys.contact_joints);
     const ScenarioResult r = run_scenario(sc, {});

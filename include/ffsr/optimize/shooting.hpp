@@ -30,7 +30,7 @@ struct GlobalCaptureOptions {
   ReconfigureOptions reconfigure;
   /// Optional check of a reaching run (its series recorded) and the time its approach begins (0, or
   /// the end of its reconfiguration): a message rejects the run, whose goal is then given up (e.g.
-  /// the clearance along the path, geometry/clearance.hpp).
+  /// the clearance along the path, optimize/clearance.hpp).
   std::function<std::optional<std::string>(const CaptureResult&, double approach_begin)> check_run;
 };
 
