@@ -28,9 +28,9 @@ pinocchio::JointIndex add_joint(pinocchio::Model& pm, pinocchio::JointIndex pare
 }  // namespace
 
 struct PinocchioBench::Impl {
+  pinocchio::FrameIndex fid = 0;  // before pm: build() writes it while pm is initialized
   pinocchio::Model pm;
   pinocchio::Data pd;
-  pinocchio::FrameIndex fid = 0;
   std::vector<Eigen::VectorXd> q;
   std::vector<Eigen::Vector3d> u;
   pinocchio::Data::Matrix6x J;
