@@ -82,7 +82,7 @@ def main():
         fid = pm.getFrameId(model.frame_names[model.end_effector])
         u = target.normal_world()
         inv_t = target.inverse_mass_along_normal()
-        lwa = pin.ReferenceFrame.LOCAL_WORLD_ATTACHED
+        lwa = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
         qs = [np.concatenate([[0, 0, 0, 0, 0, 0, 1], th]) for th in thetas]
 
         def pin_mie(q):

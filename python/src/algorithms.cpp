@@ -182,7 +182,7 @@ void bind_algorithms(nb::module_& m) {
         if (joints == "free" && armature.is_none()) return effective_mass(model, data, base, c.theta.map(), f, uu);
         return effective_mass(model, data, base, c.theta.map(), f, uu, joints_arg(model, joints, armature));
       },
-      "model"_a, "data"_a, "base"_a, "theta"_a, "frame"_a, "u"_a, "joints"_a = "free", "armature"_a.none() = nb::none(),
+      "model"_a, "data"_a, "base"_a, "theta"_a, "frame"_a.none(), "u"_a, "joints"_a = "free", "armature"_a.none() = nb::none(),
       (std::string("Effective mass m_e = 1 / (u^T J_v H^-1 J_v^T u) of the free-floating robot at a frame's\n"
                    "origin along the unit inertial direction u (Eq. 4), kg. Runs crba.\n") +
        kJointsDoc)

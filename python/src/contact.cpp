@@ -124,11 +124,11 @@ void bind_contact(nb::module_& m) {
       .def_ro("separation_velocity", &SingleBodyResult::separation_velocity)
       .def_ro("restitution", &SingleBodyResult::restitution)
       .def_ro("num_steps", &SingleBodyResult::num_steps)
-      .def_prop_ro("t", [](const SingleBodyResult& r) { return array_of(r.series.t); }, "Series (record_series): time, s.", nb::rv_policy::move)
-      .def_prop_ro("force", [](const SingleBodyResult& r) { return array_of(r.series.force); }, "Series: F, N.", nb::rv_policy::move)
-      .def_prop_ro("delta", [](const SingleBodyResult& r) { return array_of(r.series.delta); }, "Series: delta, m.", nb::rv_policy::move)
+      .def_prop_ro("t", [](const SingleBodyResult& r) { return array_of(r.series.t); }, "Series (record_series): time, s.", nb::rv_policy::automatic)
+      .def_prop_ro("force", [](const SingleBodyResult& r) { return array_of(r.series.force); }, "Series: F, N.", nb::rv_policy::automatic)
+      .def_prop_ro("delta", [](const SingleBodyResult& r) { return array_of(r.series.delta); }, "Series: delta, m.", nb::rv_policy::automatic)
       .def_prop_ro("delta_dot", [](const SingleBodyResult& r) { return array_of(r.series.delta_dot); },
-                   "Series: delta_dot, m/s.", nb::rv_policy::move);
+                   "Series: delta_dot, m/s.", nb::rv_policy::automatic);
 
   m.def(
       "simulate_single_body",
@@ -155,28 +155,28 @@ void bind_contact(nb::module_& m) {
       .def_ro("contact_duration", &MultibodyContactResult::contact_duration)
       .def_ro("separation_velocity", &MultibodyContactResult::separation_velocity)
       .def_ro("restitution", &MultibodyContactResult::restitution)
-      .def_prop_ro("momentum_start", [](const MultibodyContactResult& r) { return out(r.momentum_start); }, nb::rv_policy::move)
-      .def_prop_ro("momentum_end", [](const MultibodyContactResult& r) { return out(r.momentum_end); }, nb::rv_policy::move)
+      .def_prop_ro("momentum_start", [](const MultibodyContactResult& r) { return out(r.momentum_start); }, nb::rv_policy::automatic)
+      .def_prop_ro("momentum_end", [](const MultibodyContactResult& r) { return out(r.momentum_end); }, nb::rv_policy::automatic)
       .def_ro("energy_start", &MultibodyContactResult::energy_start)
       .def_ro("energy_end", &MultibodyContactResult::energy_end)
       .def_ro("steps", &MultibodyContactResult::steps)
-      .def_prop_ro("base_velocity_start", [](const MultibodyContactResult& r) { return out(r.base_velocity_start); }, nb::rv_policy::move)
-      .def_prop_ro("base_velocity_end", [](const MultibodyContactResult& r) { return out(r.base_velocity_end); }, nb::rv_policy::move)
+      .def_prop_ro("base_velocity_start", [](const MultibodyContactResult& r) { return out(r.base_velocity_start); }, nb::rv_policy::automatic)
+      .def_prop_ro("base_velocity_end", [](const MultibodyContactResult& r) { return out(r.base_velocity_end); }, nb::rv_policy::automatic)
       .def_prop_ro("t", [](const MultibodyContactResult& r) {
             std::vector<double> v;
             for (const auto& s : r.series) v.push_back(s.t);
             return array_of(v);
-          }, "Series (record_series): time, s.", nb::rv_policy::move)
+          }, "Series (record_series): time, s.", nb::rv_policy::automatic)
       .def_prop_ro("force", [](const MultibodyContactResult& r) {
             std::vector<double> v;
             for (const auto& s : r.series) v.push_back(s.force);
             return array_of(v);
-          }, "Series: F, N.", nb::rv_policy::move)
+          }, "Series: F, N.", nb::rv_policy::automatic)
       .def_prop_ro("delta", [](const MultibodyContactResult& r) {
             std::vector<double> v;
             for (const auto& s : r.series) v.push_back(s.delta);
             return array_of(v);
-          }, "Series: delta, m.", nb::rv_policy::move);
+          }, "Series: delta, m.", nb::rv_policy::automatic);
 
   m.def(
       "simulate_contact",

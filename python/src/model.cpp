@@ -86,10 +86,10 @@ void bind_model(nb::module_& m) {
           "xyz"_a, "rpy"_a, "The pose of a URDF <origin xyz rpy> (roll, pitch, yaw about fixed x, y, z; radians).")
       .def_prop_rw(
           "p", [](const Pose& s) { return out(s.p); },
-          [](Pose& s, nb::handle v) { s.p = vec3(v, "Pose", "p"); }, "Origin of b in a (3,).", nb::rv_policy::move)
+          [](Pose& s, nb::handle v) { s.p = vec3(v, "Pose", "p"); }, "Origin of b in a (3,).", nb::rv_policy::automatic)
       .def_prop_rw(
           "R", [](const Pose& s) { return out(s.R); },
-          [](Pose& s, nb::handle v) { s.R = mat3(v, "Pose", "R"); }, "Rotation aRb (3, 3).", nb::rv_policy::move)
+          [](Pose& s, nb::handle v) { s.R = mat3(v, "Pose", "R"); }, "Rotation aRb (3, 3).", nb::rv_policy::automatic)
       .def("__mul__", &Pose::operator*, "Composition a_pose * b_pose.");
 
   nb::class_<BasePose>(m, "BasePose",
@@ -105,11 +105,11 @@ void bind_model(nb::module_& m) {
           "position"_a.none() = nb::none(), "orientation"_a.none() = nb::none())
       .def_prop_rw(
           "position", [](const BasePose& s) { return out(s.position); },
-          [](BasePose& s, nb::handle v) { s.position = vec3(v, "BasePose", "position"); }, nb::rv_policy::move)
+          [](BasePose& s, nb::handle v) { s.position = vec3(v, "BasePose", "position"); }, nb::rv_policy::automatic)
       .def_prop_rw(
           "orientation", [](const BasePose& s) { return out_quat(s.orientation); },
           [](BasePose& s, nb::handle v) { s.orientation = quat_xyzw(v, "BasePose", "orientation"); },
-          "Attitude quaternion (x, y, z, w) of the base in the inertial frame.", nb::rv_policy::move);
+          "Attitude quaternion (x, y, z, w) of the base in the inertial frame.", nb::rv_policy::automatic);
 
   nb::class_<Inertia>(m, "Inertia", "Mass (kg), centre of mass and inertia about it (kg m^2), in the link frame.")
       .def(
@@ -124,14 +124,14 @@ void bind_model(nb::module_& m) {
       .def_rw("mass", &Inertia::mass)
       .def_prop_rw(
           "com", [](const Inertia& s) { return out(s.com); },
-          [](Inertia& s, nb::handle v) { s.com = vec3(v, "Inertia", "com"); }, nb::rv_policy::move)
+          [](Inertia& s, nb::handle v) { s.com = vec3(v, "Inertia", "com"); }, nb::rv_policy::automatic)
       .def_prop_rw(
-          "I", [](const Inertia& s) { return out(s.I); }, [](Inertia& s, nb::handle v) { s.I = mat3(v, "Inertia", "I"); }, nb::rv_policy::move);
+          "I", [](const Inertia& s) { return out(s.I); }, [](Inertia& s, nb::handle v) { s.I = mat3(v, "Inertia", "I"); }, nb::rv_policy::automatic);
 
   nb::class_<Joint>(m, "Joint", "A moving joint: name, type, unit axis (child frame), limits (rad or m).")
       .def_ro("name", &Joint::name)
       .def_ro("type", &Joint::type)
-      .def_prop_ro("axis", [](const Joint& j) { return out(j.axis); }, nb::rv_policy::move)
+      .def_prop_ro("axis", [](const Joint& j) { return out(j.axis); }, nb::rv_policy::automatic)
       .def_ro("lower", &Joint::lower)
       .def_ro("upper", &Joint::upper)
       .def("has_limits", &Joint::has_limits);
@@ -169,8 +169,8 @@ void bind_model(nb::module_& m) {
           "mass"_a, "inertia"_a, "com"_a.none() = nb::none(), "mount"_a.none() = nb::none(), "name"_a = "bus")
       .def_rw("name", &Bus::name)
       .def_rw("mass", &Bus::mass)
-      .def_prop_ro("inertia", [](const Bus& b) { return out(b.inertia); }, nb::rv_policy::move)
-      .def_prop_ro("com", [](const Bus& b) { return out(b.com); }, nb::rv_policy::move)
+      .def_prop_ro("inertia", [](const Bus& b) { return out(b.inertia); }, nb::rv_policy::automatic)
+      .def_prop_ro("com", [](const Bus& b) { return out(b.com); }, nb::rv_policy::automatic)
       .def_rw("mount", &Bus::mount);
 
   nb::class_<ModelRepair>(m, "ModelRepair", "One change the URDF loader made to a link's inertial values.")
@@ -228,7 +228,7 @@ void bind_model(nb::module_& m) {
       .def_prop_ro("end_effector", &Model::end_effector, "Index of the default end-effector frame.")
       .def_prop_ro("joint_names", &Model::joint_names, "Names of the coordinates' joints, in coordinate order.")
       .def_prop_ro("total_mass", &Model::total_mass)
-      .def_prop_ro("gravity", [](const Model& s) { return out(s.gravity); }, "Gravity in the inertial frame (zero by default).", nb::rv_policy::move)
+      .def_prop_ro("gravity", [](const Model& s) { return out(s.gravity); }, "Gravity in the inertial frame (zero by default).", nb::rv_policy::automatic)
       .def_ro("source", &Model::source, "A label for error messages (the URDF file).")
       .def("joint", [](const Model& s, int k) {
             if (k < 0 || k >= s.n()) throw InputError(str("Model.joint: index ", k, " out of range (n = ", s.n(), ")"));
@@ -288,11 +288,11 @@ void bind_model(nb::module_& m) {
                    "The workspace every algorithm writes into, made once from a Model (one per thread).\n"
                    "H, L, J, Jf and tau are read-only views into it: the next call on this Data overwrites them.")
       .def(nb::init<const Model&>(), "model"_a)
-      .def_prop_ro("H", [](nb::handle s) { return view(nb::cast<Data&>(s).H, s); }, "H of the last crba, (6+n, 6+n).", nb::rv_policy::move)
-      .def_prop_ro("L", [](nb::handle s) { return view(nb::cast<Data&>(s).L, s); }, "Cholesky factor of H (lower).", nb::rv_policy::move)
-      .def_prop_ro("J", [](nb::handle s) { return view(nb::cast<Data&>(s).J, s); }, "J_bm of the last frame_jacobian, (6, 6+n).", nb::rv_policy::move)
-      .def_prop_ro("Jf", [](nb::handle s) { return view(nb::cast<Data&>(s).Jf, s); }, "J_f of the last generalized_jacobian, (6, n).", nb::rv_policy::move)
-      .def_prop_ro("tau", [](nb::handle s) { return view(nb::cast<Data&>(s).tau, s); }, "tau of the last rnea, (6+n,).", nb::rv_policy::move)
+      .def_prop_ro("H", [](nb::handle s) { return view(nb::cast<Data&>(s).H, s); }, "H of the last crba, (6+n, 6+n).", nb::rv_policy::automatic)
+      .def_prop_ro("L", [](nb::handle s) { return view(nb::cast<Data&>(s).L, s); }, "Cholesky factor of H (lower).", nb::rv_policy::automatic)
+      .def_prop_ro("J", [](nb::handle s) { return view(nb::cast<Data&>(s).J, s); }, "J_bm of the last frame_jacobian, (6, 6+n).", nb::rv_policy::automatic)
+      .def_prop_ro("Jf", [](nb::handle s) { return view(nb::cast<Data&>(s).Jf, s); }, "J_f of the last generalized_jacobian, (6, n).", nb::rv_policy::automatic)
+      .def_prop_ro("tau", [](nb::handle s) { return view(nb::cast<Data&>(s).tau, s); }, "tau of the last rnea, (6+n,).", nb::rv_policy::automatic)
       .def_prop_ro(
           "positions",
           [](const Data& d) {
@@ -300,7 +300,7 @@ void bind_model(nb::module_& m) {
             for (size_t i = 0; i < d.p.size(); ++i) P.row(Eigen::Index(i)) = d.p[i].transpose();
             return out(P);
           },
-          "Body frame origins in the inertial frame, (nb, 3) (a copy).", nb::rv_policy::move)
+          "Body frame origins in the inertial frame, (nb, 3) (a copy).", nb::rv_policy::automatic)
       .def_prop_ro(
           "rotations",
           [](const Data& d) {
@@ -308,7 +308,7 @@ void bind_model(nb::module_& m) {
             for (const auto& R : d.R) Rs.push_back(out(R));
             return Rs;
           },
-          "Body frame rotations oR_i, a list of (3, 3) (copies).", nb::rv_policy::move);
+          "Body frame rotations oR_i, a list of (3, 3) (copies).", nb::rv_policy::automatic);
 
   nb::class_<Target>(m, "Target",
                      "The tumbling target (Section 2.2). Defaults are the paper's: 200 kg, diag(100, 100, 100) kg m^2,\n"
@@ -337,26 +337,26 @@ void bind_model(nb::module_& m) {
       .def_rw("mass", &Target::mass, "m_t, kg.")
       .def_prop_rw(
           "inertia", [](const Target& s) { return out(s.inertia); },
-          [](Target& s, nb::handle v) { s.inertia = mat3(v, "Target", "inertia"); }, "I_t about the centre of mass (target frame).", nb::rv_policy::move)
+          [](Target& s, nb::handle v) { s.inertia = mat3(v, "Target", "inertia"); }, "I_t about the centre of mass (target frame).", nb::rv_policy::automatic)
       .def_prop_rw(
           "position", [](const Target& s) { return out(s.position); },
-          [](Target& s, nb::handle v) { s.position = vec3(v, "Target", "position"); }, "Centre of mass in o.", nb::rv_policy::move)
+          [](Target& s, nb::handle v) { s.position = vec3(v, "Target", "position"); }, "Centre of mass in o.", nb::rv_policy::automatic)
       .def_prop_rw(
           "attitude", [](const Target& s) { return out_quat(s.attitude); },
-          [](Target& s, nb::handle v) { s.attitude = quat_xyzw(v, "Target", "attitude"); }, "oR_t as (x, y, z, w).", nb::rv_policy::move)
+          [](Target& s, nb::handle v) { s.attitude = quat_xyzw(v, "Target", "attitude"); }, "oR_t as (x, y, z, w).", nb::rv_policy::automatic)
       .def_prop_rw(
           "velocity", [](const Target& s) { return out(s.velocity); },
-          [](Target& s, nb::handle v) { s.velocity = vec3(v, "Target", "velocity"); }, "v_t, inertial frame.", nb::rv_policy::move)
+          [](Target& s, nb::handle v) { s.velocity = vec3(v, "Target", "velocity"); }, "v_t, inertial frame.", nb::rv_policy::automatic)
       .def_prop_rw(
           "angular_velocity", [](const Target& s) { return out(s.angular_velocity); },
           [](Target& s, nb::handle v) { s.angular_velocity = vec3(v, "Target", "angular_velocity"); },
-          "omega_t (target frame), rad/s.", nb::rv_policy::move)
+          "omega_t (target frame), rad/s.", nb::rv_policy::automatic)
       .def_prop_rw(
           "contact_offset", [](const Target& s) { return out(s.contact_offset); },
-          [](Target& s, nb::handle v) { s.contact_offset = vec3(v, "Target", "contact_offset"); }, "r_tp (target frame).", nb::rv_policy::move)
+          [](Target& s, nb::handle v) { s.contact_offset = vec3(v, "Target", "contact_offset"); }, "r_tp (target frame).", nb::rv_policy::automatic)
       .def_prop_rw(
           "normal", [](const Target& s) { return out(s.normal); },
-          [](Target& s, nb::handle v) { s.normal = vec3(v, "Target", "normal"); }, "u_n (target frame), unit.", nb::rv_policy::move)
+          [](Target& s, nb::handle v) { s.normal = vec3(v, "Target", "normal"); }, "u_n (target frame), unit.", nb::rv_policy::automatic)
       .def("validate", [](const Target& t) { t.validate(); }, "Checks every field; InputError naming the field.")
       .def("rotation", [](const Target& t) { return out(t.rotation()); }, "oR_t.")
       .def("normal_world", [](const Target& t) { return out(t.normal_world()); }, "u = R_t u_n in o.")

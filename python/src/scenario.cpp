@@ -68,10 +68,10 @@ nb::object json_loads(const std::string& text) { return nb::module_::import_("js
 void bind_scenario(nb::module_& m) {
   nb::class_<CaptureResult>(m, "CaptureResult", "One capture run of the planner (plain, paper's method or global).")
       .def_prop_ro("theta", [](const CaptureResult& r) { return out(r.theta); }, "Capture configuration, rad.",
-                   nb::rv_policy::move)
+                   nb::rv_policy::automatic)
       .def_ro("base", &CaptureResult::base, "Base pose at T.")
-      .def_prop_ro("end_effector", [](const CaptureResult& r) { return out(r.end_effector); }, nb::rv_policy::move)
-      .def_prop_ro("capture_point", [](const CaptureResult& r) { return out(r.capture_point); }, nb::rv_policy::move)
+      .def_prop_ro("end_effector", [](const CaptureResult& r) { return out(r.end_effector); }, nb::rv_policy::automatic)
+      .def_prop_ro("capture_point", [](const CaptureResult& r) { return out(r.capture_point); }, nb::rv_policy::automatic)
       .def_ro("M_ie", &CaptureResult::M_ie, "Integrated effective mass at the capture (Eq. 14), kg.")
       .def_ro("approach_velocity", &CaptureResult::approach_velocity, "delta_dot^- at the capture, m/s.")
       .def_ro("f_max_closed_form", &CaptureResult::f_max_closed_form, "Peak force, closed form (Eq. 24), N.")
@@ -121,7 +121,7 @@ void bind_scenario(nb::module_& m) {
       .def_prop_ro("target", [](const Scenario& s) { return s.problem.target; }, "The target at t = 0.")
       .def_prop_ro("base", [](const Scenario& s) { return s.problem.base; }, "The base pose at t = 0.")
       .def_prop_ro("theta", [](const Scenario& s) { return out(s.problem.theta); }, "The joint angles at t = 0, rad.",
-                   nb::rv_policy::move)
+                   nb::rv_policy::automatic)
       .def(
           "run",
           [](const Scenario& sc) {

@@ -104,7 +104,7 @@ class Case:
         M = np.triu(self.pd.M) + np.triu(self.pd.M, 1).T  # Pinocchio fills the upper triangle
         pin.computeJointJacobians(self.pm, self.pd, q)
         pin.updateFramePlacements(self.pm, self.pd)
-        J = pin.getFrameJacobian(self.pm, self.pd, self.fid, pin.ReferenceFrame.LOCAL_WORLD_ATTACHED)
+        J = pin.getFrameJacobian(self.pm, self.pd, self.fid, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
         H = T.T @ M @ T
         J = J @ T
         Jf = J[:, 6:] - J[:, :6] @ np.linalg.solve(H[:6, :6], H[:6, 6:])
