@@ -234,6 +234,10 @@ NB_MODULE(_ffsr, m) {
       "ffsr.InputError",
       "A caller's argument is wrong: size, non-finite value, range, unknown name, dtype or layout.",
       nb::make_tuple(nb::handle(error), nb::handle(PyExc_ValueError)).ptr(), nullptr);
+  static PyObject* joint_rate_limit_error = PyErr_NewExceptionWithDoc(
+      "ffsr.JointRateLimitError",
+      "A joint-rate limit the motion cannot keep (below what the task alone needs, or invalid): an InputError.",
+      input_error, nullptr);
   static PyObject* model_error = PyErr_NewExceptionWithDoc(
       "ffsr.ModelError", "A URDF file or a built tree is malformed or unphysical.", error, nullptr);
   static PyObject* numerical_error = PyErr_NewExceptionWithDoc(
@@ -245,10 +249,11 @@ NB_MODULE(_ffsr, m) {
       nullptr);
   static PyObject* integration_error = PyErr_NewExceptionWithDoc(
       "ffsr.IntegrationError", "SUNDIALS CVODE reported a failure (the message names the flag).", error, nullptr);
-  if (!error || !input_error || !model_error || !numerical_error || !joint_limit_error || !integration_error)
+  if (!error || !input_error || !joint_rate_limit_error || !model_error || !numerical_error || !joint_limit_error || !integration_error)
     throw nb::python_error();
   m.attr("Error") = nb::borrow(error);
   m.attr("InputError") = nb::borrow(input_error);
+  m.attr("JointRateLimitError") = nb::borrow(joint_rate_limit_error);
   m.attr("ModelError") = nb::borrow(model_error);
   m.attr("NumericalError") = nb::borrow(numerical_error);
   m.attr("JointLimitError") = nb::borrow(joint_limit_error);
@@ -256,6 +261,8 @@ NB_MODULE(_ffsr, m) {
   nb::register_exception_translator([](const std::exception_ptr& p, void*) {
     try {
       std::rethrow_exception(p);
+    } catch (const ffsr::JointRateLimitError& e) {
+      PyErr_SetString(joint_rate_limit_error, e.what());
     } catch (const ffsr::InputError& e) {
       PyErr_SetString(input_error, e.what());
     } catch (const ffsr::ModelError& e) {

@@ -4,11 +4,7 @@
 // result's to_dict() is the command's --json for the same scenario.
 #include "common.hpp"
 
-#if __has_include(<ffsr/jobs/scenario_run.hpp>)
 #include <ffsr/jobs/scenario_run.hpp>
-#else
-#include <ffsr/io/scenario_run.hpp>
-#endif
 
 #include <nanobind/stl/optional.h>
 #include <nanobind/stl/string.h>

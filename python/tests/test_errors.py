@@ -21,6 +21,7 @@ def test_hierarchy():
     for cls in (ffsr.InputError, ffsr.ModelError, ffsr.NumericalError, ffsr.IntegrationError):
         assert issubclass(cls, ffsr.Error)
     assert issubclass(ffsr.JointLimitError, ffsr.NumericalError)
+    assert issubclass(ffsr.JointRateLimitError, ffsr.InputError)
     assert issubclass(ffsr.InputError, ValueError)
     assert not issubclass(ffsr.ModelError, ffsr.InputError)
 
