@@ -19,7 +19,7 @@ def python_blocks(path):
 
 def command_rows():
     """The command's rows for the paper's 3-DOF scenario: configuration, M_ie (kg), F_max (kN)."""
-    out = subprocess.run([command(), "--config", "robots/paper_3dof.toml", "--global", "false"], cwd=REPO,
+    out = subprocess.run([command(), "--config", "robots/paper_3dof.toml", "--global=false"], cwd=REPO,
                          capture_output=True, text=True, check=True, timeout=600).stdout
     rows = {}
     for line in out.splitlines():

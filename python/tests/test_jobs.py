@@ -69,7 +69,7 @@ def test_run_equals_the_command(tmp_path, name):
 
 def test_override_equals_the_flag(tmp_path):
     scenario = ROBOTS / "paper_3dof.toml"
-    expected = command_json(tmp_path, scenario, "--gain", "-0.02", "--global", "false")
+    expected = command_json(tmp_path, scenario, "--gain", "-0.02", "--global=false")
     # `global` is a Python keyword: passed through a dict
     got = ffsr.Scenario.load(str(scenario), gain=-0.02, **{"global": False}).run().to_dict()
     assert differences(got, expected) == []
