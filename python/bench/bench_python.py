@@ -70,7 +70,7 @@ def main():
     configs = list(thetas)  # rows: contiguous float64 views
 
     t_ffsr = median_per_call(lambda th: ffsr.integrated_effective_mass(model, data, base, th, None, target), configs)
-    t_cpp = ffsr._time_cpp_integrated_effective_mass(model, data, base, thetas, target, BATCHES, BATCH_SECONDS)
+    t_cpp = ffsr._ffsr._time_cpp_integrated_effective_mass(model, data, base, thetas, target, BATCHES, BATCH_SECONDS)
     print(f"{'7-DOF M_ie (Eq. 14), one call':44s} {'median per call':>16s}")
     print(f"{'ffsr from C++ (this process)':44s} {t_cpp * 1e6:13.3f} us")
     print(f"{'ffsr.integrated_effective_mass from Python':44s} {t_ffsr * 1e6:13.3f} us"
@@ -83,7 +83,17 @@ def main():
         u = target.normal_world()
         inv_t = target.inverse_mass_along_normal()
         lwa = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
-        qs = [np.concatenate([[0, 0, 0, 0, 0, 0, 1], th]) for th in thetas]
+        def pin_q(theta):  # the same configuration in Pinocchio's q (continuous joints as cos, sin)
+            q = pin.neutral(pm)
+            for k, name in enumerate(model.joint_names):
+                j = pm.joints[pm.getJointId(name)]
+                if j.nq == 2:
+                    q[j.idx_q:j.idx_q + 2] = [np.cos(theta[k]), np.sin(theta[k])]
+                else:
+                    q[j.idx_q] = theta[k]
+            return q
+
+        qs = [pin_q(th) for th in thetas]
 
         def pin_mie(q):
             M = pin.crba(pm, pd, q)
