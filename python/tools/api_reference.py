@@ -21,7 +21,8 @@ BEGIN, END = "<!-- api-reference: begin -->", "<!-- api-reference: end -->"
 
 def clean(sig):
     """A nanobind signature without the extension's module prefix."""
-    return re.sub(r"\bffsr\._ffsr\.", "", sig)
+    sig = re.sub(r"\bffsr\._ffsr\.", "", sig)
+    return re.sub(r"<(\w+) object at 0x[0-9a-f]+>", r"\1()", sig)  # a default's repr: no address
 
 
 def split_doc(obj):
