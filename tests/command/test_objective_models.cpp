@@ -188,7 +188,8 @@ TEST_CASE("Joint models through pareto and closed-loop: the front's and the loop
 
     const auto l = cli_sub(
         "closed-loop",
-        with(common, {"--control-rate", "10", "--estimate-rate", "1", "--quiet", "--json", dir / "l.json"}), dir.str());
+        with(common, {"--control-rate", "10", "--estimate-rate", "1", "--quiet", "--json", dir / "l.json"}),
+        dir.str());
     INFO(l.err);
     REQUIRE(l.exit_code == 0);
     const nlohmann::json lj = read_json_file(dir / "l.json");

@@ -127,12 +127,11 @@ class CaptureEvaluator {
     return mass_at(data);
   }
 
-  /// M_ie at (base, theta) by the faster path for many evaluations (maps): free joints,
-  /// integrated_effective_mass_fast (the articulated-body recursion from kArticulatedMinJoints joints
-  /// on; the same M_ie to rounding); locked and armature, mass. Runs crba or the recursion.
+  /// M_ie at (base, theta) by the faster path for many evaluations (maps): the articulated-body
+  /// recursion of the joint model (integrated_effective_mass_fast; the same M_ie to rounding). Writes
+  /// the kinematics and the recursion's fields.
   double mass_fast(Data& data, const BasePose& base, const Eigen::Ref<const Eigen::VectorXd>& theta) const {
-    if (joints_->model != JointModel::Free) return mass(data, base, theta);
-    return integrated_effective_mass_fast(*model_, data, base, theta, frame_, u_, b_);
+    return integrated_effective_mass_fast(*model_, data, base, theta, frame_, u_, b_, *joints_);
   }
 
   /// M_ie and its analytic gradient in theta (size n) at a fixed base pose

@@ -268,8 +268,8 @@ inline BasePose task_alone_base(const CaptureProblem& pb, const CaptureTask& tas
     const CaptureResult plain = integrate_capture(pb, task, quiet, setup, none, where);
     if (quiet.max_joint_rate > 0 && plain.max_joint_rate > quiet.max_joint_rate)
       throw JointRateLimitError(str(where, ": max joint rate ", quiet.max_joint_rate * 180 / M_PI,
-                           " deg/s is below what the task alone needs (", plain.max_joint_rate * 180 / M_PI,
-                           " deg/s)"));
+                                    " deg/s is below what the task alone needs (",
+                                    plain.max_joint_rate * 180 / M_PI, " deg/s)"));
     extra.push_back(plain.theta);
     return plain.base;
   } catch (const NumericalError& e) {
