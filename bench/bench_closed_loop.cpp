@@ -1,4 +1,4 @@
-// The closed loop of the capture controller (simulate/closed_loop.hpp) over seeds: capture error
+// The closed loop of the capture controller (control/closed_loop.hpp) over seeds: capture error
 // and M_ie against the open-loop plan, the global plan's servo (its capture configuration read from
 // the stored baseline tests/data/baselines/<scenario>.json) on a paper scenario.
 // Run (Release): build/bench/ffsr-bench-closed-loop [--scenario paper_7dof_position] [--seeds 20]
@@ -11,8 +11,8 @@
 #include "support/baselines.hpp"
 
 #include "ffsr/control/capture_controller.hpp"
+#include "ffsr/control/closed_loop.hpp"
 #include "ffsr/io/scenario.hpp"
-#include "ffsr/simulate/closed_loop.hpp"
 
 #include <algorithm>
 #include <chrono>

@@ -1,6 +1,6 @@
 // ffsr-optimize closed-loop [--config SCENARIO.toml] [flags]: the capture controller
 // (ffsr/control/capture_controller.hpp) in a closed loop with the robot's full dynamics and a noisy
-// target estimate (ffsr/simulate/closed_loop.hpp), beside the open-loop plan it follows. The plan is
+// target estimate (ffsr/control/closed_loop.hpp), beside the open-loop plan it follows. The plan is
 // the paper's method (--plan paper), the global run's servo (--plan global: the global search of the
 // main job first) or the servo to a given capture configuration (--goal-joints-deg). A flag overrides
 // the scenario file's key.
@@ -11,7 +11,7 @@
 #include "subcommands.hpp"
 
 #include "ffsr/control/capture_controller.hpp"
-#include "ffsr/simulate/closed_loop.hpp"
+#include "ffsr/control/closed_loop.hpp"
 
 #include <iomanip>
 #include <iostream>

@@ -8,8 +8,8 @@
 #include "support/baselines.hpp"
 
 #include "ffsr/control/capture_controller.hpp"
+#include "ffsr/control/closed_loop.hpp"
 #include "ffsr/io/scenario.hpp"
-#include "ffsr/simulate/closed_loop.hpp"
 
 #include <cmath>
 #include <fstream>

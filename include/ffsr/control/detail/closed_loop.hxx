@@ -1,4 +1,4 @@
-// ffsr/simulate/detail/closed_loop.hxx -- body of ffsr/simulate/closed_loop.hpp.
+// ffsr/control/detail/closed_loop.hxx -- body of ffsr/control/closed_loop.hpp.
 #pragma once
 
 namespace ffsr {

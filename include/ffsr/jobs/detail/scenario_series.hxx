@@ -1,4 +1,4 @@
-// ffsr/io/detail/scenario_series.hxx -- the main job's time series (the CSV of `ffsr-optimize
+// ffsr/jobs/detail/scenario_series.hxx -- the main job's time series (the CSV of `ffsr-optimize
 // --csv`) and the scene that a picture or a 3-D view of it needs (the "scene" key of the JSON):
 // per sample the joint angles, the base's, every body's and the target's pose, the end-effector,
 // M_ie, the F_max estimate and the phase; once the bodies' tree, their shapes, the target's shape,

@@ -1,4 +1,4 @@
-// ffsr/simulate/closed_loop.hpp -- the capture controller in a closed loop with the robot's full
+// ffsr/control/closed_loop.hpp -- the capture controller in a closed loop with the robot's full
 // dynamics and a noisy target estimate. Component ffsr::cvode (SUNDIALS).
 //
 // Plant: the free-floating robot, forward dynamics of Eq. 1 (H a = tau - C, CRBA + RNEA, no external
@@ -214,4 +214,4 @@ ClosedLoopResult simulate_closed_loop(CaptureController<Policy>& ctrl, const Clo
 
 }  // namespace ffsr
 
-#include "ffsr/simulate/detail/closed_loop.hxx"
+#include "ffsr/control/detail/closed_loop.hxx"
