@@ -321,7 +321,7 @@ def _raw_script(text: str, what: str) -> str:
 
 def page(data: Dict[str, Any]) -> str:
     """The HTML page of page_data()'s data: three.js, the viewer and the data in one file."""
-    name = os.path.basename(data["source"]) or "capture"
+    name = os.path.splitext(os.path.basename(data["source"]))[0] or "capture"
     joints = len(data["joint_names"])
     T = data["capture_time"]
     subtitle = (f"{joints} joints · capture at T = {T:g} s · ffsr-optimize {data['version']}"

@@ -10,7 +10,8 @@
 window.ffsrView = function (THREE, OrbitControls, data) {
   const COLOURS = {
     baseline: 0x0072b2, optimized: 0xd55e00, global: 0x009e73,  // the runs, as in the figures
-    target: 0xcc79a7, reconfiguration: 0xe69f00, normal: 0x882255, bus: 0xb8bec6, busEdge: 0x5b6470,
+    target: 0xcc79a7, reconfiguration: 0xe69f00, normal: 0x882255, bus: 0x9aa4b1, busEdge: 0x4b5360,
+    link: 0xdfe3e8,
   };
   const hex = (c) => '#' + c.toString(16).padStart(6, '0');
 
@@ -119,7 +120,7 @@ window.ffsrView = function (THREE, OrbitControls, data) {
     scene.add(g);
     bodyGroups.push(g);
   }
-  const linkMaterial = material(COLOURS.global);
+  const linkMaterial = material(COLOURS.link, { metalness: 0.25, roughness: 0.4 });
   const jointMaterial = material(0x30343a, { roughness: 0.35 });
   const busMaterial = material(COLOURS.bus, { metalness: 0.35, roughness: 0.45 });
 
@@ -209,9 +210,10 @@ window.ffsrView = function (THREE, OrbitControls, data) {
   scene.add(capture);
 
   // --- the grid under the scene -------------------------------------------------------------------
-  const size = Math.max(extent.x, extent.y, 1) * 1.6;
-  const step = Math.pow(10, Math.floor(Math.log10(size / 4)));
-  const divisions = Math.min(200, Math.round(size / step));
+  const size = Math.max(extent.x, extent.y, 1) * 1.8;
+  const decade = Math.pow(10, Math.floor(Math.log10(size / 8)));  // a line every 1, 2 or 5 x 10^k m, ~8 of them
+  const step = [1, 2, 5, 10].map((f) => f * decade).find((x) => size / x <= 10);
+  const divisions = Math.max(2, Math.round(size / step));
   const grid = new THREE.GridHelper(divisions * step, divisions, 0xc5c9d0, 0xdfe2e6);
   grid.rotateX(Math.PI / 2);
   const centre = box.getCenter(new THREE.Vector3());
@@ -225,7 +227,7 @@ window.ffsrView = function (THREE, OrbitControls, data) {
   function tube(points, colour, role) {
     if (points.length < 2) return null;
     const curve = new THREE.CatmullRomCurve3(points, false, 'centripetal');
-    const g = new THREE.TubeGeometry(curve, Math.min(2000, 3 * points.length), 0.4 * lineRadius, 8, false);
+    const g = new THREE.TubeGeometry(curve, Math.min(2000, 3 * points.length), 0.55 * lineRadius, 10, false);
     const m = new THREE.Mesh(g, material(colour, { roughness: 0.5 }));
     m.userData.role = role;
     m.userData.points = points.length;
@@ -251,7 +253,7 @@ window.ffsrView = function (THREE, OrbitControls, data) {
   function frameScene() {
     const radius = 0.5 * Math.max(extent.length(), 0.5);
     const fov = (camera.fov * Math.PI) / 180;
-    const dist = (1.0 * radius) / Math.sin(Math.min(fov, fov * camera.aspect) / 2);
+    const dist = (0.9 * radius) / Math.sin(Math.min(fov, fov * camera.aspect) / 2);
     const dir = new THREE.Vector3(0.45, -1.0, 0.8).normalize();
     camera.position.copy(centre).addScaledVector(dir, dist);
     camera.near = dist / 100;
@@ -336,7 +338,6 @@ window.ffsrView = function (THREE, OrbitControls, data) {
   }
   function selectRun(name) {
     run = runs.find((r) => r.name === name) || runs[0];
-    linkMaterial.color.setHex(COLOURS[run.name] || 0x777777);
     buildPath(run);
     const T = run.t[run.t.length - 1];
     slider.min = String(run.t[0]);
@@ -356,7 +357,6 @@ window.ffsrView = function (THREE, OrbitControls, data) {
     mark(T, 'capture', 'capture');
     for (const b of document.querySelectorAll('#runs button')) b.classList.toggle('on', b.dataset.run === run.name);
     $('legend-approach').style.background = hex(COLOURS[run.name] || 0x444444);
-    $('legend-links').style.background = hex(COLOURS[run.name] || 0x777777);
     $('legend-reconfiguration-row').style.display = run.approach_begin > 0 ? '' : 'none';
     setTime(Math.min(time, T));
   }
@@ -376,6 +376,7 @@ window.ffsrView = function (THREE, OrbitControls, data) {
   $('legend-normal').style.background = hex(COLOURS.normal);
   $('legend-reconfiguration').style.background = hex(COLOURS.reconfiguration);
   $('legend-bus').style.background = hex(COLOURS.bus);
+  $('legend-links').style.background = hex(COLOURS.link);
 
   let playing = false, last = 0;
   const playSeconds = () => Number(speedSelect.value);  // a whole run in this many seconds (0: real time)
@@ -424,7 +425,8 @@ window.ffsrView = function (THREE, OrbitControls, data) {
   // first run at its capture instant -----------------------------------------------------------
   const hash = new URLSearchParams(window.location.hash.slice(1));
   selectRun(hash.get('run') || data.initial_run);
-  setTime(hash.has('t') ? Number(hash.get('t')) : run.t[run.t.length - 1]);
+  const t0 = Number(hash.get('t'));
+  setTime(hash.has('t') && Number.isFinite(t0) ? t0 : run.t[run.t.length - 1]);
   renderer.render(scene, camera);
   requestAnimationFrame(loop);
 
