@@ -12,8 +12,9 @@ try:
 except ImportError as _error:  # no compiled extension (a source tree): ffsr.view still works from files
     _missing_extension = _error
 
-    def __getattr__(name):
-        raise ImportError(f"ffsr.{name}: the compiled extension ffsr._ffsr is not available ({_missing_extension}); "
-                          "only ffsr.view (the 3-D view of the command's --json and --csv) works without it")
+    def __getattr__(name):  # AttributeError, so that `from ffsr import view` still finds the submodule
+        raise AttributeError(f"ffsr.{name}: the compiled extension ffsr._ffsr is not available "
+                             f"({_missing_extension}); only ffsr.view (the 3-D view of the command's --json and "
+                             "--csv) works without it")
 
 __version__ = "0.1.0"
