@@ -57,7 +57,8 @@ void check_series_csv(const std::string& path, size_t n_joints) {
   }
   // run, t, joints, base, ee, M_ie, F_max, target pose, a pose per moving body (one per joint here), phase
   CHECK(c.header.size() == 2 + n_joints + 7 + 3 + 2 + 7 + 7 * n_joints + 1);
-  for (const std::string col : {"target_x", "target_qz", "body1_x", "body" + std::to_string(n_joints) + "_qz"}) {
+  for (const std::string& col : std::vector<std::string>{"target_x", "target_qz", "body1_x",
+                                                          "body" + std::to_string(n_joints) + "_qz"}) {
     INFO(col);
     CHECK(c.column(col) >= 0);
   }
