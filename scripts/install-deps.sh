@@ -7,6 +7,7 @@ packages=(cmake ninja-build g++ pkg-config libeigen3-dev liburdfdom-dev libtinyx
           libplplot-dev plplot-driver-cairo zlib1g-dev)  # figures (--plot; optional) and their test
 packages+=(libnlopt-cxx-dev)  # NLopt: the global capture search (optimize/global.hpp)
 packages+=(libfcl-dev)  # FCL: distances between the robot, the bus and the target (geometry/distance.hpp; optional)
+packages+=(chromium)  # the 3-D view's tests (python/tests/test_view.py): headless, WebGL through SwiftShader
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -55,7 +55,13 @@ void check_series_csv(const std::string& path, size_t n_joints) {
     INFO(col);
     CHECK(c.column(col) >= 0);
   }
-  CHECK(c.header.size() == 2 + n_joints + 7 + 3 + 2 + 1);  // run, t, joints, base, ee, M_ie, F_max, phase
+  // run, t, joints, base, ee, M_ie, F_max, target pose, a pose per moving body (one per joint here), phase
+  CHECK(c.header.size() == 2 + n_joints + 7 + 3 + 2 + 7 + 7 * n_joints + 1);
+  for (const std::string& col : std::vector<std::string>{"target_x", "target_qz", "body1_x",
+                                                          "body" + std::to_string(n_joints) + "_qz"}) {
+    INFO(col);
+    CHECK(c.column(col) >= 0);
+  }
   REQUIRE(c.column("phase") == static_cast<int>(c.header.size()) - 1);
   size_t baseline = 0, optimized = 0, global = 0;
   for (const auto& row : c.rows) {

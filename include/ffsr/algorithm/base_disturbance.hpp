@@ -21,7 +21,7 @@
 // (SingleBodyResult::restitution); a test compares them.
 #pragma once
 
-#include "ffsr/algorithm/effective_mass.hpp"
+#include "ffsr/algorithm/joint_models.hpp"
 #include "ffsr/algorithm/jacobian.hpp"
 #include "ffsr/contact/contact_law.hpp"
 
@@ -55,6 +55,14 @@ inline double single_body_restitution(const AnyContactLaw& law) {
 inline Vector6 base_velocity_per_unit_impulse(const Model& model, Data& data, int frame, const Vector3& u,
                                               const Vector3& rho = Vector3::Zero());
 
+/// The same under the joint model of the contact (joint_models.hpp): Free as above; Armature, the
+/// base rows of (H + diag(0, a))^-1 J^T s; Locked, H_bb^-1 J_b^T s (the robot moves as one rigid
+/// body). Writes inverse_mass = s^T Lambda^-1 s of that model, s = [u; rho x u]. Reads data.H (crba)
+/// and the kinematics. Writes data.L, data.w and data.y.
+inline Vector6 base_velocity_per_unit_impulse(const Model& model, Data& data, int frame, const Vector3& u,
+                                              const ContactJoints& joints, double& inverse_mass,
+                                              const Vector3& rho = Vector3::Zero());
+
 /// The impact disturbance at the configuration of the last crba: the contact along the unit
 /// inertial direction u (the robot approaches along +u and receives -P u), the target's inverse
 /// mass along the normal (Target::inverse_mass_along_normal) and `law` (its approach velocity is
@@ -63,6 +71,11 @@ inline Vector6 base_velocity_per_unit_impulse(const Model& model, Data& data, in
 inline BaseDisturbance base_disturbance_at(const Model& model, Data& data, int frame, const Vector3& u,
                                            double target_inverse_mass, const AnyContactLaw& law,
                                            const Vector3& rho = Vector3::Zero());
+
+/// The same under the joint model of the contact (M_ie and the base's jump of that model).
+inline BaseDisturbance base_disturbance_at(const Model& model, Data& data, int frame, const Vector3& u,
+                                           double target_inverse_mass, const AnyContactLaw& law,
+                                           const ContactJoints& joints, const Vector3& rho = Vector3::Zero());
 
 /// The impact disturbance of the robot at (base, theta) with `frame` touching `target` (its attitude
 /// gives u = R_t u_n) under `law`. Runs crba. Writes data.
@@ -73,6 +86,16 @@ inline BaseDisturbance base_disturbance(const Model& model, Data& data, const Ba
   crba(model, data, base, theta);
   return base_disturbance_at(model, data, frame, target.normal_world(), target.inverse_mass_along_normal(),
                              law, rho);
+}
+
+/// base_disturbance under the joint model of the contact. Runs crba. Writes data.
+inline BaseDisturbance base_disturbance(const Model& model, Data& data, const BasePose& base,
+                                        const Eigen::Ref<const Eigen::VectorXd>& theta, int frame,
+                                        const Target& target, const AnyContactLaw& law,
+                                        const ContactJoints& joints, const Vector3& rho = Vector3::Zero()) {
+  crba(model, data, base, theta);
+  return base_disturbance_at(model, data, frame, target.normal_world(), target.inverse_mass_along_normal(),
+                             law, joints, rho);
 }
 
 // ============================================================================================
@@ -111,13 +134,45 @@ inline Vector6 base_velocity_per_unit_impulse(const Model& model, Data& data, in
   return data.y.head<6>();
 }
 
+inline Vector6 base_velocity_per_unit_impulse(const Model& model, Data& data, int frame, const Vector3& u,
+                                              const ContactJoints& joints, double& inverse_mass,
+                                              const Vector3& rho) {
+  if (joints.model == JointModel::Free) {
+    const Vector6 b = base_velocity_per_unit_impulse(model, data, frame, u, rho);
+    inverse_mass = data.w.dot(data.y);  // s^T J H^-1 J^T s
+    return b;
+  }
+  detail::check_frame(model, frame, "base_disturbance");
+  detail::require_finite_all(u, "base_disturbance", "direction u");
+  detail::require_finite_all(rho, "base_disturbance", "contact offset rho");
+  if (joints.model == JointModel::Locked) {
+    Vector6 yb;
+    inverse_mass = detail::locked_wrench_form(model, data, frame, u, rho.cross(u), yb);
+    return yb;
+  }
+  detail::require_size(joints.armature.size(), model.n(), "base_disturbance", "armature");
+  detail::jacobian_transpose_times(model, data, frame, u, rho.cross(u));
+  detail::factor_with_armature(data, joints.armature, "base_disturbance");
+  data.y = data.w;
+  detail::cholesky_forward(data.L, data.y);
+  detail::cholesky_backward(data.L, data.y);
+  inverse_mass = data.w.dot(data.y);
+  return data.y.head<6>();
+}
+
 inline BaseDisturbance base_disturbance_at(const Model& model, Data& data, int frame, const Vector3& u,
                                            double target_inverse_mass, const AnyContactLaw& law,
                                            const Vector3& rho) {
+  return base_disturbance_at(model, data, frame, u, target_inverse_mass, law, ContactJoints{}, rho);
+}
+
+inline BaseDisturbance base_disturbance_at(const Model& model, Data& data, int frame, const Vector3& u,
+                                           double target_inverse_mass, const AnyContactLaw& law,
+                                           const ContactJoints& joints, const Vector3& rho) {
   detail::check_unit_direction(u, "base_disturbance");
   BaseDisturbance d;
-  const Vector6 per_unit = base_velocity_per_unit_impulse(model, data, frame, u, rho);
-  const double inv_me = data.w.dot(data.y);  // s^T J H^-1 J^T s
+  double inv_me = 0;
+  const Vector6 per_unit = base_velocity_per_unit_impulse(model, data, frame, u, joints, inv_me, rho);
   d.M_ie = 1.0 / (inv_me + target_inverse_mass);
   d.approach_velocity = approach_velocity(law);
   d.restitution = single_body_restitution(law);

@@ -90,10 +90,12 @@ inline void factor_with_armature(Data& data, const Eigen::VectorXd& armature, co
   cholesky(data.L, data.L, where);  // in place: column j reads only entries not yet overwritten
 }
 
-/// The locked system's inverse form s_b^T H_bb^-1 s_b for s_b = J_b^T u (u along the linear
-/// velocity of the frame origin); writes y_b = H_bb^-1 s_b. Reads data.H, the kinematics. Writes data.w.
-inline double locked_inverse_form(const Model& model, Data& data, int frame, const Vector3& u, Vector6& yb) {
-  linear_jacobian_transpose_times(model, data, frame, u);
+/// The locked system's inverse form s_b^T H_bb^-1 s_b for the wrench [f; m] at the origin of
+/// `frame` (a force f at the point and a couple m), s_b = J_b^T [f; m] = [f; (p_e - p_0) x f + m];
+/// writes y_b = H_bb^-1 s_b. Reads data.H, the kinematics. Writes data.w.
+inline double locked_wrench_form(const Model& model, Data& data, int frame, const Vector3& f,
+                                 const Vector3& m, Vector6& yb) {
+  jacobian_transpose_times(model, data, frame, f, m);
   const Vector6 sb = data.w.head<6>();
   const Matrix6 Hbb = data.H.topLeftCorner<6, 6>();
   const Eigen::LLT<Matrix6> llt(Hbb);
@@ -103,22 +105,29 @@ inline double locked_inverse_form(const Model& model, Data& data, int frame, con
   return sb.dot(yb);
 }
 
-/// Gradient of the locked form q = s_b^T H_bb^-1 s_b in the joint angles at a fixed base pose:
+/// locked_wrench_form for a unit force u alone (u along the linear velocity of the frame origin).
+inline double locked_inverse_form(const Model& model, Data& data, int frame, const Vector3& u, Vector6& yb) {
+  return locked_wrench_form(model, data, frame, u, Vector3::Zero(), yb);
+}
+
+/// Gradient of the locked form q = s_b^T H_bb^-1 s_b in the joint angles at a fixed base pose, for
+/// the wrench [u; m] (the couple m constant in the inertial frame, as the base pose is):
 /// dq/dtheta_k = 2 y_b . d s_b/dtheta_k - y_b^T dH_bb/dtheta_k y_b, where d s_b = [0; dp_e x u]
 /// (dp_e the motion of the contact point for the twist S_k, when joint k carries it) and, as the
 /// subtree of k (composite inertia Ic_k) moves by S_k, y^T dH_bb y = -2 (S_k x y) . (Ic_k y).
-/// Reads data.Ic (crba), data.S and the kinematics. Writes grad (size n).
+/// Reads data.Ic (crba), data.S and the kinematics. Writes data.on_path and grad (size n). O(n).
 inline void locked_inverse_form_gradient(const Model& model, Data& data, int frame, const Vector3& u,
                                          const Vector6& yb, Eigen::Ref<Eigen::VectorXd> grad) {
   const int ee_body = model.frame(frame).body;
   const Vector3 pe = frame_pose(model, data, frame).p;
   const Vector3& p0 = data.p[0];
+  mark_path(model, data, ee_body);
   grad.setZero();
   for (int i = 1; i < model.nb(); ++i) {
     const Vector6 S = data.S.col(i - 1);
     const double yHy = -2.0 * cross_motion(S, yb).dot(data.Ic[static_cast<size_t>(i)] * yb);
     double dsy = 0.0;
-    if (supports(model, i, ee_body)) {
+    if (data.on_path[static_cast<size_t>(i)]) {  // joint i carries the contact point
       const Vector3 dp = S.head<3>() + S.tail<3>().cross(pe - p0);
       dsy = yb.tail<3>().dot(dp.cross(u));
     }
@@ -202,6 +211,76 @@ inline double integrated_effective_mass_gradient(const Model& model, Data& data,
   const double M = 1.0 / (inv_me + target_inverse_mass);
   grad *= -M * M;
   return M;
+}
+
+/// The robot's 6x6 inverse inertia Lambda^-1 at the origin of `frame` under the joint model, at the
+/// configuration of the last crba: for a wrench s = [f; m] at the point (a force f and a couple m,
+/// inertial frame) s^T Lambda^-1 s is the inverse effective mass of that wrench. Free:
+/// inverse_inertia_matrix, J H^-1 J^T. Armature: J (H + diag(0, a))^-1 J^T, as Y^T Y with
+/// Y = L_a^-1 J^T. Locked: X^T H_bb^-1 X with X = [E 0; [p_e - p_0]x E], which maps the wrench to the
+/// base wrench s_b = J_b^T s. Exactly symmetric. Reads data.H and the kinematics. Writes data.L (the
+/// factor of H, or of H + diag(0, a)), data.w and data.y.
+inline Matrix6 inverse_inertia_matrix(const Model& model, Data& data, int frame,
+                                      const ContactJoints& joints) {
+  if (joints.model == JointModel::Free) return inverse_inertia_matrix(model, data, frame);
+  detail::check_frame(model, frame, "inverse_inertia_matrix");
+  Matrix6 Linv;
+  if (joints.model == JointModel::Locked) {
+    Matrix6 X = Matrix6::Identity();
+    X.bottomLeftCorner<3, 3>() = skew(frame_pose(model, data, frame).p - data.p[0]);
+    const Matrix6 Hbb = data.H.topLeftCorner<6, 6>();
+    const Eigen::LLT<Matrix6> llt(Hbb);
+    if (llt.info() != Eigen::Success)
+      throw NumericalError("inverse_inertia_matrix: the locked robot's inertia is not positive definite");
+    Linv = X.transpose() * llt.solve(X);
+  } else {
+    detail::require_size(joints.armature.size(), model.n(), "inverse_inertia_matrix", "armature");
+    detail::factor_with_armature(data, joints.armature, "inverse_inertia_matrix");
+    Eigen::Matrix<double, Eigen::Dynamic, 6> Y(data.H.rows(), 6);
+    for (int k = 0; k < 6; ++k) {
+      const Vector6 e = Vector6::Unit(k);
+      detail::jacobian_transpose_times(model, data, frame, e.head<3>(), e.tail<3>());
+      data.y = data.w;
+      detail::cholesky_forward(data.L, data.y);
+      Y.col(k) = data.y;
+    }
+    Linv = Y.transpose() * Y;
+  }
+  return 0.5 * (Linv + Linv.transpose());
+}
+
+namespace detail {
+/// The gradient of q = s^T Lambda^-1 s under the joint model with the factor already in data.L: that
+/// of H (Free) or of H + diag(0, a) (Armature), as inverse_inertia_matrix(joints) leaves it; Locked
+/// reads data.H alone. No argument checks. Writes data.w, data.y, data.V, data.F and grad. Returns q.
+inline double inverse_inertia_form_gradient_prepared(const Model& model, Data& data, int frame,
+                                                     const Vector6& s, const ContactJoints& joints,
+                                                     Eigen::Ref<Eigen::VectorXd> grad) {
+  if (joints.model != JointModel::Locked)  // the armature is constant: dH/dtheta is that of H
+    return inverse_inertia_form_gradient_factored(model, data, frame, s, grad);
+  Vector6 yb;
+  const double q = locked_wrench_form(model, data, frame, s.head<3>(), s.tail<3>(), yb);
+  locked_inverse_form_gradient(model, data, frame, s.head<3>(), yb, grad);
+  return q;
+}
+}  // namespace detail
+
+/// Analytic gradient in the joint angles of q = s^T Lambda^-1 s (Lambda^-1 of
+/// inverse_inertia_matrix under the joint model) for a constant wrench s = [f; m], at a fixed base
+/// pose and the configuration of the last crba. Free: inverse_inertia_form_gradient. Armature: the
+/// same with H + diag(0, a) factorized. Locked: detail::locked_inverse_form_gradient with f in place
+/// of u. Writes data.L, data.w, data.y, data.V, data.F and grad (size n). Returns q.
+inline double inverse_inertia_form_gradient(const Model& model, Data& data, int frame, const Vector6& s,
+                                            const ContactJoints& joints, Eigen::Ref<Eigen::VectorXd> grad) {
+  if (joints.model == JointModel::Free) return inverse_inertia_form_gradient(model, data, frame, s, grad);
+  detail::require_size(grad.size(), model.n(), "inverse_inertia_form_gradient", "grad");
+  detail::check_frame(model, frame, "inverse_inertia_form_gradient");
+  detail::require_finite_all(s, "inverse_inertia_form_gradient", "s");
+  if (joints.model == JointModel::Armature) {
+    detail::require_size(joints.armature.size(), model.n(), "inverse_inertia_form_gradient", "armature");
+    detail::factor_with_armature(data, joints.armature, "inverse_inertia_form_gradient");
+  }
+  return detail::inverse_inertia_form_gradient_prepared(model, data, frame, s, joints, grad);
 }
 
 }  // namespace ffsr

@@ -16,6 +16,7 @@
 #pragma once
 
 #include "ffsr/jobs/scenario_run.hpp"
+#include "ffsr/optimize/objective.hpp"
 #include "ffsr/uncertainty/multibody.hpp"
 #include "ffsr/uncertainty/sampling.hpp"
 

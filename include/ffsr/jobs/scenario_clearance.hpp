@@ -6,6 +6,11 @@
 
 #include "ffsr/io/scenario.hpp"
 
+#ifdef FFSR_HAVE_GEOMETRY
+#include "ffsr/optimize/clearance.hpp"
+#include "ffsr/optimize/global.hpp"
+#endif
+
 #include <algorithm>
 #include <memory>
 #include <optional>

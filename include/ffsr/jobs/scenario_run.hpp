@@ -103,6 +103,17 @@ ScenarioResult run_scenario(const Scenario& sc, const ScenarioRunOptions& option
 /// global and the robust rows (`version` is recorded as given).
 nlohmann::json scenario_json(const Scenario& sc, const ScenarioResult& r, const std::string& version);
 
+/// The number of the global run's first samples that belong to its reconfiguration (0: none).
+long reconfiguration_samples(const ScenarioResult& r);
+
+/// The time series of every run that holds a result (CaptureResult::series: record_series on), as
+/// the CSV of `ffsr-optimize --csv`: one row per sample and run (column `run`: baseline, optimized,
+/// global), t, the joint angles (deg), the base pose, the end-effector, M_ie, the F_max estimate,
+/// the target's pose (propagated from the start, sample to sample), the pose of every moving body
+/// (body<i>, i as in the JSON's scene.bodies: its joint frame) and the phase (reconfiguration or
+/// approach). A pose is x, y, z (m) and the unit quaternion qw, qx, qy, qz, in the inertial frame.
+std::string scenario_series_csv(const Scenario& sc, const ScenarioResult& r);
+
 /// Reduction of `after` against `before`, percent: 100 (before - after) / before.
 inline double reduction_percent(double before, double after) { return 100.0 * (before - after) / before; }
 
@@ -111,3 +122,4 @@ inline double reduction_percent(double before, double after) { return 100.0 * (b
 #include "ffsr/jobs/detail/scenario_run.hxx"
 #include "ffsr/jobs/detail/result_json.hxx"
 #include "ffsr/jobs/detail/base_disturbance_json.hxx"
+#include "ffsr/jobs/detail/scenario_series.hxx"

@@ -41,6 +41,7 @@
 #include "ffsr/optimize/free_floating_step.hpp"
 #include "ffsr/optimize/line_reference.hpp"
 #include "ffsr/optimize/null_space.hpp"
+#include "ffsr/optimize/objective.hpp"
 #include "ffsr/optimize/run_monitors.hpp"
 #include "ffsr/optimize/task_solver.hpp"
 
@@ -110,9 +111,10 @@ inline void prepare_base_attitude_hold(const CaptureProblem& pb, const CaptureOp
   const int needed = joints_needed_to_hold(m, r, opt.gain != 0.0);
   if (needed > model.n())
     throw InputError(str(where, ": holding the base attitude takes ", m, " task rows + ", r,
-                         r == 1 ? " base-attitude row = " : " base-attitude rows = ", m + r, " of the robot's ", model.n(), " joints",
-                         opt.gain != 0.0 ? ": no freedom left for the objective" : "", " (it needs ",
-                         needed, " joints)"));
+                         r == 1 ? " base-attitude row = " : " base-attitude rows = ", m + r,
+                         " of the robot's ", model.n(), " joints",
+                         opt.gain != 0.0 ? ": no freedom left for the objective" : "", " (it needs ", needed,
+                         " joints)"));
 }
 
 }  // namespace detail
@@ -181,7 +183,7 @@ struct CaptureRateField {
   Data data;
   TaskSolver solver;
   Eigen::VectorXd qd_null;
-  Eigen::MatrixXd attitude_rows;  ///< hold_base_attitude: Q^T A (r x n), the held rows
+  Eigen::MatrixXd attitude_rows;     ///< hold_base_attitude: Q^T A (r x n), the held rows
   std::unique_ptr<RateGuard> guard;  ///< opt.rate_guard's filter (null: none)
   double min_singular_value = std::numeric_limits<double>::infinity();
   long damped_steps = 0;
@@ -239,8 +241,9 @@ inline CaptureSample capture_sample(const Model& model, Data& data, const Captur
   c.base = base;
   crba(model, data, base, theta);
   c.end_effector = frame_pose(model, data, pb.frame).p;
-  c.M_ie = 1.0 / (inverse_effective_mass(model, data, pb.frame, s.u_cap, pb.joints) + s.target_inv_mass);
-  c.f_max_estimate = max_force_closed_form(s.law, c.M_ie);
+  const CaptureEvaluator objective(pb, s);
+  c.M_ie = objective.mass_at(data);
+  c.f_max_estimate = objective.f_max_closed_form(c.M_ie);
   return c;
 }
 
@@ -266,11 +269,11 @@ inline void finish_capture(const Model& model, Data& data, const CaptureProblem&
   res.base_position_drift = (base.position - pb.base.position).norm();
   res.base_attitude_drift = rotation_angle(base.orientation.toRotationMatrix() *
                                            pb.base.orientation.normalized().toRotationMatrix().transpose());
-  res.M_ie =
-      1.0 / (inverse_effective_mass(model, data, pb.frame, setup.u_cap, pb.joints) + setup.target_inv_mass);
+  const CaptureEvaluator objective(pb, setup);
+  res.M_ie = objective.mass_at(data);
   res.approach_velocity = setup.v_in;
-  res.f_max_closed_form = max_force_closed_form(setup.law, res.M_ie);
-  res.f_max_exact = max_force_exact(setup.law, res.M_ie);
+  res.f_max_closed_form = objective.f_max_closed_form(res.M_ie);
+  res.f_max_exact = objective.f_max_exact(res.M_ie);
   if (!std::isfinite(res.M_ie) || !std::isfinite(res.f_max_exact) || !std::isfinite(res.f_max_closed_form))
     throw NumericalError(str(where, ": the capture configuration gives a non-finite M_ie or F_max"));
   if (res.tracking_error > opt.tolerance)
@@ -295,10 +298,12 @@ inline std::string held_singularity_message(const Model& model, const CaptureOpt
   const std::vector<std::string> names = model.joint_names();
   std::ostringstream m;
   m.precision(3);
-  m << where << ": holding the base attitude, the arm meets an algorithmic singularity: from t = " << t_singular
-    << " s the task rows in the held rows' null space (J_t N_A) lose rank (smallest singular value " << sigma_min
-    << ", damped below " << opt.singular_value_threshold << ") and at t = " << t << " s the end-effector is "
-    << error << " m off the line, which it cannot follow without turning the base; the freedom the task and the "
+  m << where
+    << ": holding the base attitude, the arm meets an algorithmic singularity: from t = " << t_singular
+    << " s the task rows in the held rows' null space (J_t N_A) lose rank (smallest singular value "
+    << sigma_min << ", damped below " << opt.singular_value_threshold << ") and at t = " << t
+    << " s the end-effector is " << error
+    << " m off the line, which it cannot follow without turning the base; the freedom the task and the "
     << "held rows leave at t = 0 is in ";
   if (shares.empty()) m << "no joint";
   for (size_t i = 0; i < shares.size(); ++i)

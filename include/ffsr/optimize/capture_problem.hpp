@@ -38,7 +38,7 @@ enum class CaptureObjective { IntegratedEffectiveMass, ExactMaxForce };
 
 /// A filter of a capture run's joint rates inside the task's null space, applied at every evaluation
 /// of the rate law after the null-space policy and the joint-rate scaling (for example the clearance
-/// barrier of geometry/clearance.hpp, which keeps the distances to obstacles). `filter` receives the
+/// barrier of optimize/clearance.hpp, which keeps the distances to obstacles). `filter` receives the
 /// kinematics and data.H of (base, theta) (crba, frame_jacobian, generalized_jacobian run), the time,
 /// the null-space projector N of the task (and of the held rows, with hold_base_attitude) and the
 /// joint rates, which it may change by adding N v only (the task rates stay). It keeps per-run state,

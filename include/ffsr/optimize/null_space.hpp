@@ -14,6 +14,7 @@
 
 #include "ffsr/algorithm/effective_mass.hpp"
 #include "ffsr/optimize/capture_problem.hpp"
+#include "ffsr/optimize/objective.hpp"
 
 #include <cmath>
 
@@ -55,7 +56,7 @@ inline void configuration_error(const Model& model, const Eigen::VectorXd& theta
 /// Eq. 14, or the exact maximum force, a monotone function of it: dF/dtheta = f_scale
 /// M_ie^(-1/(alpha+1)) dM_ie/dtheta) at the current base pose, plus the joint-limit repulsion
 /// (detail::add_joint_limit_repulsion), M_ie under the problem's joint model (pb.joints). Runs
-/// integrated_effective_mass_gradient (crba at (base, theta)). Writes data.H, data.L, data.w, data.y, data.V, data.F, grad and qd_null.
+/// CaptureEvaluator::mass_gradient (crba at (base, theta)). Writes data.H, data.L, data.w, data.y, data.V, data.F, grad and qd_null.
 struct GradientPolicy {
   double gain = 0.0;  ///< rho
   CaptureObjective objective = CaptureObjective::IntegratedEffectiveMass;
@@ -66,8 +67,7 @@ struct GradientPolicy {
                   double /*t*/, const BasePose& base, const Eigen::VectorXd& theta,
                   const Eigen::MatrixXd& Nproj, Eigen::VectorXd& qd_null) {
     grad.resize(model.n());
-    const double M = integrated_effective_mass_gradient(model, data, base, theta, pb.frame, s.u_cap,
-                                                        s.target_inv_mass, pb.joints, grad);
+    const double M = CaptureEvaluator(pb, s).mass_gradient(data, base, theta, grad);
     if (objective == CaptureObjective::ExactMaxForce)
       grad *= f_scale * std::pow(M, -1.0 / (alpha + 1));  // dF/dM dM/dtheta
     detail::add_joint_limit_repulsion(model, theta, grad);

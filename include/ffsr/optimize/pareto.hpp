@@ -4,10 +4,12 @@
 // M_ie (Eq. 14) sets the peak contact force; |Delta w_0| is the jump of the base's angular velocity
 // caused by the contact impulse (algorithm/base_disturbance.hpp): |Delta w_0| = P |b_w|, with
 // P = M_ie delta_dot^- (1 + e) and b_w the angular base rows of H^-1 J^T [u; 0] per unit impulse.
-// Both are functions of the capture configuration theta on the capture manifold C(B) of global.hpp
-// (the base at the pose B, the task's constraints c(theta) = 0 within the joint limits).
+// Both are functions of the capture configuration theta on the capture manifold C(B) of
+// capture_manifold.hpp (the base at the pose B, the task's constraints c(theta) = 0 within the joint
+// limits), both of the problem's joint model (the capture objective, objective.hpp).
 //
-// Epsilon-constraint sweep with NLopt's SLSQP (the manifold set up as in global.hpp):
+// Epsilon-constraint sweep with the searches' SLSQP adapter and local-optimum routine
+// (manifold_search.hpp; the base-rate function and constraint: capture_manifold.hpp):
 //  1. the M_ie end: search_capture_manifold (mass objective) from `starts` random starts;
 //  2. the rate end: SLSQP minimizing (|Delta w_0| / w_ref)^2 from the same starts and the M_ie local
 //     optima (w_ref the rate at the M_ie end);
@@ -28,7 +30,7 @@
 #pragma once
 
 #include "ffsr/algorithm/base_disturbance.hpp"
-#include "ffsr/optimize/global.hpp"
+#include "ffsr/optimize/manifold_search.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -63,108 +65,60 @@ struct ParetoFront {
 
 namespace detail {
 
-/// The two objectives at theta (base fixed): M_ie and |Delta w_0| with the restitution e of the law.
-/// Runs crba. Writes data.
+/// The two objectives at theta (base fixed): M_ie and |Delta w_0| with the restitution e of the law,
+/// under the problem's joint model (detail::base_rate of capture_manifold.hpp). Runs crba. Writes data.
 inline ParetoPoint pareto_point(const Model& model, Data& data, const CaptureProblem& pb,
                                 const CaptureSetup& s, const BasePose& base, const Eigen::VectorXd& theta,
                                 double restitution) {
-  crba(model, data, base, theta);
-  const Vector6 b = base_velocity_per_unit_impulse(model, data, pb.frame, s.u_cap);
-  const double M = 1.0 / (data.w.dot(data.y) + s.target_inv_mass);
-  const double P = M * approach_velocity(s.law) * (1.0 + restitution);
-  return {theta, M, P * b.tail<3>().norm()};
+  (void)model;  // pb.model's
+  BaseRateContext c;
+  c.pb = &pb;
+  c.setup = &s;
+  c.base = &base;
+  c.data = &data;
+  c.restitution = restitution;
+  double M = 0;
+  const double rate = base_rate(c, theta, M);
+  return {theta, M, rate};
 }
 
 struct ParetoContext {
-  SlsqpContext manifold;  ///< the constraints c = 0 (slsqp_constraints)
-  double restitution = 0, scale = 1;
-  long evaluations = 0;
+  BaseRateContext rate;  ///< the problem at the base pose, the rate's scale and its evaluations
+  long evaluations = 0;  ///< of M_ie (pareto_mass)
   Eigen::VectorXd theta, g;
 };
 
-/// (|Delta w_0| / scale)^2 and its central-difference gradient.
-inline double pareto_rate2(unsigned n, const double* x, double* grad, void* p) {
-  auto& c = *static_cast<ParetoContext*>(p);
-  ++c.evaluations;
-  const SlsqpContext& m = c.manifold;
-  c.theta = Eigen::Map<const Eigen::VectorXd>(x, n);
-  auto f = [&](const Eigen::VectorXd& th) {
-    const double r = pareto_point(*m.model, *m.data, *m.pb, *m.setup, *m.base, th, c.restitution).base_rate;
-    return (r / c.scale) * (r / c.scale);
-  };
-  const double value = f(c.theta);
-  if (grad) {
-    const double h = 1e-6;
-    for (unsigned k = 0; k < n; ++k) {
-      Eigen::VectorXd t = c.theta;
-      t(k) += h;
-      const double fp = f(t);
-      t(k) -= 2 * h;
-      grad[k] = (fp - f(t)) / (2 * h);
-    }
-  }
-  return value;
-}
-
-/// (|Delta w_0| / scale)^2 - 1 <= 0: the sweep's constraint.
-inline double pareto_rate_constraint(unsigned n, const double* x, double* grad, void* p) {
-  return pareto_rate2(n, x, grad, p) - 1.0;
-}
-
-/// M_ie with its analytic gradient.
+/// M_ie with its analytic gradient (the capture objective's), NLopt's signature.
 inline double pareto_mass(unsigned n, const double* x, double* grad, void* p) {
   auto& c = *static_cast<ParetoContext*>(p);
   ++c.evaluations;
-  const SlsqpContext& m = c.manifold;
   c.theta = Eigen::Map<const Eigen::VectorXd>(x, n);
   c.g.resize(n);
-  const double M = integrated_effective_mass_gradient(*m.model, *m.data, *m.base, c.theta, m.pb->frame,
-                                                      m.setup->u_cap, m.setup->target_inv_mass, c.g);
+  const double M =
+      CaptureEvaluator(*c.rate.pb, *c.rate.setup).mass_gradient(*c.rate.data, *c.rate.base, c.theta, c.g);
   if (grad) Eigen::Map<Eigen::VectorXd>(grad, n) = c.g;
   return M;
 }
 
-/// One SLSQP run from q: minimizes the rate (eps <= 0) or M_ie under rate <= eps, on C(base) within
-/// the limits; the result projected on C again. Returns the point, or nothing when unusable or
-/// (for a level) infeasible beyond 1e-6 relative.
+/// One local optimum from q (local_manifold_optimum, the routine the global search uses): the rate
+/// (eps <= 0) or M_ie under rate <= eps minimized on C(base) within the limits. Returns the point, or
+/// nothing when unusable or (for a level) infeasible beyond 1e-6 relative.
 inline std::optional<ParetoPoint> pareto_local(ParetoContext& ctx, const CaptureTask& task,
-                                               const ParetoOptions& o, Eigen::VectorXd q, double eps,
+                                               const ParetoOptions& o, const Eigen::VectorXd& q, double eps,
                                                double rate_scale) {
-  const Model& model = *ctx.manifold.model;
-  const CaptureSetup& s = *ctx.manifold.setup;
-  const BasePose& base = *ctx.manifold.base;
-  const int n = model.n();
-  if (!project_to_manifold(model, *ctx.manifold.data, *ctx.manifold.pb, task, s, base, q,
-                           o.constraint_tolerance) ||
-      !within_limits(model, q))
-    return std::nullopt;
-  nlopt::opt local(nlopt::LD_SLSQP, static_cast<unsigned>(n));
-  ManifoldSearchOptions so;
-  so.constraint_tolerance = o.constraint_tolerance;
-  so.max_local_evaluations = o.max_local_evaluations;
-  configure_slsqp(local, model, task.rows(), ctx.manifold, so);  // sets M_ie as the objective
+  const BaseRateContext& r = ctx.rate;
+  ManifoldSlsqp slsqp(*r.pb, task, *r.setup, *r.base, o.constraint_tolerance, o.max_local_evaluations);
   if (eps > 0) {
-    ctx.scale = eps;
-    local.set_min_objective(pareto_mass, &ctx);
-    local.add_inequality_constraint(pareto_rate_constraint, &ctx, 1e-9);
+    ctx.rate.scale = eps;
+    slsqp.minimize(pareto_mass, &ctx);
+    slsqp.add_inequality(base_rate_constraint, &ctx.rate, 1e-9);
   } else {
-    ctx.scale = rate_scale;
-    local.set_min_objective(pareto_rate2, &ctx);
+    ctx.rate.scale = rate_scale;
+    slsqp.minimize(base_rate2, &ctx.rate);
   }
-  std::vector<double> x(q.data(), q.data() + n);
-  double f = 0;
-  try {
-    local.optimize(x, f);
-  } catch (const nlopt::roundoff_limited&) {
-  } catch (const std::runtime_error&) {
-    x.assign(q.data(), q.data() + n);
-  }
-  Eigen::VectorXd th = Eigen::Map<const Eigen::VectorXd>(x.data(), n);
-  if (!project_to_manifold(model, *ctx.manifold.data, *ctx.manifold.pb, task, s, base, th,
-                           o.constraint_tolerance, 20) ||
-      !within_limits(model, th))
-    return std::nullopt;
-  ParetoPoint p = pareto_point(model, *ctx.manifold.data, *ctx.manifold.pb, s, base, th, ctx.restitution);
+  const std::optional<Eigen::VectorXd> th = local_manifold_optimum(slsqp, q, false);
+  if (!th) return std::nullopt;
+  ParetoPoint p = pareto_point(*r.pb->model, *r.data, *r.pb, *r.setup, *r.base, *th, r.restitution);
   if (!std::isfinite(p.M_ie) || !std::isfinite(p.base_rate)) return std::nullopt;
   if (eps > 0 && p.base_rate > eps * (1 + 1e-6)) return std::nullopt;
   return p;
@@ -226,17 +180,16 @@ inline ParetoFront pareto_front(const CaptureProblem& pb, const CaptureTask& tas
   f.evaluations = mass.evaluations;
   Data data(model);
   detail::ParetoContext ctx{};
-  ctx.manifold.model = &model;
-  ctx.manifold.data = &data;
-  ctx.manifold.pb = &pb;
-  ctx.manifold.task = &task;
-  ctx.manifold.setup = &s;
-  ctx.manifold.base = &base;
-  ctx.restitution = single_body_restitution(s.law);
+  ctx.rate.pb = &pb;
+  ctx.rate.setup = &s;
+  ctx.rate.base = &base;
+  ctx.rate.data = &data;
+  ctx.rate.restitution = single_body_restitution(s.law);
+  const double e = ctx.rate.restitution;
   std::vector<ParetoPoint> all;
   for (const ManifoldPoint& m : mass.local_optima)
-    all.push_back(detail::pareto_point(model, data, pb, s, base, m.theta, ctx.restitution));
-  f.min_mass = detail::pareto_point(model, data, pb, s, base, mass.best.theta, ctx.restitution);
+    all.push_back(detail::pareto_point(model, data, pb, s, base, m.theta, e));
+  f.min_mass = detail::pareto_point(model, data, pb, s, base, mass.best.theta, e);
   // the rate end: from the random starts and the M_ie local optima
   std::vector<Eigen::VectorXd> starts = detail::manifold_starts(model, o.seed, extra_starts, o.starts);
   for (const ManifoldPoint& m : mass.local_optima) starts.push_back(m.theta);
@@ -268,46 +221,9 @@ inline ParetoFront pareto_front(const CaptureProblem& pb, const CaptureTask& tas
   f.min_mass = f.points.front();
   f.min_rate = f.points.back();
   detail::pareto_measures(f);
-  f.evaluations += ctx.evaluations + ctx.manifold.evaluations;
+  f.evaluations += ctx.evaluations + ctx.rate.evaluations;
   f.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return f;
-}
-
-/// The base-rate constraint of a capture search: ((|Delta w_0| / max_rate)^2 - 1 <= 0 at the search's
-/// base pose, with the restitution of the law; gradient by central differences as in the sweep), the
-/// epsilon-constraint of the front as a ManifoldInequalities for search_capture_manifold and
-/// plan_capture_global: their least M_ie under it is the front's point at eps = max_rate, and the
-/// reaching planner plans to it as to the unconstrained optimum. max_rate in rad/s, > 0.
-inline std::shared_ptr<const ManifoldInequalities> base_rate_inequality(const CaptureProblem& pb,
-                                                                        const CaptureSetup& s,
-                                                                        double max_rate) {
-  if (!pb.model) throw InputError("base_rate_inequality: no model");
-  if (!(max_rate > 0) || !std::isfinite(max_rate))
-    throw InputError(detail::str("base_rate_inequality: the largest base rate must be positive and finite, got ",
-                                 max_rate));
-  auto q = std::make_shared<ManifoldInequalities>();
-  q->count = 1;
-  q->tolerance = 1e-6;        // relative: (rate / max)^2 - 1
-  q->reach_tolerance = 0.0201;  // a reached configuration: rate <= 1.01 max
-  // the sweep's constraint function on a context of its own (the searches call it one at a time)
-  struct Context {
-    CaptureProblem pb;
-    CaptureSetup s;
-    Data data;
-    detail::ParetoContext ctx{};
-  };
-  auto c = std::make_shared<Context>(Context{pb, s, Data(*pb.model), {}});
-  c->ctx.manifold.model = c->pb.model;
-  c->ctx.manifold.data = &c->data;
-  c->ctx.manifold.pb = &c->pb;
-  c->ctx.manifold.setup = &c->s;
-  c->ctx.restitution = single_body_restitution(s.law);
-  c->ctx.scale = max_rate;
-  q->eval = [c](const BasePose& base, const Eigen::VectorXd& theta, double* g, double* grad) {
-    c->ctx.manifold.base = &base;
-    g[0] = detail::pareto_rate_constraint(static_cast<unsigned>(theta.size()), theta.data(), grad, &c->ctx);
-  };
-  return q;
 }
 
 }  // namespace ffsr

@@ -27,6 +27,7 @@
 // inverse_inertia_form_gradient) whatever the number of samples.
 #pragma once
 
+#include "ffsr/algorithm/joint_models.hpp"
 #include "ffsr/uncertainty/sampling.hpp"
 
 #include <algorithm>
@@ -83,15 +84,23 @@ class RobustForceObjective {
     return v;
   }
 
-  /// CVaR_95 at (base, theta) and its gradient in theta (size n). Runs crba; writes data.
+  /// CVaR_95 at (base, theta) and its gradient in theta (size n), free joints. Runs crba; writes data.
   double value_and_gradient(const Model& model, Data& data, const BasePose& base,
                             const Eigen::Ref<const Eigen::VectorXd>& theta, int frame,
                             Eigen::Ref<Eigen::VectorXd> grad) {
+    return value_and_gradient(model, data, base, theta, frame, ContactJoints{}, grad);
+  }
+
+  /// The same under the joint model of the contact: Lambda^-1 and its form gradients of that model
+  /// (inverse_inertia_matrix and inverse_inertia_form_gradient of joint_models.hpp).
+  double value_and_gradient(const Model& model, Data& data, const BasePose& base,
+                            const Eigen::Ref<const Eigen::VectorXd>& theta, int frame,
+                            const ContactJoints& joints, Eigen::Ref<Eigen::VectorXd> grad) {
     const int n = model.n();
     detail::require_size(grad.size(), n, "RobustForceObjective", "grad");
     g_.resize(n);
     crba(model, data, base, theta);
-    forces(inverse_inertia_matrix(model, data, frame));
+    forces(inverse_inertia_matrix(model, data, frame, joints));
     select_tail();
     double cvar = 0;
     Matrix6 W = Matrix6::Zero();
@@ -109,8 +118,9 @@ class RobustForceObjective {
     for (int k = 0; k < 6; ++k) {
       const double l = es.eigenvalues()(k);
       if (!(std::abs(l) > 1e-15 * scale)) continue;  // rank-deficient W (no contact-point: rank <= 3)
-      // data.L is the factor of H from inverse_inertia_matrix above: not factorized again
-      detail::inverse_inertia_form_gradient_factored(model, data, frame, es.eigenvectors().col(k), g_);
+      // data.L is the factor from inverse_inertia_matrix above: not factorized again
+      detail::inverse_inertia_form_gradient_prepared(model, data, frame, es.eigenvectors().col(k), joints,
+                                                     g_);
       grad += l * g_;
     }
     return cvar;

@@ -106,11 +106,19 @@ nlohmann::json result_json(const Scenario& sc, const Plan& p, const ClosedLoopOp
                     {"spin_deg_per_s", rad2deg(o.noise.angular_velocity)}}},
                   {"noise_seed", o.seed}};
   j["options"]["prediction_window"] = copt.prediction_window;
+  auto quaternion = [](const BasePose& b) {  // w, x, y, z, as the main job writes it
+    const Eigen::Vector4d q = b.orientation.coeffs();
+    return nlohmann::json{q(3), q(0), q(1), q(2)};
+  };
   j["open_loop"] = {{"capture_configuration_deg", to_json(Eigen::VectorXd(p.open.theta * 180 / M_PI))},
+                    {"base_position", to_json(Eigen::VectorXd(p.open.base.position))},
+                    {"base_quaternion_wxyz", quaternion(p.open.base)},
                     {"capture_error", p.open.capture_distance},
                     {"integrated_effective_mass", p.open.M_ie},
                     {"f_max_closed_form", p.open.f_max_closed_form}};
   j["closed_loop"] = {{"capture_configuration_deg", to_json(Eigen::VectorXd(r.theta * 180 / M_PI))},
+                      {"base_position", to_json(Eigen::VectorXd(r.base.position))},
+                      {"base_quaternion_wxyz", quaternion(r.base)},
                       {"capture_error", r.capture_error},
                       {"integrated_effective_mass", r.M_ie},
                       {"f_max_closed_form", r.f_max_closed_form},
@@ -185,8 +193,8 @@ plot::Figure closed_loop_figure(const Scenario& sc, const Plan& p, const ClosedL
   f.open_loop = &p.open;
   const std::string plan = p.name == "paper" || p.name == "global" ? p.name : "servo";  // fits the title
   f.title = str("Closed loop, ", plan, " plan, control ", o.control_rate, " Hz: capture error ",
-                std::setprecision(3), r.capture_error * 1e3, " mm, M#die#u ", r.M_ie, " kg (plan ", p.open.M_ie,
-                ")");
+                std::setprecision(3), r.capture_error * 1e3, " mm, M#die#u ", r.M_ie, " kg (plan ",
+                p.open.M_ie, ")");
   return figures::closed_loop(f);
 }
 

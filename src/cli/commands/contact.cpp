@@ -9,6 +9,7 @@
 #include "ffsr/jobs/scenario_run.hpp"
 
 #include "ffsr/algorithm/base_disturbance.hpp"
+#include "ffsr/optimize/objective.hpp"
 #include "ffsr/simulate/multibody.hpp"
 
 #include <iomanip>
@@ -39,10 +40,10 @@ struct Row {
   std::vector<Prediction> predictions;  ///< --contact-joints all: free, locked, armature
 };
 
-/// The closed-form predictions under each joint model asked for (the chosen one, or all three).
-std::vector<Row::Prediction> joint_predictions(const Subject& s, const AnyContactLaw& law, double M_free) {
+/// The closed-form predictions under each joint model asked for (the chosen one, or all three): the
+/// capture objective's M_ie and peaks (CaptureEvaluator).
+std::vector<Row::Prediction> joint_predictions(const Subject& s, const AnyContactLaw& law) {
   const Robot& r = s.robot;
-  const Target& target = s.target;
   ContactJoints joints = s.contact_joints();
   std::vector<JointModel> models{joints.model};
   if (s.all_joint_models()) models = {JointModel::Free, JointModel::Locked, JointModel::Armature};
@@ -50,10 +51,9 @@ std::vector<Row::Prediction> joint_predictions(const Subject& s, const AnyContac
   Data data(r.model);
   for (JointModel m : models) {
     joints.model = m;
-    const double M = m == JointModel::Free ? M_free  // the multibody run's, the same computation
-                                           : integrated_effective_mass(r.model, data, r.base, r.theta,
-                                                                       r.end_effector, target, joints);
-    out.push_back({m, M, max_force_closed_form(law, M), max_force_exact(law, M)});
+    const CaptureEvaluator objective(r.model, r.end_effector, s.target, &law, joints);
+    const double M = objective.mass(data, r.base, r.theta);
+    out.push_back({m, M, objective.f_max_closed_form(M), objective.f_max_exact(M)});
   }
   return out;
 }
@@ -70,8 +70,10 @@ Row evaluate(const Subject& s, const ContactOptions& o, const std::string& law_n
   MultibodyContactResult mb =
       simulate_contact(r.model, r.base, r.theta, r.end_effector, target, s.approach_speed, p, law_name, mo);
   const AnyContactLaw law = make_contact_law(law_name, p, mb.approach_velocity);
-  auto predictions = joint_predictions(s, law, mb.integrated_effective_mass);
+  auto predictions = joint_predictions(s, law);
   const double M_ie = predictions.front().M_ie;  // the chosen model's (free for all)
+  ContactJoints joints = s.contact_joints();
+  joints.model = predictions.front().joints;
   Row row{law_name,
           M_ie,
           mb.approach_velocity,
@@ -95,7 +97,8 @@ Row evaluate(const Subject& s, const ContactOptions& o, const std::string& law_n
   row.mb_delta_at_f_max = mb.delta_at_f_max;
   row.base_jump_multibody = mb.base_velocity_end - mb.base_velocity_start;
   Data data(r.model);  // the target's position does not enter (only its attitude, inertia and offset)
-  row.base_jump = base_disturbance(r.model, data, r.base, r.theta, r.end_effector, target, law);
+  row.base_jump =
+      CaptureEvaluator(r.model, r.end_effector, target, &law, joints).disturbance(data, r.base, r.theta);
   return row;
 }
 

@@ -9,6 +9,7 @@
 #include "ffsr/jobs/scenario_run.hpp"
 
 #include "ffsr/algorithm/base_disturbance.hpp"
+#include "ffsr/optimize/objective.hpp"
 
 #include <iomanip>
 #include <iostream>
@@ -24,23 +25,19 @@ struct InspectOptions {
   OutputKeys out;  ///< --json, --quiet
 };
 
-/// The impact disturbance of the base at the configuration (single-body impulse), or nothing when the
-/// end-effector moving at the approach speed along u does not approach the target's contact point.
-std::optional<BaseDisturbance> inspect_disturbance(const Subject& s) {
-  const Robot& r = s.robot;
+/// The contact law at the approach velocity of the configuration, or nothing when the end-effector
+/// moving at the approach speed along u does not approach the target's contact point.
+std::optional<AnyContactLaw> inspect_law(const Subject& s) {
   const Target& target = s.target;
   const Vector3 u = target.normal_world();
   const double vin = approach_velocity(u, Vector3(s.approach_speed * u), target.velocity,
                                        target.angular_velocity_world(), target.offset_world());
   if (!(vin > 0)) return std::nullopt;
-  AnyContactLaw law = make_contact_law("hunt-crossley", s.params, vin);
   try {
-    law = make_contact_law(s.law, s.params, vin);
+    return make_contact_law(s.law, s.params, vin);
   } catch (const InputError& e) {
     throw InputError(std::string("--model: ") + e.what());
   }
-  Data data(r.model);
-  return base_disturbance(r.model, data, r.base, r.theta, r.end_effector, target, law);
 }
 
 nlohmann::json disturbance_json(const std::optional<BaseDisturbance>& d) {
@@ -100,6 +97,7 @@ void print_load_report(std::ostream& out, const UrdfReport& rep) {
 
 /// What inspect evaluates at the subject's configuration.
 struct Evaluation {
+  ContactJoints joints;  ///< the joint model of M_ie, m_e and the base's jump
   double M_ie = 0, m_e = 0;
   Vector3 u;
   Eigen::MatrixXd Jf;
@@ -111,15 +109,22 @@ struct Evaluation {
 };
 
 Evaluation evaluate(const Subject& s) {
+  if (s.all_joint_models())
+    throw InputError(
+        "--contact-joints: inspect evaluates one joint model; 'all' is for the contact subcommand");
   const Robot& r = s.robot;
   Evaluation e(r.model);
+  e.joints = s.contact_joints();
   e.u = s.target.normal_world();
-  e.M_ie = integrated_effective_mass(r.model, e.data, r.base, r.theta, r.end_effector, s.target);
-  e.m_e = 1.0 / inverse_effective_mass(r.model, e.data, r.end_effector, e.u);
+  const std::optional<AnyContactLaw> law = inspect_law(s);
+  // M_ie and the base's jump (single-body impulse) of the joint model: the capture objective's
+  const CaptureEvaluator objective(r.model, r.end_effector, s.target, law ? &*law : nullptr, e.joints);
+  if (law) e.dist = objective.disturbance(e.data, r.base, r.theta);
+  e.M_ie = objective.mass(e.data, r.base, r.theta);
+  e.m_e = 1.0 / inverse_effective_mass(r.model, e.data, r.end_effector, e.u, e.joints);
   frame_jacobian(r.model, e.data, r.end_effector);
   e.Jf = generalized_jacobian(r.model, e.data);
   e.ee = frame_pose(r.model, e.data, r.end_effector);
-  e.dist = inspect_disturbance(s);
   e.clearance = inspect_clearance(s);
   return e;
 }
@@ -139,6 +144,8 @@ nlohmann::json inspect_json(const Subject& s, const Evaluation& e) {
   j["J_bm"] = to_json(e.data.J);
   j["J_f"] = to_json(e.Jf);
   j["total_mass"] = r.model.total_mass();
+  j["contact_joints"] = joint_model_name(e.joints.model);
+  if (e.joints.model == JointModel::Armature) j["armature"] = to_json(e.joints.armature);
   j["effective_mass"] = e.m_e;
   j["integrated_effective_mass"] = e.M_ie;
   j["base_disturbance"] = disturbance_json(e.dist);
@@ -163,6 +170,8 @@ void print_inspect(std::ostream& out, const Subject& s, const Evaluation& e) {
         << (i + 1 < names.size() ? ", " : " deg\n");
   print_load_report(out, r.report);
   out << "direction u      [" << e.u.transpose().format(Eigen::IOFormat(6, 0, ", ")) << "]\n";
+  if (e.joints.model != JointModel::Free)
+    out << "contact joints   " << joint_model_name(e.joints.model) << " (M_ie, m_e and the base jump)\n";
   out << "effective mass   m_e  = " << e.m_e << " kg   (Eq. 4)\n";
   out << "integrated mass  M_ie = " << e.M_ie << " kg   (Eq. 14)\n";
   if (e.dist)
@@ -198,6 +207,7 @@ void register_inspect(CLI::App& app, Action& action) {
   // where the target is and the shapes: the distances between them (the clearance constrains plans only)
   std::set<std::string> also = scenario_key_names({KeyGroup::TargetPlace, KeyGroup::Shapes});
   also.erase("clearance");
+  also.insert({"contact-joints", "armature"});  // the joint model of M_ie, m_e and the base's jump
   // the base's jump at the impact depends on the law's damping (model, restitution), not on K or alpha
   opts->subject.add_to(*sub, also, {"stiffness", "exponent"});
   add_output_flags(*sub, opts->out, {"Write the evaluation (H, J_f, m_e, M_ie, ...) as JSON to FILE"});

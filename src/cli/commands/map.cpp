@@ -33,6 +33,7 @@
 #include "ffsr/jobs/scenario_run.hpp"
 
 #include "ffsr/detail/parallel.hpp"
+#include "ffsr/optimize/objective.hpp"
 
 #include <charconv>
 #include <cstdint>
@@ -134,12 +135,8 @@ inline char* put(char* p, char* end, double x, char sep) {
 struct Worker {
   const Model& model;
   const Grid& grid;
-  const AnyContactLaw& law;
+  const CaptureEvaluator& objective;  ///< M_ie of the joint model (free: the fast path) and F_max
   const BasePose base;
-  const int frame;
-  const Vector3 u;
-  const double target_inverse_mass;
-  ContactJoints joints;  ///< the joint model of M_ie (free: the fast path)
   Data data;
   Eigen::VectorXd theta;
   std::vector<char> text;
@@ -150,25 +147,15 @@ struct Worker {
   double max_M = -1, min_M = std::numeric_limits<double>::infinity();
   std::uint64_t argmax = 0, argmin = 0;
 
-  Worker(const Model& m, const Grid& g, const AnyContactLaw& l, const Robot& r, const Vector3& u_, double tim,
-         size_t block)
+  Worker(const Model& m, const Grid& g, const CaptureEvaluator& f, const Robot& r, size_t block)
       : model(m),
         grid(g),
-        law(l),
+        objective(f),
         base(r.base),
-        frame(r.end_effector),
-        u(u_),
-        target_inverse_mass(tim),
         data(m),
         theta(r.theta),
         text((g.axes.size() + 2) * 32 * block + 1),
         angles(g.axes.size()) {}
-
-  /// M_ie (Eq. 14) at theta under the joint model. Runs crba.
-  double joint_model_M() {
-    crba(model, data, base, theta);
-    return 1.0 / (inverse_effective_mass(model, data, frame, u, joints) + target_inverse_mass);
-  }
 
   /// Evaluates points [first, last) and formats their rows into `text`; returns the byte count.
   size_t run(std::uint64_t first, std::uint64_t last) {
@@ -183,11 +170,8 @@ struct Worker {
         rest /= ax.count;
         theta(ax.joint) = angles[a] * (M_PI / 180.0);  // as load_robot converts --joints-deg
       }
-      const double M = joints.model == JointModel::Free
-                           ? integrated_effective_mass_fast(model, data, base, theta, frame, u,
-                                                            target_inverse_mass)  // Eq. 14
-                           : joint_model_M();
-      const double F = max_force_closed_form(law, M);  // Eq. 24
+      const double M = objective.mass_fast(data, base, theta);  // Eq. 14
+      const double F = objective.f_max_closed_form(M);          // Eq. 24
       if (values) values[idx - first_point] = M;
       if (M > max_M) max_M = M, argmax = idx;
       if (M < min_M) min_M = M, argmin = idx;
@@ -428,11 +412,9 @@ int run_map(const MapOptions& o) {
   GridRun g;
   g.threads = o.threads ? o.threads : std::max(1U, std::thread::hardware_concurrency());
   g.threads = static_cast<unsigned>(std::max<std::uint64_t>(1, std::min<std::uint64_t>(g.threads, blocks)));
-  const Vector3 u = target.normal_world();
-  const double target_inverse_mass = target.inverse_mass_along_normal();
+  const CaptureEvaluator objective(r.model, r.end_effector, target, &law, joints);
   for (unsigned t = 0; t < g.threads; ++t) {
-    g.workers.push_back(std::make_unique<Worker>(r.model, grid, law, r, u, target_inverse_mass, kBlock));
-    g.workers.back()->joints = joints;
+    g.workers.push_back(std::make_unique<Worker>(r.model, grid, objective, r, kBlock));
     g.workers.back()->values = plotting ? values.data() : nullptr;
     g.workers.back()->first_point = first;
   }

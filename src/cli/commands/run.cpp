@@ -118,34 +118,6 @@ std::vector<std::pair<const char*, const CaptureResult*>> reported_runs(const Sc
   return runs;
 }
 
-/// The number of the global run's first samples that belong to its reconfiguration (0: none).
-long reconfiguration_samples(const ScenarioResult& r) {
-  if (!r.global || !r.global->result.reconfigured) return 0;
-  return r.global->result.phases.front().samples;
-}
-
-/// The time series of every run, one row per sample; `phase`: reconfiguration or approach.
-std::string series_csv(const Scenario& sc, const ScenarioResult& r) {
-  std::ostringstream c;
-  c << std::setprecision(12) << "run,t";
-  for (const auto& name : sc.model->joint_names()) c << "," << name << "_deg";
-  c << ",base_x,base_y,base_z,base_qw,base_qx,base_qy,base_qz,ee_x,ee_y,ee_z,M_ie,F_max_estimate,phase\n";
-  for (auto [label, run] : reported_runs(r)) {
-    if (run == &r.plain) label = "baseline";  // the CSV's name of the plain run
-    const long reconfiguring = r.global && run == &r.global->result.run ? reconfiguration_samples(r) : 0;
-    for (const CaptureSample& s : run->series) {
-      c << label << "," << s.t;
-      for (Eigen::Index i = 0; i < s.theta.size(); ++i) c << "," << s.theta(i) * 180.0 / M_PI;
-      const auto& q = s.base.orientation;
-      c << "," << s.base.position.x() << "," << s.base.position.y() << "," << s.base.position.z() << ","
-        << q.w() << "," << q.x() << "," << q.y() << "," << q.z() << "," << s.end_effector.x() << ","
-        << s.end_effector.y() << "," << s.end_effector.z() << "," << s.M_ie << "," << s.f_max_estimate << ","
-        << (&s - run->series.data() < reconfiguring ? "reconfiguration" : "approach") << "\n";
-    }
-  }
-  return c.str();
-}
-
 /// The scenario's collision shapes for the pictures; none without geometry.
 std::optional<figures::SceneShapes> scene_shapes(const Scenario& sc) {
 #ifdef FFSR_HAVE_GEOMETRY
@@ -174,7 +146,7 @@ void write_outputs(const Scenario& sc, const ScenarioResult& r, const RunSetting
                  o.plot, q.plot_format);
   }
   q.outputs.set("--json", j.dump(2) + "\n");
-  q.outputs.set("--csv", o.csv.empty() ? std::string() : series_csv(sc, r));
+  q.outputs.set("--csv", o.csv.empty() ? std::string() : scenario_series_csv(sc, r));
   q.outputs.write();
 }
 

@@ -5,8 +5,8 @@ namespace ffsr {
 
 namespace detail {
 
-/// The state at T: capture error against the true target, M_ie and F_max at the reached
-/// configuration, base changes. Runs crba. Writes the result's final fields.
+/// The state at T: capture error against the true target, M_ie (the problem's joint model) and F_max
+/// at the reached configuration, base changes. Runs crba. Writes the result's final fields.
 template <class Policy>
 void finish_closed_loop(const CaptureController<Policy>& ctrl, ClosedLoopPlant& p, const Eigen::VectorXd& y,
                         ClosedLoopResult& res) {
@@ -18,9 +18,9 @@ void finish_closed_loop(const CaptureController<Policy>& ctrl, ClosedLoopPlant& 
   res.end_effector = frame_pose(p.model, p.data, pb.frame).p;
   res.capture_point = truth.contact_point();
   res.capture_error = (res.end_effector - res.capture_point).norm();
-  res.M_ie = 1.0 / (inverse_effective_mass(p.model, p.data, pb.frame, truth.normal_world()) +
-                    truth.inverse_mass_along_normal());
-  res.f_max_closed_form = max_force_closed_form(ctrl.setup().law, res.M_ie);
+  const CaptureEvaluator objective(p.model, pb.frame, truth, &ctrl.setup().law, pb.joints);
+  res.M_ie = objective.mass_at(p.data);
+  res.f_max_closed_form = objective.f_max_closed_form(res.M_ie);
   res.base_attitude_change = rotation_angle(res.base.orientation.toRotationMatrix() *
                                             p.base0.orientation.toRotationMatrix().transpose());
   res.base_position_change = y.segment<3>(0).norm();

@@ -8,11 +8,13 @@ namespace ffsr {
 namespace detail {
 
 /// The impact disturbance of a run's capture configuration: the target at T (its attitude gives
-/// the normal), the scenario's law at the run's delta_dot^-. Runs crba. Writes data.
+/// the normal), the scenario's law at the run's delta_dot^-, the scenario's joint model of the
+/// contact. Runs crba. Writes data.
 inline BaseDisturbance run_base_disturbance(const Scenario& sc, Data& data, const CaptureResult& run) {
   const Target at_capture = propagate_target(sc.problem.target, sc.capture.duration);
   const AnyContactLaw law = make_contact_law(sc.problem.law, sc.problem.contact, run.approach_velocity);
-  return base_disturbance(*sc.model, data, run.base, run.theta, sc.problem.frame, at_capture, law);
+  return CaptureEvaluator(*sc.model, sc.problem.frame, at_capture, &law, sc.problem.joints)
+      .disturbance(data, run.base, run.theta);
 }
 
 inline nlohmann::json base_disturbance_json(const BaseDisturbance& d) {

@@ -183,6 +183,8 @@ inline void add_clearance_json(nlohmann::json& j, const ScenarioResult& r) {
 namespace detail {
 /// Defined in base_disturbance_json.hxx (the impact disturbance of each run).
 inline void add_base_disturbance_json(nlohmann::json& j, const Scenario& sc, const ScenarioResult& r);
+/// Defined in scenario_series.hxx (the bodies, shapes, capture instant and normal).
+inline nlohmann::json scene_json(const Scenario& sc);
 }  // namespace detail
 
 inline nlohmann::json scenario_json(const Scenario& sc, const ScenarioResult& r, const std::string& version) {
@@ -202,6 +204,7 @@ inline nlohmann::json scenario_json(const Scenario& sc, const ScenarioResult& r,
   if (r.global) detail::add_global_json(j, sc, *r.global, plain);
   detail::add_base_disturbance_json(j, sc, r);
   if (sc.geometry) detail::add_clearance_json(j, r);
+  j["scene"] = detail::scene_json(sc);
   if (r.robust) {
     nlohmann::json rj = {
         {"measure", "CVaR_95 (mean of the largest 5 %) and p95 (nearest rank) of the exact F_max, N"},

@@ -46,6 +46,10 @@ inline RobustRun run_robust(const Scenario& sc, const UncertaintySpec& spec,
   if (options.shard_n < 1 || options.shard_k >= options.shard_n)
     throw InputError(str("run_robust: shard ", options.shard_k, " of ", options.shard_n, " does not exist"));
   if (options.threads < 1) throw InputError(str("run_robust: threads must be >= 1, got ", options.threads));
+  if (options.force_model == ForceModel::Multibody && sc.problem.joints.model != JointModel::Free)
+    throw InputError(
+        str("--contact-joints: the multibody force model simulates the joints free (servoed by "
+            "joint-stiffness and joint-damping); use it with --force-model exact or closed"));
   RobustRun run;
   run.spec = spec;
   run.options = options;
@@ -89,7 +93,9 @@ inline RobustRun run_robust(const Scenario& sc, const UncertaintySpec& spec,
       e.nominal = force(nominal_sample);
       each([&](std::uint64_t i) { e.forces[i] = force(run.samples[i]); });
     } else {
-      const Matrix6 G = robot_inverse_inertia(model, data, k.base, k.theta, pb.frame);
+      // Lambda^-1 of the scenario's joint model (the capture objective's); each sample its own target and law
+      const Matrix6 G = CaptureEvaluator(model, pb.frame, run.nominal.target, nullptr, pb.joints)
+                            .inverse_inertia(data, k.base, k.theta);
       e.nominal = sample_force(G, nominal_sample, pb.law, options.force_model);
       each([&](std::uint64_t i) { e.forces[i] = sample_force(G, run.samples[i], pb.law, options.force_model); });
     }

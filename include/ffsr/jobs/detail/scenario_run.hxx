@@ -109,7 +109,7 @@ inline GlobalRun run_global(const Scenario& sc, const CaptureResult* paper_run, 
   }
   const CaptureSetup setup = prepare_capture(sc.problem, sc.task, opt);
   r.paper_objective = paper_run ? evaluate_capture(sc.problem, setup, paper_run->base, paper_run->theta,
-                                                   objective, {}, robust.get())
+                                                   objective, g.search.multibody, robust.get())
                                       .objective
                                 : std::numeric_limits<double>::quiet_NaN();
   r.branches = capture_branches(sc.problem, sc.task, opt, setup, r.result.search, r.result.run.base, 6,
@@ -144,6 +144,27 @@ inline UncertaintySpec robust_force_spec(const Scenario& sc) {
 
 }  // namespace detail
 
+namespace detail {
+
+/// The robust-force measure (CVaR_95 and p95 of the exact F_max over the sample set, the scenario's
+/// joint model: the capture objective's) of each run that holds a configuration, into r.robust_rows.
+inline void add_robust_rows(const Scenario& sc, ScenarioResult& r) {
+  Data data(*sc.model);
+  const CaptureSetup setup = prepare_capture(sc.problem, sc.task, sc.capture);
+  const CaptureEvaluator objective(sc.problem, setup, GlobalObjective::RobustForce, nullptr, r.robust.get());
+  const std::pair<const char*, const CaptureResult*> rows[] = {
+      {"baseline", r.plain_ok() ? &r.plain : nullptr},
+      {"optimized", r.optimized_ok() ? &r.optimized : nullptr},
+      {"global", &r.global->result.run}};
+  for (const auto& [name, run] : rows) {
+    if (!run) continue;
+    const auto v = objective.robust_value(data, run->base, run->theta);
+    r.robust_rows.push_back({name, v.cvar95, v.p95});
+  }
+}
+
+}  // namespace detail
+
 inline ScenarioResult run_scenario(const Scenario& sc, const ScenarioRunOptions& options) {
   ScenarioResult r;
   if (!options.keep_going || !sc.keys.global) {
@@ -173,20 +194,7 @@ inline ScenarioResult run_scenario(const Scenario& sc, const ScenarioRunOptions&
                                      "; the global run failed too: ", e.what()));
   }
   if (sc.geometry) r.clearances.emplace_back("global", run_clearance(sc, r.global->result.run));
-  if (r.robust) {
-    const Model& model = *sc.model;
-    Data data(model);
-    const std::pair<const char*, const CaptureResult*> rows[] = {
-        {"baseline", r.plain_ok() ? &r.plain : nullptr},
-        {"optimized", r.optimized_ok() ? &r.optimized : nullptr},
-        {"global", &r.global->result.run}};
-    for (const auto& [name, run] : rows) {
-      if (!run) continue;
-      const auto v =
-          r.robust->value(robot_inverse_inertia(model, data, run->base, run->theta, sc.problem.frame));
-      r.robust_rows.push_back({name, v.cvar95, v.p95});
-    }
-  }
+  if (r.robust) detail::add_robust_rows(sc, r);
   return r;
 }
 

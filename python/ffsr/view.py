@@ -1,0 +1,440 @@
+"""The 3-D view of a capture: one self-contained HTML file that animates a run of the main job.
+
+The page shows the bus, the links (their collision shapes where the scenario has shapes, else
+segments between the joint origins with a marker at each joint), the target's shape tumbling (the
+scenario's ``target-shape``, else a schematic cube of half side max(0.1 m, largest component of
+r_tp), as in the command's figures), the end-effector's path (the approach in the run's colour, a
+reconfiguration in orange), the contact point and normal on the target, the capture point, and a
+time slider with play and pause. Every run of the result (plain, paper's method, global) can be
+chosen; the page opens on the global run at the capture instant.
+
+Forward kinematics is not redone here: the command's series holds the pose of every body at every
+sample (``body<i>_*`` columns), the target's pose (``target_*``) and the phase, and its JSON result
+holds the bodies' tree and shapes (``scene``). three.js is vendored in ``view_assets/three`` (npm
+``three`` 0.170.0, MIT) and written into the page: the file opens offline, from disk, with no
+server and nothing fetched.
+
+From the command's outputs::
+
+    ffsr-optimize --config robots/paper_3dof.toml --json result.json --csv series.csv
+    python -m ffsr.view result.json --csv series.csv -o capture.html
+
+From Python: ``ffsr.view.capture(result, "capture.html", series)`` where ``result`` is the job's
+result (an object with ``to_dict()``, or the dict of the command's ``--json``) and ``series`` the
+time series (a path to the ``--csv`` file, its text, or a mapping of its columns; by default
+``result.series``). Bad input raises :class:`ViewInputError` naming the file (or argument); nothing
+is written then. This module needs the Python standard library only.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import html
+import io
+import json
+import math
+import os
+import sys
+import tempfile
+from pathlib import Path
+from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
+
+__all__ = ["ViewInputError", "capture", "page", "page_data", "main"]
+
+ASSETS = Path(__file__).resolve().parent / "view_assets"
+RUNS = ("baseline", "optimized", "global")  # the result's keys and the series' run labels
+RUN_LABELS = {"baseline": "Without optimization", "optimized": "With optimization", "global": "Global"}
+POSE = ("x", "y", "z", "qw", "qx", "qy", "qz")
+DEFAULT_FRAMES = 400
+
+
+class ViewInputError(ValueError):
+    """A result or a series the view cannot show; the message names the file or argument."""
+
+
+# --- reading ------------------------------------------------------------------------------------------
+
+
+def _read_text(path: Union[str, os.PathLike], what: str) -> str:
+    try:
+        with open(path, "r", encoding="utf-8") as f:
+            return f.read()
+    except FileNotFoundError:
+        raise ViewInputError(f"{os.fspath(path)}: {what} not found") from None
+    except IsADirectoryError:
+        raise ViewInputError(f"{os.fspath(path)}: {what} is a directory") from None
+    except UnicodeDecodeError:
+        raise ViewInputError(f"{os.fspath(path)}: {what} is not text (UTF-8)") from None
+    except OSError as e:
+        raise ViewInputError(f"{os.fspath(path)}: cannot read the {what}: {e.strerror}") from None
+
+
+def load_result(path: Union[str, os.PathLike]) -> Dict[str, Any]:
+    """The main job's ``--json`` file as a dict (ViewInputError naming the file otherwise)."""
+    text = _read_text(path, "result")
+    try:
+        return json.loads(text)
+    except json.JSONDecodeError as e:
+        raise ViewInputError(f"{os.fspath(path)}: not JSON ({e.msg} at line {e.lineno})") from None
+
+
+def _result_dict(result: Any) -> Dict[str, Any]:
+    if hasattr(result, "to_dict"):
+        result = result.to_dict()
+    if not isinstance(result, Mapping):
+        raise ViewInputError(f"result: expected the main job's result (to_dict()) or its JSON dict, got "
+                             f"{type(result).__name__}")
+    return dict(result)
+
+
+def _series_table(series: Any, name: str) -> Tuple[List[str], List[List[Any]]]:
+    """The series as a header and rows: from a CSV file, CSV text or a mapping of columns."""
+    if isinstance(series, (str, os.PathLike)) and not (isinstance(series, str) and "\n" in series):
+        text = _read_text(series, "series")
+    elif isinstance(series, str):
+        text = series
+    elif isinstance(series, bytes):
+        text = series.decode("utf-8")
+    elif hasattr(series, "keys") and hasattr(series, "__getitem__"):  # a mapping of columns (dict, DataFrame)
+        header = [str(k) for k in series.keys()]
+        columns = [list(series[k]) for k in series.keys()]
+        lengths = {len(c) for c in columns}
+        if len(lengths) > 1:
+            raise ViewInputError(f"{name}: the columns have different lengths ({sorted(lengths)})")
+        return header, [list(r) for r in zip(*columns)]
+    else:
+        raise ViewInputError(f"{name}: expected the CSV of the main job's --csv (a path or its text) or a "
+                             f"mapping of its columns, got {type(series).__name__}")
+    if not text.strip():
+        raise ViewInputError(f"{name}: empty, not a time series of ffsr-optimize --csv")
+    rows = list(csv.reader(io.StringIO(text)))
+    return rows[0], rows[1:]
+
+
+# --- checking the result and the series together ----------------------------------------------------
+
+
+def _runs_of(result: Dict[str, Any], name: str) -> List[str]:
+    """The runs the result holds (without an error), checking that it is the main job's result."""
+    held = [r for r in RUNS if isinstance(result.get(r), Mapping)]
+    if not held or "scenario" not in result:
+        keys = ", ".join(sorted(result)[:6]) or "none"
+        raise ViewInputError(f"{name}: not the --json of the main job of ffsr-optimize (no baseline, optimized "
+                             f"or global run; its keys: {keys})")
+    if "scene" not in result:
+        raise ViewInputError(f"{name}: no 'scene' key: written by an ffsr-optimize older than the 3-D view "
+                             f"(version {result.get('version', '?')}); run it again")
+    runs = [r for r in held if "error" not in result[r]]
+    if not runs:
+        raise ViewInputError(f"{name}: every run of the result failed; nothing to show")
+    return runs
+
+
+def _number(text: Any, where: str) -> float:
+    try:
+        x = float(text)
+    except (TypeError, ValueError):
+        raise ViewInputError(f"{where}: '{text}' is not a number") from None
+    if not math.isfinite(x):
+        raise ViewInputError(f"{where}: {text} is not finite")
+    return x
+
+
+def _close(a: float, b: float, rtol: float = 1e-9, atol: float = 1e-7) -> bool:
+    return abs(a - b) <= atol + rtol * max(abs(a), abs(b))
+
+
+class _Series:
+    """The columns of one run of the series (numbers), and its phases."""
+
+    def __init__(self) -> None:
+        self.rows: List[List[float]] = []
+        self.phases: List[str] = []
+
+
+def _check_series(result: Dict[str, Any], runs: List[str], header: List[str], rows: List[List[Any]],
+                  result_name: str, name: str) -> Tuple[Dict[str, int], Dict[str, _Series]]:
+    scenario = result["scenario"]
+    scene = result["scene"]
+    joints = [f"{j}_deg" for j in scenario.get("joint_names", [])]
+    nb = len(scene.get("bodies", []))
+    expected = (["run", "t"] + joints + [f"base_{k}" for k in POSE] + ["ee_x", "ee_y", "ee_z", "M_ie", "F_max_estimate"]
+                + [f"target_{k}" for k in POSE] + [f"body{b}_{k}" for b in range(1, nb) for k in POSE] + ["phase"])
+    col = {h: i for i, h in enumerate(header)}
+    missing = [h for h in expected if h not in col]
+    if "run" not in col or "phase" not in col or "t" not in col:
+        raise ViewInputError(f"{name}: not a time series of ffsr-optimize --csv (no run, t or phase column)")
+    csv_joints = [h for h in header if h.endswith("_deg")]
+    if csv_joints != joints:
+        raise ViewInputError(f"{name}: its joints ({', '.join(csv_joints)}) are not those of {result_name} "
+                             f"({', '.join(joints)}): the series of another robot")
+    if missing:
+        shown = ", ".join(missing[:4]) + (", ..." if len(missing) > 4 else "")
+        raise ViewInputError(f"{name}: {len(missing)} column(s) missing ({shown}): not the series of "
+                             f"{result_name}'s run, or written by an older ffsr-optimize")
+    numeric = [i for i, h in enumerate(header) if h not in ("run", "phase")]
+    series: Dict[str, _Series] = {}
+    for line, row in enumerate(rows, start=2):
+        if not row:
+            continue
+        if len(row) != len(header):
+            raise ViewInputError(f"{name}: line {line} has {len(row)} fields, the header {len(header)}")
+        label, phase = row[col["run"]], row[col["phase"]]
+        if label not in RUNS:
+            raise ViewInputError(f"{name}: line {line}: unknown run '{label}' (baseline, optimized, global)")
+        if phase not in ("reconfiguration", "approach"):
+            raise ViewInputError(f"{name}: line {line}: unknown phase '{phase}' (reconfiguration, approach)")
+        s = series.setdefault(label, _Series())
+        values = [0.0] * len(header)
+        for i in numeric:
+            values[i] = _number(row[i], f"{name}: line {line}, column {header[i]}")
+        if s.rows and values[col["t"]] < s.rows[-1][col["t"]]:
+            raise ViewInputError(f"{name}: line {line}: time goes back in the {label} run")
+        if s.phases and s.phases[-1] == "approach" and phase == "reconfiguration":
+            raise ViewInputError(f"{name}: line {line}: a reconfiguration after the approach in the {label} run")
+        s.rows.append(values)
+        s.phases.append(phase)
+    if sorted(series) != sorted(runs):
+        raise ViewInputError(f"{name}: its runs ({', '.join(sorted(series)) or 'none'}) are not those of "
+                             f"{result_name} ({', '.join(sorted(runs))}): the series of another run")
+    capture_time = _number(scene.get("capture_time"), f"{result_name}: scene.capture_time")
+    for r in runs:
+        last = series[r].rows[-1]
+        q = result[r].get("capture_configuration_deg", [])
+        got = [last[col[j]] for j in joints]
+        base = [last[col[f"base_{k}"]] for k in "xyz"]
+        if (len(q) != len(got) or not all(_close(a, b) for a, b in zip(got, q))
+                or not all(_close(a, b, atol=1e-9) for a, b in zip(base, result[r].get("base_position", [])))
+                or not _close(last[col["t"]], capture_time)):
+            shown = ", ".join(f"{x:.4f}" for x in got)
+            want = ", ".join(f"{x:.4f}" for x in q)
+            raise ViewInputError(f"{name}: its {r} run ends at [{shown}] deg, t = {last[col['t']]:g} s; "
+                                 f"{result_name}'s capture configuration is [{want}] deg at t = "
+                                 f"{capture_time:g} s: the series of another run")
+    return col, series
+
+
+# --- the page's data ------------------------------------------------------------------------------------
+
+
+def _frames(n: int, keep: Sequence[int], frames: int) -> List[int]:
+    """About `frames` sample indices evenly spread over n, with 0, n - 1 and `keep`."""
+    if n <= frames:
+        return list(range(n))
+    idx = {round(i * (n - 1) / (frames - 1)) for i in range(frames)}
+    idx.update(k for k in keep if 0 <= k < n)
+    return sorted(idx)
+
+
+def _schematic_target(result: Dict[str, Any]) -> Dict[str, Any]:
+    """The figures' schematic target: a cube of half side max(0.1 m, largest |r_tp| component)."""
+    h = max([0.1] + [abs(x) for x in result["scene"]["contact_offset"]])
+    return {"kind": "box", "size": [2 * h] * 3, "position": [0, 0, 0], "quaternion_wxyz": [1, 0, 0, 0],
+            "schematic": True}
+
+
+def page_data(result: Any, series: Any = None, *, run: Optional[str] = None, frames: int = DEFAULT_FRAMES,
+              result_name: str = "result", series_name: str = "series") -> Dict[str, Any]:
+    """The data the page animates (checked): every run's frames, the bodies and shapes, the capture."""
+    if isinstance(frames, bool) or not isinstance(frames, int) or frames < 2:
+        raise ViewInputError(f"frames: must be an integer >= 2, got {frames!r}")
+    res = _result_dict(result)
+    runs = _runs_of(res, result_name)
+    if run is not None and run not in runs:
+        raise ViewInputError(f"run: '{run}' is not a run of {result_name} ({', '.join(runs)})")
+    if series is None:
+        raise ViewInputError(f"{series_name}: missing: the view needs the time series (ffsr-optimize --csv)")
+    header, rows = _series_table(series, series_name)
+    col, table = _check_series(res, runs, header, rows, result_name, series_name)
+    scene = res["scene"]
+    nb = len(scene["bodies"])
+
+    def cols(prefix: str) -> List[int]:
+        return [col[f"{prefix}_{k}"] for k in POSE]
+
+    base_cols, target_cols = cols("base"), cols("target")
+    body_cols = [cols(f"body{b}") for b in range(1, nb)]
+    ee_cols = [col["ee_x"], col["ee_y"], col["ee_z"]]
+
+    def pose(row: List[float], c: List[int], out: List[float]) -> None:
+        out.extend(round(row[i], 5) for i in c[:3])
+        out.extend(round(row[i], 6) for i in c[3:])
+
+    out_runs = []
+    for r in runs:
+        s = table[r]
+        n = len(s.rows)
+        split = next((k for k, p in enumerate(s.phases) if p == "approach"), n)
+        idx = _frames(n, [split - 1, split], frames)
+        d: Dict[str, Any] = {"name": r, "label": RUN_LABELS[r], "t": [], "base": [], "bodies": [], "target": [],
+                             "ee": [], "mie": [], "fmax": []}
+        for k in idx:
+            row = s.rows[k]
+            d["t"].append(round(row[col["t"]], 6))
+            pose(row, base_cols, d["base"])
+            for c in body_cols:
+                pose(row, c, d["bodies"])
+            pose(row, target_cols, d["target"])
+            d["ee"].extend(round(row[i], 5) for i in ee_cols)
+            d["mie"].append(round(row[col["M_ie"]], 6))
+            d["fmax"].append(round(row[col["F_max_estimate"]], 3))
+        d["approach_begin"] = idx.index(split) if split < n else 0
+        for key in ("integrated_effective_mass", "f_max_closed_form", "f_max_exact"):
+            d[key] = res[r].get(key)
+        d["reconfigured"] = bool(res[r].get("reconfigured", False))
+        out_runs.append(d)
+    target_shape = scene.get("target_shape") or _schematic_target(res)
+    source = str(res["scenario"].get("source", ""))
+    return {
+        "source": source,
+        "version": str(res.get("version", "")),
+        "joint_names": list(res["scenario"].get("joint_names", [])),
+        "bodies": scene["bodies"],
+        "end_effector_body": scene["end_effector_body"],
+        "end_effector_point": scene["end_effector_point"],
+        "target_shape": target_shape,
+        "contact_offset": scene["contact_offset"],
+        "contact_normal_target_frame": scene["contact_normal_target_frame"],
+        "capture_time": scene["capture_time"],
+        "capture_point": res.get("capture_point"),
+        "capture_normal": scene["capture_normal"],
+        "runs": out_runs,
+        "initial_run": run or runs[-1],
+    }
+
+
+# --- the page -------------------------------------------------------------------------------------------
+
+
+def _asset(name: str) -> str:
+    return (ASSETS / name).read_text(encoding="utf-8")
+
+
+def _raw_script(text: str, what: str) -> str:
+    """Text that goes inside a <script> element as it is: it must not close or comment the element."""
+    lowered = text.lower()
+    if "</script" in lowered or "<!--" in lowered:
+        raise RuntimeError(f"ffsr.view: {what} holds '</script' or '<!--' and cannot be embedded")
+    return text
+
+
+def page(data: Dict[str, Any]) -> str:
+    """The HTML page of page_data()'s data: three.js, the viewer and the data in one file."""
+    name = os.path.splitext(os.path.basename(data["source"]))[0] or "capture"
+    joints = len(data["joint_names"])
+    T = data["capture_time"]
+    subtitle = (f"{joints} joints · capture at T = {T:g} s · ffsr-optimize {data['version']}"
+                if data["version"] else f"{joints} joints · capture at T = {T:g} s")
+    blob = json.dumps(data, separators=(",", ":"), allow_nan=False).replace("<", "\\u003c")
+    out = _asset("page.html")
+    for key, value in (
+        ("@@FFSR_VERSION@@", html.escape(data["version"])),
+        ("@@FFSR_TITLE@@", html.escape(f"Capture: {name}")),
+        ("@@FFSR_HEADING@@", html.escape(f"Capture: {name}")),
+        ("@@FFSR_SUBTITLE@@", html.escape(subtitle)),
+        ("@@FFSR_DATA@@", blob),
+        ("@@FFSR_THREE@@", _raw_script(_asset("three/three.module.min.js"), "three.module.min.js")),
+        ("@@FFSR_ORBIT@@", _raw_script(_asset("three/OrbitControls.js"), "OrbitControls.js")),
+        ("@@FFSR_VIEWER@@", _raw_script(_asset("viewer.js"), "viewer.js")),
+    ):
+        out = out.replace(key, value, 1)
+    return out
+
+
+def _write_atomically(path: Union[str, os.PathLike], text: str) -> Path:
+    """Writes `text` to a temporary file beside `path`, then renames it into place (all or nothing)."""
+    target = Path(path)
+    folder = target.parent if str(target.parent) else Path(".")
+    try:
+        mode = target.stat().st_mode & 0o7777 if target.exists() else None
+    except OSError:
+        mode = None
+    if mode is None:
+        umask = os.umask(0)
+        os.umask(umask)
+        mode = 0o666 & ~umask
+    tmp = None
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=".ffsr-view-", suffix=".tmp", dir=folder)
+        with os.fdopen(fd, "w", encoding="utf-8") as f:
+            f.write(text)
+        os.chmod(tmp, mode)
+        os.replace(tmp, target)
+        tmp = None
+    except OSError as e:
+        raise ViewInputError(f"{os.fspath(path)}: cannot write the page: {e.strerror}") from None
+    finally:
+        if tmp is not None:
+            try:
+                os.unlink(tmp)
+            except OSError:
+                pass
+    return target
+
+
+def capture(result: Any, path: Union[str, os.PathLike], series: Any = None, *, run: Optional[str] = None,
+            frames: int = DEFAULT_FRAMES) -> Path:
+    """Writes the 3-D view of a capture to `path` (one HTML file; returns its path).
+
+    result: the main job's result (an object with ``to_dict()``, or the dict of ``ffsr-optimize --json``).
+    series: its time series: a path to the ``--csv`` file, the CSV text, or a mapping of its columns;
+        None: ``result.series`` (called when it is a method).
+    run: the run the page opens on (baseline, optimized, global; default: the last the result holds).
+    frames: at most this many samples per run go into the page (evenly spread; the first, the last
+        and the phase boundary always).
+    Raises ViewInputError (a ValueError) naming the argument on bad input; nothing is written then.
+    """
+    if series is None:
+        series = getattr(result, "series", None)
+        if callable(series):
+            series = series()
+    html_text = page(page_data(result, series, run=run, frames=frames))
+    return _write_atomically(path, html_text)
+
+
+# --- python -m ffsr.view ----------------------------------------------------------------------------------
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message: str) -> None:  # one line, exit 2 (as ffsr-optimize)
+        self.exit(2, f"ffsr.view: error: {message}\n")
+
+
+def main(argv: Optional[Sequence[str]] = None) -> int:
+    p = _Parser(prog="python -m ffsr.view",
+                description="Write the 3-D view of a capture (one HTML file) from ffsr-optimize's --json and --csv.")
+    p.add_argument("result", help="the main job's result (ffsr-optimize --json FILE)")
+    p.add_argument("--csv", required=True, metavar="SERIES", help="its time series (ffsr-optimize --csv FILE)")
+    p.add_argument("-o", "--output", required=True, metavar="HTML", help="the page to write ('-': standard output)")
+    p.add_argument("--run", choices=RUNS, help="the run the page opens on (default: global, else the last held)")
+    p.add_argument("--frames", type=int, default=DEFAULT_FRAMES,
+                   help=f"at most this many samples per run in the page (default {DEFAULT_FRAMES})")
+    a = p.parse_args(argv)
+    try:
+        if a.frames < 2:
+            raise ViewInputError(f"--frames: must be >= 2, got {a.frames}")
+        result = load_result(a.result)
+        if not isinstance(result, dict):
+            raise ViewInputError(f"{a.result}: not the --json of the main job of ffsr-optimize (not a JSON object)")
+        try:
+            data = page_data(result, a.csv, run=a.run, frames=a.frames, result_name=a.result, series_name=a.csv)
+        except ViewInputError as e:
+            msg = str(e)
+            if msg.startswith("run: "):
+                msg = "--run: " + msg[len("run: "):]
+            raise ViewInputError(msg) from None
+        text = page(data)
+        if a.output == "-":
+            sys.stdout.write(text)
+            sys.stdout.flush()
+        else:
+            _write_atomically(a.output, text)
+    except ViewInputError as e:
+        print(f"ffsr.view: error: {e}", file=sys.stderr)
+        return 2
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
