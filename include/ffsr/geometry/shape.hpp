@@ -179,6 +179,20 @@ inline std::vector<Vector3> centre_line_ends(const Model& model, int b) {
   return ends;
 }
 
+/// The base's box `bus_box` (edge lengths, centred on the base frame) when given; refused when the
+/// URDF's base has <collision> primitives already (the key would change nothing).
+inline void add_bus_box(RobotGeometry& g, const std::vector<double>& bus_box) {
+  if (bus_box.empty()) return;
+  if (!g.shapes[0].empty())
+    throw InputError(str("--bus-box: the URDF's base '", g.names[0],
+                         "' has <collision> primitives already (bus-box stands for a base without any)"));
+  if (bus_box.size() != 3) throw InputError(str("--bus-box: expected 3 numbers, got ", bus_box.size()));
+  const Shape s = Shape::box(Vector3(bus_box[0], bus_box[1], bus_box[2]));
+  validate_shape(s, "--bus-box");
+  g.shapes[0].push_back(s);
+  g.origin[0] = "bus-box";
+}
+
 }  // namespace detail
 
 /// The robot's shapes: `urdf_shapes` (the <collision> primitives, mapped to bodies through the
@@ -213,16 +227,7 @@ inline RobotGeometry robot_geometry(const Model& model, const std::vector<LinkSh
     g.shapes[static_cast<size_t>(f.body)].push_back(s);
     g.origin[static_cast<size_t>(f.body)] = "urdf";
   }
-  if (!g.shapes[0].empty() && !bus_box.empty())  // a key that would change nothing is refused
-    throw InputError(str("--bus-box: the URDF's base '", g.names[0],
-                         "' has <collision> primitives already (bus-box stands for a base without any)"));
-  if (g.shapes[0].empty() && !bus_box.empty()) {
-    if (bus_box.size() != 3) throw InputError(str("--bus-box: expected 3 numbers, got ", bus_box.size()));
-    const Shape s = Shape::box(Vector3(bus_box[0], bus_box[1], bus_box[2]));
-    validate_shape(s, "--bus-box");
-    g.shapes[0].push_back(s);
-    g.origin[0] = "bus-box";
-  }
+  detail::add_bus_box(g, bus_box);
   const Frame& ee = model.frame(model.end_effector());
   g.line_radius.assign(static_cast<size_t>(nb), 0.0);
   for (int b = 1; b < nb; ++b) {

@@ -75,6 +75,11 @@ struct RobustRun {
   std::uint64_t redraws = 0;  ///< samples redrawn by the physical rules
 };
 
+/// The job's options against the scenario, before anything is planned or drawn: InputError on a bad
+/// shard or thread count, or on the multibody force model with a joint model other than free (it
+/// simulates the joints free). run_robust calls it.
+void check_robust_job(const Scenario& sc, const RobustJobOptions& options);
+
 /// Draws the shard's samples of `spec` around the scenario's target at T and evaluates F_max of every
 /// configuration on each, on options.threads threads. InputError on a bad shard or thread count.
 RobustRun run_robust(const Scenario& sc, const UncertaintySpec& spec, std::vector<RobustConfiguration> configs,

@@ -297,6 +297,7 @@ int run_robust(const RobustOptions& flags, const CLI::App& app) {
   const plot::Format plot_format = plot::check_request(o.plot, o.plot_format);
   auto [spec, job] = parse_robust(o, keys);
   const Scenario sc = robust_scenario(std::move(keys), o);
+  check_robust_job(sc, job);  // before the planning
   Progress p1{"plain"}, p2{"optimized"}, progress("robust", o.quiet, "evaluations");
   ScenarioRunOptions planning;
   if (!o.quiet) {
@@ -323,9 +324,13 @@ void register_robust(CLI::App& app, Action& action) {
   // before the scenario's keys: here --seed is the Monte Carlo seed, not the global search's
   // (ScenarioFlags leaves an existing --seed alone; robust_scenario sets the global search's to 1)
   sub->add_option("--seed", o->seed, "Seed, a non-negative integer (overrides uncertainty.seed)");
-  // the samples are evaluated with free joints during the contact: no joint-model keys
-  o->flags.add_groups(*sub, {KeyGroup::Robot, KeyGroup::Start, KeyGroup::Target, KeyGroup::TargetPlace,
-                             KeyGroup::Contact, KeyGroup::Planner, KeyGroup::Global, KeyGroup::Shapes});
+  // the samples' Lambda^-1 is the joint model's (contact-joints, armature); the multibody force model
+  // runs with the library's default servo, so the multibody reference's servo keys are not taken
+  o->flags.add_groups(*sub,
+                      {KeyGroup::Robot, KeyGroup::Start, KeyGroup::Target, KeyGroup::TargetPlace,
+                       KeyGroup::Contact, KeyGroup::Planner, KeyGroup::Global, KeyGroup::JointModels,
+                       KeyGroup::Shapes},
+                      {"joint-stiffness", "joint-damping"});
   sub->add_option("--force-model", o->force_model,
                   "F_max per sample: closed (Eq. 24), exact (Eq. 16) or multibody (CVODE)")
       ->capture_default_str();

@@ -40,16 +40,20 @@ inline const char* robust_force_model_name(ForceModel model) {
   return model == ForceModel::Closed ? "closed" : model == ForceModel::Exact ? "exact" : "multibody";
 }
 
-inline RobustRun run_robust(const Scenario& sc, const UncertaintySpec& spec,
-                            std::vector<RobustConfiguration> configs, const RobustJobOptions& options) {
+inline void check_robust_job(const Scenario& sc, const RobustJobOptions& options) {
   using detail::str;
   if (options.shard_n < 1 || options.shard_k >= options.shard_n)
     throw InputError(str("run_robust: shard ", options.shard_k, " of ", options.shard_n, " does not exist"));
   if (options.threads < 1) throw InputError(str("run_robust: threads must be >= 1, got ", options.threads));
   if (options.force_model == ForceModel::Multibody && sc.problem.joints.model != JointModel::Free)
     throw InputError(
-        str("--contact-joints: the multibody force model simulates the joints free (servoed by "
-            "joint-stiffness and joint-damping); use it with --force-model exact or closed"));
+        str("--contact-joints: the multibody force model simulates the joints free; use '",
+            joint_model_name(sc.problem.joints.model), "' with --force-model exact or closed"));
+}
+
+inline RobustRun run_robust(const Scenario& sc, const UncertaintySpec& spec,
+                            std::vector<RobustConfiguration> configs, const RobustJobOptions& options) {
+  check_robust_job(sc, options);
   RobustRun run;
   run.spec = spec;
   run.options = options;
