@@ -9,8 +9,8 @@
 // Best of 3, with the search's evaluations and the reaching runs. Target for the 7-DOF scenario:
 // < 5 s in Release. DIR holds the scenario files (default FFSR_SOURCE_DIR/robots).
 #include <ffsr/io/scenario.hpp>
-#include <ffsr/io/scenario_geometry.hpp>
-#include <ffsr/io/scenario_run.hpp>
+#include <ffsr/jobs/scenario_clearance.hpp>
+#include <ffsr/jobs/scenario_run.hpp>
 
 #include <algorithm>
 #include <chrono>

@@ -500,6 +500,20 @@ void bench_crossover(const Settings& s, AllocCheck& check) {
     print_row(name, "1/m_e: crba + dense Cholesky", dense, "");
     print_row(name, "1/m_e: articulated-body recursion, O(n)", aba, ratio);
     check.require_zero(name, "inverse_effective_mass_articulated", aba);
+    const ContactJoints armature{JointModel::Armature, Eigen::VectorXd::Constant(n, 0.1)};
+    const Timing arm = measure(s, [&](long i) {
+      return integrated_effective_mass_fast(model, data, base, thetas[static_cast<size_t>(i % K)], ee, u, 0.005,
+                                            armature);
+    });
+    print_row(name, "M_ie, armature joints, O(n)", arm, "");
+    check.require_zero(name, "integrated_effective_mass_fast (armature)", arm);
+    Eigen::VectorXd grad(n);
+    const Timing g = measure(s, [&](long i) {
+      return integrated_effective_mass_gradient_fast(model, data, base, thetas[static_cast<size_t>(i % K)], ee, u,
+                                                     0.005, ContactJoints{}, grad);
+    });
+    print_row(name, "gradient of M_ie, O(n)", g, "");
+    check.require_zero(name, "integrated_effective_mass_gradient_fast", g);
   }
 }
 

@@ -1,32 +1,39 @@
-// bench/bench_pinocchio.cpp -- ffsr-bench-pinocchio: the inverse effective mass u^T J_v H^-1 J_v^T u
-// (the robot part of Eq. 14) per evaluation, ffsr against Pinocchio in the same run.
+// bench/bench_pinocchio.cpp -- ffsr-bench-pinocchio: the joint-space inertia matrix H (CRBA) and the
+// inverse effective mass u^T J_v H^-1 J_v^T u of the integrated effective mass (Eq. 14), per call,
+// ffsr now, ffsr before the fixed-size rewrite and Pinocchio in the same run.
 //
 //   ffsr-bench-pinocchio [DIR]     DIR: the robots folder (default FFSR_SOURCE_DIR/robots)
 //
 // Built only with -DFFSR_BENCH_PINOCCHIO=ON (bench/CMakeLists.txt), against Pinocchio's C++ headers
-// and libraries, e.g. those of the PyPI package `pin` (pip install pin; CMAKE_PREFIX_PATH=
-// <site-packages>/cmeel.prefix). Nothing else in the project needs Pinocchio.
+// and libraries, e.g. those of the PyPI package `pin` (pip install pin==4.1.0). Nothing else in the
+// project needs Pinocchio.
 //
-// Robots: the paper's 3-DOF and 7-DOF robots, and serial chains of 14, 28 and 56 revolute joints
-// (random axes, offsets and inertias from a fixed seed), each loaded from the same URDF text by both
-// libraries: ffsr's model from URDF, Pinocchio's built from it joint by joint with a free-flyer
-// root (bench_pinocchio_side.cpp: Pinocchio's URDF parser and the system urdfdom headers that
-// ffsr's loader uses do not mix in one translation unit). Poses: the same 1000 random configurations
-// (fixed seed) and unit directions u for both. Pinocchio: crba, computeJointJacobians +
-// getFrameJacobian (LOCAL_WORLD_ALIGNED, linear rows), an LLT of M and the solve. ffsr: crba and the
-// dense Cholesky path (inverse_effective_mass), the articulated-body recursion
-// (inverse_effective_mass_articulated) and the dispatching integrated_effective_mass_fast. Each
-// time is the median over 21 passes over the 1000 poses of the mean time per evaluation, in CPU time
-// of the thread (CLOCK_THREAD_CPUTIME_ID: stable on a loaded machine, where wall time is not); the
-// values of the two libraries are compared too (the quantity does not depend on the velocity
-// coordinates, so they must agree to rounding).
-#include <ffsr/ffsr.hpp>
+// Robots: the paper's 3-DOF and 7-DOF robots (joint axes along x or z) and serial chains of 3, 7, 14,
+// 28 and 56 revolute joints on a floating base (random axes, offsets and inertias from a fixed seed),
+// each loaded from the same URDF text by both libraries: ffsr's model from URDF, Pinocchio's built
+// from it joint by joint with a free-flyer root, RX/RY/RZ joints for axes along x, y, z and the
+// unaligned revolute joint otherwise (bench_pinocchio_side.cpp: Pinocchio's URDF parser and the
+// system urdfdom headers that ffsr's loader uses do not mix in one translation unit). Poses: the same
+// 1000 random configurations (fixed seed) and unit directions u for all.
+//
+// Columns: CRBA -- ffsr::crba (the full symmetric H), the frozen code before the rewrite
+// (bench_before.hpp), pinocchio::crba (upper triangle; the default LOCAL convention and WORLD); M_ie --
+// ffsr::integrated_effective_mass_fast (the O(n) articulated-body route), the frozen dispatching
+// function, and Pinocchio's crba + computeJointJacobians + getFrameJacobian + LLT solve. Each time is
+// the median over 51 passes of the mean time per call over 200 of the poses, in CPU time of the
+// thread (CLOCK_THREAD_CPUTIME_ID: time while descheduled does not count); every pass times the seven
+// loops back to back, so that a change of the machine's load hits them alike. All 1000 poses serve the
+// agreement checks. Ratios are ffsr over Pinocchio
+// (the faster of its two CRBA conventions for CRBA). The last columns check the numbers: H against
+// the frozen code (largest entry difference over the largest entry), H's joint block against
+// Pinocchio's, and the inverse effective mass against both (relative).
+#include <ffsr/algorithm/articulated_effective_mass.hpp>
 #include <ffsr/io/urdf.hpp>
 
+#include "bench_before.hpp"
 #include "bench_pinocchio.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -101,57 +108,74 @@ Poses random_poses(int n, int count, unsigned seed) {
   return p;
 }
 
-/// Median over `passes` of the mean time per evaluation of fn(k) over all poses; sums the values.
-template <class Fn>
-double time_per_eval(int count, int passes, Fn&& fn) {
-  std::vector<double> t;
-  double acc = 0;
-  for (int k = 0; k < count; ++k) acc += fn(k);  // warm-up
-  for (int r = 0; r < passes; ++r) {
-    const double t0 = ffsr_bench::thread_seconds();
-    for (int k = 0; k < count; ++k) acc += fn(k);
-    t.push_back((ffsr_bench::thread_seconds() - t0) / count);
-  }
-  g_sink = g_sink + acc;
-  std::sort(t.begin(), t.end());
-  return t[t.size() / 2];
+/// The median of v.
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
 }
 
 void compare(const std::string& name, const std::string& urdf) {
+  namespace before = ffsr_bench::before;
+  using Kind = ffsr_bench::PinocchioBench::Kind;
   const ffsr::Model fm = ffsr::model_from_urdf_string(urdf, name, "ee");
   const int fee = fm.frame_index("ee");
   ffsr::Data fd(fm);
+  before::BeforeData bd(fm);
   const int n = fm.n();
-  constexpr int kPoses = 1000, kPasses = 21;
+  constexpr int kPoses = 1000, kBlocks = 20, kPassPoses = 200, kPasses = 51;
   const Poses P = random_poses(n, kPoses, 1234u + static_cast<unsigned>(n));
-  std::vector<double> pin_values;
-  const double tp =
-      ffsr_bench::pinocchio_inverse_effective_mass(fm, fee, P.base, P.theta, P.u, kPasses, pin_values);
+  ffsr_bench::PinocchioBench pin(fm, fee, P.base, P.theta, P.u);
 
-  auto dense = [&](int k) {
-    const auto uk = static_cast<size_t>(k);
-    ffsr::crba(fm, fd, P.base[uk], P.theta[uk]);
-    return ffsr::inverse_effective_mass(fm, fd, fee, P.u[uk]);
-  };
-  auto articulated = [&](int k) {
-    const auto uk = static_cast<size_t>(k);
-    ffsr::forward_kinematics(fm, fd, P.base[uk], P.theta[uk]);
-    return ffsr::inverse_effective_mass_articulated(fm, fd, fee, P.u[uk]);
-  };
-  auto fast = [&](int k) {
+  auto crba_now = [&](int k) { return ffsr::crba(fm, fd, P.base[size_t(k)], P.theta[size_t(k)])(6, 6); };
+  auto crba_before = [&](int k) { return before::crba(fm, bd, P.base[size_t(k)], P.theta[size_t(k)])(6, 6); };
+  auto mie_now = [&](int k) {
     const auto uk = static_cast<size_t>(k);
     return 1.0 / ffsr::integrated_effective_mass_fast(fm, fd, P.base[uk], P.theta[uk], fee, P.u[uk], 0.0);
   };
-  double worst = 0;
+  auto mie_before = [&](int k) {
+    const auto uk = static_cast<size_t>(k);
+    return 1.0 / before::integrated_effective_mass_fast(fm, bd, P.base[uk], P.theta[uk], fee, P.u[uk], 0.0);
+  };
+  double dH = 0, dHpin = 0, dM = 0, dMpin = 0;
   for (int k = 0; k < kPoses; ++k) {
-    const double a = pin_values[static_cast<size_t>(k)], b = dense(k), c = articulated(k);
-    worst = std::max({worst, std::abs(b - a) / a, std::abs(c - a) / a});
+    const auto uk = static_cast<size_t>(k);
+    const Eigen::MatrixXd& Hb = before::crba(fm, bd, P.base[uk], P.theta[uk]);
+    const Eigen::MatrixXd& Hn = ffsr::crba(fm, fd, P.base[uk], P.theta[uk]);
+    dH = std::max(dH, (Hn - Hb).cwiseAbs().maxCoeff() / Hb.cwiseAbs().maxCoeff());
+    if (k < kBlocks) {
+      const Eigen::MatrixXd Hp = pin.joint_block(k);
+      dHpin = std::max(dHpin, (Hn.bottomRightCorner(n, n) - Hp).cwiseAbs().maxCoeff() / Hp.cwiseAbs().maxCoeff());
+    }
+    const double a = mie_now(k), b = mie_before(k), p = pin.inverse_effective_mass(k);
+    dM = std::max(dM, std::abs(a - b) / b);
+    dMpin = std::max(dMpin, std::abs(a - p) / p);
   }
-  const double td = time_per_eval(kPoses, kPasses, dense);
-  const double ta = time_per_eval(kPoses, kPasses, articulated);
-  const double tf = time_per_eval(kPoses, kPasses, fast);
-  std::printf("%-10s %3d %11.3f %11.3f %11.3f %11.3f %9.2fx %9.2fx %9.2fx %10.1e\n", name.c_str(), n,
-              tp * 1e6, td * 1e6, ta * 1e6, tf * 1e6, td / tp, ta / tp, tf / tp, worst);
+  // Interleaved passes: every pass times the seven loops back to back over the same 200 poses, so a
+  // change of the machine's load hits them alike; the median over the passes of each.
+  auto ffsr_pass = [&](auto&& fn) {
+    double acc = 0;
+    const double t0 = ffsr_bench::thread_seconds();
+    for (int k = 0; k < kPassPoses; ++k) acc += fn(k);
+    const double t = ffsr_bench::thread_seconds() - t0;
+    g_sink = g_sink + acc;
+    return t / kPassPoses;
+  };
+  std::vector<double> t[7];
+  for (int r = -1; r < kPasses; ++r) {  // pass -1 warms up
+    const double a[7] = {ffsr_pass(crba_now), ffsr_pass(crba_before),
+                         pin.pass(Kind::CrbaLocal, kPassPoses) / kPassPoses,
+                         pin.pass(Kind::CrbaWorld, kPassPoses) / kPassPoses, ffsr_pass(mie_now),
+                         ffsr_pass(mie_before), pin.pass(Kind::InverseEffectiveMass, kPassPoses) / kPassPoses};
+    if (r >= 0)
+      for (int i = 0; i < 7; ++i) t[i].push_back(a[i]);
+  }
+  const double tcn = median(t[0]), tcb = median(t[1]), tpl = median(t[2]), tpw = median(t[3]);
+  const double tmn = median(t[4]), tmb = median(t[5]), tmp = median(t[6]);
+  const double tcp = std::min(tpl, tpw);
+  std::printf("%-9s %2d | %6.0f %6.0f %6.0f %6.0f %5.2fx %5.2fx | %6.0f %6.0f %6.0f %5.2fx %5.2fx | %7.0e %7.0e %7.0e %7.0e\n",
+              name.c_str(), n, tcn * 1e9, tcb * 1e9, tpl * 1e9, tpw * 1e9, tcn / tcp, tcb / tcp, tmn * 1e9,
+              tmb * 1e9, tmp * 1e9, tmn / tmp, tmb / tmp, dH, dHpin, dM, dMpin);
+  std::fflush(stdout);
 }
 
 }  // namespace
@@ -160,12 +184,14 @@ int main(int argc, char** argv) {
   const std::string dir = argc > 1 ? argv[1] : std::string(FFSR_SOURCE_DIR) + "/robots";
   try {
     std::printf(
-        "u^T J_v H^-1 J_v^T u per evaluation, median of 21 passes over the same 1000 random poses (us)\n");
-    std::printf("%-10s %3s %11s %11s %11s %11s %10s %10s %10s %10s\n", "robot", "n", "pinocchio",
-                "ffsr dense", "ffsr ABA", "ffsr fast", "dense/pin", "ABA/pin", "fast/pin", "max rel");
+        "ns per call, median of 51 interleaved passes over the same 200 random poses (thread CPU time)\n");
+    std::printf("%-9s %2s | %-48s | %-41s | %s\n", "", "", "CRBA", "M_ie (u^T J_v H^-1 J_v^T u)", "agreement");
+    std::printf("%-9s %2s | %6s %6s %6s %6s %6s %6s | %6s %6s %6s %6s %6s | %7s %7s %7s %7s\n", "robot", "n",
+                "ffsr", "before", "pinL", "pinW", "ffsr/p", "bef/p", "ffsr", "before", "pin", "ffsr/p", "bef/p",
+                "H-bef", "H-pin", "M-bef", "M-pin");
     compare("3-DOF", read_text(dir + "/paper_3dof.urdf"));
     compare("7-DOF", read_text(dir + "/paper_7dof.urdf"));
-    for (int n : {14, 28, 56}) compare("chain " + std::to_string(n), chain_urdf(n, static_cast<unsigned>(n)));
+    for (int n : {3, 7, 14, 28, 56}) compare("chain " + std::to_string(n), chain_urdf(n, static_cast<unsigned>(n)));
   } catch (const std::exception& e) {
     std::fprintf(stderr, "ffsr-bench-pinocchio: error: %s\n", e.what());
     return 1;

@@ -2,9 +2,10 @@
 // compiled apart so that Pinocchio's include folder never meets ffsr's URDF loader.
 #pragma once
 
-#include <ffsr/ffsr.hpp>
+#include <ffsr/model/model.hpp>
 
 #include <ctime>
+#include <memory>
 #include <vector>
 
 namespace ffsr_bench {
@@ -16,14 +17,27 @@ inline double thread_seconds() {
   return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
 }
 
-/// Builds a Pinocchio model equal to `model` (free-flyer root, one revolute or prismatic joint per
-/// body, the frame `frame` as an operational frame) and evaluates u^T J_v M^-1 J_v^T u at every pose
-/// (crba, computeJointJacobians, getFrameJacobian LOCAL_WORLD_ALIGNED, LLT solve). Writes the values
-/// to `values`; returns the median over `passes` passes of the mean thread CPU time per evaluation, seconds.
-double pinocchio_inverse_effective_mass(const ffsr::Model& model, int frame,
-                                        const std::vector<ffsr::BasePose>& base,
-                                        const std::vector<Eigen::VectorXd>& theta,
-                                        const std::vector<Eigen::Vector3d>& u, int passes,
-                                        std::vector<double>& values);
+/// A Pinocchio model equal to an ffsr model (free-flyer root; one joint per body: RX, RY or RZ for a
+/// revolute axis +x, +y or +z, else the unaligned revolute or prismatic joint; the frame `frame` as
+/// an operational frame) and the poses to evaluate it at.
+class PinocchioBench {
+ public:
+  enum class Kind { CrbaLocal, CrbaWorld, InverseEffectiveMass };
+  PinocchioBench(const ffsr::Model& model, int frame, const std::vector<ffsr::BasePose>& base,
+                 const std::vector<Eigen::VectorXd>& theta, const std::vector<Eigen::Vector3d>& u);
+  ~PinocchioBench();
+  /// One pass over poses [0, count): pinocchio::crba (Convention::LOCAL, the default, or WORLD; upper
+  /// triangle), or u^T J_v M^-1 J_v^T u (crba, computeJointJacobians, getFrameJacobian
+  /// LOCAL_WORLD_ALIGNED, LLT solve). Returns the thread CPU time of the pass, seconds.
+  double pass(Kind kind, int count);
+  /// u^T J_v M^-1 J_v^T u at pose k.
+  double inverse_effective_mass(int k);
+  /// M's joint-joint block (symmetrized) at pose k.
+  Eigen::MatrixXd joint_block(int k);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 }  // namespace ffsr_bench

@@ -10,7 +10,7 @@
 // first and not timed. Best of 3. Target: < 2 s in Release. DIR holds paper_7dof_pose.toml (default
 // FFSR_SOURCE_DIR/robots).
 #include <ffsr/io/scenario.hpp>
-#include <ffsr/io/scenario_run.hpp>
+#include <ffsr/jobs/scenario_run.hpp>
 
 #include <algorithm>
 #include <chrono>

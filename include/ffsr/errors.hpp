@@ -25,6 +25,12 @@ class InputError : public Error {
  public:
   using Error::Error;
 };
+/// A joint-rate limit the motion cannot keep (the caller's limit is below what the task alone needs,
+/// or the limit itself is invalid): an InputError, so that a caller who set the limit can name it.
+class JointRateLimitError : public InputError {
+ public:
+  using InputError::InputError;
+};
 class ModelError : public Error {
  public:
   using Error::Error;

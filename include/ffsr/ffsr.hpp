@@ -1,8 +1,26 @@
-// ffsr/ffsr.hpp -- umbrella header of the dynamics part (Eigen only).
-// The URDF loader (ffsr/io/urdf.hpp, urdfdom) and the CVODE parts (ffsr/simulate/, ffsr/optimize/)
-// are included separately, so that a user who wants the dynamics pulls in only Eigen. The parts of
-// the capture planner below (Eigen only) are here, so that an onboard controller can use the rate
-// law without the planner: ffsr/optimize/capture.hpp composes them.
+// ffsr/ffsr.hpp -- umbrella header of the dynamics (Eigen only).
+//
+// It pulls in exactly this, and nothing of the planner, the simulations or the parsers:
+//   errors.hpp                      the exception hierarchy
+//   spatial/spatial.hpp             skew, Plücker transforms, spatial inertia
+//   model/model.hpp, model/data.hpp the robot (Model, ModelBuilder) and its workspace (Data)
+//   model/target.hpp                the tumbling target
+//   algorithm/kinematics.hpp        forward kinematics, frame poses
+//   algorithm/crba.hpp              H (composite rigid body algorithm)
+//   algorithm/rnea.hpp              C (recursive Newton-Euler)
+//   algorithm/jacobian.hpp          J_bm, J_f
+//   algorithm/momentum.hpp          linear and angular momentum
+//   algorithm/effective_mass.hpp    m_e (Eq. 4), M_ie (Eq. 14) and its gradient
+//   algorithm/articulated_effective_mass.hpp, algorithm/joint_models.hpp
+//                                   M_ie under the contact-joint models (free, locked, armature)
+// Include the rest where it is needed, each with its CMake target (docs/library.md):
+//   ffsr/contact/contact_law.hpp    contact laws, closed-form and exact maxima   (ffsr::ffsr)
+//   ffsr/io/urdf.hpp                the URDF loader                              (ffsr::urdf)
+//   ffsr/optimize/capture.hpp       the paper's planner and its parts            (ffsr::ffsr)
+//   ffsr/control/capture_controller.hpp the onboard controller                  (ffsr::ffsr)
+//   ffsr/simulate/*.hpp             CVODE integrations                           (ffsr::cvode)
+//   ffsr/optimize/global.hpp        the capture-manifold search                  (ffsr::global)
+// A translation unit that needs only M_ie compiles several times faster without the planner.
 #pragma once
 
 #include "ffsr/errors.hpp"
@@ -17,9 +35,4 @@
 #include "ffsr/algorithm/momentum.hpp"
 #include "ffsr/algorithm/effective_mass.hpp"
 #include "ffsr/algorithm/articulated_effective_mass.hpp"
-#include "ffsr/optimize/line_reference.hpp"
-#include "ffsr/optimize/task_solver.hpp"
-#include "ffsr/optimize/capture_problem.hpp"
-#include "ffsr/optimize/null_space.hpp"
-#include "ffsr/optimize/free_floating_step.hpp"
-#include "ffsr/optimize/run_monitors.hpp"
+#include "ffsr/algorithm/joint_models.hpp"

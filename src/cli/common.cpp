@@ -84,35 +84,10 @@ double rad2deg(double rad) { return rad * 180.0 / M_PI; }
 namespace {
 
 /// The keys of a subject (SubjectOptions): the robot and its start state, the bus and the loader, the
-/// target and the contact law.
+/// target and the contact law (the key table's groups).
 const std::set<std::string>& subject_keys() {
-  static const std::set<std::string> keys = {"urdf",
-                                             "end-effector",
-                                             "joints-deg",
-                                             "base-position",
-                                             "base-rpy-deg",
-                                             "bus-mass",
-                                             "bus-inertia",
-                                             "bus-com",
-                                             "mount-xyz",
-                                             "mount-rpy-deg",
-                                             "lock-joints",
-                                             "inertia-repair",
-                                             "min-mass",
-                                             "min-inertia",
-                                             "end-effector-offset",
-                                             "target-mass",
-                                             "target-inertia",
-                                             "target-rpy-deg",
-                                             "target-angular-velocity-deg",
-                                             "target-velocity",
-                                             "contact-offset",
-                                             "normal",
-                                             "model",
-                                             "stiffness",
-                                             "exponent",
-                                             "restitution",
-                                             "approach-speed"};
+  static const std::set<std::string> keys =
+      scenario_key_names({KeyGroup::Robot, KeyGroup::Start, KeyGroup::Target, KeyGroup::Contact});
   return keys;
 }
 

@@ -3,7 +3,7 @@
 #pragma once
 
 #include "ffsr/io/scenario.hpp"
-#include "ffsr/io/scenario_run.hpp"
+#include "ffsr/jobs/scenario_run.hpp"
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>

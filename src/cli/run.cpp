@@ -2,7 +2,7 @@
 // the tumbling target twice -- plain (rho = 0) and optimized (rho of the scenario) -- and, unless
 // global = false, globally; reports how much the capture configuration lowers M_ie and the maximum
 // contact force (Tables 4 and 7). The scenario and the runs are the library's (ffsr/io/scenario.hpp,
-// ffsr/io/scenario_run.hpp); this file turns flags into overrides and writes the outputs.
+// ffsr/jobs/scenario_run.hpp); this file turns flags into overrides and writes the outputs.
 #include "baseline.hpp"
 #include "common.hpp"
 #include "embedded.hpp"

@@ -6,7 +6,7 @@
 #include "common.hpp"
 
 #include "ffsr/io/scenario.hpp"
-#include "ffsr/io/scenario_run.hpp"
+#include "ffsr/jobs/scenario_run.hpp"
 
 #include <set>
 #include <string>

@@ -8,6 +8,7 @@
 // directory of the test runner.
 #include "support/command.hpp"
 
+#include "ffsr/contact/contact_law.hpp"
 #include "ffsr/ffsr.hpp"
 #include "ffsr/io/urdf.hpp"
 

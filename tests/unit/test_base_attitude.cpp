@@ -5,7 +5,7 @@
 
 #include "support/paper.hpp"
 
-#include "ffsr/io/scenario_run.hpp"
+#include "ffsr/jobs/scenario_run.hpp"
 #include "ffsr/io/urdf.hpp"
 #include "ffsr/optimize/base_attitude.hpp"
 

@@ -10,7 +10,7 @@
 #include "support/paper.hpp"
 
 #include "ffsr/io/scenario.hpp"
-#include "ffsr/io/scenario_run.hpp"
+#include "ffsr/jobs/scenario_run.hpp"
 #include "ffsr/optimize/branches.hpp"
 
 #include <cstdio>

@@ -2,7 +2,7 @@
 // line naming the key; every run of the clearance scenarios (plain, paper's method through the clearance
 // barrier, global) keeps the clearance along its path; the barrier's free-floating distance rate
 // against central differences.
-#include "ffsr/io/scenario_run.hpp"
+#include "ffsr/jobs/scenario_run.hpp"
 
 #include <catch2/catch.hpp>
 

@@ -16,7 +16,7 @@
 
 #include "ffsr/algorithm/joint_models.hpp"
 #include "ffsr/io/scenario.hpp"
-#include "ffsr/io/scenario_run.hpp"
+#include "ffsr/jobs/scenario_run.hpp"
 #include "ffsr/simulate/multibody.hpp"
 #include "support/command.hpp"
 

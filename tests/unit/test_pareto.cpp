@@ -5,7 +5,7 @@
 
 #include <string>
 
-#include "ffsr/io/scenario_run.hpp"
+#include "ffsr/jobs/scenario_run.hpp"
 #include "ffsr/io/urdf.hpp"
 #include "ffsr/optimize/pareto.hpp"
 

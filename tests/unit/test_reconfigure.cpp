@@ -5,7 +5,7 @@
 #include <catch2/catch.hpp>
 
 #include "ffsr/io/scenario.hpp"
-#include "ffsr/io/scenario_run.hpp"
+#include "ffsr/jobs/scenario_run.hpp"
 #include "ffsr/optimize/global.hpp"
 #include "ffsr/optimize/reconfigure.hpp"
 

@@ -1,7 +1,7 @@
-// Scenarios through the library (ffsr/io/scenario.hpp, ffsr/io/scenario_run.hpp): a scenario file
+// Scenarios through the library (ffsr/io/scenario.hpp, ffsr/jobs/scenario_run.hpp): a scenario file
 // gives the same result as `ffsr-optimize --json`, every shipped scenario loads, bad keys are named.
 #include "ffsr/io/scenario.hpp"
-#include "ffsr/io/scenario_run.hpp"
+#include "ffsr/jobs/scenario_run.hpp"
 
 #include "support/run_command.hpp"
 

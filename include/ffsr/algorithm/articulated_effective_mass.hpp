@@ -1,8 +1,8 @@
-// ffsr/algorithm/articulated_effective_mass.hpp -- u^T J_v H^-1 J_v^T u in O(n) by articulated-body
-// inertias, without forming H.
+// ffsr/algorithm/articulated_effective_mass.hpp -- the effective mass (Eq. 4), the integrated
+// effective mass (Eq. 14) and its gradient in O(n), by articulated-body inertias, without forming H.
 #pragma once
 
-#include "ffsr/algorithm/effective_mass.hpp"
+#include "ffsr/algorithm/joint_models.hpp"
 
 namespace ffsr {
 namespace detail {
@@ -37,6 +37,110 @@ inline bool solve_spd6(const Matrix6& A, const Vector6& b, Vector6& x) {
   return true;
 }
 
+/// The unit force u at the origin of `frame` as a spatial force about the base origin p_0 (inertial
+/// axes, linear first): f = [u; (p_e - p_0) x u]. Checks u and the frame index. Reads the kinematics.
+inline Vector6 unit_point_force(const Model& model, const Data& data, int frame, const Vector3& u) {
+  check_unit_direction(u, "effective_mass");
+  check_frame(model, frame, "effective_mass");
+  const Vector3 pe = frame_pose(model, data, frame).p;
+  if (!pe.allFinite())
+    throw NumericalError(str("effective_mass: the position of frame '", model.frame(frame).name,
+                             "' overflows double precision"));
+  Vector6 f;
+  f << u, (pe - data.p[0]).cross(u);
+  return f;
+}
+
+/// The backward pass of the articulated-body algorithm at rest (RBDA 7.3, floating base RBDA 9.4),
+/// in inertial axes about p_0 so that no transform is needed: with IA_i starting as body i's own
+/// inertia,
+///   i = n..1:  U_i = IA_i S_i,  D_i = S_i^T U_i + a_i,  IA_parent += IA_i - U_i U_i^T / D_i,
+/// where a_i is the armature of joint i (a reflected rotor inertia on H's diagonal; `armature` null
+/// for none). A joint whose armature is infinite would pass IA_i unchanged: that is the Locked
+/// model, which needs the composite inertia only (written too: data.Ic[i] ends as the composite
+/// inertia of the subtree of i, as crba leaves it). Requires one body per coordinate (no mimics).
+/// Reads the kinematics. Writes data.Ic, data.IA, data.U, data.D. Throws NumericalError when a
+/// D_i is not positive.
+inline void articulated_inertias(const Model& model, Data& data, const Eigen::VectorXd* armature) {
+  body_inertias(model, data);
+  const int nb = model.nb();
+  for (int i = 0; i < nb; ++i) data.IA[static_cast<size_t>(i)].set(data.Ic[static_cast<size_t>(i)]);
+  for (int i = nb - 1; i > 0; --i) {
+    const auto ui = static_cast<size_t>(i);
+    const auto up = static_cast<size_t>(model.body(i).parent);
+    const Vector6 S = data.S.col(i - 1);
+    const Vector6 U = data.IA[ui] * S;
+    const double D = S.dot(U) + (armature ? (*armature)(i - 1) : 0.0);
+    if (!(D > 0.0))
+      throw NumericalError(
+          str("effective_mass: the articulated inertia is not positive definite (joint ", i, ")"));
+    data.U[ui] = U;
+    data.D(i - 1) = D;
+    data.IA[up].add_projected(data.IA[ui], U, D);
+    data.Ic[up] += data.Ic[ui];
+  }
+}
+
+/// The rest of the articulated-body algorithm for the spatial force f on body `ee` and no joint
+/// torque, after articulated_inertias: the bias forces along the path from `ee` to the base,
+///   pA = -f on ee;  u_i = -S_i^T pA_i,  pA_parent = pA_i + U_i u_i / D_i  (only the path carries one),
+/// the base acceleration a_0 = -IA_0^-1 pA_0 and the accelerations a_i = a_parent + S_i qdd_i,
+/// qdd_i = (u_i - U_i^T a_parent) / D_i, along the path (`all` false) or for every body (`all` true,
+/// with u_i = 0 off the path; then data.y = [a_0; qdd] = (H + diag(0, a))^-1 J^T f). Returns f^T a_ee
+/// = w^T (H + diag(0, a))^-1 w for w the generalized force of f.
+/// Reads data.IA, data.U, data.D, data.S. Writes data.path, data.on_path, data.u, data.A (and data.y
+/// when `all`). Throws NumericalError when IA_0 is not positive definite.
+inline double articulated_solve(const Model& model, Data& data, int ee, const Vector6& f, bool all) {
+  const int nb = model.nb();
+  int len = 0;
+  for (int i = ee; i > 0; i = model.body(i).parent) data.path[static_cast<size_t>(len++)] = i;
+  Vector6 pA = -f;
+  for (int k = 0; k < len; ++k) {  // from ee towards the base
+    const int i = data.path[static_cast<size_t>(k)];
+    const double ui = -data.S.col(i - 1).dot(pA);
+    data.u(i - 1) = ui;
+    pA.noalias() += data.U[static_cast<size_t>(i)] * (ui / data.D(i - 1));
+  }
+  if (!solve_spd6(data.IA[0].matrix(), -pA, data.A[0]))
+    throw NumericalError("effective_mass: the articulated inertia of the base is not positive definite");
+  if (!all) {
+    for (int k = len - 1; k >= 0; --k) {
+      const int i = data.path[static_cast<size_t>(k)];
+      const auto ui = static_cast<size_t>(i);
+      const Vector6& ap = data.A[static_cast<size_t>(model.body(i).parent)];
+      const double qdd = (data.u(i - 1) - data.U[ui].dot(ap)) / data.D(i - 1);
+      data.A[ui] = ap + data.S.col(i - 1) * qdd;
+    }
+    return f.dot(data.A[static_cast<size_t>(ee)]);
+  }
+  std::fill(data.on_path.begin(), data.on_path.end(), char(0));
+  for (int k = 0; k < len; ++k) data.on_path[static_cast<size_t>(data.path[static_cast<size_t>(k)])] = 1;
+  data.y.head<6>() = data.A[0];
+  for (int i = 1; i < nb; ++i) {
+    const auto ui = static_cast<size_t>(i);
+    const Vector6& ap = data.A[static_cast<size_t>(model.body(i).parent)];
+    const double u_i = data.on_path[ui] ? data.u(i - 1) : 0.0;
+    const double qdd = (u_i - data.U[ui].dot(ap)) / data.D(i - 1);
+    data.A[ui] = ap + data.S.col(i - 1) * qdd;
+    data.y(5 + i) = qdd;
+  }
+  return f.dot(data.A[static_cast<size_t>(ee)]);
+}
+
+/// The locked robot's inverse form f^T Ic_0^-1 f (Ic_0 = H_bb, the composite inertia of the whole
+/// robot about p_0, in data.Ic[0]); writes y_b = Ic_0^-1 f.
+inline double locked_inverse_form_composite(const Data& data, const Vector6& f, Vector6& yb) {
+  if (!solve_spd6(data.Ic[0].matrix(), f, yb))
+    throw NumericalError("effective_mass: the locked robot's inertia is not positive definite");
+  return f.dot(yb);
+}
+
+inline const Eigen::VectorXd* armature_of(const Model& model, const ContactJoints& joints) {
+  if (joints.model != JointModel::Armature) return nullptr;
+  require_size(joints.armature.size(), model.n(), "effective_mass", "armature");
+  return &joints.armature;
+}
+
 }  // namespace detail
 
 /// Inverse effective mass u^T J_v H^-1 J_v^T u (the denominator of Eq. 4) of the free-floating robot
@@ -49,93 +153,115 @@ inline bool solve_spd6(const Matrix6& A, const Vector6& b, Vector6& x) {
 /// f = [u; (p_e - p_0) x u] on the frame's body; the articulated-body algorithm at zero velocity
 /// finds the body accelerations it causes, and the result is f^T a_e (a_e the spatial acceleration
 /// of that body). All quantities are in inertial axes about the base origin p_0, as in crba, so the
-/// motion subspaces are data.S and inertias add without transforms:
-///   backward, i = n..1:  U_i = IA_i S_i, D_i = S_i^T U_i, u_i = -S_i^T pA_i,
-///                        IA_par += IA_i - U_i U_i^T / D_i, pA_par += pA_i + U_i u_i / D_i;
-///   base:                a_0 = -IA_0^-1 pA_0;
-///   forward, along the path from the base to the frame's body:
-///                        a_i = a_par + S_i (u_i - U_i^T a_par) / D_i,
-/// with IA_i the body inertias and pA = -f on the frame's body only. Cost: one 6x6 rank-one update
-/// per body, one 6x6 Cholesky, no n x n matrix; it beats crba + dense Cholesky (O(n^2) + O(n^3))
-/// from about kArticulatedMinJoints joints on (see integrated_effective_mass_fast).
-/// Reads the kinematics (data.R, data.p, data.S). Writes data.IA, data.pA, data.U, data.D, data.u,
-/// data.A. Allocation-free. Throws NumericalError when an articulated inertia is not positive definite.
+/// motion subspaces are data.S and inertias add without transforms (detail::articulated_inertias,
+/// detail::articulated_solve): one symmetric rank-one update of a 6x6 articulated inertia (kept as
+/// 3x3 blocks) per body, bias forces only along the path from the frame's body to the base, one 6x6
+/// Cholesky at the base, no n x n matrix.
+/// Reads the kinematics (data.R, data.p, data.S). Writes data.Ic (composite), data.IA, data.U,
+/// data.D, data.u, data.A, data.path. Allocation-free. Throws InputError for a model with mimic joints
+/// (use inverse_effective_mass), NumericalError when an articulated inertia is not positive definite.
 inline double inverse_effective_mass_articulated(const Model& model, Data& data, int frame,
                                                  const Vector3& u) {
-  detail::check_unit_direction(u, "effective_mass");
-  if (frame < 0 || frame >= static_cast<int>(model.frames().size()))
-    throw InputError(detail::str("effective_mass: frame index ", frame, " out of range"));
-  const Vector3 pe = frame_pose(model, data, frame).p;
-  if (!pe.allFinite())
-    throw NumericalError(detail::str("effective_mass: the position of frame '", model.frame(frame).name,
-                                     "' overflows double precision"));
-  const int nb = model.nb();
-  if (nb - 1 != model.n())  // a mimic joint couples bodies through one coordinate: not a tree recursion
+  const Vector6 f = detail::unit_point_force(model, data, frame, u);
+  if (model.nb() - 1 != model.n())  // a mimic joint couples bodies through one coordinate: not a tree recursion
     throw InputError(
         "inverse_effective_mass_articulated: the model has mimic joints; use inverse_effective_mass");
-  const int ee = model.frame(frame).body;
-  const Vector3& p0 = data.p[0];
-  Vector6 f;
-  f << u, (pe - p0).cross(u);
-  for (int i = 0; i < nb; ++i) {
-    const auto ui = static_cast<size_t>(i);
-    const Inertia& in = model.body(i).inertia;
-    const Matrix3& Ri = data.R[ui];
-    data.IA[ui] =
-        SpatialInertia::from_com(in.mass, data.p[ui] + Ri * in.com - p0, Ri * in.I * Ri.transpose()).matrix();
-    data.pA[ui].setZero();
-  }
-  data.pA[static_cast<size_t>(ee)] = -f;
-  for (int i = nb - 1; i > 0; --i) {
-    const auto ui = static_cast<size_t>(i);
-    const auto up = static_cast<size_t>(model.body(i).parent);
-    const Vector6 S = data.S.col(i - 1);
-    Vector6& U = data.U[ui];
-    U.noalias() = data.IA[ui] * S;
-    const double D = S.dot(U);
-    if (!(D > 0.0))
-      throw NumericalError(
-          detail::str("effective_mass: the articulated inertia is not positive definite (joint ", i, ")"));
-    data.D(i - 1) = D;
-    const double ui_ = -S.dot(data.pA[ui]);
-    data.u(i - 1) = ui_;
-    data.IA[up].noalias() += data.IA[ui] - U * (U.transpose() / D);
-    data.pA[up].noalias() += data.pA[ui] + U * (ui_ / D);
-  }
-  if (!detail::solve_spd6(data.IA[0], -data.pA[0], data.A[0]))
-    throw NumericalError("effective_mass: the articulated inertia of the base is not positive definite");
-  // forward pass along the path base -> ee only (the other bodies do not change f^T a_e): collect the
-  // path in data.path from the leaf, then walk it from the base
-  int len = 0;
-  for (int i = ee; i > 0; i = model.body(i).parent) data.path[static_cast<size_t>(len++)] = i;
-  for (int k = len - 1; k >= 0; --k) {
-    const int i = data.path[static_cast<size_t>(k)];
-    const auto ui = static_cast<size_t>(i);
-    const Vector6& ap = data.A[static_cast<size_t>(model.body(i).parent)];
-    const double qdd = (data.u(i - 1) - data.U[ui].dot(ap)) / data.D(i - 1);
-    data.A[ui] = ap + data.S.col(i - 1) * qdd;
-  }
-  return f.dot(data.A[static_cast<size_t>(ee)]);
+  detail::articulated_inertias(model, data, nullptr);
+  return detail::articulated_solve(model, data, model.frame(frame).body, f, false);
 }
 
-/// From this many joints on, integrated_effective_mass_fast uses the articulated-body recursion;
-/// below, crba and the dense Cholesky solve are faster (measured with ffsr-bench; see the README).
-inline constexpr int kArticulatedMinJoints = 8;
+/// The same inverse effective mass under the joint model `joints` (joint_models.hpp), in O(n):
+/// Free as above; Armature with the armature a_i added to each D_i (the recursion's form of
+/// H + diag(0, a)); Locked from the composite inertia of the whole robot, f^T Ic_0^-1 f (the 6x6
+/// H_bb, without the joint rows of H). Equal to inverse_effective_mass(model, data, frame, u, joints)
+/// after crba to rounding. Reads the kinematics. Writes data.Ic (composite) and, unless Locked, the
+/// fields of the recursion as above.
+inline double inverse_effective_mass_articulated(const Model& model, Data& data, int frame, const Vector3& u,
+                                                 const ContactJoints& joints) {
+  const Vector6 f = detail::unit_point_force(model, data, frame, u);
+  if (model.nb() - 1 != model.n())
+    throw InputError(
+        "inverse_effective_mass_articulated: the model has mimic joints; use inverse_effective_mass");
+  if (joints.model == JointModel::Locked) {
+    detail::body_inertias(model, data);
+    for (int i = model.nb() - 1; i > 0; --i)
+      data.Ic[static_cast<size_t>(model.body(i).parent)] += data.Ic[static_cast<size_t>(i)];
+    Vector6 yb;
+    return detail::locked_inverse_form_composite(data, f, yb);
+  }
+  detail::articulated_inertias(model, data, detail::armature_of(model, joints));
+  return detail::articulated_solve(model, data, model.frame(frame).body, f, false);
+}
 
-/// Integrated effective mass (Eq. 14) as integrated_effective_mass, by the faster of the two paths
-/// for the model's size: crba + dense Cholesky below kArticulatedMinJoints joints, the O(n)
-/// articulated-body recursion (inverse_effective_mass_articulated) from there on. The two agree to
-/// rounding (tested to 1e-10 relative). Writes the kinematics and either data.H, data.L, data.w,
-/// data.y (dense) or the articulated-body fields: do not rely on data.H afterwards.
+/// Kept for callers that chose the path by size: the articulated-body recursion is now the faster
+/// path at every size (ffsr-bench-pinocchio), so integrated_effective_mass_fast uses it from one joint on.
+inline constexpr int kArticulatedMinJoints = 1;
+
+/// Integrated effective mass (Eq. 14) as integrated_effective_mass, in O(n) by the articulated-body
+/// recursion (inverse_effective_mass_articulated); a model with mimic joints takes crba and the dense
+/// Cholesky solve. The two agree to rounding (tested to 1e-12 relative). Writes the kinematics and
+/// the recursion's fields (or data.H, data.L, data.w, data.y for mimics): do not rely on data.H afterwards.
 inline double integrated_effective_mass_fast(const Model& model, Data& data, const BasePose& base,
                                              const Eigen::Ref<const Eigen::VectorXd>& theta, int frame,
                                              const Vector3& u, double target_inverse_mass) {
-  if (model.n() < kArticulatedMinJoints || model.nb() - 1 != model.n()) {  // small, or mimic joints: dense
+  if (model.n() < kArticulatedMinJoints || model.nb() - 1 != model.n()) {  // mimic joints: dense
     crba(model, data, base, theta);
     return 1.0 / (inverse_effective_mass(model, data, frame, u) + target_inverse_mass);
   }
   forward_kinematics(model, data, base, theta);
   return 1.0 / (inverse_effective_mass_articulated(model, data, frame, u) + target_inverse_mass);
+}
+
+/// Integrated effective mass (Eq. 14) under the joint model `joints`, in O(n)
+/// (inverse_effective_mass_articulated with `joints`); mimic joints: crba and the dense path of
+/// joint_models.hpp. Writes the kinematics and the recursion's fields: do not rely on data.H afterwards.
+inline double integrated_effective_mass_fast(const Model& model, Data& data, const BasePose& base,
+                                             const Eigen::Ref<const Eigen::VectorXd>& theta, int frame,
+                                             const Vector3& u, double target_inverse_mass,
+                                             const ContactJoints& joints) {
+  if (model.nb() - 1 != model.n()) {
+    crba(model, data, base, theta);
+    return 1.0 / (inverse_effective_mass(model, data, frame, u, joints) + target_inverse_mass);
+  }
+  forward_kinematics(model, data, base, theta);
+  return 1.0 / (inverse_effective_mass_articulated(model, data, frame, u, joints) + target_inverse_mass);
+}
+
+/// Analytic gradient of the integrated effective mass in the joint angles under the joint model, at a
+/// fixed base pose, in O(n): the same formula as integrated_effective_mass_gradient
+/// (inverse_inertia_form_gradient: dq = 2 s . d(J y) - y^T dH y with q = 1/m_e, y = (H + diag(0, a))^-1 w,
+/// w = J_v^T u), with y the generalized acceleration of the articulated-body algorithm under the test
+/// force (detail::articulated_solve with every body) instead of a dense Cholesky solve; Locked: the
+/// composite inertias and detail::locked_inverse_form_gradient. dM_ie = -M_ie^2 d(1/m_e). Mimic joints:
+/// integrated_effective_mass_gradient. Runs forward_kinematics. Writes the recursion's fields,
+/// data.Ic (composite), data.y, data.V, data.F and grad (size n); not data.H. Returns M_ie.
+inline double integrated_effective_mass_gradient_fast(const Model& model, Data& data, const BasePose& base,
+                                                      const Eigen::Ref<const Eigen::VectorXd>& theta,
+                                                      int frame, const Vector3& u, double target_inverse_mass,
+                                                      const ContactJoints& joints,
+                                                      Eigen::Ref<Eigen::VectorXd> grad) {
+  if (model.nb() - 1 != model.n())
+    return integrated_effective_mass_gradient(model, data, base, theta, frame, u, target_inverse_mass, joints,
+                                              grad);
+  detail::require_size(grad.size(), model.n(), "integrated_effective_mass_gradient", "grad");
+  forward_kinematics(model, data, base, theta);
+  const Vector6 f = detail::unit_point_force(model, data, frame, u);
+  double inv_me;
+  if (joints.model == JointModel::Locked) {
+    detail::body_inertias(model, data);
+    for (int i = model.nb() - 1; i > 0; --i)
+      data.Ic[static_cast<size_t>(model.body(i).parent)] += data.Ic[static_cast<size_t>(i)];
+    Vector6 yb;
+    inv_me = detail::locked_inverse_form_composite(data, f, yb);
+    detail::locked_inverse_form_gradient(model, data, frame, u, yb, grad);
+  } else {
+    detail::articulated_inertias(model, data, detail::armature_of(model, joints));
+    inv_me = detail::articulated_solve(model, data, model.frame(frame).body, f, true);
+    detail::inverse_inertia_form_gradient_from_y(model, data, frame, f.head<3>(), Vector3::Zero(), grad);
+  }
+  const double M = 1.0 / (inv_me + target_inverse_mass);
+  grad *= -M * M;
+  return M;
 }
 
 }  // namespace ffsr

@@ -4,6 +4,8 @@
 #include "ffsr/algorithm/crba.hpp"
 #include "ffsr/model/target.hpp"
 
+#include <algorithm>
+
 namespace ffsr {
 namespace detail {
 
@@ -128,7 +130,7 @@ inline double inverse_inertia_form_gradient_factored(const Model& model, Data& d
 /// moving the subtree of k by the twist S_k. O(n) after the Cholesky factorization. For s = [u; 0]
 /// q is the inverse effective mass of Eq. 4; for s = [u; rho x u], that at the point p_e + rho
 /// (rho held fixed in the inertial frame). Reads data.H (crba) and the kinematics. Writes data.L,
-/// data.w, data.y, data.V, data.F and `grad` (size n). Returns q.
+/// data.w, data.y, data.V, data.F, data.on_path and `grad` (size n). Returns q.
 inline double inverse_inertia_form_gradient(const Model& model, Data& data, int frame, const Vector6& s,
                                             Eigen::Ref<Eigen::VectorXd> grad) {
   detail::require_size(grad.size(), model.n(), "inverse_inertia_form_gradient", "grad");
@@ -139,16 +141,18 @@ inline double inverse_inertia_form_gradient(const Model& model, Data& data, int 
 }
 
 namespace detail {
-/// inverse_inertia_form_gradient with data.L already the Cholesky factor of data.H (callers that
-/// evaluate several forms at one configuration factorize once). No argument checks.
-inline double inverse_inertia_form_gradient_factored(const Model& model, Data& data, int frame,
-                                                     const Vector6& s, Eigen::Ref<Eigen::VectorXd> grad) {
-  const Vector3 u = s.head<3>(), mc = s.tail<3>();
-  detail::jacobian_transpose_times(model, data, frame, u, mc);
-  data.y = data.w;
-  detail::cholesky_forward(data.L, data.y);
-  const double q = data.y.squaredNorm();
-  detail::cholesky_backward(data.L, data.y);  // y = H^-1 w
+/// Marks the bodies on the path from `body` to the base (the base included) in data.on_path.
+inline void mark_path(const Model& model, Data& data, int body) {
+  std::fill(data.on_path.begin(), data.on_path.end(), char(0));
+  for (int i = body; i >= 0; i = model.body(i).parent) data.on_path[static_cast<size_t>(i)] = 1;
+}
+
+/// The gradient part of inverse_inertia_form_gradient for s = [u; mc], given y = H^-1 w in data.y
+/// (whichever way it was solved): the velocities V_i and subtree momenta F_i of the bodies for the
+/// generalized velocity y, then per joint k: 2 s . d(J y)/dtheta_k - 2 (V_k x S_k) . F_k. O(n).
+/// Reads data.y and the kinematics. Writes data.V, data.F, data.on_path and grad (size n).
+inline void inverse_inertia_form_gradient_from_y(const Model& model, Data& data, int frame, const Vector3& u,
+                                                 const Vector3& mc, Eigen::Ref<Eigen::VectorXd> grad) {
   const int nb = model.nb();
   const Vector3& p0 = data.p[0];
   // velocities and momenta of the bodies for the generalized velocity y
@@ -159,14 +163,12 @@ inline double inverse_inertia_form_gradient_factored(const Model& model, Data& d
   for (int i = 0; i < nb; ++i) {
     const auto ui = static_cast<size_t>(i);
     const Inertia& in = model.body(i).inertia;
-    const Matrix3& Ri = data.R[ui];
-    data.F[ui] =
-        SpatialInertia::from_com(in.mass, data.p[ui] + Ri * in.com - p0, Ri * in.I * Ri.transpose()) *
-        data.V[ui];
+    data.F[ui] = SpatialInertia::from_body(in.mass, in.com, in.I, data.R[ui], data.p[ui] - p0) * data.V[ui];
   }
   for (int i = nb - 1; i > 0; --i)
     data.F[static_cast<size_t>(model.body(i).parent)] += data.F[static_cast<size_t>(i)];
   const int ee_body = model.frame(frame).body;
+  mark_path(model, data, ee_body);
   const Vector3 pe = frame_pose(model, data, frame).p;
   const Vector6& Vee = data.V[static_cast<size_t>(ee_body)];
   grad.setZero();
@@ -175,13 +177,26 @@ inline double inverse_inertia_form_gradient_factored(const Model& model, Data& d
     const Vector6 S = data.S.col(i - 1);
     const double yHy = 2.0 * cross_motion(data.V[ui], S).dot(data.F[ui]);
     double sdv = 0.0;
-    if (supports(model, i, ee_body)) {
+    if (data.on_path[ui]) {  // joint i carries the end-effector
       const Vector6 X = cross_motion(S, Vee - data.V[ui]);  // d(V_ee)/dtheta_k, referred to p0
       const Vector3 dp = S.head<3>() + S.tail<3>().cross(pe - p0);
       sdv = u.dot(X.head<3>() + X.tail<3>().cross(pe - p0) + Vee.tail<3>().cross(dp)) + mc.dot(X.tail<3>());
     }
     grad(model.body(i).coord) += 2.0 * sdv - yHy;
   }
+}
+
+/// inverse_inertia_form_gradient with data.L already the Cholesky factor of data.H (callers that
+/// evaluate several forms at one configuration factorize once). No argument checks.
+inline double inverse_inertia_form_gradient_factored(const Model& model, Data& data, int frame,
+                                                     const Vector6& s, Eigen::Ref<Eigen::VectorXd> grad) {
+  const Vector3 u = s.head<3>(), mc = s.tail<3>();
+  detail::jacobian_transpose_times(model, data, frame, u, mc);
+  data.y = data.w;
+  detail::cholesky_forward(data.L, data.y);
+  const double q = data.y.squaredNorm();
+  detail::cholesky_backward(data.L, data.y);  // y = H^-1 w
+  inverse_inertia_form_gradient_from_y(model, data, frame, u, mc, grad);
   return q;
 }
 }  // namespace detail

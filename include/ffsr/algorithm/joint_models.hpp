@@ -107,18 +107,19 @@ inline double locked_inverse_form(const Model& model, Data& data, int frame, con
 /// dq/dtheta_k = 2 y_b . d s_b/dtheta_k - y_b^T dH_bb/dtheta_k y_b, where d s_b = [0; dp_e x u]
 /// (dp_e the motion of the contact point for the twist S_k, when joint k carries it) and, as the
 /// subtree of k (composite inertia Ic_k) moves by S_k, y^T dH_bb y = -2 (S_k x y) . (Ic_k y).
-/// Reads data.Ic (crba), data.S and the kinematics. Writes grad (size n).
+/// Reads data.Ic (crba), data.S and the kinematics. Writes data.on_path and grad (size n). O(n).
 inline void locked_inverse_form_gradient(const Model& model, Data& data, int frame, const Vector3& u,
                                          const Vector6& yb, Eigen::Ref<Eigen::VectorXd> grad) {
   const int ee_body = model.frame(frame).body;
   const Vector3 pe = frame_pose(model, data, frame).p;
   const Vector3& p0 = data.p[0];
+  mark_path(model, data, ee_body);
   grad.setZero();
   for (int i = 1; i < model.nb(); ++i) {
     const Vector6 S = data.S.col(i - 1);
     const double yHy = -2.0 * cross_motion(S, yb).dot(data.Ic[static_cast<size_t>(i)] * yb);
     double dsy = 0.0;
-    if (supports(model, i, ee_body)) {
+    if (data.on_path[static_cast<size_t>(i)]) {  // joint i carries the contact point
       const Vector3 dp = S.head<3>() + S.tail<3>().cross(pe - p0);
       dsy = yb.tail<3>().dot(dp.cross(u));
     }

@@ -17,6 +17,16 @@ inline void check_configuration(const Model& model, const BasePose& base,
   if (qn < 1e-9) throw InputError(str(where, ": base orientation quaternion has zero norm"));
 }
 
+/// C = A B for 3x3 matrices, written out (27 products; Eigen's lazy product is a call at -O2).
+inline void multiply3(const Matrix3& A, const Matrix3& B, Matrix3& C) {
+  for (int c = 0; c < 3; ++c) {
+    const double b0 = B(0, c), b1 = B(1, c), b2 = B(2, c);
+    C(0, c) = A(0, 0) * b0 + A(0, 1) * b1 + A(0, 2) * b2;
+    C(1, c) = A(1, 0) * b0 + A(1, 1) * b1 + A(1, 2) * b2;
+    C(2, c) = A(2, 0) * b0 + A(2, 1) * b1 + A(2, 2) * b2;
+  }
+}
+
 /// 0, 1 or 2 when the unit vector `axis` is +-x, +-y or +-z exactly (as most URDF joint axes are), else -1.
 inline int coordinate_axis(const Vector3& axis) {
   if (axis.y() == 0.0 && axis.z() == 0.0) return 0;
@@ -43,30 +53,61 @@ inline void forward_kinematics(const Model& model, Data& data, const BasePose& b
     const Body& b = model.body(i);
     const auto ui = static_cast<size_t>(i);
     const auto pi = static_cast<size_t>(b.parent);
-    const Matrix3 Rj = data.R[pi].lazyProduct(b.tree.R);
-    const Vector3 pj = data.p[pi] + data.R[pi] * b.tree.p;
-    const Vector3 z = Rj * b.joint.axis;
+    const Matrix3& Rp = data.R[pi];
+    // the joint frame in o; a joint origin without rotation (rpy 0 0 0, most URDF joints) keeps the
+    // parent's axes as they are (the product with the identity would give the same numbers)
+    Matrix3 Rj;
+    if (b.tree.R == Matrix3::Identity())
+      Rj = Rp;
+    else
+      detail::multiply3(Rp, b.tree.R, Rj);
+    const Vector3& t = b.tree.p;
+    const Vector3& pp = data.p[pi];
+    const Vector3 pj(pp(0) + (Rp(0, 0) * t(0) + Rp(0, 1) * t(1) + Rp(0, 2) * t(2)),
+                     pp(1) + (Rp(1, 0) * t(0) + Rp(1, 1) * t(1) + Rp(1, 2) * t(2)),
+                     pp(2) + (Rp(2, 0) * t(0) + Rp(2, 1) * t(1) + Rp(2, 2) * t(2)));
+    const Vector3& ax = b.joint.axis;
+    const int a = detail::coordinate_axis(ax);
+    // the joint axis in o: for an axis +-x, +-y or +-z (exactly +-1 after normalization) a column of Rj
+    Vector3 z;
+    if (a >= 0)
+      z = ax(a) * Rj.col(a);
+    else
+      z = Vector3(Rj(0, 0) * ax(0) + Rj(0, 1) * ax(1) + Rj(0, 2) * ax(2),
+                  Rj(1, 0) * ax(0) + Rj(1, 1) * ax(1) + Rj(1, 2) * ax(2),
+                  Rj(2, 0) * ax(0) + Rj(2, 1) * ax(1) + Rj(2, 2) * ax(2));
     const double q = b.joint_position(theta), k = b.multiplier;
+    double* S = data.S.col(i - 1).data();
     if (b.joint.type == JointType::Revolute) {
-      const int a = detail::coordinate_axis(b.joint.axis);
+      Matrix3& R = data.R[ui];
       if (a >= 0) {  // about +-x, +-y or +-z: a plane rotation of two columns (12 products, not 27 + 15)
         double s, c;
         detail::sin_cos(q, s, c);
-        s *= b.joint.axis(a);
+        s *= ax(a);
         const int c1 = (a + 1) % 3, c2 = (a + 2) % 3;
-        Matrix3& R = data.R[ui];
-        R.col(a) = Rj.col(a);
-        R.col(c1) = c * Rj.col(c1) + s * Rj.col(c2);
-        R.col(c2) = c * Rj.col(c2) - s * Rj.col(c1);
+        for (int r = 0; r < 3; ++r) {
+          R(r, a) = Rj(r, a);
+          R(r, c1) = c * Rj(r, c1) + s * Rj(r, c2);
+          R(r, c2) = c * Rj(r, c2) - s * Rj(r, c1);
+        }
       } else {
-        data.R[ui].noalias() = Rj.lazyProduct(rotation_about(b.joint.axis, q));
+        detail::multiply3(Rj, rotation_about(ax, q), R);
       }
       data.p[ui] = pj;
-      data.S.col(i - 1) << k * (pj - data.p[0]).cross(z), k * z;
+      const double d0 = pj(0) - data.p[0](0), d1 = pj(1) - data.p[0](1), d2 = pj(2) - data.p[0](2);
+      S[0] = k * (d1 * z(2) - d2 * z(1));  // (p_j - p_0) x z
+      S[1] = k * (d2 * z(0) - d0 * z(2));
+      S[2] = k * (d0 * z(1) - d1 * z(0));
+      S[3] = k * z(0);
+      S[4] = k * z(1);
+      S[5] = k * z(2);
     } else {
       data.R[ui] = Rj;
       data.p[ui] = pj + z * q;
-      data.S.col(i - 1) << k * z, Vector3::Zero();
+      S[0] = k * z(0);
+      S[1] = k * z(1);
+      S[2] = k * z(2);
+      S[3] = S[4] = S[5] = 0.0;
     }
   }
 }

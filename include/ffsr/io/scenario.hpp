@@ -43,8 +43,6 @@ struct ModelLoadKeys {
   std::set<std::string> given;  ///< the keys that were set (bus-mass, the mount keys, ...)
   /// The loader options; InputError naming the key on a bad value.
   UrdfOptions build(const std::string& end_effector) const;
-  /// The keys as given (the resolved scenario of the JSON result).
-  nlohmann::json to_json() const;
 };
 
 /// The keys of a scenario, as read (units of the file: degrees where the key says so).
@@ -92,8 +90,28 @@ struct ScenarioKeys {
 /// The kind of a key's value: one parser each, from a TOML node and from text.
 enum class KeyKind { Text, Texts, Number, Numbers, Integer, Boolean };
 
-/// One key of a scenario: its name (as in the file; the flag is "--" + name), kind, help text and
-/// how it is set. Both setters throw InputError naming the key ("--name: ...").
+/// What part of the scenario a key describes (the sections of docs/scenario-keys.md). A subcommand
+/// takes the keys of the groups it evaluates: inspect, contact and map the subject (Robot, Start,
+/// Target, Contact), the main job all of them.
+enum class KeyGroup {
+  Robot,        ///< the URDF, its end-effector and how it is loaded (bus, locks, repairs)
+  Start,        ///< the start state: joint angles, base pose
+  Target,       ///< the target's mass, inertia, attitude, motion, contact point and normal
+  TargetPlace,  ///< where the target is (target-position): the capture point, distances
+  Contact,      ///< the contact law and the approach speed
+  Planner,      ///< the plain and the paper's-method runs: tasks, time, step, gains
+  Global,       ///< the global capture optimization
+  JointModels,  ///< the joints during the contact and the multibody reference's servo
+  Shapes,       ///< collision shapes and the clearance
+};
+
+struct Scenario;
+
+/// One key of a scenario, everything about it in one entry: its name (as in the file; the flag is
+/// "--" + name), kind, help text, group, whether a file must give it, how it is set, its own check
+/// and its echo in the result's resolved scenario. The setters and the check throw InputError naming
+/// the key ("--name: ..."). Checks that involve several keys or the robot are made where the problem
+/// is built (build_scenario).
 struct ScenarioKey {
   std::string name;
   KeyKind kind;
@@ -101,6 +119,31 @@ struct ScenarioKey {
   std::string default_text;  ///< shown in a command's help; empty: none shown
   std::function<void(ScenarioKeys&, const toml::node&)> from_toml;
   std::function<void(ScenarioKeys&, const std::string&)> from_text;  ///< lists: comma-separated
+  KeyGroup group = KeyGroup::Planner;
+  bool required = false;  ///< a scenario file must give it (required_scenario_keys)
+  /// The key's own check (a range, a name among the known ones); null: none beyond its kind.
+  std::function<void(const ScenarioKeys&)> check;
+  /// Writes the key into the resolved scenario of the result (the "scenario" object of
+  /// scenario_json); null: the key is not echoed.
+  std::function<void(const Scenario&, nlohmann::json&)> echo;
+
+  // building the table: key(...).in(KeyGroup::Robot).needed().checked(f).echoed(f)
+  ScenarioKey& in(KeyGroup g) {
+    group = g;
+    return *this;
+  }
+  ScenarioKey& needed() {
+    required = true;
+    return *this;
+  }
+  ScenarioKey& checked(std::function<void(const ScenarioKeys&)> f) {
+    check = std::move(f);
+    return *this;
+  }
+  ScenarioKey& echoed(std::function<void(const Scenario&, nlohmann::json&)> f) {
+    echo = std::move(f);
+    return *this;
+  }
 };
 
 /// Every key, in the order a command lists them.
@@ -108,8 +151,13 @@ const std::vector<ScenarioKey>& scenario_keys();
 /// The key named `name`, or null.
 const ScenarioKey* find_scenario_key(const std::string& name);
 
-/// Keys a scenario file must name (the others have defaults).
+/// Keys a scenario file must name (the others have defaults): the table's required keys.
 const std::vector<std::string>& required_scenario_keys();
+/// The names of the keys of `groups`, in the table's order.
+std::set<std::string> scenario_key_names(std::initializer_list<KeyGroup> groups);
+/// The known key nearest to `name` by edit distance (for "did you mean"), or "" when none is close
+/// (more than a third of the name's letters apart).
+std::string nearest_scenario_key(const std::string& name);
 
 /// Reads a scenario file: every key and the [uncertainty] table (kept, parsed by uncertainty_spec).
 /// `extra_keys`: further keys the caller allows (a command's output keys), kept as text in
@@ -121,6 +169,13 @@ ScenarioKeys read_scenario_text(const std::string& text, const std::string& wher
                                 const std::string& file = "", const std::set<std::string>& extra_keys = {});
 /// Sets key `name` from text, as an override (a flag overrides the file). InputError naming the key.
 void override_scenario_key(ScenarioKeys& keys, const std::string& name, const std::string& text);
+/// Runs every key's own check (ScenarioKey::check; build_scenario does). InputError naming the key.
+void check_scenario_keys(const ScenarioKeys& keys);
+/// The line of key `name` in the scenario file (0: not in the file, or overridden by a flag).
+long scenario_key_line(const ScenarioKeys& keys, const std::string& name);
+/// A message that starts with a key's flag ("--duration: ..."), located in the file when the file
+/// gave that key: "scenario FILE:LINE: --duration: ...". Unchanged otherwise.
+std::string located_key_message(const ScenarioKeys& keys, const std::string& message);
 
 struct SceneGeometry;  // io/scenario_geometry.hpp
 
@@ -137,10 +192,11 @@ struct Scenario {
   UrdfReport report;                                  ///< what the loader did to the file
   GlobalObjective objective = GlobalObjective::Mass;  ///< the global run's objective
   std::uint64_t seed = 1;                             ///< the global search's seed
-  bool hold_base_attitude = false;  ///< base-attitude = hold: the optimized run's CaptureOptions::hold_base_attitude
+  bool hold_base_attitude =
+      false;  ///< base-attitude = hold: the optimized run's CaptureOptions::hold_base_attitude
   /// Multibody reference: per-joint PD gains holding the pre-contact rates (N m/rad, N m s/rad; size n).
   Eigen::VectorXd joint_stiffness, joint_damping;
-  std::shared_ptr<const SceneGeometry> geometry;      ///< shapes and clearance; null: none given
+  std::shared_ptr<const SceneGeometry> geometry;  ///< shapes and clearance; null: none given
 };
 
 /// A URDF given as text for a built-in scenario whose `urdf` key names it (not read from disk).
@@ -166,4 +222,7 @@ UncertaintySpec uncertainty_spec(const ScenarioKeys& keys, std::optional<std::ui
 }  // namespace ffsr
 
 #include "ffsr/io/scenario_geometry.hpp"
+#include "ffsr/io/detail/scenario_values.hxx"
+#include "ffsr/io/detail/scenario_keys.hxx"
 #include "ffsr/io/detail/scenario.hxx"
+#include "ffsr/io/detail/uncertainty_table.hxx"

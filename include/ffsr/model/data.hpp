@@ -17,6 +17,9 @@ struct Data {
         p(static_cast<size_t>(model.nb())),
         S(6, model.nb() - 1),
         Ic(static_cast<size_t>(model.nb())),
+        Fc(model.nb() - 1, 6),
+        last(static_cast<size_t>(model.nb())),
+        nsub(static_cast<size_t>(model.nb())),
         H(model.nv(), model.nv()),
         L(model.nv(), model.nv()),
         J(6, model.nv()),
@@ -34,8 +37,10 @@ struct Data {
         U(static_cast<size_t>(model.nb())),
         D(model.n()),
         u(model.n()),
-        path(static_cast<size_t>(model.nb())) {
+        path(static_cast<size_t>(model.nb())),
+        on_path(static_cast<size_t>(model.nb())) {
     S.setZero();
+    Fc.setZero();
     H.setZero();
     L.setZero();
     J.setZero();
@@ -50,6 +55,10 @@ struct Data {
   Eigen::Matrix<double, 6, Eigen::Dynamic> S;
   // --- CRBA --------------------------------------------------------------------------------------
   std::vector<SpatialInertia> Ic;  ///< composite inertias about the base origin, inertial axes
+  Eigen::Matrix<double, Eigen::Dynamic, 6> Fc;  ///< (Ic_i S_i)^T, one row per moving body
+  /// The tree's numbering, written by crba: last[i] is the largest body index in the subtree of i,
+  /// nsub[i] the number of bodies in it (depth-first numbering: the subtree is [i, last[i]]).
+  std::vector<int> last, nsub;
   Eigen::MatrixXd H;               ///< (6+n)x(6+n) joint-space inertia
   Eigen::MatrixXd L;               ///< Cholesky factor of H (lower), written by the solves
   // --- Jacobians -------------------------------------------------------------------------------
@@ -65,11 +74,12 @@ struct Data {
   Eigen::VectorXd tau;
   Eigen::Matrix<double, 6, Eigen::Dynamic> HbInv_Hbm;  ///< H_b^-1 H_bm
   // --- articulated-body recursion (RBDA 7.3; inertial axes about the base origin) -------------
-  std::vector<Matrix6> IA;  ///< articulated inertias
+  std::vector<ArticulatedInertia> IA;  ///< articulated inertias
   std::vector<Vector6> pA;  ///< articulated bias forces
   std::vector<Vector6> U;   ///< IA_i S_i
   Eigen::VectorXd D, u;     ///< S_i^T U_i and tau_i - S_i^T pA_i, one per joint
   std::vector<int> path;    ///< bodies from a leaf to the base (scratch of one call, never read after it)
+  std::vector<char> on_path;  ///< 1 for the bodies of `path` (scratch of one call)
 };
 
 }  // namespace ffsr

@@ -79,7 +79,8 @@ inline void check_capture_input(const CaptureProblem& pb, const CaptureTask& tas
   detail::require_finite(opt.feedback, where, "feedback gain");
   if (opt.feedback < 0) throw InputError(str(where, ": feedback gain must be >= 0"));
   if (!std::isfinite(opt.max_joint_rate) || opt.max_joint_rate < 0)
-    throw InputError(str(where, ": max joint rate must be >= 0 (0: not limited), got ", opt.max_joint_rate));
+    throw JointRateLimitError(
+        str(where, ": max joint rate must be >= 0 (0: not limited), got ", opt.max_joint_rate));
   if (opt.duration / opt.step > 1e7)
     throw InputError(
         str(where, ": duration / step = ", opt.duration / opt.step, " steps is too many (at most 1e7)"));

@@ -924,7 +924,7 @@ inline GlobalCaptureResult plan_capture_global(const CaptureProblem& pb, const C
   try {
     const CaptureResult plain = integrate_capture(pb, task, quiet, setup, none, where);
     if (o.max_joint_rate > 0 && plain.max_joint_rate > o.max_joint_rate)
-      throw InputError(str(where, ": max joint rate ", o.max_joint_rate * 180 / M_PI,
+      throw JointRateLimitError(str(where, ": max joint rate ", o.max_joint_rate * 180 / M_PI,
                            " deg/s is below what the task alone needs (", plain.max_joint_rate * 180 / M_PI,
                            " deg/s)"));
     extra.push_back(plain.theta);

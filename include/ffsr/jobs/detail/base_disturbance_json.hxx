@@ -1,4 +1,4 @@
-// ffsr/io/detail/base_disturbance_json.hxx -- the impact disturbance of the base
+// ffsr/jobs/detail/base_disturbance_json.hxx -- the impact disturbance of the base
 // (algorithm/base_disturbance.hpp) of each run of the main job, as JSON.
 #pragma once
 

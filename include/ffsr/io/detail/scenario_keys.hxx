@@ -1,0 +1,496 @@
+// ffsr/io/detail/scenario_keys.hxx -- the key table of ffsr/io/scenario.hpp (every key in one entry:
+// name, kind, help, group, required, check, echo) and the reader of a scenario file. Adding a key is
+// one entry here, its member in ScenarioKeys and its line in docs/scenario-keys.md.
+#pragma once
+
+#include <fstream>
+
+namespace ffsr {
+namespace detail {
+
+// --- echoes of the resolved scenario that are not the value as stored -------------------------------
+
+/// The value as stored, only when the key was given.
+template <class T>
+std::function<void(const Scenario&, nlohmann::json&)> echo_given(const char* name, T ScenarioKeys::*member) {
+  return [name, member](const Scenario& sc, nlohmann::json& j) {
+    if (sc.keys.given.count(name)) j[name] = sc.keys.*member;
+  };
+}
+
+/// A key of the bus: echoed with bus-mass only; `zero`: a vector that was not given is 0,0,0.
+inline std::function<void(const Scenario&, nlohmann::json&)> echo_bus(
+    const char* name, std::vector<double> ModelLoadKeys::*member, bool zero = true) {
+  return [name, member, zero](const Scenario& sc, nlohmann::json& j) {
+    if (!sc.keys.load.given.count("bus-mass")) return;
+    const std::vector<double>& v = sc.keys.load.*member;
+    j[name] = v.empty() && zero ? std::vector<double>{0, 0, 0} : v;
+  };
+}
+
+/// A per-joint vector as resolved by the problem (one value per joint).
+inline nlohmann::json joint_values_json(const Eigen::VectorXd& v) {
+  return std::vector<double>(v.data(), v.data() + v.size());
+}
+
+/// A key of the shapes: echoed when the scenario uses shapes (scenario_uses_geometry).
+template <class T>
+std::function<void(const Scenario&, nlohmann::json&)> echo_shape(const char* name, T ScenarioKeys::*member) {
+  return [name, member](const Scenario& sc, nlohmann::json& j) {
+    if (scenario_uses_geometry(sc.keys)) j[name] = sc.keys.*member;
+  };
+}
+
+/// "given and not a positive finite number": the check of an optional limit.
+inline void check_positive_if_given(const ScenarioKeys& k, const char* name, double value) {
+  if (k.given.count(name) && !(finite(value, name) > 0))
+    throw InputError(str("--", name, ": must be positive, got ", value));
+}
+
+// --- the keys ------------------------------------------------------------------------------------
+
+#define FFSR_KEY(name, member, ...) \
+  make_key(                         \
+      name, +[](ScenarioKeys& k) -> decltype(k.member)& { return k.member; }, __VA_ARGS__)
+
+/// The robot, its start state, the target and the contact law: what inspect, contact and map evaluate.
+inline void add_subject_keys(std::vector<ScenarioKey>& keys) {
+  using G = KeyGroup;
+  using K = ScenarioKeys;
+  using L = ModelLoadKeys;
+  keys.push_back(FFSR_KEY("urdf", urdf, "Robot URDF (relative to the scenario file)").in(G::Robot).needed());
+  keys.push_back(FFSR_KEY("end-effector", end_effector, "End-effector frame (default: the single leaf link)")
+                     .in(G::Robot)
+                     .echoed(echo_given("end-effector", &K::end_effector)));
+  keys.push_back(FFSR_KEY("bus-mass", load.bus_mass,
+                          "Mount the URDF on a spacecraft bus of this mass, kg (the bus is the base)")
+                     .in(G::Robot)
+                     .echoed([](const Scenario& sc, nlohmann::json& j) {
+                       if (sc.keys.load.given.count("bus-mass")) j["bus-mass"] = sc.keys.load.bus_mass;
+                     }));
+  keys.push_back(
+      FFSR_KEY("bus-inertia", load.bus_inertia,
+               "Bus inertia about its centre of mass (bus frame): Ixx,Iyy,Izz[,Ixy,Ixz,Iyz], kg m^2")
+          .in(G::Robot)
+          .echoed(echo_bus("bus-inertia", &L::bus_inertia, false)));
+  keys.push_back(FFSR_KEY("bus-com", load.bus_com, "Bus centre of mass in the bus frame, m (default 0,0,0)")
+                     .in(G::Robot)
+                     .echoed(echo_bus("bus-com", &L::bus_com)));
+  keys.push_back(FFSR_KEY("mount-xyz", load.mount_xyz,
+                          "Position of the URDF's root link in the bus frame, m (default 0,0,0)")
+                     .in(G::Robot)
+                     .echoed(echo_bus("mount-xyz", &L::mount_xyz)));
+  keys.push_back(
+      FFSR_KEY("mount-rpy-deg", load.mount_rpy_deg,
+               "Attitude of the URDF's root link in the bus frame, roll,pitch,yaw deg (default 0,0,0)")
+          .in(G::Robot)
+          .echoed(echo_bus("mount-rpy-deg", &L::mount_rpy_deg)));
+  keys.push_back(FFSR_KEY("lock-joints", load.lock_joints,
+                          "Joints frozen at a value, name=value (rad or m), comma-separated")
+                     .in(G::Robot));
+  keys.push_back(FFSR_KEY("inertia-repair", load.inertia_repair,
+                          "Inertias breaking the triangle inequality: none (error) or balance", "none")
+                     .in(G::Robot));
+  keys.push_back(
+      FFSR_KEY("min-mass", load.min_mass, "Links lighter than this get this mass, kg (0: off)", "0")
+          .in(G::Robot));
+  keys.push_back(FFSR_KEY("min-inertia", load.min_inertia,
+                          "Principal moments below this are raised to it, kg m^2 (0: off)", "0")
+                     .in(G::Robot));
+  keys.push_back(FFSR_KEY("end-effector-offset", load.end_effector_offset,
+                          "Contact point in the end-effector frame, m (x,y,z)")
+                     .in(G::Robot)
+                     .echoed([](const Scenario& sc, nlohmann::json& j) {
+                       const auto& v = sc.keys.load.end_effector_offset;
+                       if (!v.empty()) j["end-effector-offset"] = v;
+                     }));
+  keys.push_back(FFSR_KEY("joints-deg", joints_deg, "Initial joint angles, deg").in(G::Start).needed());
+  keys.push_back(FFSR_KEY("base-position", base_position, "Initial base position, m").in(G::Start));
+  keys.push_back(
+      FFSR_KEY("base-rpy-deg", base_rpy_deg, "Initial base attitude (roll, pitch, yaw), deg").in(G::Start));
+  keys.push_back(FFSR_KEY("target-mass", target_mass, "Target mass, kg").in(G::Target).needed());
+  keys.push_back(FFSR_KEY("target-inertia", target_inertia,
+                          "Target inertia: Ixx,Iyy,Izz[,Ixy,Ixz,Iyz], kg m^2 (target frame)")
+                     .in(G::Target)
+                     .needed());
+  keys.push_back(FFSR_KEY("target-position", target_position, "Target centre of mass at t = 0, m")
+                     .in(G::TargetPlace)
+                     .needed());
+  keys.push_back(FFSR_KEY("target-rpy-deg", target_rpy_deg, "Target attitude at t = 0, deg").in(G::Target));
+  keys.push_back(FFSR_KEY("target-angular-velocity-deg", target_angular_velocity_deg,
+                          "Target spin (target frame), deg/s")
+                     .in(G::Target)
+                     .needed());
+  keys.push_back(FFSR_KEY("target-velocity", target_velocity, "Target linear velocity, m/s").in(G::Target));
+  keys.push_back(FFSR_KEY("contact-offset", contact_offset,
+                          "r_tp: contact point from the target centre of mass (target frame), m")
+                     .in(G::Target)
+                     .needed());
+  keys.push_back(FFSR_KEY("normal", normal, "u_n: contact normal (target frame)").in(G::Target).needed());
+  keys.push_back(FFSR_KEY("model", model, "Hysteresis damping law (Table 1)").in(G::Contact).needed());
+  keys.push_back(FFSR_KEY("stiffness", stiffness, "K, N/m^alpha").in(G::Contact).needed());
+  keys.push_back(FFSR_KEY("exponent", exponent, "alpha").in(G::Contact).needed());
+  keys.push_back(FFSR_KEY("restitution", restitution, "c_r, 0 < c_r <= 1").in(G::Contact).needed());
+  keys.push_back(
+      FFSR_KEY("approach-speed", approach_speed, "End-effector speed along the normal at the capture, m/s")
+          .in(G::Contact)
+          .needed());
+}
+
+/// The plain and the paper's-method runs.
+inline void add_planner_keys(std::vector<ScenarioKey>& keys) {
+  using K = ScenarioKeys;
+  keys.push_back(FFSR_KEY("task", task, "Optimized run's task: position or pose").needed());
+  keys.push_back(
+      FFSR_KEY("task-axes", task_axes, "Position task: constrained inertial axes, e.g. xy", "xyz"));
+  keys.push_back(FFSR_KEY("baseline-task", baseline_task, "Plain run's task (default: the optimized run's)")
+                     .echoed([](const Scenario& sc, nlohmann::json& j) {
+                       j["baseline-task"] =
+                           sc.keys.baseline_task.empty() ? sc.keys.task : sc.keys.baseline_task;
+                     }));
+  keys.push_back(FFSR_KEY("final-rpy-deg", final_rpy_deg,
+                          "Pose task: final end-effector orientation (default: hold the initial)")
+                     .echoed(echo_given("final-rpy-deg", &K::final_rpy_deg)));
+  keys.push_back(FFSR_KEY("duration", duration, "Task time T, s").needed());
+  keys.push_back(FFSR_KEY("step", step, "RK4 step, s").needed());
+  keys.push_back(FFSR_KEY("gain", gain, "rho of Eq. 30 (< 0 lowers the objective)").needed());
+  keys.push_back(FFSR_KEY("feedback", feedback, "Tracking feedback gain, 1/s", "1"));
+  keys.push_back(FFSR_KEY("tolerance", tolerance, "Required capture-point accuracy, m").needed());
+  keys.push_back(FFSR_KEY("orientation-tolerance-deg", orientation_tolerance_deg,
+                          "Pose task: required orientation accuracy, deg", "0.5"));
+  keys.push_back(FFSR_KEY(
+      "objective", objective,
+      "mass (M_ie, the paper's), exact-force, or multibody-force (CVODE peak; global search only, the "
+      "paper's method then descends M_ie)",
+      "mass"));
+  // the spacecraft's side: the reaction-null-space approach
+  keys.push_back(
+      FFSR_KEY("base-attitude", base_attitude,
+               "Optimized run: free, or hold (the base's angular velocity stays zero; the objective "
+               "uses the freedom left)",
+               "free"));
+}
+
+/// The global capture optimization and the reconfiguration before its approach (optimize/reconfigure.hpp).
+inline void add_global_keys(std::vector<ScenarioKey>& keys) {
+  using G = KeyGroup;
+  using K = ScenarioKeys;
+  keys.push_back(FFSR_KEY("global", global, "Also run the global capture optimization (true/false)", "true")
+                     .in(G::Global));
+  keys.push_back(
+      FFSR_KEY("seed", seed, "Seed of the global search's random starts (non-negative integer)", "1")
+          .in(G::Global)
+          .checked([](const K& k) { seed_of(k.seed); }));
+  keys.push_back(
+      FFSR_KEY("max-joint-rate-deg", max_joint_rate_deg,
+               "Global run: largest joint rate, deg/s (> 0; default: not limited; the paper's method is "
+               "not limited)")
+          .in(G::Global)
+          .checked(
+              [](const K& k) { check_positive_if_given(k, "max-joint-rate-deg", k.max_joint_rate_deg); }));
+  keys.push_back(FFSR_KEY("global-starts", global_starts, "Global search: random starts (>= 1)", "32")
+                     .in(G::Global)
+                     .checked([](const K& k) {
+                       if (k.global_starts < 1)
+                         throw InputError(str("--global-starts: must be >= 1, got ", k.global_starts));
+                     }));
+  keys.push_back(
+      FFSR_KEY(
+          "max-base-rate-deg", max_base_rate_deg,
+          "Global search: largest jump of the base's angular velocity at the impact, deg/s (a constraint; "
+          "> 0; default: not limited; `pareto` shows the trade-off against M_ie)")
+          .in(G::Global)
+          .checked([](const K& k) { check_positive_if_given(k, "max-base-rate-deg", k.max_base_rate_deg); })
+          .echoed(echo_given("max-base-rate-deg", &K::max_base_rate_deg)));
+  keys.push_back(
+      FFSR_KEY("reconfigure", reconfigure,
+               "Global run: reconfigure the arm before the approach: auto (only when the best capture "
+               "configuration is not reached otherwise), always or never",
+               "auto")
+          .in(G::Global)
+          .checked([](const K& k) { reconfigure_mode_of(k.reconfigure, "--reconfigure"); }));
+  keys.push_back(
+      FFSR_KEY("reconfigure-duration", reconfigure_duration,
+               "Global run: time of the reconfiguration, s, 0 < t < duration (default: duration / 4, longer "
+               "if max-joint-rate-deg needs it)")
+          .in(G::Global)
+          .checked([](const K& k) {
+            if (k.given.count("reconfigure-duration") &&
+                !(finite(k.reconfigure_duration, "reconfigure-duration") > 0 &&
+                  k.reconfigure_duration < k.duration))
+              throw InputError(str("--reconfigure-duration: must lie in (0, duration = ", k.duration,
+                                   ") s, got ", k.reconfigure_duration));
+          })
+          .echoed(echo_given("reconfigure-duration", &K::reconfigure_duration)));
+}
+
+/// The joints during the contact (algorithm/joint_models.hpp) and the multibody reference's servo;
+/// shapes and clearance (io/scenario_geometry.hpp, docs/geometry.md).
+inline void add_joint_and_shape_keys(std::vector<ScenarioKey>& keys) {
+  using G = KeyGroup;
+  using K = ScenarioKeys;
+  // joint models: absent from the echo means free (the paper's); the armature as resolved per joint
+  keys.push_back(
+      FFSR_KEY("contact-joints", contact_joints,
+               "The joints during the contact: free (the paper's), locked (one rigid body) or armature "
+               "(free with the armature's reflected rotor inertia)",
+               "free")
+          .in(G::JointModels)
+          .echoed([](const Scenario& sc, nlohmann::json& j) {
+            if (sc.keys.contact_joints != "free") j["contact-joints"] = sc.keys.contact_joints;
+          }));
+  keys.push_back(
+      FFSR_KEY("armature", armature,
+               "Reflected rotor inertia per joint, kg m^2 (kg for prismatic): one value or one per joint",
+               "0")
+          .in(G::JointModels)
+          .echoed([](const Scenario& sc, nlohmann::json& j) {
+            if (sc.keys.contact_joints != "free")
+              j["armature"] = joint_values_json(sc.problem.joints.armature);
+          }));
+  keys.push_back(
+      FFSR_KEY("joint-stiffness", joint_stiffness,
+               "Multibody reference: joint PD stiffness holding the pre-contact rates, N m/rad (one or "
+               "per joint)",
+               "0")
+          .in(G::JointModels)
+          .echoed([](const Scenario& sc, nlohmann::json& j) {
+            if (sc.keys.given.count("joint-stiffness"))
+              j["joint-stiffness"] = joint_values_json(sc.joint_stiffness);
+          }));
+  keys.push_back(FFSR_KEY("joint-damping", joint_damping,
+                          "Multibody reference: joint PD damping, N m s/rad (one or per joint)", "0")
+                     .in(G::JointModels)
+                     .echoed([](const Scenario& sc, nlohmann::json& j) {
+                       if (sc.keys.given.count("joint-damping"))
+                         j["joint-damping"] = joint_values_json(sc.joint_damping);
+                     }));
+  keys.push_back(FFSR_KEY("target-shape", target_shape,
+                          "Target's collision shape: box, sphere or cylinder (default: none)")
+                     .in(G::Shapes)
+                     .echoed(echo_shape("target-shape", &K::target_shape)));
+  keys.push_back(
+      FFSR_KEY("target-size", target_size,
+               "Target shape's size, m: box edge lengths; sphere radius; cylinder radius, length (along z)")
+          .in(G::Shapes)
+          .echoed(echo_shape("target-size", &K::target_size)));
+  keys.push_back(FFSR_KEY("target-shape-offset", target_shape_offset,
+                          "Target shape's centre in the target frame, m", "0,0,0")
+                     .in(G::Shapes)
+                     .echoed(echo_shape("target-shape-offset", &K::target_shape_offset)));
+  keys.push_back(
+      FFSR_KEY("link-radius", link_radius,
+               "Capsule radius of links without URDF collision primitives, m (one, or one per moving body)",
+               "0.05")
+          .in(G::Shapes)
+          .echoed(echo_shape("link-radius", &K::link_radius)));
+  keys.push_back(
+      FFSR_KEY("bus-box", bus_box,
+               "The bus as a box centred on the base frame (edge lengths, m), when the URDF's base has no "
+               "collision primitive")
+          .in(G::Shapes)
+          .echoed(echo_shape("bus-box", &K::bus_box)));
+  keys.push_back(FFSR_KEY("clearance", clearance,
+                          "Least distance the global run keeps between arm, bus and target, m (0: none)", "0")
+                     .in(G::Shapes)
+                     .echoed(echo_shape("clearance", &K::clearance)));
+  keys.push_back(
+      FFSR_KEY("contact-exemption", contact_exemption,
+               "Length of the arm before the contact point (along the links' centre lines) not checked "
+               "against the target, m",
+               "0.2")
+          .in(G::Shapes)
+          .echoed(echo_shape("contact-exemption", &K::contact_exemption)));
+}
+
+#undef FFSR_KEY
+
+/// The table, in the order a command lists the keys (the flags of `ffsr-optimize --help`).
+inline std::vector<ScenarioKey> build_scenario_keys() {
+  std::vector<ScenarioKey> keys;
+  add_subject_keys(keys);
+  add_planner_keys(keys);
+  add_global_keys(keys);
+  add_joint_and_shape_keys(keys);
+  return keys;
+}
+
+/// Levenshtein distance (insertions, deletions, substitutions).
+inline size_t edit_distance(const std::string& a, const std::string& b) {
+  std::vector<size_t> row(b.size() + 1);
+  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (size_t i = 1; i <= a.size(); ++i) {
+    size_t diagonal = row[0];
+    row[0] = i;
+    for (size_t j = 1; j <= b.size(); ++j) {
+      const size_t up = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diagonal = up;
+    }
+  }
+  return row[b.size()];
+}
+
+/// The name of `names` nearest to `name`, or "" when none is within a third of its length (at least 1).
+inline std::string nearest_name(const std::string& name, const std::vector<std::string>& names) {
+  std::string best;
+  size_t best_d = std::max<size_t>(1, name.size() / 3) + 1;
+  for (const std::string& n : names) {
+    const size_t d = edit_distance(name, n);
+    if (d < best_d) {
+      best = n;
+      best_d = d;
+    }
+  }
+  return best;
+}
+
+}  // namespace detail
+
+inline const std::vector<ScenarioKey>& scenario_keys() {
+  static const std::vector<ScenarioKey> keys = detail::build_scenario_keys();
+  return keys;
+}
+
+inline const ScenarioKey* find_scenario_key(const std::string& name) {
+  for (const ScenarioKey& k : scenario_keys())
+    if (k.name == name) return &k;
+  return nullptr;
+}
+
+inline const std::vector<std::string>& required_scenario_keys() {
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> out;
+    for (const ScenarioKey& k : scenario_keys())
+      if (k.required) out.push_back(k.name);
+    return out;
+  }();
+  return names;
+}
+
+inline std::set<std::string> scenario_key_names(std::initializer_list<KeyGroup> groups) {
+  std::set<std::string> out;
+  for (const ScenarioKey& k : scenario_keys())
+    if (std::find(groups.begin(), groups.end(), k.group) != groups.end()) out.insert(k.name);
+  return out;
+}
+
+inline std::string nearest_scenario_key(const std::string& name) {
+  std::vector<std::string> names;
+  for (const ScenarioKey& k : scenario_keys()) names.push_back(k.name);
+  return detail::nearest_name(name, names);
+}
+
+// --- the reader --------------------------------------------------------------------------------------
+
+namespace detail {
+
+/// A caller's key as text: a scalar as written, a list joined with commas.
+inline std::string extra_text(const toml::node& v, const std::string& key) {
+  if (const toml::array* a = v.as_array()) {
+    std::string joined;
+    for (const toml::node& e : *a) {
+      const auto t = text_of(e);
+      if (!t) throw InputError(str("--", key, ": expected a list of single values"));
+      joined += (joined.empty() ? "" : ",") + *t;
+    }
+    return joined;
+  }
+  const auto t = text_of(v);
+  if (!t) throw InputError(str("--", key, ": expected a single value"));
+  return *t;
+}
+
+/// "WHERE:LINE" of a node of the file (WHERE alone when toml++ gives no line).
+inline std::string where_line(const std::string& where, const toml::node& n) {
+  const auto line = n.source().begin.line;
+  return line > 0 ? str(where, ":", line) : where;
+}
+
+/// "unknown key 'k'", with the nearest known key (of the table and the caller's) when one is close.
+inline std::string unknown_key_message(const std::string& name, const std::set<std::string>& extra_keys) {
+  std::vector<std::string> names(extra_keys.begin(), extra_keys.end());
+  for (const ScenarioKey& k : scenario_keys()) names.push_back(k.name);
+  names.push_back("uncertainty");
+  const std::string near = nearest_name(name, names);
+  return str("unknown key '", name, "'", near.empty() ? "" : str(" (did you mean '", near, "'?)"));
+}
+
+/// An error of a key's value from the file: "WHERE:LINE: " before the message, which names the key.
+inline std::string located(const std::string& where, const toml::node& n, const std::string& message) {
+  return str(where_line(where, n), ": ", message);
+}
+
+}  // namespace detail
+
+/// The line of key `name` in the scenario file the keys were read from (0: not in the file, or
+/// overridden by a flag).
+inline long scenario_key_line(const ScenarioKeys& k, const std::string& name) {
+  if (!k.document || k.overridden.count(name)) return 0;
+  const toml::node* n = k.document->get(name);
+  return n ? static_cast<long>(n->source().begin.line) : 0;
+}
+
+/// A message about the keys ("--key: ...", the flag of the key it names first) located in the file
+/// that gave the key: "scenario FILE:LINE: --key: ...". Unchanged when the key came from a flag or
+/// the built-in scenario.
+inline std::string located_key_message(const ScenarioKeys& k, const std::string& message) {
+  if (k.file.empty() || message.rfind("--", 0) != 0) return message;
+  const size_t end = message.find_first_of(":/ ", 2);
+  const long line = scenario_key_line(k, message.substr(2, end == std::string::npos ? end : end - 2));
+  return line > 0 ? detail::str(k.where, ":", line, ": ", message) : message;
+}
+
+inline ScenarioKeys read_scenario_text(const std::string& text, const std::string& where,
+                                       const std::string& file, const std::set<std::string>& extra_keys) {
+  auto root = std::make_shared<toml::table>();
+  try {
+    *root = toml::parse(text, file.empty() ? std::string_view{} : std::string_view{file});
+  } catch (const toml::parse_error& e) {
+    throw InputError(detail::str(where, ":", e.source().begin.line, ": ", e.description()));
+  }
+  ScenarioKeys keys;
+  keys.file = file;
+  keys.where = where;
+  for (const auto& [k, v] : *root) {
+    const std::string name(k.str());
+    if (name == "uncertainty") continue;  // read by uncertainty_spec
+    try {
+      if (extra_keys.count(name)) {
+        keys.extra[name] = detail::extra_text(v, name);
+        continue;
+      }
+      const ScenarioKey* key = find_scenario_key(name);
+      if (!key) throw InputError(detail::unknown_key_message(name, extra_keys));
+      key->from_toml(keys, v);
+    } catch (const InputError& e) {
+      throw InputError(detail::located(where, v, e.what()));
+    }
+  }
+  keys.document = std::move(root);
+  return keys;
+}
+
+inline ScenarioKeys read_scenario_file(const std::string& path, const std::set<std::string>& extra_keys) {
+  const std::string where = "scenario " + path;
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(detail::str(where, ": cannot open the file"));
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return read_scenario_text(ss.str(), where, path, extra_keys);
+}
+
+inline void override_scenario_key(ScenarioKeys& keys, const std::string& name, const std::string& text) {
+  const ScenarioKey* key = find_scenario_key(name);
+  if (!key) throw InputError(detail::str("unknown scenario key '", name, "'"));
+  key->from_text(keys, text);
+  keys.overridden.insert(name);
+}
+
+/// Runs the check of every key of the table (ScenarioKey::check). InputError naming the key.
+inline void check_scenario_keys(const ScenarioKeys& keys) {
+  for (const ScenarioKey& key : scenario_keys())
+    if (key.check) key.check(keys);
+}
+
+}  // namespace ffsr

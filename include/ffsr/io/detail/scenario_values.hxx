@@ -1,0 +1,201 @@
+// ffsr/io/detail/scenario_values.hxx -- the value parsers of the scenario keys (one per kind of
+// value, from a TOML node and from text), the constructor of a key-table entry and the checks of one
+// value. Part of ffsr/io/scenario.hpp.
+#pragma once
+
+#include <algorithm>
+#include <cerrno>
+#include <climits>
+#include <cmath>
+#include <cstdlib>
+#include <iomanip>
+#include <sstream>
+#include <type_traits>
+
+namespace ffsr {
+namespace detail {
+
+// --- one parser per kind of value ------------------------------------------------------------------
+
+inline std::string trimmed(const std::string& s) {
+  const size_t b = s.find_first_not_of(" \t"), e = s.find_last_not_of(" \t");
+  return b == std::string::npos ? std::string() : s.substr(b, e - b + 1);
+}
+
+/// A number written as text; NaN and infinities written as such pass (the validation names them), a
+/// finite number too large for a double ("1e999") does not.
+inline double number_from_text(const std::string& text, const std::string& key, const std::string& in = "") {
+  const std::string t = trimmed(text);
+  char* end = nullptr;
+  errno = 0;
+  const double x = std::strtod(t.c_str(), &end);
+  const std::string within = in.empty() ? "" : " (in '" + in + "')";
+  if (t.empty() || end != t.c_str() + t.size())
+    throw InputError(str(key, ": '", t, "' is not a number", within));
+  if (errno == ERANGE && std::isinf(x))
+    throw InputError(str(key, ": '", t, "' is out of the range of a double", within));
+  return x;
+}
+
+inline std::vector<std::string> split_list(const std::string& text) {
+  std::vector<std::string> items;
+  std::string item;
+  std::stringstream ss(text);
+  while (std::getline(ss, item, ',')) items.push_back(item);
+  return items;
+}
+
+inline std::vector<double> numbers_from_text(const std::string& text, const std::string& key) {
+  if (text.empty()) throw InputError(str(key, ": expected comma-separated numbers, got an empty value"));
+  if (text.back() == ',') throw InputError(str(key, ": trailing comma in '", text, "'"));
+  std::vector<double> out;
+  for (const std::string& item : split_list(text)) out.push_back(number_from_text(item, key, text));
+  return out;
+}
+
+inline long long integer_from_text(const std::string& text, const std::string& key) {
+  const std::string t = trimmed(text);
+  char* end = nullptr;
+  errno = 0;
+  const long long x = std::strtoll(t.c_str(), &end, 10);
+  if (t.empty() || end != t.c_str() + t.size() || errno == ERANGE || x < INT_MIN || x > INT_MAX)
+    throw InputError(str(key, ": '", t, "' is not an integer"));
+  return x;
+}
+
+inline bool boolean_from_text(const std::string& text, const std::string& key) {
+  std::string t = trimmed(text);
+  std::transform(t.begin(), t.end(), t.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  for (const char* yes : {"true", "1", "on", "yes", "y", "t", "enable", "+"})
+    if (t == yes) return true;
+  for (const char* no : {"false", "0", "off", "no", "n", "f", "disable", "-"})
+    if (t == no) return false;
+  throw InputError(str(key, ": expected true or false, got '", text, "'"));
+}
+
+/// A scalar node as text (a text key takes a number or a boolean as written).
+inline std::optional<std::string> text_of(const toml::node& n) {
+  if (auto s = n.value_exact<std::string>()) return *s;
+  if (auto i = n.value_exact<int64_t>()) return std::to_string(*i);
+  if (auto d = n.value_exact<double>()) {
+    std::ostringstream os;
+    os << std::setprecision(17) << *d;
+    return os.str();
+  }
+  if (auto b = n.value_exact<bool>()) return std::string(*b ? "true" : "false");
+  return std::nullopt;
+}
+
+inline double number_of(const toml::node& n, const std::string& key) {
+  if (auto i = n.value_exact<int64_t>()) return static_cast<double>(*i);
+  if (auto d = n.value_exact<double>()) return *d;
+  if (auto s = n.value_exact<std::string>()) return number_from_text(*s, key);
+  throw InputError(str(key, ": expected a number"));
+}
+
+template <class T>
+T value_from_text(const std::string& text, const std::string& key) {
+  if constexpr (std::is_same_v<T, std::string>) {
+    return text;
+  } else if constexpr (std::is_same_v<T, std::vector<std::string>>) {
+    return split_list(text);
+  } else if constexpr (std::is_same_v<T, double>) {
+    return number_from_text(text, key);
+  } else if constexpr (std::is_same_v<T, std::vector<double>>) {
+    return numbers_from_text(text, key);
+  } else if constexpr (std::is_same_v<T, int>) {
+    return static_cast<int>(integer_from_text(text, key));
+  } else {
+    static_assert(std::is_same_v<T, bool>);
+    return boolean_from_text(text, key);
+  }
+}
+
+template <class T>
+T value_from_toml(const toml::node& n, const std::string& key) {
+  if constexpr (std::is_same_v<T, std::vector<double>> || std::is_same_v<T, std::vector<std::string>>) {
+    if (const toml::array* a = n.as_array()) {
+      T out;
+      for (const toml::node& e : *a) {
+        if constexpr (std::is_same_v<T, std::vector<double>>) {
+          out.push_back(number_of(e, key));
+        } else {
+          const auto t = text_of(e);
+          if (!t) throw InputError(str(key, ": expected a list of text values"));
+          out.push_back(*t);
+        }
+      }
+      return out;
+    }
+    if constexpr (std::is_same_v<T, std::vector<double>>)
+      if (!n.is_string()) return {number_of(n, key)};
+  } else if constexpr (std::is_same_v<T, double>) {
+    return number_of(n, key);
+  } else if constexpr (std::is_same_v<T, int>) {
+    if (auto i = n.value_exact<int64_t>()) {
+      if (*i < INT_MIN || *i > INT_MAX) throw InputError(str(key, ": '", *i, "' is not an integer"));
+      return static_cast<int>(*i);
+    }
+  } else if constexpr (std::is_same_v<T, bool>) {
+    if (auto b = n.value_exact<bool>()) return *b;
+  }
+  const auto t = text_of(n);
+  if (!t) throw InputError(str(key, ": expected a single value"));
+  return value_from_text<T>(*t, key);
+}
+
+template <class T>
+constexpr KeyKind kind_of() {
+  if constexpr (std::is_same_v<T, std::string>) return KeyKind::Text;
+  if constexpr (std::is_same_v<T, std::vector<std::string>>) return KeyKind::Texts;
+  if constexpr (std::is_same_v<T, double>) return KeyKind::Number;
+  if constexpr (std::is_same_v<T, std::vector<double>>) return KeyKind::Numbers;
+  if constexpr (std::is_same_v<T, int>) return KeyKind::Integer;
+  return KeyKind::Boolean;
+}
+
+/// A key of member type T reached by `get`: its setters parse, store and mark the key as given; its
+/// echo writes the value as stored (ScenarioKey::echoed replaces it).
+template <class T>
+ScenarioKey make_key(const char* name, T& (*get)(ScenarioKeys&), const char* help, const char* shown = "") {
+  const std::string n = name, flag = std::string("--") + name;
+  auto mark = [n](ScenarioKeys& k) {
+    k.given.insert(n);
+    k.load.given.insert(n);
+  };
+  ScenarioKey key;
+  key.name = n;
+  key.kind = kind_of<T>();
+  key.help = help;
+  key.default_text = shown;
+  key.from_toml = [get, flag, mark](ScenarioKeys& k, const toml::node& node) {
+    get(k) = value_from_toml<T>(node, flag);
+    mark(k);
+  };
+  key.from_text = [get, flag, mark](ScenarioKeys& k, const std::string& text) {
+    get(k) = value_from_text<T>(text, flag);
+    mark(k);
+  };
+  // the keys are read-only here: `get` takes a mutable reference only to share one accessor
+  key.echo = [get, n](const Scenario& sc, nlohmann::json& j) {
+    j[n] = get(const_cast<ScenarioKeys&>(sc.keys));
+  };
+  return key;
+}
+
+// --- checks of one value ------------------------------------------------------------------------------
+
+inline double finite(double x, const char* key) {
+  if (!std::isfinite(x)) throw InputError(str("--", key, ": must be finite, got ", x));
+  return x;
+}
+
+/// The seed as a non-negative integer (text, so that a bad value names the key).
+inline std::uint64_t seed_of(const std::string& sd) {
+  if (sd.empty() || sd.size() > 19 || sd.find_first_not_of("0123456789") != std::string::npos)
+    throw InputError(str("--seed: expected a non-negative integer (at most 19 digits), got '", sd, "'"));
+  return std::stoull(sd);
+}
+
+}  // namespace detail
+}  // namespace ffsr

@@ -1,0 +1,136 @@
+// ffsr/io/detail/uncertainty_table.hxx -- the [uncertainty] table of a scenario file
+// (ffsr/io/scenario.hpp: uncertainty_spec), read into the sampler's laws (uncertainty/sampling.hpp).
+#pragma once
+
+namespace ffsr {
+
+namespace detail {
+
+inline double spread_number(const toml::node& n, const std::string& key) {
+  if (auto i = n.value_exact<int64_t>()) return static_cast<double>(*i);
+  if (auto d = n.value_exact<double>()) {
+    if (!std::isfinite(*d)) throw InputError(str(key, ": must be finite, got ", *d));
+    return *d;
+  }
+  throw InputError(str(key, ": expected a number"));
+}
+
+/// Exactly one of `opts` given, or InputError naming them.
+inline void one_of(const std::string& key, const std::string& law,
+                   std::initializer_list<std::pair<const char*, std::optional<double>>> opts) {
+  int count = 0;
+  std::string names;
+  for (const auto& [n, v] : opts) {
+    count += v.has_value();
+    names += (names.empty() ? "" : " or ") + std::string(n);
+  }
+  if (count != 1) throw InputError(str(key, ": the ", law, " law takes exactly one of ", names));
+}
+
+inline Spread spread_of(Quantity q, const toml::table& t, const std::string& key) {
+  static const std::set<std::string> known{"law", "std", "relative-std", "half-width", "relative",
+                                           "min", "max", "sigma",        "angle-deg",  "axes-deg"};
+  for (const auto& [k, v] : t)
+    if (!known.count(std::string(k.str())))
+      throw InputError(str(key, ".", k.str(),
+                           ": unknown parameter; expected law, std, relative-std, half-width, ",
+                           "relative, min, max, sigma, angle-deg or axes-deg"));
+  const auto law = t["law"].value<std::string>();
+  if (!law) throw InputError(str(key, ": missing law (normal, uniform, log-normal or cone)"));
+  auto get = [&](const char* name) -> std::optional<double> {
+    if (const toml::node* n = t.get(name)) return spread_number(*n, str(key, ".", name));
+    return std::nullopt;
+  };
+  const auto sd = get("std"), rsd = get("relative-std"), hw = get("half-width"), rel = get("relative"),
+             lo = get("min"), hi = get("max"), sigma = get("sigma"), angle = get("angle-deg"),
+             axes = get("axes-deg");
+  for (const auto& [name, v] : {std::pair{"std", sd},
+                                {"relative-std", rsd},
+                                {"half-width", hw},
+                                {"relative", rel},
+                                {"sigma", sigma},
+                                {"angle-deg", angle},
+                                {"axes-deg", axes}})
+    if (v && *v < 0)
+      throw InputError(str(key, ".", name, ": a spread must be non-negative, got ", short_number(*v)));
+  // spin is given in deg/s, the library takes rad/s
+  const double unit = q == Quantity::Spin ? M_PI / 180.0 : 1.0;
+  Spread sp;
+  if (*law == "normal") {
+    sp.law = Spread::Law::Normal;
+    one_of(key, *law, {{"std", sd}, {"relative-std", rsd}});
+    sp.relative = rsd.has_value();
+    sp.scale = sd ? *sd * unit : *rsd;
+  } else if (*law == "uniform") {
+    sp.law = Spread::Law::Uniform;
+    const bool range = lo.has_value() && hi.has_value() && !hw && !rel;
+    if (!range) one_of(key, *law, {{"half-width", hw}, {"relative", rel}});
+    sp.has_range = range;
+    sp.relative = rel.has_value();
+    sp.scale = hw ? *hw * unit : rel ? *rel : 0.0;
+  } else if (*law == "log-normal") {
+    sp.law = Spread::Law::LogNormal;
+    if (!sigma) throw InputError(str(key, ": the log-normal law needs sigma (standard deviation of ln x)"));
+    sp.scale = *sigma;
+  } else if (*law == "cone") {
+    sp.law = Spread::Law::Cone;
+    if (!angle) throw InputError(str(key, ": the cone law needs angle-deg (half-angle)"));
+    sp.scale = *angle * M_PI / 180.0;
+  } else {
+    throw InputError(
+        str(key, ".law: unknown law '", *law, "'; expected normal, uniform, log-normal or cone"));
+  }
+  if (q == Quantity::TargetInertia && sp.law != Spread::Law::Cone && !sp.relative)
+    throw InputError(str(key, ": the inertia takes a relative spread (relative-std or relative)"));
+  if (lo) sp.min = *lo * unit;
+  if (hi) sp.max = *hi * unit;
+  if (axes) sp.axes = *axes * M_PI / 180.0;
+  if (axes && q != Quantity::TargetInertia)
+    throw InputError(str(key, ".axes-deg: only the inertia takes it"));
+  return sp;
+}
+
+/// samples or seed of the table.
+inline std::uint64_t count_of(const toml::node& v, const std::string& name, const std::string& key) {
+  const auto i = v.value_exact<int64_t>();
+  if (!i) throw InputError(str(key, ": must be an integer"));
+  if (name == "samples" && *i < 1) throw InputError(str(key, ": must be at least 1, got ", *i));
+  if (name == "seed" && *i < 0) throw InputError(str(key, ": must be a non-negative integer, got ", *i));
+  return static_cast<std::uint64_t>(*i);
+}
+
+}  // namespace detail
+
+inline UncertaintySpec uncertainty_spec(const ScenarioKeys& keys, std::optional<std::uint64_t> samples,
+                                        std::optional<std::uint64_t> seed) {
+  using detail::str;
+  const toml::node* node = keys.document ? keys.document->get("uncertainty") : nullptr;
+  if (!node) throw InputError(str(keys.where, ": no [uncertainty] table"));
+  const toml::table* u = node->as_table();
+  if (!u) throw InputError(str(keys.where, ": 'uncertainty' must be a table"));
+  UncertaintySpec spec;
+  for (const auto& [k, v] : *u) {
+    const std::string name(k.str());
+    const std::string key = "uncertainty." + name;
+    if (name == "samples" || name == "seed") {
+      (name == "samples" ? spec.samples : spec.seed) = detail::count_of(v, name, key);
+      continue;
+    }
+    const auto it = std::find(kQuantityNames.begin(), kQuantityNames.end(), name);
+    if (it == kQuantityNames.end()) {
+      std::string names;
+      for (auto n : kQuantityNames) names += (names.empty() ? "" : ", ") + std::string(n);
+      throw InputError(str(key, ": unknown uncertain quantity; expected one of ", names, ", samples, seed"));
+    }
+    const toml::table* t = v.as_table();
+    if (!t) throw InputError(str(key, ": expected a table such as { law = \"normal\", std = 0.01 }"));
+    const Quantity q = static_cast<Quantity>(it - kQuantityNames.begin());
+    spec[q] = detail::spread_of(q, *t, key);
+  }
+  if (samples) spec.samples = *samples;
+  if (seed) spec.seed = *seed;
+  validate(spec);
+  return spec;
+}
+
+}  // namespace ffsr

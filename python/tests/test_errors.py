@@ -1,0 +1,142 @@
+"""Bad input raises the Python class of the library's exception, with the library's message: the C++
+hierarchy (ffsr::Error > InputError, ModelError, NumericalError > JointLimitError, IntegrationError)
+mirrored, a message that names the function or file and the argument, and no silent conversion of an
+array of the wrong dtype, layout or shape."""
+
+import numpy as np
+import pytest
+
+import ffsr
+from conftest import ROBOTS
+
+
+@pytest.fixture(scope="module")
+def robot():
+    model = ffsr.Model.from_urdf(str(ROBOTS / "paper_3dof.urdf"))
+    return model, ffsr.Data(model)
+
+
+def test_hierarchy():
+    assert issubclass(ffsr.Error, RuntimeError)
+    for cls in (ffsr.InputError, ffsr.ModelError, ffsr.NumericalError, ffsr.IntegrationError):
+        assert issubclass(cls, ffsr.Error)
+    assert issubclass(ffsr.JointLimitError, ffsr.NumericalError)
+    assert issubclass(ffsr.JointRateLimitError, ffsr.InputError)
+    assert issubclass(ffsr.InputError, ValueError)
+    assert not issubclass(ffsr.ModelError, ffsr.InputError)
+
+
+def test_urdf_that_is_not_xml(tmp_path):
+    path = tmp_path / "robot.urdf"
+    path.write_text("this is not XML\n")
+    with pytest.raises(ffsr.ModelError) as e:
+        ffsr.Model.from_urdf(str(path))
+    assert str(e.value).startswith(f"{path}: ")  # the loader names the file first
+
+
+def test_missing_urdf(tmp_path):
+    path = tmp_path / "absent.urdf"
+    with pytest.raises(ffsr.ModelError, match="absent.urdf: cannot open the URDF file"):
+        ffsr.Model.from_urdf(str(path))
+
+
+def test_urdf_string_names_its_source():
+    with pytest.raises(ffsr.ModelError, match="^mine.urdf: "):
+        ffsr.Model.from_urdf_string("<robot name='x'><link name='a'/></robot>", "mine.urdf")
+
+
+def test_unknown_inertia_repair():
+    with pytest.raises(ffsr.InputError, match="inertia-repair: unknown mode 'fix'"):
+        ffsr.Model.from_urdf(str(ROBOTS / "paper_3dof.urdf"), inertia_repair="fix")
+
+
+def test_wrong_joint_count(robot):
+    model, data = robot
+    with pytest.raises(ffsr.InputError, match=r"^forward_kinematics: theta has 4 entries, expected 3$"):
+        ffsr.crba(model, data, ffsr.BasePose(), np.zeros(4))
+    with pytest.raises(ffsr.InputError, match=r"theta has 2 entries, expected 3"):
+        ffsr.integrated_effective_mass(model, data, ffsr.BasePose(), [0.0, 1.0])
+
+
+def test_nan(robot):
+    model, data = robot
+    theta = np.array([0.0, np.nan, 0.0])
+    with pytest.raises(ffsr.InputError, match=r"^forward_kinematics: theta must be finite, entry 1 is nan$"):
+        ffsr.integrated_effective_mass(model, data, ffsr.BasePose(), theta)
+    with pytest.raises(ffsr.InputError, match="^forward_kinematics: base position must be finite, entry 1 is inf$"):
+        ffsr.crba(model, data, ffsr.BasePose(position=[0, np.inf, 0]), np.zeros(3))
+    with pytest.raises(ffsr.InputError, match="thetas must be finite"):
+        ffsr.integrated_effective_mass_batch(model, ffsr.BasePose(), np.array([[0, 0, 0], [0, np.nan, 0.0]]))
+
+
+def test_non_contiguous(robot):
+    model, data = robot
+    strided = np.zeros(6)[::2]
+    assert strided.shape == (3,)
+    with pytest.raises(ffsr.InputError, match="^crba: theta must be contiguous"):
+        ffsr.crba(model, data, ffsr.BasePose(), strided)
+    thetas = np.zeros((3, 10))[:, :3]  # rows of 3 in a wider array
+    with pytest.raises(ffsr.InputError, match="thetas must be C-contiguous"):
+        ffsr.integrated_effective_mass_batch(model, ffsr.BasePose(), thetas)
+    with pytest.raises(ffsr.InputError, match="C-contiguous"):
+        ffsr.integrated_effective_mass_batch(model, ffsr.BasePose(), np.zeros((3, 5)).T)
+
+
+def test_wrong_dtype(robot):
+    model, data = robot
+    with pytest.raises(ffsr.InputError, match="^crba: theta must be an array of float64, got float32$"):
+        ffsr.crba(model, data, ffsr.BasePose(), np.zeros(3, dtype=np.float32))
+    with pytest.raises(ffsr.InputError, match="got int64"):
+        ffsr.crba(model, data, ffsr.BasePose(), np.zeros(3, dtype=np.int64))
+    with pytest.raises(ffsr.InputError, match="must hold numbers, got str"):
+        ffsr.crba(model, data, ffsr.BasePose(), [0.0, "a", 0.0])
+    with pytest.raises(ffsr.InputError, match="must be a numpy array of float64 or a list of numbers, got dict"):
+        ffsr.crba(model, data, ffsr.BasePose(), {})
+
+
+def test_wrong_shape(robot):
+    model, data = robot
+    with pytest.raises(ffsr.InputError, match="^crba: theta must be a 1-dimensional array, got 2 dimensions$"):
+        ffsr.crba(model, data, ffsr.BasePose(), np.zeros((3, 1)))
+    with pytest.raises(ffsr.InputError, match=r"thetas has shape \(5, 4\), expected \(5, 3\)"):
+        ffsr.integrated_effective_mass_batch(model, ffsr.BasePose(), np.zeros((5, 4)))
+    with pytest.raises(ffsr.InputError, match=r"Target: inertia has shape \(2, 2\), expected \(3, 3\)"):
+        ffsr.Target(inertia=np.eye(2))
+    with pytest.raises(ffsr.InputError, match="rnea: v has 8 entries, expected 9"):
+        ffsr.rnea(model, data, ffsr.BasePose(), np.zeros(3), np.zeros(8), np.zeros(9))
+
+
+def test_data_of_another_model(robot):
+    model, _ = robot
+    other = ffsr.Model.from_urdf(str(ROBOTS / "paper_7dof.urdf"))
+    with pytest.raises(ffsr.InputError, match="data was made for a model with 7 joints"):
+        ffsr.crba(model, ffsr.Data(other), ffsr.BasePose(), np.zeros(3))
+
+
+def test_unknown_names(robot):
+    model, data = robot
+    with pytest.raises(ffsr.InputError, match="unknown frame 'hand'; the model has: base"):
+        ffsr.frame_jacobian(model, data, "hand")
+    with pytest.raises(ffsr.InputError, match="frame index 99 out of range"):
+        ffsr.frame_jacobian(model, data, 99)
+    with pytest.raises(ffsr.InputError) as e:
+        ffsr.ContactLaw("hertz", ffsr.ContactParams(), 0.2)
+    assert "hunt-crossley" in str(e.value)  # the valid names are listed
+    with pytest.raises(ffsr.InputError, match="joints: unknown joint model 'stiff'"):
+        ffsr.integrated_effective_mass(model, data, ffsr.BasePose(), np.zeros(3), joints="stiff")
+
+
+def test_bad_physical_values(robot):
+    model, data = robot
+    with pytest.raises(ffsr.InputError, match="target: mass must be positive"):
+        ffsr.Target(mass=-1.0)
+    with pytest.raises(ffsr.InputError, match="ContactParams"):
+        ffsr.ContactParams(c_r=1.5)
+    with pytest.raises(ffsr.InputError, match="effective_mass: direction u must be a unit vector"):
+        ffsr.effective_mass(model, data, ffsr.BasePose(), np.zeros(3), None, [1.0, 1.0, 0.0])
+    with pytest.raises(ffsr.InputError, match="armature: the value of joint 'joint2' must be finite and >= 0"):
+        ffsr.integrated_effective_mass(model, data, ffsr.BasePose(), np.zeros(3), joints="armature",
+                                       armature=[0.1, -1.0, 0.1])
+    with pytest.raises(ffsr.ModelError, match="mass must be positive"):
+        ffsr.ModelBuilder("base", ffsr.Inertia(10.0, I=np.eye(3))).add_joint(
+            "j1", ffsr.JointType.Revolute, "base", ffsr.Pose(), [0, 0, 1], "l1", ffsr.Inertia(0.0)).build()

@@ -1,0 +1,40 @@
+#!/usr/bin/env bash
+# Installs the Python package ffsr (python/) into a virtual environment, build-python/venv (or the
+# folder given as $1), made with Debian 12's python3: first the Debian packages it needs (python3-dev,
+# python3-venv and those of the C++ build, scripts/install-deps.sh), then every PyPI package pinned in
+# python/pyproject.toml (build requirements, numpy, and the test extra: pytest and Pinocchio's `pin`,
+# the reference of the tests and the bench), then the package itself, built by scikit-build-core in
+# build-python/cmake-* (kept between runs: a rebuild compiles only what changed).
+# Nothing is downloaded at test time: this script is the only step that reaches PyPI.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+venv=${1:-build-python/venv}
+bash scripts/install-deps.sh
+missing=()
+for p in python3-dev python3-venv; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "ffsr: installing missing Debian packages: ${missing[*]}"
+  SUDO=""
+  [ "$(id -u)" -eq 0 ] || SUDO="sudo"
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
+[ -x "$venv/bin/python" ] || /usr/bin/python3 -m venv "$venv"
+py="$venv/bin/python"
+# the pins, from the one place they are written
+"$py" - python/pyproject.toml > "$venv/ffsr-requirements.txt" <<'PY'
+import sys, tomllib
+with open(sys.argv[1], "rb") as f:
+    d = tomllib.load(f)
+pins = d["build-system"]["requires"] + d["project"]["dependencies"] + d["project"]["optional-dependencies"]["test"]
+bad = [p for p in pins if "==" not in p]
+if bad:
+    sys.exit(f"python/pyproject.toml: not pinned with ==: {bad}")
+print("\n".join(dict.fromkeys(pins)))
+PY
+"$py" -m pip install --quiet --disable-pip-version-check -r "$venv/ffsr-requirements.txt"
+# the build requirements are the pinned ones just installed (no isolated build environment)
+"$py" -m pip install --quiet --disable-pip-version-check --no-build-isolation --no-deps ./python
+"$py" -c 'import ffsr; print("ffsr: installed the Python package", ffsr.__version__, "in", __import__("sys").prefix)'
