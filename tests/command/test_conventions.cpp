@@ -324,6 +324,7 @@ TEST_CASE("--quiet, --json FILE and --json - on every subcommand", "[cli][conven
     CHECK(written.is_object());
     const CommandResult s = cli(to_stdout, tmp.str());
     REQUIRE(s.exit_code == 0);
+    CHECK(s.err.empty());  // --quiet: the table that would go to standard error is not written either
     json j;
     REQUIRE_NOTHROW(j = json::parse(s.out));  // one JSON document and nothing else
     CHECK(j.is_object());

@@ -222,7 +222,11 @@ bool Outputs::requested(const std::string& flag) const {
   return false;
 }
 
-std::ostream& Outputs::table() const { return uses_stdout() ? std::cerr : std::cout; }
+std::ostream& Outputs::table() const {
+  static std::ostream nowhere(nullptr);  // no buffer: writes are dropped
+  if (!uses_stdout()) return std::cout;
+  return quiet() ? nowhere : std::cerr;
+}
 
 void Outputs::set(const std::string& flag, std::string content) {
   for (auto& it : items_)

@@ -38,7 +38,8 @@ class Outputs {
   bool requested(const std::string& flag) const;
   /// True when an output goes to standard output.
   bool uses_stdout() const { return !stdout_flag_.empty(); }
-  /// Where the human-readable table goes: standard error when an output is standard output.
+  /// Where the human-readable table goes: standard error when an output is standard output (nowhere
+  /// then with --quiet: nothing on standard error but an error).
   std::ostream& table() const;
   /// Sets the content of the output registered by `flag` (ignored when the flag was not requested).
   void set(const std::string& flag, std::string content);
