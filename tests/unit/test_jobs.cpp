@@ -92,3 +92,25 @@ TEST_CASE("jobs: merge_shards refuses a gap and shards of another run", "[jobs][
     CHECK(std::string(e.what()).find("differ in 'seed'") != std::string::npos);
   }
 }
+
+TEST_CASE("jobs: check_robust_job refuses a shard that does not exist and multibody with a joint model",
+          "[jobs][robust]") {
+  ffsr::Scenario sc = uncertain_3dof(4);
+  ffsr::RobustJobOptions o;
+  CHECK_NOTHROW(ffsr::check_robust_job(sc, o));
+  o.shard_k = 3;
+  o.shard_n = 3;
+  CHECK_THROWS_AS(ffsr::check_robust_job(sc, o), ffsr::InputError);
+  o.shard_k = 0;
+  o.force_model = ffsr::ForceModel::Multibody;
+  CHECK_NOTHROW(ffsr::check_robust_job(sc, o));  // free joints: what the multibody run simulates
+  sc.problem.joints.model = ffsr::JointModel::Locked;
+  try {
+    ffsr::check_robust_job(sc, o);
+    FAIL("multibody with locked joints was accepted");
+  } catch (const ffsr::InputError& e) {
+    CHECK(std::string(e.what()).rfind("--contact-joints:", 0) == 0);
+  }
+  o.force_model = ffsr::ForceModel::Exact;  // the exact peak takes Lambda^-1 of the joint model
+  CHECK_NOTHROW(ffsr::check_robust_job(sc, o));
+}
