@@ -256,10 +256,11 @@ void register_closed_loop(CLI::App& app, Action& action) {
       "The capture controller with the robot's dynamics, joint rate loops and a noisy target estimate");
   sub->add_option("--config", o->config, "Scenario file (TOML); default: the built-in paper 3-DOF scenario")
       ->check(CLI::ExistingFile);
-  // one plan (--plan), no plain run, free joints and no shapes in the controller's dynamics
+  // one plan (--plan), no plain run, no shapes in the controller's dynamics; the M_ie reported (the
+  // plan's and the loop's) is the scenario's joint model's
   o->flags.add_groups(*sub,
                       {KeyGroup::Robot, KeyGroup::Start, KeyGroup::Target, KeyGroup::TargetPlace,
-                       KeyGroup::Contact, KeyGroup::Planner, KeyGroup::Global},
+                       KeyGroup::Contact, KeyGroup::Planner, KeyGroup::Global, KeyGroup::JointModels},
                       {"global", "baseline-task"});
   sub->add_option("--plan", o->plan, "The plan the controller follows: paper or global")
       ->capture_default_str();

@@ -149,9 +149,11 @@ void register_pareto(CLI::App& app, Action& action) {
       "pareto", "Front of M_ie against the base's angular rate jump at the impact, on the capture manifold");
   sub->add_option("--config", o->config, "Scenario file (TOML); default: the built-in paper 3-DOF scenario")
       ->check(CLI::ExistingFile);
-  // the front is of M_ie with free joints during the contact: no joint-model keys
+  // the front is of M_ie under the scenario's joint model (the capture objective's); the multibody
+  // reference's servo keys act with the global run's objective multibody-force only (refused otherwise)
   o->flags.add_groups(*sub, {KeyGroup::Robot, KeyGroup::Start, KeyGroup::Target, KeyGroup::TargetPlace,
-                             KeyGroup::Contact, KeyGroup::Planner, KeyGroup::Global, KeyGroup::Shapes});
+                             KeyGroup::Contact, KeyGroup::Planner, KeyGroup::Global, KeyGroup::JointModels,
+                             KeyGroup::Shapes});
   sub->add_option("--levels", o->levels, "Epsilon levels of the sweep between the two ends")
       ->capture_default_str();
   sub->add_option("--starts", o->starts, "Random starts of the two single-objective searches")

@@ -204,10 +204,11 @@ bool is_stdout_name(const std::string& path) {
   return path == "-" || path == "/dev/stdout" || path == "/dev/fd/1" || path == "/proc/self/fd/1";
 }
 
-void Outputs::add(const std::string& flag, const std::string& path) {
+void Outputs::add(const std::string& flag, const std::string& path, const std::string& given_as) {
   if (path.empty()) return;
-  if (is_stdout_name(path)) claim_stdout(flag + " " + path);
-  items_.push_back({flag, path, {}, false});
+  const std::string name = given_as.empty() ? flag : given_as;
+  if (is_stdout_name(path)) claim_stdout(name + " " + path);
+  items_.push_back({flag, name, path, {}, false});
 }
 
 void Outputs::claim_stdout(const std::string& flag) {
@@ -239,7 +240,7 @@ void Outputs::set(const std::string& flag, std::string content) {
 void Outputs::write() const {
   std::vector<OutputSpec> specs;
   for (const auto& it : items_)
-    if (it.has_content) specs.push_back({it.flag, it.path, &it.content});
+    if (it.has_content) specs.push_back({it.given_as, it.path, &it.content});
   write_outputs(specs);
 }
 
@@ -305,7 +306,7 @@ void flush_stdout() {
 Outputs OutputKeys::outputs() const {
   Outputs o;
   o.add("--json", json);
-  o.add(csv_flag, csv);
+  o.add("--csv", csv, csv_flag);
   return o;
 }
 

@@ -31,8 +31,10 @@ namespace ffsr::cli {
 class Outputs {
  public:
   /// Registers the output of `flag` (for example "--json") at `path`; an empty path: not requested.
-  /// Throws InputError naming both flags when a second output names standard output.
-  void add(const std::string& flag, const std::string& path);
+  /// `given_as`: the name messages use when the flag was given under another name (contact's
+  /// --series for --csv); empty: `flag`. Throws InputError naming both flags when a second output
+  /// names standard output.
+  void add(const std::string& flag, const std::string& path, const std::string& given_as = {});
   /// `flag` prints on standard output itself (for example `contact --json`); same check as add.
   void claim_stdout(const std::string& flag);
   bool requested(const std::string& flag) const;
@@ -49,7 +51,7 @@ class Outputs {
 
  private:
   struct Item {
-    std::string flag, path, content;
+    std::string flag, given_as, path, content;
     bool has_content = false;
   };
   std::vector<Item> items_;
