@@ -4,9 +4,13 @@
 // Run (Release): build/bench/ffsr-bench-closed-loop [--scenario paper_7dof_position] [--seeds 20]
 //   [--control-rate 1000] [--estimate-rate 5] [--position-noise 0.005] [--attitude-noise-deg 0.5]
 //   [--spin-noise-deg 0] [--policy servo|gradient] [--bandwidth 50] [--torque-limit 100] [--window 1]
-//   [--first-seed 1] [--no-exact]
+//   [--first-seed 1] [--no-exact] [--integrator rk|cvode] [--reference]
 // Prints the exact-target run, one line per seed, then the worst and the median. Seeds first-seed to
 // first-seed + seeds - 1: split a long study into processes run side by side (e.g. GNU parallel).
+// --reference runs the exact target a second time with CVODE restarted at every tick
+// (ClosedLoopIntegrator::CvodeRestart) and prints the differences of capture error, M_ie and largest
+// torque and the ratio of the two wall times. Times are wall clock of the simulation alone (the plan
+// and the controller's construction are outside).
 
 #include "support/baselines.hpp"
 
@@ -45,10 +49,12 @@ Run run_once(Make&& make, const ClosedLoopOptions& o) {
   return {std::move(r), std::chrono::duration<double>(std::chrono::steady_clock::now() - a).count()};
 }
 
+double relative(double a, double b) { return std::abs(a - b) / std::abs(b); }
+
 void print(const char* label, const Run& x, double M_open) {
   std::printf(
-      "%-10s capture error %8.3f mm  M_ie %8.4f kg (%+7.3f %%)  F_max %7.1f N  max torque %7.3f N m  "
-      "max lag %8.2e rad/s  base turn %6.3f deg  |h| max %8.1e  %5.1f s\n",
+      "%-10s capture error %10.6f mm  M_ie %10.8f kg (%+7.3f %%)  F_max %7.1f N  max torque %9.6f N m  "
+      "max lag %8.2e rad/s  base turn %6.3f deg  |h| max %8.1e  %6.2f s\n",
       label, 1e3 * x.r.capture_error, x.r.M_ie, 100 * (x.r.M_ie - M_open) / M_open, x.r.f_max_closed_form,
       x.r.max_torque, x.r.max_tracking_lag, x.r.base_attitude_change * 180 / M_PI, x.r.max_momentum,
       x.seconds);
@@ -59,15 +65,16 @@ void print(const char* label, const Run& x, double M_open) {
 int main(int argc, char** argv) {
   std::string name = "paper_7dof_position", policy = "servo";
   int seeds = 20, first_seed = 1;
-  bool exact_run = true;
+  bool exact_run = true, reference = false;
   ControllerOptions copt;
   ClosedLoopOptions o;
   o.noise.position = 0.005;
   o.noise.attitude = 0.5 * M_PI / 180;
   for (int i = 1; i < argc; i += 2) {
     const std::string a = argv[i];
-    if (a == "--no-exact") {
-      exact_run = false;
+    if (a == "--no-exact" || a == "--reference") {  // flags without a value
+      if (a == "--no-exact") exact_run = false;
+      if (a == "--reference") reference = true;
       --i;
       continue;
     }
@@ -100,7 +107,14 @@ int main(int argc, char** argv) {
       copt.prediction_window = static_cast<int>(v);
     else if (a == "--torque-limit")
       o.loop.torque_limit = v;
-    else {
+    else if (a == "--integrator") {
+      const std::string x = argv[i + 1];
+      if (x != "rk" && x != "cvode") {
+        std::fprintf(stderr, "bench_closed_loop: --integrator: expected rk or cvode, got %s\n", x.c_str());
+        return 2;
+      }
+      o.integrator = x == "rk" ? ClosedLoopIntegrator::RungeKutta : ClosedLoopIntegrator::CvodeRestart;
+    } else {
       std::fprintf(stderr, "bench_closed_loop: unknown argument %s\n", a.c_str());
       return 2;
     }
@@ -136,11 +150,23 @@ int main(int argc, char** argv) {
     const Run ex = run(exact);
     print("exact", ex, M_open);
     std::printf(
-        "exact: %ld ticks, %ld CVODE steps, %ld saturated ticks, %ld damped, %ld rate-limited, max |p_e - "
-        "x_d| "
-        "%.2e m\n",
-        ex.r.ticks, ex.r.cvode_steps, ex.r.saturated_ticks, ex.r.damped_ticks, ex.r.rate_limited_ticks,
-        ex.r.max_reference_error);
+        "exact: %ld ticks, %ld %s steps (%ld refused), %ld saturated ticks, %ld damped, %ld rate-limited, "
+        "max |p_e - x_d| %.2e m\n",
+        ex.r.ticks, ex.r.integrator_steps,
+        o.integrator == ClosedLoopIntegrator::RungeKutta ? "Runge-Kutta" : "CVODE", ex.r.rejected_steps,
+        ex.r.saturated_ticks, ex.r.damped_ticks, ex.r.rate_limited_ticks, ex.r.max_reference_error);
+    if (reference) {
+      exact.integrator = o.integrator == ClosedLoopIntegrator::RungeKutta ? ClosedLoopIntegrator::CvodeRestart
+                                                                          : ClosedLoopIntegrator::RungeKutta;
+      const Run other = run(exact);
+      print(exact.integrator == ClosedLoopIntegrator::CvodeRestart ? "CVODE" : "RK", other, M_open);
+      std::printf(
+          "against the other integrator: capture error %.3e m, M_ie %.3e relative, largest torque %.3e "
+          "relative, |theta(T) difference| %.3e rad; wall time %.2f s / %.2f s = %.1fx\n",
+          std::abs(ex.r.capture_error - other.r.capture_error), relative(ex.r.M_ie, other.r.M_ie),
+          relative(ex.r.max_torque, other.r.max_torque), (ex.r.theta - other.r.theta).cwiseAbs().maxCoeff(),
+          ex.seconds, other.seconds, other.seconds / ex.seconds);
+    }
   }
   if (seeds <= 0) return 0;
   std::printf(

@@ -129,7 +129,7 @@ nlohmann::json result_json(const Scenario& sc, const Plan& p, const ClosedLoopOp
                       {"damped_ticks", r.damped_ticks},
                       {"rate_limited_ticks", r.rate_limited_ticks},
                       {"saturated_ticks", r.saturated_ticks},
-                      {"cvode_steps", r.cvode_steps}};
+                      {"integrator_steps", r.integrator_steps}};
   j["mass_difference_percent"] = 100 * (r.M_ie - p.open.M_ie) / p.open.M_ie;
   return j;
 }

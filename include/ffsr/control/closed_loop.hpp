@@ -2,13 +2,20 @@
 // dynamics and a noisy target estimate. Component ffsr::cvode (SUNDIALS).
 //
 // Plant: the free-floating robot, forward dynamics of Eq. 1 (H a = tau - C, CRBA + RNEA, no external
-// force, no gravity unless the model has some), integrated by CVODE (BDF) with the state
+// force, no gravity unless the model has some), with the state
 //   y = [p_0 - p_0(0) (3), phi_0 (3: base attitude as a rotation vector from the initial one),
 //        theta (n), v_0 (3), omega_0 (3), theta_dot (n), z (n: the PI integrators)].
 // Each joint has a rate loop: tau_k = sat(K_p,k (u_k - theta_dot_k) + K_i,k z_k, tau_max), z_k_dot =
 // u_k - theta_dot_k while the torque is not saturated (conditional integration: no wind-up), u the
-// controller's command held constant over a control period (zero-order hold). CVODE is restarted at
-// every tick (the command jumps there).
+// controller's command held constant over a control period (zero-order hold).
+// Integration (ClosedLoopOptions::integrator): the command jumps at every tick, so the right-hand
+// side is smooth within a control period and jumps at its ends. The default, RungeKutta, is one
+// continuous explicit integration whose steps end on the ticks: the Dormand-Prince 5(4) pair, its
+// step size carried from tick to tick (one step per tick when the error allows), the error of each
+// step kept below rtol |y_i| + atol (weighted RMS, as CVODE) by the embedded 4th-order solution, and
+// the last stage of a tick reused for the first of the next (only the torques change there). A
+// multistep method would carry its history across the jumps; CvodeRestart, CVODE (BDF) restarted at
+// every tick, is kept as the reference it was measured against (docs/controller.md).
 // Controller: CaptureController::step at the control rate on the true state (the measured state is
 // exact: joint encoders and the base's attitude/position sensors are not modelled).
 // Target estimate: at the estimate rate (from t = 0), the truth (propagate_target of the problem's
@@ -50,14 +57,21 @@ struct EstimateNoise {
   double angular_velocity = 0;  ///< rad/s (target frame)
 };
 
+/// How the plant is integrated from tick to tick (see the top of the file).
+enum class ClosedLoopIntegrator {
+  RungeKutta,    ///< Dormand-Prince 5(4), one continuous integration, steps ending on the ticks
+  CvodeRestart,  ///< CVODE (BDF, Newton, dense) restarted at every tick: the reference, slow
+};
+
 struct ClosedLoopOptions {
   double control_rate = 1000.0;  ///< Hz: controller ticks (zero-order hold in between)
   double estimate_rate = 5.0;    ///< Hz: target estimates (update_target)
   RateLoopGains loop;
   EstimateNoise noise;
   std::uint64_t seed = 1;
-  double rtol = 1e-9;       ///< CVODE
-  double atol = 1e-12;      ///< CVODE, m, rad, m/s, rad/s
+  ClosedLoopIntegrator integrator = ClosedLoopIntegrator::RungeKutta;
+  double rtol = 1e-9;       ///< local error per step <= rtol |y_i| + atol (both integrators)
+  double atol = 1e-12;      ///< m, rad, m/s, rad/s
   double record_every = 0;  ///< s between recorded samples (0: none)
 };
 
@@ -84,7 +98,8 @@ struct ClosedLoopResult {
   double max_momentum = 0;                  ///< largest |P| + |L| at the ticks
   long ticks = 0, estimates = 0, fault_ticks = 0, damped_ticks = 0, rate_limited_ticks = 0;
   long saturated_ticks = 0;  ///< ticks with some joint's torque at the limit
-  long cvode_steps = 0;
+  long integrator_steps = 0;  ///< accepted steps (RungeKutta) or CVODE's steps, over the run
+  long rejected_steps = 0;    ///< RungeKutta: steps the error test refused and took again, shorter
   std::vector<ClosedLoopSample> series;
 };
 
@@ -98,6 +113,7 @@ struct ClosedLoopPlant {
   int n;
   RateLoopGains gains;
   Eigen::VectorXd u, theta, v, tau, a, e, kp, ki;
+  Eigen::VectorXd bias;  ///< C(q, v) at the state of the last dynamics() call
 
   ClosedLoopPlant(const Model& m, const BasePose& b0, const Eigen::VectorXd& theta0, const RateLoopGains& g)
       : model(m),
@@ -112,7 +128,8 @@ struct ClosedLoopPlant {
         a(6 + n),
         e(n),
         kp(n),
-        ki(n) {
+        ki(n),
+        bias(6 + n) {
     base0.orientation.normalize();
     crba(model, data, base0, theta0);  // M = H_mm - H_mb H_b^-1 H_bm, its diagonal
     const Eigen::LLT<Matrix6> Hb(data.H.topLeftCorner<6, 6>());
@@ -143,20 +160,37 @@ struct ClosedLoopPlant {
     }
     return sat;
   }
-  void rhs(const Eigen::Ref<const Eigen::VectorXd>& y, Eigen::Ref<Eigen::VectorXd> ydot) {
-    torques(y);
+  /// What of the dynamics does not depend on the command: H (crba), its Cholesky factor (data.L)
+  /// and the bias forces C (rnea) at y. Writes data, theta, v, bias. NumericalError if H is not
+  /// positive definite.
+  void dynamics(const Eigen::Ref<const Eigen::VectorXd>& y) {
     const BasePose b = base(y);
     theta = y.segment(6, n);
     v = y.segment(iv(), 6 + n);
-    forward_dynamics(model, data, b, theta, v, tau, a);
-    ydot.segment<3>(0) = v.head<3>();
-    ydot.segment<3>(3) = rotation_vector_rate(y.segment<3>(3), v.segment<3>(3));
-    ydot.segment(6, n) = v.tail(n);
+    crba(model, data, b, theta);
+    bias = bias_forces(model, data, b, theta, v);
+    detail::cholesky(data.H, data.L, "closed loop");
+  }
+  /// ydot at y with the command u, from the dynamics() of the same y: the forward dynamics
+  /// a = H^-1 (tau - C) (as forward_dynamics computes it) and the rate loops. Reads y, u, bias and
+  /// data.L only. Writes tau, e, a.
+  void derivative(const Eigen::Ref<const Eigen::VectorXd>& y, Eigen::Ref<Eigen::VectorXd> ydot) {
+    torques(y);
+    a = tau - bias;
+    detail::cholesky_solve(data.L, a);
+    ydot.segment<3>(0) = y.segment<3>(iv());
+    ydot.segment<3>(3) = rotation_vector_rate(y.segment<3>(3), y.segment<3>(iv() + 3));
+    ydot.segment(6, n) = y.segment(iv() + 6, n);
     ydot.segment(iv(), 6 + n) = a;
     for (int k = 0; k < n; ++k) {  // conditional integration: hold z while the torque is at the limit
       const bool at_limit = std::abs(tau(6 + k)) >= gains.torque_limit && tau(6 + k) * e(k) > 0;
       ydot(iz() + k) = at_limit ? 0.0 : e(k);
     }
+  }
+  /// The right-hand side f(y) with the command u.
+  void rhs(const Eigen::Ref<const Eigen::VectorXd>& y, Eigen::Ref<Eigen::VectorXd> ydot) {
+    dynamics(y);
+    derivative(y, ydot);
   }
 };
 

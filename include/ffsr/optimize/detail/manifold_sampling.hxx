@@ -98,15 +98,17 @@ inline double posture_distance(const Model& model, const Eigen::VectorXd& a, con
   return e.size() ? e.cwiseAbs().maxCoeff() : 0.0;
 }
 
-/// Moves every revolute joint with finite limits of theta by whole turns to the value within its
-/// limits nearest to ref(k) (a function of the posture and ref alone). Joints without limits and
-/// prismatic joints are left as they are. Returns false when some joint has no value within its
-/// limits (the posture is outside the joint box).
+/// Moves every revolute joint of theta by whole turns to the value nearest to ref(k) within its
+/// limits (a function of the posture and ref alone: the search's optima are reported, and compared
+/// between runs, as the angles the joints turn to from ref, never as 446 deg for 86 deg). A joint
+/// without limits takes the value within half a turn of ref(k); prismatic joints are left as
+/// they are. Returns false when some joint has no value within its limits (the posture is outside
+/// the joint box).
 inline bool nearest_representative(const Model& model, const Eigen::VectorXd& ref, Eigen::VectorXd& theta) {
   constexpr double tol = 1e-12;
   for (int k = 0; k < model.n(); ++k) {
     const Joint& j = model.joint(k);
-    if (j.type != JointType::Revolute || !std::isfinite(j.lower) || !std::isfinite(j.upper)) continue;
+    if (j.type != JointType::Revolute) continue;
     const double near = ref(k) + std::remainder(theta(k) - ref(k), 2 * M_PI);  // nearest to ref
     double best = near;
     bool found = false;
