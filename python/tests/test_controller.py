@@ -225,3 +225,13 @@ def test_the_docs_control_loop_captures():
     assert error < 1e-3  # the scenario's tolerance, 1 mm
     from_plan_deg = float(re.search(r"([\d.]+) deg from the plan's", out).group(1))
     assert from_plan_deg < 0.5
+
+
+def test_the_controller_keeps_its_scenario_alive():
+    import gc
+
+    ctrl = ffsr.CaptureController(ffsr.Scenario.load(str(ROBOTS / "paper_3dof.toml"), **{"global": False}))
+    gc.collect()  # the scenario (its robot model) has no other reference
+    td, xb = np.zeros(3), np.zeros(6)
+    assert ctrl.step(0.0, [0.0, 0.0, 0.0], [0.0, 0.0, 0.0, 1.0], np.radians([0.0, 150.0, -100.0]), td, xb) == "ok"
+    assert np.all(np.isfinite(td)) and np.all(np.isfinite(xb))
