@@ -4,11 +4,12 @@
 // Run (Release): build/bench/ffsr-bench-closed-loop [--scenario paper_7dof_position] [--seeds 20]
 //   [--control-rate 1000] [--estimate-rate 5] [--position-noise 0.005] [--attitude-noise-deg 0.5]
 //   [--spin-noise-deg 0] [--policy servo|gradient] [--bandwidth 50] [--torque-limit 100] [--window 1]
-//   [--first-seed 1] [--no-exact] [--integrator rk|cvode] [--reference]
+//   [--first-seed 1] [--no-exact] [--integrator rk|cvode] [--rtol 1e-9] [--atol 1e-12] [--reference]
 // Prints the exact-target run, one line per seed, then the worst and the median. Seeds first-seed to
 // first-seed + seeds - 1: split a long study into processes run side by side (e.g. GNU parallel).
 // --reference runs the exact target a second time with CVODE restarted at every tick
-// (ClosedLoopIntegrator::CvodeRestart) and prints the differences of capture error, M_ie and largest
+// (ClosedLoopIntegrator::CvodeRestart) at the default rtol and atol (--rtol and --atol set the
+// measured run's) and prints the differences of capture error, M_ie and largest
 // torque and the ratio of the two wall times. Times are wall clock of the simulation alone (the plan
 // and the controller's construction are outside).
 
@@ -107,6 +108,10 @@ int main(int argc, char** argv) {
       copt.prediction_window = static_cast<int>(v);
     else if (a == "--torque-limit")
       o.loop.torque_limit = v;
+    else if (a == "--rtol")
+      o.rtol = v;
+    else if (a == "--atol")
+      o.atol = v;
     else if (a == "--integrator") {
       const std::string x = argv[i + 1];
       if (x != "rk" && x != "cvode") {
@@ -158,6 +163,8 @@ int main(int argc, char** argv) {
     if (reference) {
       exact.integrator = o.integrator == ClosedLoopIntegrator::RungeKutta ? ClosedLoopIntegrator::CvodeRestart
                                                                           : ClosedLoopIntegrator::RungeKutta;
+      exact.rtol = ClosedLoopOptions{}.rtol;  // the reference at the default tolerances
+      exact.atol = ClosedLoopOptions{}.atol;
       const Run other = run(exact);
       print(exact.integrator == ClosedLoopIntegrator::CvodeRestart ? "CVODE" : "RK", other, M_open);
       std::printf(

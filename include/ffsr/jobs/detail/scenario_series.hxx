@@ -112,14 +112,16 @@ inline nlohmann::json scene_json(const Scenario& sc) {
   const Frame& ee = model.frame(sc.problem.frame);
   const Target& t0 = sc.problem.target;
   const Target at_capture = propagate_target(t0, sc.capture.duration);
-  return {{"bodies", bodies},
-          {"end_effector_body", ee.body},
-          {"end_effector_point", vector_json(ee.pose.p)},
-          {"target_shape", target_shape ? shape_json(*target_shape) : nlohmann::json(nullptr)},
-          {"contact_offset", vector_json(t0.contact_offset)},
-          {"contact_normal_target_frame", vector_json(t0.normal.normalized())},
-          {"capture_time", sc.capture.duration},
-          {"capture_normal", vector_json(at_capture.normal_world())}};
+  nlohmann::json scene = {{"bodies", bodies},
+                          {"end_effector_body", ee.body},
+                          {"end_effector_point", vector_json(ee.pose.p)},
+                          {"contact_offset", vector_json(t0.contact_offset)},
+                          {"contact_normal_target_frame", vector_json(t0.normal.normalized())},
+                          {"capture_time", sc.capture.duration},
+                          {"capture_normal", vector_json(at_capture.normal_world())}};
+  // present with a shape only: a null in the results means a value that is not a number
+  if (target_shape) scene["target_shape"] = shape_json(*target_shape);
+  return scene;
 }
 
 }  // namespace detail
