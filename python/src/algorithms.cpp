@@ -216,16 +216,26 @@ void bind_algorithms(nb::module_& m) {
   m.def(
       "integrated_effective_mass_fast",
       [](const Model& model, Data& data, const BasePose& base, nb::handle theta, nb::handle frame,
-         const Target* target) {
+         const Target* target, const std::string& joints, nb::handle armature) {
         const Config c(model, data, theta, "integrated_effective_mass_fast");
         const Target& t = target_or_default(target);
-        return integrated_effective_mass_fast(model, data, base, c.theta.map(),
-                                              frame_arg(model, frame, "integrated_effective_mass_fast"),
-                                              t.normal_world(), t.inverse_mass_along_normal());
+        const int f = frame_arg(model, frame, "integrated_effective_mass_fast");
+        if (joints == "free" && armature.is_none())  // the paper's joints, without the joint model's vectors
+          return integrated_effective_mass_fast(model, data, base, c.theta.map(), f, t.normal_world(),
+                                                t.inverse_mass_along_normal());
+        return integrated_effective_mass_fast(model, data, base, c.theta.map(), f, t.normal_world(),
+                                              t.inverse_mass_along_normal(), joints_arg(model, joints, armature));
       },
       "model"_a, "data"_a, "base"_a, "theta"_a, "frame"_a.none() = nb::none(), "target"_a.none() = nb::none(),
-      "M_ie (Eq. 14) by the faster of crba + dense Cholesky and the O(n) articulated-body recursion\n"
-      "(RBDA 7.3) for the model's size; the same value as integrated_effective_mass to rounding.");
+      "joints"_a = "free", "armature"_a.none() = nb::none(),
+      (std::string(
+           "M_ie (Eq. 14) as integrated_effective_mass, in O(n) by the articulated-body recursion (RBDA 7.3)\n"
+           "with the joint model's contact inertia (locked: the composite inertia of the whole robot); a model\n"
+           "with mimic joints takes crba and the dense solve. The same value as integrated_effective_mass with\n"
+           "the same joints to rounding. Writes the kinematics and the recursion's fields: do not rely on Data.H\n"
+           "afterwards.\n") +
+       kJointsDoc)
+          .c_str());
 
   m.def(
       "integrated_effective_mass_gradient",

@@ -216,7 +216,8 @@ ContactJoints joints_arg(const Model& model, const std::string& joints, nb::hand
 }  // namespace ffsr::python
 
 namespace ffsr::python {
-void bind_scenario(nb::module_& m);  // scenario.cpp
+void bind_scenario(nb::module_& m);    // scenario.cpp
+void bind_controller(nb::module_& m);  // controller.cpp
 }  // namespace ffsr::python
 
 using namespace ffsr::python;
@@ -283,4 +284,5 @@ NB_MODULE(_ffsr, m) {
   bind_contact(m);
   bind_batch(m);
   bind_scenario(m);
+  bind_controller(m);
 }
