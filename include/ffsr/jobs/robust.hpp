@@ -46,6 +46,19 @@ struct RobustConfiguration {
 std::vector<RobustConfiguration> planned_robust_configurations(const Scenario& sc,
                                                                const ScenarioRunOptions& run = {});
 
+/// The keys of robust's scenario: the global runs use seed 1 (the job's `seed` is the Monte Carlo
+/// seed, uncertainty.seed; a top-level `seed` key of the file is not the global search's here).
+inline void robust_global_seed(ScenarioKeys& keys) {
+  keys.seed = "1";
+  keys.given.erase("seed");
+}
+
+/// A capture configuration given by its joint angles (deg) and base pose (m, deg): named "given" (the
+/// command's --capture-joints-deg, --capture-base-position, --capture-base-rpy-deg, which errors name).
+RobustConfiguration given_robust_configuration(const Model& model, const std::vector<double>& joints_deg,
+                                               const std::vector<double>& base_position = {0, 0, 0},
+                                               const std::vector<double>& base_rpy_deg = {0, 0, 0});
+
 /// The force model's name as the command spells it: closed, exact or multibody; InputError naming
 /// --force-model otherwise.
 ForceModel robust_force_model(const std::string& name);

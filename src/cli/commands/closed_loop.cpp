@@ -3,7 +3,7 @@
 // target estimate (ffsr/control/closed_loop.hpp), beside the open-loop plan it follows. The plan is
 // the paper's method (--plan paper), the global run's servo (--plan global: the global search of the
 // main job first) or the servo to a given capture configuration (--goal-joints-deg). A flag overrides
-// the scenario file's key.
+// the scenario file's key. The job is the library's (ffsr/jobs/closed_loop.hpp).
 #include "support/output.hpp"
 #include "support/parse.hpp"
 #include "support/progress.hpp"
@@ -12,10 +12,7 @@
 #include "figures/plot.hpp"
 #include "commands/subcommands.hpp"
 
-#include "ffsr/jobs/scenario_run.hpp"
-
-#include "ffsr/control/capture_controller.hpp"
-#include "ffsr/control/closed_loop.hpp"
+#include "ffsr/jobs/closed_loop.hpp"
 
 #include <iomanip>
 #include <iostream>
@@ -27,131 +24,16 @@ namespace {
 
 using detail::str;
 
-struct ClosedLoopCliOptions : OutputKeys {
-  std::string config, plan = "paper";
+/// The job's options (plan, goal, loop, noise, controller) and the command's.
+struct ClosedLoopCliOptions : OutputKeys, ClosedLoopJobOptions {
+  std::string config;
   ScenarioFlags flags;
-  std::vector<double> goal_joints_deg;
-  ClosedLoopOptions loop;
-  double attitude_noise_deg = 0, spin_noise_deg = 0;
   std::string noise_seed = "1";
-  ControllerOptions controller;
 };
 
 const std::set<std::string> kClosedLoopKeys = {"json", "csv", "plot", "plot-format", "quiet"};
 
-/// The open-loop plan and the controller that follows it.
-struct Plan {
-  std::string name;
-  CaptureResult open;
-  CaptureOptions options;
-  Eigen::VectorXd goal;  ///< servo goal (empty: the paper's gradient policy)
-};
-
-Plan make_plan(const Scenario& sc, const ClosedLoopCliOptions& o) {
-  Plan p;
-  p.options = sc.capture;
-  p.options.progress = nullptr;
-  p.options.record_series = !o.plot.empty();  // the plan's joint angles beside the closed loop's
-  p.options.record_every = std::max(1, static_cast<int>(sc.capture.duration / sc.capture.step / 1000));
-  if (!o.goal_joints_deg.empty()) {
-    if (static_cast<int>(o.goal_joints_deg.size()) != sc.model->n())
-      throw InputError(str("--goal-joints-deg: got ", o.goal_joints_deg.size(), " angles, the robot has ",
-                           sc.model->n(), " joints"));
-    p.goal = Eigen::Map<const Eigen::VectorXd>(o.goal_joints_deg.data(), sc.model->n()) * (M_PI / 180);
-    p.name = "servo to --goal-joints-deg";
-  } else if (o.plan == "global") {
-    const CaptureResult paper = plan_capture(sc.problem, sc.task, p.options);
-    p.goal = run_global(sc, paper, sc.objective).result.run.theta;
-    p.name = "global";
-  } else if (o.plan == "paper") {
-    p.name = "paper";
-    p.open = plan_capture(sc.problem, sc.task, p.options);
-    return p;
-  } else {
-    throw InputError(str("--plan: expected paper or global, got '", o.plan, "'"));
-  }
-  p.options.gain = 0.0;
-  p.options.max_joint_rate = sc.keys.max_joint_rate_deg * M_PI / 180.0;
-  const CaptureSetup setup = prepare_capture(sc.problem, sc.task, p.options);
-  ServoPolicy servo;
-  servo.theta_goal = p.goal;
-  p.open = integrate_capture(sc.problem, sc.task, p.options, setup, servo);
-  return p;
-}
-
-ClosedLoopResult simulate(const Scenario& sc, const Plan& p, const ClosedLoopOptions& o,
-                          const ControllerOptions& copt) {
-  if (p.goal.size() == 0) {
-    auto ctrl = make_gradient_controller(sc.problem, sc.task, p.options, copt);
-    return simulate_closed_loop(ctrl, o);
-  }
-  auto ctrl = make_servo_controller(sc.problem, sc.task, p.options, p.goal, 0.0, copt);
-  return simulate_closed_loop(ctrl, o);
-}
-
-nlohmann::json result_json(const Scenario& sc, const Plan& p, const ClosedLoopOptions& o,
-                           const ControllerOptions& copt, const ClosedLoopResult& r) {
-  nlohmann::json j;
-  j["version"] = FFSR_VERSION;
-  j["scenario"] = sc.where;
-  j["plan"] = p.name;
-  j["options"] = {{"control_rate_hz", o.control_rate},
-                  {"estimate_rate_hz", o.estimate_rate},
-                  {"rate_loop_bandwidth", o.loop.bandwidth},
-                  {"torque_limit", o.loop.torque_limit},
-                  {"noise",
-                   {{"position", o.noise.position},
-                    {"attitude_deg", rad2deg(o.noise.attitude)},
-                    {"velocity", o.noise.velocity},
-                    {"spin_deg_per_s", rad2deg(o.noise.angular_velocity)}}},
-                  {"noise_seed", o.seed}};
-  j["options"]["prediction_window"] = copt.prediction_window;
-  auto quaternion = [](const BasePose& b) {  // w, x, y, z, as the main job writes it
-    const Eigen::Vector4d q = b.orientation.coeffs();
-    return nlohmann::json{q(3), q(0), q(1), q(2)};
-  };
-  j["open_loop"] = {{"capture_configuration_deg", to_json(Eigen::VectorXd(p.open.theta * 180 / M_PI))},
-                    {"base_position", to_json(Eigen::VectorXd(p.open.base.position))},
-                    {"base_quaternion_wxyz", quaternion(p.open.base)},
-                    {"capture_error", p.open.capture_distance},
-                    {"integrated_effective_mass", p.open.M_ie},
-                    {"f_max_closed_form", p.open.f_max_closed_form}};
-  j["closed_loop"] = {{"capture_configuration_deg", to_json(Eigen::VectorXd(r.theta * 180 / M_PI))},
-                      {"base_position", to_json(Eigen::VectorXd(r.base.position))},
-                      {"base_quaternion_wxyz", quaternion(r.base)},
-                      {"capture_error", r.capture_error},
-                      {"integrated_effective_mass", r.M_ie},
-                      {"f_max_closed_form", r.f_max_closed_form},
-                      {"max_torque", r.max_torque},
-                      {"max_tracking_lag", r.max_tracking_lag},
-                      {"max_reference_error", r.max_reference_error},
-                      {"base_attitude_change_deg", rad2deg(r.base_attitude_change)},
-                      {"base_position_change", r.base_position_change},
-                      {"max_momentum", r.max_momentum},
-                      {"ticks", r.ticks},
-                      {"estimates", r.estimates},
-                      {"damped_ticks", r.damped_ticks},
-                      {"rate_limited_ticks", r.rate_limited_ticks},
-                      {"saturated_ticks", r.saturated_ticks},
-                      {"integrator_steps", r.integrator_steps}};
-  j["mass_difference_percent"] = 100 * (r.M_ie - p.open.M_ie) / p.open.M_ie;
-  return j;
-}
-
-std::string series_csv(const ClosedLoopResult& r) {
-  std::ostringstream s;
-  s << std::setprecision(10)
-    << "t,joint,theta,theta_dot,command,torque,ee_x,ee_y,ee_z,ref_x,ref_y,ref_z,momentum\n";
-  for (const ClosedLoopSample& x : r.series)
-    for (Eigen::Index k = 0; k < x.theta.size(); ++k)
-      s << x.t << ',' << k + 1 << ',' << x.theta(k) << ',' << x.theta_dot(k) << ',' << x.command(k) << ','
-        << x.torque(k) << ',' << x.end_effector.x() << ',' << x.end_effector.y() << ',' << x.end_effector.z()
-        << ',' << x.reference.x() << ',' << x.reference.y() << ',' << x.reference.z() << ',' << x.momentum
-        << '\n';
-  return s.str();
-}
-
-void print_table(std::ostream& out, const Scenario& sc, const Plan& p, const ClosedLoopOptions& o,
+void print_table(std::ostream& out, const Scenario& sc, const ClosedLoopPlan& p, const ClosedLoopOptions& o,
                  const ClosedLoopResult& r) {
   out << "ffsr-optimize closed-loop: " << sc.where << ", plan " << p.name << ", control " << o.control_rate
       << " Hz, estimates " << o.estimate_rate << " Hz, rate loops " << o.loop.bandwidth
@@ -178,7 +60,7 @@ void print_table(std::ostream& out, const Scenario& sc, const Plan& p, const Clo
 }
 
 /// The picture: the recorded series of the closed loop beside the open-loop plan's.
-plot::Figure closed_loop_figure(const Scenario& sc, const Plan& p, const ClosedLoopOptions& o,
+plot::Figure closed_loop_figure(const Scenario& sc, const ClosedLoopPlan& p, const ClosedLoopOptions& o,
                                 const ClosedLoopResult& r) {
   figures::ClosedLoopSeries f;
   f.joint_names = sc.model->joint_names();
@@ -196,23 +78,6 @@ plot::Figure closed_loop_figure(const Scenario& sc, const Plan& p, const ClosedL
                 std::setprecision(3), r.capture_error * 1e3, " mm, M#die#u ", r.M_ie, " kg (plan ",
                 p.open.M_ie, ")");
   return figures::closed_loop(f);
-}
-
-/// The closed loop's flags, each error naming its flag.
-void check_flags(const ClosedLoopCliOptions& o) {
-  auto check = [](double x, bool zero_ok, const char* flag) {
-    if (!std::isfinite(x) || x < 0 || (!zero_ok && x == 0))
-      throw InputError(str(flag, ": must be ", zero_ok ? ">= 0" : "positive", " and finite, got ", x));
-  };
-  check(o.loop.control_rate, false, "--control-rate");
-  check(o.loop.estimate_rate, false, "--estimate-rate");
-  check(o.loop.noise.position, true, "--position-noise");
-  check(o.attitude_noise_deg, true, "--attitude-noise-deg");
-  check(o.loop.noise.velocity, true, "--velocity-noise");
-  check(o.spin_noise_deg, true, "--spin-noise-deg");
-  check(o.loop.loop.bandwidth, false, "--rate-loop-bandwidth");
-  check(o.loop.loop.torque_limit, false, "--torque-limit");
-  detail::check_closed_loop_options(o.loop);
 }
 
 int run_closed_loop(ClosedLoopCliOptions o, const CLI::App& app) {
@@ -233,17 +98,16 @@ int run_closed_loop(ClosedLoopCliOptions o, const CLI::App& app) {
   if (!o.plot.empty() && !(o.loop.record_every > 0))  // about 1000 points per curve
     o.loop.record_every = std::max(sc.capture.duration / 1000, 1.0 / o.loop.control_rate);
   Outputs outputs = o.outputs();
-  check_flags(o);  // before the planning
+  check_closed_loop_job(o);  // before the planning
   const plot::Format plot_format = plot::check_request(o.plot, o.plot_format);
-  if (o.controller.prediction_window < 1 || o.controller.prediction_window > 100000)
-    throw InputError(str("--prediction-window: must be in 1..100000, got ", o.controller.prediction_window));
-  const Plan plan = make_plan(sc, o);
-  const ClosedLoopResult r = simulate(sc, plan, o.loop, o.controller);
-  if (!o.plot.empty()) plot::render({closed_loop_figure(sc, plan, o.loop, r)}, o.plot, plot_format);
-  outputs.set("--json", result_json(sc, plan, o.loop, o.controller, r).dump(2) + "\n");
-  outputs.set("--csv", series_csv(r));
+  o.record_plan_series = !o.plot.empty();  // the plan's joint angles beside the closed loop's
+  const ClosedLoopJobResult job = closed_loop(sc, o);  // checks --prediction-window, plans, runs the loop
+  const ClosedLoopResult& r = job.result;
+  if (!o.plot.empty()) plot::render({closed_loop_figure(sc, job.plan, job.loop, r)}, o.plot, plot_format);
+  outputs.set("--json", closed_loop_json(sc, job, FFSR_VERSION).dump(2) + "\n");
+  outputs.set("--csv", closed_loop_series_csv(r));
   outputs.write();
-  print_table(outputs.table(), sc, plan, o.loop, r);
+  print_table(outputs.table(), sc, job.plan, job.loop, r);
   return 0;
 }
 

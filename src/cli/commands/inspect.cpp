@@ -1,15 +1,12 @@
 // ffsr-optimize inspect: evaluate one configuration (H, J_f, m_e, M_ie, the base's jump at the impact,
-// the distances between the shapes).
+// the distances between the shapes; the job is the library's, ffsr/jobs/inspect.hpp) and print it.
 #include "support/output.hpp"
 #include "support/parse.hpp"
 #include "support/progress.hpp"
 #include "support/subject.hpp"
 #include "commands/subcommands.hpp"
 
-#include "ffsr/jobs/scenario_run.hpp"
-
-#include "ffsr/algorithm/base_disturbance.hpp"
-#include "ffsr/optimize/objective.hpp"
+#include "ffsr/jobs/inspect.hpp"
 
 #include <iomanip>
 #include <iostream>
@@ -24,45 +21,6 @@ struct InspectOptions {
   SubjectOptions subject;
   OutputKeys out;  ///< --json, --quiet
 };
-
-/// The contact law at the approach velocity of the configuration, or nothing when the end-effector
-/// moving at the approach speed along u does not approach the target's contact point.
-std::optional<AnyContactLaw> inspect_law(const Subject& s) {
-  const Target& target = s.target;
-  const Vector3 u = target.normal_world();
-  const double vin = approach_velocity(u, Vector3(s.approach_speed * u), target.velocity,
-                                       target.angular_velocity_world(), target.offset_world());
-  if (!(vin > 0)) return std::nullopt;
-  try {
-    return make_contact_law(s.law, s.params, vin);
-  } catch (const InputError& e) {
-    throw InputError(std::string("--model: ") + e.what());
-  }
-}
-
-nlohmann::json disturbance_json(const std::optional<BaseDisturbance>& d) {
-  if (!d) return nullptr;
-  return {{"impulse", d->impulse},
-          {"restitution_single_body", d->restitution},
-          {"approach_velocity", d->approach_velocity},
-          {"angular_velocity_jump", to_json(Eigen::VectorXd(d->angular))},
-          {"angular_rate_jump_deg_s", d->angular_rate() * 180.0 / M_PI},
-          {"linear_velocity_jump", to_json(Eigen::VectorXd(d->linear))}};
-}
-
-/// The distances of the configuration to the target at t = 0 (and to the bus, between the links) when
-/// the scenario gives shapes (io/scenario_geometry.hpp), else nothing.
-std::optional<ClearanceReport> inspect_clearance(const Subject& s) {
-  const EmbeddedUrdf embedded = builtin_urdf();
-  const std::shared_ptr<const SceneGeometry> g =
-      scene_geometry(s.keys, s.robot.model, s.target.contact_offset, &embedded);
-#ifdef FFSR_HAVE_GEOMETRY
-  if (g)
-    return configuration_clearance(s.robot.model, *g->checker, s.robot.base, s.robot.theta,
-                                   target_pose(s.target));
-#endif
-  return std::nullopt;
-}
 
 void print_clearance(std::ostream& out, const ClearanceReport& c) {
   out << "distances        ";
@@ -95,68 +53,7 @@ void print_load_report(std::ostream& out, const UrdfReport& rep) {
   line("inertia repairs  ", r);
 }
 
-/// What inspect evaluates at the subject's configuration.
-struct Evaluation {
-  ContactJoints joints;  ///< the joint model of M_ie, m_e and the base's jump
-  double M_ie = 0, m_e = 0;
-  Vector3 u;
-  Eigen::MatrixXd Jf;
-  Pose ee;
-  Data data;
-  std::optional<BaseDisturbance> dist;
-  std::optional<ClearanceReport> clearance;
-  explicit Evaluation(const Model& model) : data(model) {}
-};
-
-Evaluation evaluate(const Subject& s) {
-  if (s.all_joint_models())
-    throw InputError(
-        "--contact-joints: inspect evaluates one joint model; 'all' is for the contact subcommand");
-  const Robot& r = s.robot;
-  Evaluation e(r.model);
-  e.joints = s.contact_joints();
-  e.u = s.target.normal_world();
-  const std::optional<AnyContactLaw> law = inspect_law(s);
-  // M_ie and the base's jump (single-body impulse) of the joint model: the capture objective's
-  const CaptureEvaluator objective(r.model, r.end_effector, s.target, law ? &*law : nullptr, e.joints);
-  if (law) e.dist = objective.disturbance(e.data, r.base, r.theta);
-  e.M_ie = objective.mass(e.data, r.base, r.theta);
-  e.m_e = 1.0 / inverse_effective_mass(r.model, e.data, r.end_effector, e.u, e.joints);
-  frame_jacobian(r.model, e.data, r.end_effector);
-  e.Jf = generalized_jacobian(r.model, e.data);
-  e.ee = frame_pose(r.model, e.data, r.end_effector);
-  e.clearance = inspect_clearance(s);
-  return e;
-}
-
-nlohmann::json inspect_json(const Subject& s, const Evaluation& e) {
-  const Robot& r = s.robot;
-  nlohmann::json j;
-  j["urdf"] = s.keys.urdf;
-  j["end_effector"] = r.model.frame(r.end_effector).name;
-  j["joint_names"] = r.model.joint_names();
-  j["joints_deg"] = to_json(Eigen::VectorXd(r.theta * (180.0 / M_PI)));
-  j["base_position"] = to_json(Eigen::VectorXd(r.base.position));
-  j["end_effector_position"] = to_json(Eigen::VectorXd(e.ee.p));
-  j["end_effector_rpy_deg"] = to_json(Eigen::VectorXd(rpy_from_rotation(e.ee.R) * (180.0 / M_PI)));
-  j["direction"] = to_json(Eigen::VectorXd(e.u));
-  j["H"] = to_json(e.data.H);
-  j["J_bm"] = to_json(e.data.J);
-  j["J_f"] = to_json(e.Jf);
-  j["total_mass"] = r.model.total_mass();
-  j["contact_joints"] = joint_model_name(e.joints.model);
-  if (e.joints.model == JointModel::Armature) j["armature"] = to_json(e.joints.armature);
-  j["effective_mass"] = e.m_e;
-  j["integrated_effective_mass"] = e.M_ie;
-  j["base_disturbance"] = disturbance_json(e.dist);
-  j["clearance"] = e.clearance ? ffsr::detail::clearance_json(*e.clearance) : nlohmann::json(nullptr);
-  j["model_repairs"] = repairs_json(r.report);
-  j["model_load"] = report_json(r.report);
-  j["version"] = FFSR_VERSION;
-  return j;
-}
-
-void print_inspect(std::ostream& out, const Subject& s, const Evaluation& e) {
+void print_inspect(std::ostream& out, const Subject& s, const InspectResult& e) {
   const Robot& r = s.robot;
   out << std::setprecision(6);
   out << "robot            " << s.keys.urdf << " (" << r.model.n() << " joints, " << r.model.total_mass()
@@ -174,9 +71,10 @@ void print_inspect(std::ostream& out, const Subject& s, const Evaluation& e) {
     out << "contact joints   " << joint_model_name(e.joints.model) << " (M_ie, m_e and the base jump)\n";
   out << "effective mass   m_e  = " << e.m_e << " kg   (Eq. 4)\n";
   out << "integrated mass  M_ie = " << e.M_ie << " kg   (Eq. 14)\n";
-  if (e.dist)
-    out << "base jump        |dw_0| = " << e.dist->angular_rate() * 180.0 / M_PI
-        << " deg/s, |dv_0| = " << e.dist->linear.norm() << " m/s   (impulse " << e.dist->impulse << " N s, "
+  if (e.disturbance)
+    out << "base jump        |dw_0| = " << e.disturbance->angular_rate() * 180.0 / M_PI
+        << " deg/s, |dv_0| = " << e.disturbance->linear.norm() << " m/s   (impulse " << e.disturbance->impulse
+        << " N s, "
         << s.law << ")\n";
   else
     out << "base jump        none: the end-effector does not approach the target at --approach-speed\n";
@@ -189,8 +87,9 @@ int run_inspect(const InspectOptions& o) {
   set_quiet(o.out.quiet);
   Outputs outputs = o.out.outputs();  // --json '-': the table goes to standard error
   const Subject s = load_subject(o.subject);
-  const Evaluation e = evaluate(s);
-  outputs.set("--json", inspect_json(s, e).dump(2) + "\n");
+  const EmbeddedUrdf embedded = builtin_urdf();
+  const InspectResult e = inspect(s, &embedded);
+  outputs.set("--json", inspect_json(s, e, FFSR_VERSION).dump(2) + "\n");
   outputs.write();
   print_inspect(outputs.table(), s, e);
   return 0;

@@ -1,5 +1,6 @@
 // ffsr-optimize pareto: the front of (M_ie, base angular rate jump at the impact) on the capture
-// manifold at the global run's base pose (ffsr/optimize/pareto.hpp), for a scenario as the main job.
+// manifold at the global run's base pose (ffsr/optimize/pareto.hpp), for a scenario as the main job; the
+// job is the library's (ffsr/jobs/pareto.hpp).
 #include "support/output.hpp"
 #include "support/parse.hpp"
 #include "support/progress.hpp"
@@ -8,9 +9,7 @@
 #include "figures/plot.hpp"
 #include "commands/subcommands.hpp"
 
-#include "ffsr/jobs/scenario_run.hpp"
-
-#include "ffsr/optimize/pareto.hpp"
+#include "ffsr/jobs/pareto.hpp"
 
 #include <iomanip>
 #include <iostream>
@@ -23,56 +22,12 @@ namespace {
 struct ParetoCliOptions {
   ScenarioFlags flags;
   std::string config;
-  int levels = 30, starts = 16;
-  OutputKeys out;  ///< --json, --csv, --plot, --quiet
+  ParetoJobOptions job;  ///< --levels, --starts
+  OutputKeys out;        ///< --json, --csv, --plot, --quiet
 };
 
 constexpr double kDeg = 180.0 / M_PI;
 const char* const kRunNames[] = {"plain run", "paper's method", "global run"};
-
-nlohmann::json point_json(const ParetoPoint& p) {
-  return {{"integrated_effective_mass", p.M_ie},
-          {"base_angular_rate_jump_deg_s", p.base_rate * kDeg},
-          {"capture_configuration_deg", to_json(Eigen::VectorXd(p.theta * kDeg))}};
-}
-
-nlohmann::json front_json(const Scenario& sc, const ParetoFront& f, const std::vector<ParetoPoint>& runs,
-                          const BasePose& base) {
-  nlohmann::json pts = nlohmann::json::array();
-  for (const ParetoPoint& p : f.points) pts.push_back(point_json(p));
-  const Eigen::Vector4d q = base.orientation.coeffs();
-  const char* names[] = {"baseline", "optimized", "global"};
-  nlohmann::json rj;
-  for (size_t i = 0; i < runs.size(); ++i) rj[names[i]] = point_json(runs[i]);
-  return {{"version", FFSR_VERSION},
-          {"scenario", sc.where},
-          {"base_position", to_json(Eigen::VectorXd(base.position))},
-          {"base_quaternion_wxyz", {q(3), q(0), q(1), q(2)}},
-          {"front", pts},
-          {"min_mass_end", point_json(f.min_mass)},
-          {"min_rate_end", point_json(f.min_rate)},
-          {"knee", point_json(f.points[f.knee])},
-          {"knee_index", f.knee},
-          {"hypervolume_kg_deg_s", f.hypervolume * kDeg},
-          {"hypervolume_normalized", f.hypervolume_normalized},
-          {"runs", rj},
-          {"evaluations", f.evaluations},
-          {"seconds", f.seconds}};
-}
-
-std::string front_csv(const ParetoFront& f) {
-  std::ostringstream out;
-  out << std::setprecision(12) << "index,M_ie_kg,base_rate_deg_s,knee";
-  for (Eigen::Index k = 0; k < f.points.front().theta.size(); ++k) out << ",theta" << k + 1 << "_deg";
-  out << "\n";
-  for (size_t i = 0; i < f.points.size(); ++i) {
-    const ParetoPoint& p = f.points[i];
-    out << i << "," << p.M_ie << "," << p.base_rate * kDeg << "," << (i == f.knee ? 1 : 0);
-    for (Eigen::Index k = 0; k < p.theta.size(); ++k) out << "," << p.theta(k) * kDeg;
-    out << "\n";
-  }
-  return out.str();
-}
 
 void print_front(std::ostream& out, const Scenario& sc, const ParetoFront& f,
                  const std::vector<ParetoPoint>& runs) {
@@ -111,27 +66,14 @@ plot::Figure pareto_figure(const Scenario& sc, const ParetoFront& f, const std::
 int run_pareto(const ParetoCliOptions& o) {
   set_quiet(o.out.quiet);
   Outputs outputs = o.out.outputs();
-  if (o.levels < 1) throw InputError(detail::str("--levels: must be >= 1, got ", o.levels));
-  if (o.starts < 1) throw InputError(detail::str("--starts: must be >= 1, got ", o.starts));
+  check_pareto_job(o.job);
   const plot::Format plot_format = plot::check_request(o.out.plot, o.out.plot_format);
   Scenario sc = command_scenario(command_scenario_keys(o.config, o.flags));
-  if (!sc.keys.global) throw InputError("--global: pareto needs the global run's base pose (global = true)");
-  ScenarioRunOptions ro;
-  const ScenarioResult r = run_scenario(sc, ro);
-  const CaptureResult& g = r.global->result.run;
-  const CaptureSetup setup = prepare_capture(sc.problem, sc.task, sc.capture);
-  ParetoOptions po;
-  po.levels = o.levels;
-  po.starts = o.starts;
-  po.seed = sc.seed;
-  const ParetoFront f = pareto_front(sc.problem, sc.task, setup, g.base, po, {r.optimized.theta, g.theta});
-  Data data(*sc.model);
-  const double e = single_body_restitution(setup.law);
-  std::vector<ParetoPoint> runs;
-  for (const CaptureResult* x : {&r.plain, &r.optimized, &g})
-    runs.push_back(detail::pareto_point(*sc.model, data, sc.problem, setup, x->base, x->theta, e));
-  outputs.set("--json", front_json(sc, f, runs, g.base).dump(2) + "\n");
-  outputs.set("--csv", front_csv(f));
+  const ParetoJobResult job = pareto(sc, o.job);  // the main job's runs, then the front
+  const ParetoFront& f = job.front;
+  const std::vector<ParetoPoint>& runs = job.runs;
+  outputs.set("--json", pareto_json(sc, job, FFSR_VERSION).dump(2) + "\n");
+  outputs.set("--csv", pareto_csv(f));
   std::vector<std::string> drawn;
   if (!o.out.plot.empty()) drawn = plot::render({pareto_figure(sc, f, runs)}, o.out.plot, plot_format);
   outputs.write();
@@ -154,9 +96,9 @@ void register_pareto(CLI::App& app, Action& action) {
   o->flags.add_groups(*sub, {KeyGroup::Robot, KeyGroup::Start, KeyGroup::Target, KeyGroup::TargetPlace,
                              KeyGroup::Contact, KeyGroup::Planner, KeyGroup::Global, KeyGroup::JointModels,
                              KeyGroup::Shapes});
-  sub->add_option("--levels", o->levels, "Epsilon levels of the sweep between the two ends")
+  sub->add_option("--levels", o->job.levels, "Epsilon levels of the sweep between the two ends")
       ->capture_default_str();
-  sub->add_option("--starts", o->starts, "Random starts of the two single-objective searches")
+  sub->add_option("--starts", o->job.starts, "Random starts of the two single-objective searches")
       ->capture_default_str();
   add_output_flags(*sub, o->out,
                    {"Write the front (configurations, ends, knee, hypervolume) as JSON to FILE",

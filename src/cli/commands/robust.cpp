@@ -176,30 +176,8 @@ int run_merge(const RobustOptions& o) {
 /// is not the global search's seed here (--seed is the Monte Carlo seed): the global runs use seed 1.
 Scenario robust_scenario(ScenarioKeys keys, const RobustOptions& o) {
   o.flags.apply(keys);
-  keys.seed = "1";
-  keys.given.erase("seed");
+  robust_global_seed(keys);
   return command_scenario(std::move(keys));
-}
-
-/// The capture configuration given with --capture-joints-deg.
-RobustConfiguration given_configuration(const RobustOptions& o, const Model& model) {
-  if (static_cast<int>(o.capture_joints_deg.size()) != model.n())
-    throw InputError(str("--capture-joints-deg: got ", o.capture_joints_deg.size(), " angles, the robot has ",
-                         model.n(), " joints"));
-  RobustConfiguration c;
-  c.name = "given";
-  c.theta = Eigen::Map<const Eigen::VectorXd>(o.capture_joints_deg.data(), model.n()) * (M_PI / 180.0);
-  for (double x : o.capture_joints_deg)
-    if (!std::isfinite(x)) throw InputError("--capture-joints-deg: values must be finite");
-  if (o.capture_base_position.size() != 3) throw InputError("--capture-base-position: expected 3 numbers");
-  if (o.capture_base_rpy_deg.size() != 3) throw InputError("--capture-base-rpy-deg: expected 3 numbers");
-  c.base.position =
-      Vector3(o.capture_base_position[0], o.capture_base_position[1], o.capture_base_position[2]);
-  const Vector3 rpy(o.capture_base_rpy_deg[0], o.capture_base_rpy_deg[1], o.capture_base_rpy_deg[2]);
-  if (!c.base.position.allFinite() || !rpy.allFinite())
-    throw InputError("--capture-base-position/--capture-base-rpy-deg: values must be finite");
-  c.base.orientation = Quaternion(rotation_from_rpy(rpy * (M_PI / 180.0)));
-  return c;
 }
 
 /// The [uncertainty] table with the flags' samples and seed, and the job's options (force model,
@@ -306,7 +284,9 @@ int run_robust(const RobustOptions& flags, const CLI::App& app) {
   }
   std::vector<RobustConfiguration> configs = o.capture_joints_deg.empty()
                                                  ? planned_robust_configurations(sc, planning)
-                                                 : std::vector<RobustConfiguration>{given_configuration(o, *sc.model)};
+                                                 : std::vector<RobustConfiguration>{given_robust_configuration(
+                                                       *sc.model, o.capture_joints_deg, o.capture_base_position,
+                                                       o.capture_base_rpy_deg)};
   job.progress = [&progress](std::uint64_t done, std::uint64_t total) { progress(done, total); };
   const RobustRun run = run_robust(sc, spec, std::move(configs), job);
   return report_robust(sc, run, o, outputs, plot_format);

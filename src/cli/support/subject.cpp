@@ -56,47 +56,9 @@ void SubjectOptions::add_to(CLI::App& app, const std::set<std::string>& also, co
   });
 }
 
-namespace {
-
-/// The subject of the keys (load_subject without the file's locations).
-void build_subject(Subject& s) {
-  ScenarioKeys& k = s.keys;
-  const EmbeddedUrdf embedded = builtin_urdf();
-  s.robot.model = std::move(*ffsr::detail::model_of(k, &embedded, s.robot.report));
-  warn_repairs(s.robot.report);
-  CaptureProblem pb;
-  ffsr::detail::start_of(k, s.robot.model, pb);
-  s.robot.end_effector = s.robot.model.end_effector();
-  s.robot.theta = pb.theta;
-  s.robot.base = pb.base;
-  s.target = ffsr::detail::target_of(k);
-  s.params = {k.stiffness, k.exponent, k.restitution};  // validate names a non-finite value
-  try {
-    validate(s.params, "contact");
-  } catch (const InputError& e) {
-    throw InputError(std::string("--stiffness/--exponent/--restitution: ") + e.what());
-  }
-  s.law = k.model;
-  s.approach_speed = ffsr::detail::finite(k.approach_speed, "approach-speed");
-}
-
-}  // namespace
-
 Subject load_subject(const SubjectOptions& o) {
-  Subject s;
-  s.keys = command_scenario_keys(o.config, o.flags);
-  try {  // an error of a key the file gave names the file and the key's line, as build_scenario's
-    build_subject(s);
-  } catch (const InputError& e) {
-    throw InputError(located_key_message(s.keys, e.what()));
-  }
-  return s;
-}
-
-ContactJoints Subject::contact_joints() const {
-  const JointModel m =
-      all_joint_models() ? JointModel::Free : parse_joint_model(keys.contact_joints, "--contact-joints");
-  return {m, per_joint_values(keys.armature, robot.model, "--armature")};
+  const EmbeddedUrdf embedded = builtin_urdf();
+  return ffsr::load_subject(command_scenario_keys(o.config, o.flags), &embedded, warn_repairs);
 }
 
 }  // namespace ffsr::cli

@@ -5,10 +5,9 @@
 
 #include "support/scenario_flags.hpp"
 
-#include "ffsr/algorithm/joint_models.hpp"
-#include "ffsr/contact/contact_law.hpp"
 #include "ffsr/ffsr.hpp"
 #include "ffsr/io/scenario.hpp"
+#include "ffsr/jobs/subject.hpp"
 
 #include <CLI/CLI.hpp>
 
@@ -39,30 +38,8 @@ struct SubjectOptions {
   void add_to(CLI::App& app, const std::set<std::string>& also = {}, const std::set<std::string>& except = {});
 };
 
-/// A robot at one configuration.
-struct Robot {
-  Model model;
-  int end_effector = 0;
-  BasePose base;
-  Eigen::VectorXd theta;
-  UrdfReport report;  ///< what the loader did to the file
-};
-
-/// What SubjectOptions describe, built.
-struct Subject {
-  ScenarioKeys keys;  ///< as resolved (the URDF path relative to the scenario file)
-  Robot robot;
-  Target target;              ///< at t = 0, with its spin and velocity
-  ContactParams params;       ///< K, alpha, c_r, checked
-  std::string law;            ///< the damping law's name as given (contact also takes 'all')
-  double approach_speed = 0;  ///< m/s, finite (its sign is the subcommand's to judge)
-  /// The joint models of the contact (contact-joints, armature; algorithm/joint_models.hpp); 'all'
-  /// (contact: each model in turn) gives free. InputError naming the key.
-  ContactJoints contact_joints() const;
-  bool all_joint_models() const { return keys.contact_joints == "all"; }
-};
-/// Builds the subject; warns about every repair of the model. InputError naming the key or the file,
-/// ModelError from the loader.
+/// Builds the subject (jobs/subject.hpp) of the options' keys; warns about every repair of the model.
+/// InputError naming the key or the file, ModelError from the loader.
 Subject load_subject(const SubjectOptions& options);
 
 }  // namespace ffsr::cli

@@ -476,4 +476,26 @@ inline RobustSummary merge_shards(std::vector<RobustSummary> parts) {
   return m;
 }
 
+inline RobustConfiguration given_robust_configuration(const Model& model, const std::vector<double>& joints_deg,
+                                                      const std::vector<double>& base_position,
+                                                      const std::vector<double>& base_rpy_deg) {
+  using detail::str;
+  if (static_cast<int>(joints_deg.size()) != model.n())
+    throw InputError(str("--capture-joints-deg: got ", joints_deg.size(), " angles, the robot has ", model.n(),
+                         " joints"));
+  RobustConfiguration c;
+  c.name = "given";
+  c.theta = Eigen::Map<const Eigen::VectorXd>(joints_deg.data(), model.n()) * (M_PI / 180.0);
+  for (double x : joints_deg)
+    if (!std::isfinite(x)) throw InputError("--capture-joints-deg: values must be finite");
+  if (base_position.size() != 3) throw InputError("--capture-base-position: expected 3 numbers");
+  if (base_rpy_deg.size() != 3) throw InputError("--capture-base-rpy-deg: expected 3 numbers");
+  c.base.position = Vector3(base_position[0], base_position[1], base_position[2]);
+  const Vector3 rpy(base_rpy_deg[0], base_rpy_deg[1], base_rpy_deg[2]);
+  if (!c.base.position.allFinite() || !rpy.allFinite())
+    throw InputError("--capture-base-position/--capture-base-rpy-deg: values must be finite");
+  c.base.orientation = Quaternion(rotation_from_rpy(rpy * (M_PI / 180.0)));
+  return c;
+}
+
 }  // namespace ffsr
