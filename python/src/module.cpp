@@ -218,6 +218,7 @@ ContactJoints joints_arg(const Model& model, const std::string& joints, nb::hand
 namespace ffsr::python {
 void bind_scenario(nb::module_& m);    // scenario.cpp
 void bind_controller(nb::module_& m);  // controller.cpp
+void bind_jobs(nb::module_& m);        // jobs.cpp (after bind_scenario: methods of Scenario)
 }  // namespace ffsr::python
 
 using namespace ffsr::python;
@@ -284,5 +285,6 @@ NB_MODULE(_ffsr, m) {
   bind_contact(m);
   bind_batch(m);
   bind_scenario(m);
+  bind_jobs(m);
   bind_controller(m);
 }

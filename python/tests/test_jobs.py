@@ -54,14 +54,18 @@ def differences(a, b, path="$"):
     return [f"{path}: {type(a).__name__} != {type(b).__name__}"]
 
 
-def command_json(tmp_path, scenario, *flags):
+def command_json(tmp_path, scenario, *flags, subcommand=None):
     out = tmp_path / "result.json"
-    subprocess.run([command(), "--config", str(scenario), "--quiet", "--json", str(out), *flags], check=True,
+    sub = [subcommand] if subcommand else []
+    subprocess.run([command(), *sub, "--config", str(scenario), "--quiet", "--json", str(out), *flags], check=True,
                    timeout=900)
     return json.loads(out.read_text())
 
 
-@pytest.mark.parametrize("name", ["paper_3dof", "paper_7dof_position", "paper_7dof_pose"])
+SCENARIOS = ["paper_3dof", "paper_7dof_position", "paper_7dof_pose"]
+
+
+@pytest.mark.parametrize("name", SCENARIOS)
 def test_run_equals_the_command(tmp_path, name):
     scenario = ROBOTS / f"{name}.toml"
     expected = command_json(tmp_path, scenario)
@@ -70,6 +74,120 @@ def test_run_equals_the_command(tmp_path, name):
     assert differences(got, expected) == []
     # the typed result holds the same numbers
     assert result.optimized.M_ie == got["optimized"]["integrated_effective_mass"]
+
+
+@pytest.mark.parametrize("name", SCENARIOS)
+def test_inspect_equals_the_command(tmp_path, name):
+    scenario = ROBOTS / f"{name}.toml"
+    expected = command_json(tmp_path, scenario, subcommand="inspect")
+    result = ffsr.Scenario.load(str(scenario)).inspect()
+    got = result.to_dict()
+    assert differences(got, expected) == []
+    # the typed result holds the same numbers
+    assert result.M_ie == got["integrated_effective_mass"]
+    assert result.m_e == got["effective_mass"]
+    assert result.J_f.tolist() == got["J_f"]
+    assert result.H.shape == (6 + len(got["joint_names"]),) * 2
+
+
+def test_inspect_override_equals_the_flag(tmp_path):
+    scenario = ROBOTS / "paper_7dof_position.toml"
+    expected = command_json(tmp_path, scenario, "--contact-joints", "locked", "--joints-deg",
+                            "10,20,30,40,50,60,70", subcommand="inspect")
+    got = ffsr.Scenario.load(str(scenario), contact_joints="locked", joints_deg=[10, 20, 30, 40, 50, 60, 70])
+    assert differences(got.inspect().to_dict(), expected) == []
+
+
+@pytest.mark.parametrize("name", SCENARIOS)
+def test_contact_equals_the_command(tmp_path, name):
+    scenario = ROBOTS / f"{name}.toml"
+    expected = command_json(tmp_path, scenario, subcommand="contact")
+    result = ffsr.Scenario.load(str(scenario)).contact()
+    got = result.to_dict()
+    assert differences(got, expected) == []
+    assert result.rows[0].f_max_multibody == got["f_max_multibody"]
+    assert result.rows[0].M_ie == got["integrated_effective_mass"]
+    assert result.rows[0].series.shape == (0, 3)
+
+
+def test_contact_every_law_and_joint_model(tmp_path):
+    scenario = ROBOTS / "paper_3dof.toml"
+    expected = command_json(tmp_path, scenario, "--model", "all", "--contact-joints", "all", subcommand="contact")
+    result = ffsr.Scenario.load(str(scenario)).contact(model="all", contact_joints="all", series=True)
+    got = result.to_dict()
+    assert differences(got, expected) == []
+    assert [r.model for r in result.rows] == [law["model"] for law in got["laws"]]
+    assert all(r.series.shape[0] > 10 and r.series.shape[1] == 3 for r in result.rows)
+    with pytest.raises(ffsr.InputError, match="--model"):
+        ffsr.Scenario.load(str(scenario)).contact(model="hertz-nonsense")
+
+
+@pytest.mark.parametrize("name", SCENARIOS)
+def test_closed_loop_equals_the_command(tmp_path, name):
+    scenario = ROBOTS / f"{name}.toml"
+    expected = command_json(tmp_path, scenario, subcommand="closed-loop")
+    result = ffsr.Scenario.load(str(scenario)).closed_loop()
+    got = result.to_dict()
+    assert differences(got, expected) == []
+    assert result.M_ie == got["closed_loop"]["integrated_effective_mass"]
+    assert result.open_loop.M_ie == got["open_loop"]["integrated_effective_mass"]
+
+
+def test_closed_loop_flags_equal_the_keywords(tmp_path):
+    scenario = ROBOTS / "paper_3dof.toml"
+    expected = command_json(tmp_path, scenario, "--position-noise", "0.002", "--attitude-noise-deg", "0.5",
+                            "--spin-noise-deg", "0.1", "--noise-seed", "7", "--prediction-window", "3",
+                            "--control-rate", "500", subcommand="closed-loop")
+    result = ffsr.Scenario.load(str(scenario)).closed_loop(position_noise=0.002, attitude_noise_deg=0.5,
+                                                           spin_noise_deg=0.1, noise_seed=7, prediction_window=3,
+                                                           control_rate=500)
+    assert differences(result.to_dict(), expected) == []
+    with pytest.raises(ffsr.InputError, match="--control-rate: must be positive and finite"):
+        ffsr.Scenario.load(str(scenario)).closed_loop(control_rate=0.0)
+    with pytest.raises(ffsr.InputError, match="--plan: expected paper or global"):
+        ffsr.Scenario.load(str(scenario)).closed_loop(plan="best")
+
+
+def test_robust_equals_the_command(tmp_path):
+    # the paper's scenarios have no [uncertainty] table: the 7-DOF position scenario with the table, its
+    # plain and paper's-method configurations (global = false)
+    scenario = ROBOTS / "paper_7dof_position_uncertain.toml"
+    expected = command_json(tmp_path, scenario, "--global=false", "--samples", "200", "--threads", "2",
+                            subcommand="robust")
+    result = ffsr.Scenario.load(str(scenario), **{"global": False}).robust(samples=200, threads=2)
+    got = result.to_dict()
+    assert differences(got, expected) == []
+    assert [c.name for c in result.configurations] == ["plain", "optimized"]
+    assert result.configurations[1].p95 == got["configurations"][1]["summary"]["p95"]
+    assert result.configurations[1].f_max.shape == (200,)
+
+
+def test_robust_given_configuration_equals_the_command(tmp_path):
+    scenario = ROBOTS / "paper_7dof_position_uncertain.toml"
+    joints = [10, 80, 95, -85, 80, 95, 5]
+    expected = command_json(tmp_path, scenario, "--capture-joints-deg", ",".join(map(str, joints)),
+                            "--capture-base-position", "0.01,0,-0.02", "--force-model", "closed", "--samples", "300",
+                            "--seed", "5", "--shard", "1/2", subcommand="robust")
+    got = ffsr.Scenario.load(str(scenario)).robust(capture_joints_deg=joints, capture_base_position=[0.01, 0, -0.02],
+                                                   force_model="closed", samples=300, seed=5, shard_k=1, shard_n=2)
+    assert differences(got.to_dict(), expected) == []
+    with pytest.raises(ffsr.InputError, match="no \\[uncertainty\\] table"):
+        ffsr.Scenario.load(str(ROBOTS / "paper_3dof.toml")).robust()
+    with pytest.raises(ffsr.InputError, match="--force-model"):
+        ffsr.Scenario.load(str(scenario)).robust(force_model="fast", capture_joints_deg=joints)
+
+
+@pytest.mark.parametrize("name", SCENARIOS)
+def test_pareto_equals_the_command(tmp_path, name):
+    scenario = ROBOTS / f"{name}.toml"
+    expected = command_json(tmp_path, scenario, "--levels", "6", "--starts", "4", subcommand="pareto")
+    result = ffsr.Scenario.load(str(scenario)).pareto(levels=6, starts=4)
+    got = result.to_dict()
+    assert differences(got, expected) == []  # but the search's wall-clock time (seconds)
+    assert result.knee.M_ie == got["knee"]["integrated_effective_mass"]
+    assert len(result.front) == len(got["front"])
+    with pytest.raises(ffsr.InputError, match="--levels: must be >= 1"):
+        ffsr.Scenario.load(str(scenario)).pareto(levels=0)
 
 
 def test_override_equals_the_flag(tmp_path):
