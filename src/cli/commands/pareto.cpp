@@ -114,7 +114,9 @@ int run_pareto(const ParetoCliOptions& o) {
   if (o.levels < 1) throw InputError(detail::str("--levels: must be >= 1, got ", o.levels));
   if (o.starts < 1) throw InputError(detail::str("--starts: must be >= 1, got ", o.starts));
   const plot::Format plot_format = plot::check_request(o.out.plot, o.out.plot_format);
-  Scenario sc = command_scenario(command_scenario_keys(o.config, o.flags));
+  ScenarioKeys keys = command_scenario_keys(o.config, o.flags);
+  refuse_shapes_without_clearance(keys, "pareto");
+  Scenario sc = command_scenario(std::move(keys));
   if (!sc.keys.global) throw InputError("--global: pareto needs the global run's base pose (global = true)");
   ScenarioRunOptions ro;
   const ScenarioResult r = run_scenario(sc, ro);
@@ -153,7 +155,10 @@ void register_pareto(CLI::App& app, Action& action) {
   // reference's servo keys act with the global run's objective multibody-force only (refused otherwise)
   o->flags.add_groups(*sub, {KeyGroup::Robot, KeyGroup::Start, KeyGroup::Target, KeyGroup::TargetPlace,
                              KeyGroup::Contact, KeyGroup::Planner, KeyGroup::Global, KeyGroup::JointModels,
-                             KeyGroup::Shapes});
+                             KeyGroup::Shapes},
+                      // the front is of M_ie and the base's jump (the impulse of the law's damping): the
+                      // stiffness and the exponent of the law change neither
+                      {"stiffness", "exponent"});
   sub->add_option("--levels", o->levels, "Epsilon levels of the sweep between the two ends")
       ->capture_default_str();
   sub->add_option("--starts", o->starts, "Random starts of the two single-objective searches")
