@@ -4,8 +4,7 @@
 // with malloc, not new (which is why this is an executable of its own). 1e5 calls of step() on the
 // paper's 3-DOF and 7-DOF robots (gradient and servo policies, position and pose tasks, a few faults
 // among them) must count zero allocations and zero frees. A control case checks that the counters
-// see both a `new` and an Eigen allocation. The closed loop's integration (the plant's Runge-Kutta
-// steps from tick to tick) is counted the same way.
+// see both a `new` and an Eigen allocation.
 
 #include <atomic>
 #include <cstdlib>
@@ -71,7 +70,6 @@ void operator delete[](void* p, std::size_t) noexcept { operator delete(p); }
 #include <catch2/catch.hpp>
 
 #include "ffsr/control/capture_controller.hpp"
-#include "ffsr/control/closed_loop.hpp"
 #include "ffsr/io/scenario.hpp"
 
 #include <cmath>
@@ -138,32 +136,6 @@ TEST_CASE("controller: 1e5 ticks allocate nothing (3-DOF and 7-DOF, gradient and
     CHECK(s.news == 0);
     CHECK(s.deletes == 0);
     CHECK(faults == 100);
-  }
-}
-
-TEST_CASE("closed loop: the plant's Runge-Kutta integration allocates nothing from tick to tick") {
-  // the inner loop of simulate_closed_loop: 2000 ticks of 1 ms (the command changes at every tick)
-  // through detail::TickRungeKutta and the plant's articulated-body right-hand side
-  for (const char* name : {"paper_3dof", "paper_7dof_position"}) {
-    CAPTURE(name);
-    const Scenario sc = load_scenario(kRobots + name + ".toml");
-    const int n = sc.model->n();
-    detail::ClosedLoopPlant plant(*sc.model, sc.problem.base, sc.problem.theta, RateLoopGains{});
-    REQUIRE(plant.articulated);
-    Eigen::VectorXd y = Eigen::VectorXd::Zero(12 + 3 * n);
-    y.segment(6, n) = sc.problem.theta;
-    const ClosedLoopOptions o;
-    const double dt = 1e-3;
-    detail::TickRungeKutta<detail::DormandPrince54> rk(y.size(), o.rtol, o.atol, dt);
-    const long n0 = g_news.load(), d0 = g_deletes.load();
-    for (long k = 0; k < 2000; ++k) {
-      for (int j = 0; j < n; ++j) plant.u(j) = 0.05 * std::sin(1e-3 * static_cast<double>(k) + j);
-      rk.advance(plant, static_cast<double>(k) * dt, static_cast<double>(k + 1) * dt, y);
-    }
-    CHECK(g_news.load() - n0 == 0);
-    CHECK(g_deletes.load() - d0 == 0);
-    CHECK(rk.steps() >= 2000);
-    CHECK(y.allFinite());
   }
 }
 
