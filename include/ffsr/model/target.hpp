@@ -70,7 +70,7 @@ struct Target {
   /// 1/m_t + (r x u)^T I^-1 (r x u) (the target part of Eq. 14). It does not depend on the attitude.
   double inverse_mass_along_normal() const {
     const Vector3 ru = contact_offset.cross(normal.normalized());
-    return 1.0 / mass + ru.dot(inertia.ldlt().solve(ru));
+    return 1.0 / mass + ru.dot(detail::ldlt_solve3(inertia, ru));
   }
 };
 

@@ -7,6 +7,8 @@
 #include <Eigen/Dense>
 
 #include <cmath>
+#include <limits>
+#include <utility>
 
 namespace ffsr {
 
@@ -93,6 +95,62 @@ inline void sin_cos(double x, double& s, double& c) {
   }
 }
 
+/// x = A^-1 b for a symmetric 3x3 matrix A (its lower triangle is read) by the operations of Eigen's
+/// LDLT with diagonal pivoting (Eigen 3.4, A.ldlt().solve(b)) in the same order, so the same
+/// numbers, without instantiating its templates in every translation unit. A zero pivot gives a
+/// zero component, as Eigen's pseudo-inverse of D does.
+inline Vector3 ldlt_solve3(const Matrix3& A, const Vector3& b) {
+  double m[3][3];
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) m[r][c] = A(r, c);
+  int t[3] = {0, 1, 2};
+  for (int k = 0; k < 3; ++k) {
+    int p = k;  // the largest diagonal magnitude of the trailing corner, the first of equals
+    double big = std::abs(m[k][k]);
+    for (int i = k + 1; i < 3; ++i)
+      if (std::abs(m[i][i]) > big) {
+        big = std::abs(m[i][i]);
+        p = i;
+      }
+    t[k] = p;
+    if (p != k) {  // swap rows and columns k and p, in the lower triangle
+      for (int j = 0; j < k; ++j) std::swap(m[k][j], m[p][j]);
+      for (int i = p + 1; i < 3; ++i) std::swap(m[i][k], m[i][p]);
+      std::swap(m[k][k], m[p][p]);
+      for (int i = k + 1; i < p; ++i) std::swap(m[i][k], m[p][i]);
+    }
+    double tmp[2];
+    for (int j = 0; j < k; ++j) tmp[j] = m[j][j] * m[k][j];
+    if (k == 1) {
+      m[1][1] -= m[1][0] * tmp[0];
+      m[2][1] -= m[2][0] * tmp[0];
+    } else if (k == 2) {
+      m[2][2] -= m[2][0] * tmp[0] + m[2][1] * tmp[1];
+    }
+    const double akk = m[k][k];
+    const bool valid = std::abs(akk) > 0.0;
+    if (k == 0 && !valid) {
+      t[0] = 0, t[1] = 1, t[2] = 2;
+      break;
+    }
+    if (valid)
+      for (int i = k + 1; i < 3; ++i) m[i][k] /= akk;
+  }
+  double x[3] = {b(0), b(1), b(2)};
+  for (int k = 0; k < 3; ++k) std::swap(x[k], x[t[k]]);  // P b
+  x[1] -= m[1][0] * x[0];                                 // L^-1
+  x[2] -= m[2][0] * x[0] + m[2][1] * x[1];
+  for (int i = 0; i < 3; ++i) {  // D^-1 (its pseudo-inverse)
+    if (std::abs(m[i][i]) > std::numeric_limits<double>::min())
+      x[i] /= m[i][i];
+    else
+      x[i] = 0.0;
+  }
+  x[1] -= m[2][1] * x[2];  // L^-T
+  x[0] -= m[1][0] * x[1] + m[2][0] * x[2];
+  for (int k = 2; k >= 0; --k) std::swap(x[k], x[t[k]]);  // P^T
+  return {x[0], x[1], x[2]};
+}
 }  // namespace detail
 
 /// Rotation by `angle` about the unit vector `axis` (Rodrigues), without allocation.
