@@ -96,6 +96,25 @@ inline void sin_cos(double x, double& s, double& c) {
   }
 }
 
+/// ldlt_solve3's pivot at step k: the largest diagonal magnitude of the trailing corner (the first of
+/// equals), whose row and column are swapped with k's in the lower triangle. Returns its index.
+inline int ldlt3_pivot(double (&m)[3][3], int k) {
+  int p = k;
+  double big = std::abs(m[k][k]);
+  for (int i = k + 1; i < 3; ++i)
+    if (std::abs(m[i][i]) > big) {
+      big = std::abs(m[i][i]);
+      p = i;
+    }
+  if (p != k) {
+    for (int j = 0; j < k; ++j) std::swap(m[k][j], m[p][j]);
+    for (int i = p + 1; i < 3; ++i) std::swap(m[i][k], m[i][p]);
+    std::swap(m[k][k], m[p][p]);
+    for (int i = k + 1; i < p; ++i) std::swap(m[i][k], m[p][i]);
+  }
+  return p;
+}
+
 /// x = A^-1 b for a symmetric 3x3 matrix A (its lower triangle is read) by the operations of Eigen's
 /// LDLT with diagonal pivoting (Eigen 3.4, A.ldlt().solve(b)) in the same order, so the same
 /// numbers, without instantiating its templates in every translation unit. A zero pivot gives a
@@ -106,20 +125,7 @@ inline Vector3 ldlt_solve3(const Matrix3& A, const Vector3& b) {
     for (int c = 0; c < 3; ++c) m[r][c] = A(r, c);
   int t[3] = {0, 1, 2};
   for (int k = 0; k < 3; ++k) {
-    int p = k;  // the largest diagonal magnitude of the trailing corner, the first of equals
-    double big = std::abs(m[k][k]);
-    for (int i = k + 1; i < 3; ++i)
-      if (std::abs(m[i][i]) > big) {
-        big = std::abs(m[i][i]);
-        p = i;
-      }
-    t[k] = p;
-    if (p != k) {  // swap rows and columns k and p, in the lower triangle
-      for (int j = 0; j < k; ++j) std::swap(m[k][j], m[p][j]);
-      for (int i = p + 1; i < 3; ++i) std::swap(m[i][k], m[i][p]);
-      std::swap(m[k][k], m[p][p]);
-      for (int i = k + 1; i < p; ++i) std::swap(m[i][k], m[p][i]);
-    }
+    t[k] = ldlt3_pivot(m, k);
     double tmp[2];
     for (int j = 0; j < k; ++j) tmp[j] = m[j][j] * m[k][j];
     if (k == 1) {
