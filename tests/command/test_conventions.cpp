@@ -355,7 +355,7 @@ TEST_CASE("each key a subcommand accepts changes its result, or the subcommand r
   CHECK(problems.empty());
 }
 
-TEST_CASE("--quiet, --json FILE and --json - on every subcommand", "[cli][conventions]") {
+TEST_CASE("conventions: --quiet, --json FILE and --json - on every subcommand", "[cli][conventions]") {
   for (const Sub& sub : subcommands()) {
     INFO(sub.name);
     ffsr::test::TempDir tmp;
@@ -381,7 +381,7 @@ TEST_CASE("--quiet, --json FILE and --json - on every subcommand", "[cli][conven
   }
 }
 
-TEST_CASE("--csv - is the only thing on standard output, where a subcommand has series", "[cli][conventions]") {
+TEST_CASE("conventions: --csv - is the only thing on standard output, where a subcommand has series", "[cli][conventions]") {
   for (const Sub& sub : subcommands()) {
     if (sub.name == "inspect") continue;  // one configuration: no series
     INFO(sub.name);
@@ -441,7 +441,7 @@ TEST_CASE("a bad value in a scenario file names the file, the key and its line",
   }
 }
 
-TEST_CASE("--config with --urdf keeps the file's end-effector and joints in every subcommand", "[cli][conventions]") {
+TEST_CASE("conventions: --config with --urdf keeps the file's end-effector and joints in every subcommand", "[cli][conventions]") {
   // the file names end-effector = "ee" and its joints; --urdf gives the same robot under another
   // path: every subcommand evaluates the file's end-effector, as the main job does
   ffsr::test::TempDir tmp;
