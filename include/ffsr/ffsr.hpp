@@ -10,7 +10,9 @@
 //   algorithm/rnea.hpp              C (recursive Newton-Euler)
 //   algorithm/jacobian.hpp          J_bm, J_f
 //   algorithm/momentum.hpp          linear and angular momentum
-//   algorithm/effective_mass.hpp    m_e (Eq. 4), M_ie (Eq. 14) and its gradient
+//   algorithm/effective_mass.hpp    m_e (Eq. 4), M_ie (Eq. 14)
+//   algorithm/effective_mass_gradient.hpp
+//                                   the inverse inertia at a frame, the gradients of m_e and M_ie
 //   algorithm/articulated_effective_mass.hpp, algorithm/joint_models.hpp
 //                                   M_ie under the contact-joint models (free, locked, armature)
 // Include the rest where it is needed, each with its CMake target (docs/library.md):
@@ -34,5 +36,6 @@
 #include "ffsr/algorithm/jacobian.hpp"
 #include "ffsr/algorithm/momentum.hpp"
 #include "ffsr/algorithm/effective_mass.hpp"
+#include "ffsr/algorithm/effective_mass_gradient.hpp"
 #include "ffsr/algorithm/articulated_effective_mass.hpp"
 #include "ffsr/algorithm/joint_models.hpp"

@@ -37,9 +37,10 @@ def paper_3dof(tmp_path_factory):
 
 @pytest.fixture(scope="module")
 def shapes_3dof(tmp_path_factory):
-    """The 3-DOF scenario with shapes (capsules, the target's box) and a bus box, without the global row."""
+    """The 3-DOF scenario with shapes (capsules, the target's box, the URDF's <collision> box as the bus), without
+    the global row."""
     return run_job(tmp_path_factory.mktemp("shapes_3dof"), "--config", str(ROBOTS / "paper_3dof_clearance.toml"),
-                   "--bus-box", "0.8,0.8,0.8", "--global", "false")
+                   "--global", "false")
 
 
 def cli(*args: str, cwd: Path = None) -> subprocess.CompletedProcess:

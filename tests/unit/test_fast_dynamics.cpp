@@ -11,8 +11,13 @@
 // coordinates, no composite inertias); the O(n) inverse effective mass under the free, locked and
 // armature models against crba + the dense Cholesky path of joint_models.hpp (which forms H and
 // factorizes it); the O(n) gradient against the dense analytic gradient and against central finite
-// differences of the O(n) value. Tolerances are stated at each check.
+// differences of the O(n) value; the O(n) forward dynamics (aba) against forward_dynamics (crba, the
+// RNEA bias, a dense Cholesky solve) and against the identity H a + C = tau with RNEA (body
+// coordinates) as the inverse dynamics. Tolerances are stated at each check.
 #include "support/dynamics_helpers.hpp"
+
+#include "ffsr/algorithm/aba.hpp"
+#include "ffsr/algorithm/forward_dynamics.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -34,9 +39,10 @@ struct Named {
 
 /// A serial chain of n joints; `unit_axes`: axes +-x, +-y, +-z in turn and every third joint origin
 /// without rotation; else random axes and rotations. Inertias full, every other one diagonal.
-Model chain(int n, unsigned seed, bool unit_axes) {
+Model chain(int n, unsigned seed, bool unit_axes, const Vector3& gravity = Vector3::Zero()) {
   Rng rng(seed);
   ModelBuilder b("base", Inertia{400, rng.vec3(0.2), rng.inertia(100)});
+  b.set_gravity(gravity);
   std::string parent = "base";
   const Vector3 axes[] = {Vector3::UnitX(), -Vector3::UnitY(), Vector3::UnitZ(),
                           -Vector3::UnitX(), Vector3::UnitY(), -Vector3::UnitZ()};
@@ -208,6 +214,73 @@ TEST_CASE("the O(n) gradient of M_ie equals the dense gradient and finite differ
       }
     }
   }
+}
+
+TEST_CASE("aba: the O(n) forward dynamics equals crba + RNEA + Cholesky and inverts RNEA", "[dynamics][fast]") {
+  Rng rng(59);
+  std::vector<Named> models = models_under_test();
+  models.push_back({"chain 7 with gravity", chain(7, 61, false, Vector3(0.3, -9.81, 1.2))});
+  for (const auto& [name, model] : models) {
+    Data d(model), e(model);
+    const Eigen::Index nv = model.nv();
+    for (int k = 0; k < 3; ++k) {
+      const Config q = random_config(model, rng);
+      // base velocity ~ 0.1 m/s and 0.1 rad/s, joint rates ~ 1 rad/s, forces ~ 100 N, 100 N m
+      VectorXd v = rng.vec(nv, 1.0), tau = rng.vec(nv, 100.0);
+      v.head<6>() *= 0.1;
+      INFO(name << " config " << k);
+      VectorXd a, a_ref;
+      aba(model, d, q.base, q.theta, v, tau, a);
+      forward_dynamics(model, e, q.base, q.theta, v, tau, a_ref);
+      // two exact solves of the same system: rounding amplified by H's condition number (up to ~1e6 on
+      // the 28-joint chain): 1e-9 of the largest acceleration
+      const double as = a_ref.cwiseAbs().maxCoeff();
+      INFO("aba " << a.transpose() << "\nforward_dynamics " << a_ref.transpose());
+      CHECK((a - a_ref).cwiseAbs().maxCoeff() < 1e-9 * as);
+      // H a + C = tau by RNEA with the acceleration aba found (body coordinates, no articulated
+      // inertias): rounding, 1e-11 of the largest of |tau|, |C| and |H| |a|
+      const VectorXd C = bias_forces(model, e, q.base, q.theta, v);
+      const MatrixXd H = crba(model, e, q.base, q.theta);
+      const double fs =
+          std::max({tau.cwiseAbs().maxCoeff(), C.cwiseAbs().maxCoeff(), H.cwiseAbs().maxCoeff() * as});
+      CHECK((rnea(model, e, q.base, q.theta, v, a) - tau).cwiseAbs().maxCoeff() < 1e-11 * fs);
+      CHECK((H * a + C - tau).cwiseAbs().maxCoeff() < 1e-11 * fs);
+      // the second half again with other forces at the same state (as the closed loop does when only
+      // the joint torques change): the same numbers as a full aba with those forces
+      const VectorXd tau2 = rng.vec(nv, 100.0);
+      VectorXd a2(nv), a2_full;
+      detail::aba_acceleration_pass(model, d, v, tau2, a2);
+      aba(model, e, q.base, q.theta, v, tau2, a2_full);
+      CHECK(a2 == a2_full);
+    }
+  }
+  // no velocity, no force, no gravity: at rest, exactly
+  const Model c = chain(3, 67, true);
+  Data dc(c);
+  const Config qc = random_config(c, rng);
+  VectorXd a;
+  aba(c, dc, qc.base, qc.theta, VectorXd::Zero(c.nv()), VectorXd::Zero(c.nv()), a);
+  CHECK(a.cwiseAbs().maxCoeff() == 0.0);
+}
+
+TEST_CASE("aba refuses mimic joints and bad sizes, naming them", "[dynamics][fast]") {
+  const Model m = mimic_chain(3);
+  Data d(m);
+  Rng rng(71);
+  const Config q = random_config(m, rng);
+  VectorXd a;
+  CHECK_THROWS_WITH(aba(m, d, q.base, q.theta, VectorXd::Zero(m.nv()), VectorXd::Zero(m.nv()), a),
+                    Catch::Contains("aba: the model has mimic joints; use forward_dynamics"));
+  const Model c = chain(3, 1, true);
+  Data dc(c);
+  const Config qc = random_config(c, rng);
+  CHECK_THROWS_WITH(aba(c, dc, qc.base, qc.theta, VectorXd::Zero(c.nv() - 1), VectorXd::Zero(c.nv()), a),
+                    Catch::Contains("aba: v has"));
+  VectorXd bad = VectorXd::Zero(c.nv());
+  bad(2) = std::nan("");
+  CHECK_THROWS_WITH(aba(c, dc, qc.base, qc.theta, VectorXd::Zero(c.nv()), bad, a), Catch::Contains("tau"));
+  CHECK_THROWS_WITH(aba(c, dc, qc.base, VectorXd::Zero(2), VectorXd::Zero(c.nv()), VectorXd::Zero(c.nv()), a),
+                    Catch::Contains("theta"));
 }
 
 TEST_CASE("the O(n) paths refuse what they cannot do and fall back for mimic joints", "[dynamics][fast]") {

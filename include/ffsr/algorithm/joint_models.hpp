@@ -17,7 +17,7 @@
 // on its diagonal, factorized in place); data.H stays that of the configuration.
 #pragma once
 
-#include "ffsr/algorithm/effective_mass.hpp"
+#include "ffsr/algorithm/effective_mass_gradient.hpp"
 
 #include <string>
 #include <vector>

@@ -1,7 +1,8 @@
 // ffsr/control/closed_loop.hpp -- the capture controller in a closed loop with the robot's full
 // dynamics and a noisy target estimate. Component ffsr::cvode (SUNDIALS).
 //
-// Plant: the free-floating robot, forward dynamics of Eq. 1 (H a = tau - C, CRBA + RNEA, no external
+// Plant: the free-floating robot, forward dynamics of Eq. 1 (H a = tau - C by the articulated-body
+// algorithm, algorithm/aba.hpp; CRBA + RNEA + Cholesky for a model with mimic joints; no external
 // force, no gravity unless the model has some), with the state
 //   y = [p_0 - p_0(0) (3), phi_0 (3: base attitude as a rotation vector from the initial one),
 //        theta (n), v_0 (3), omega_0 (3), theta_dot (n), z (n: the PI integrators)].
@@ -31,6 +32,7 @@
 // acts, so anything else is integration error).
 #pragma once
 
+#include "ffsr/algorithm/aba.hpp"
 #include "ffsr/control/capture_controller.hpp"
 #include "ffsr/simulate/multibody.hpp"
 #include "ffsr/uncertainty/sampling.hpp"
@@ -117,7 +119,8 @@ struct ClosedLoopPlant {
   int n;
   RateLoopGains gains;
   Eigen::VectorXd u, theta, v, tau, a, e, kp, ki;
-  Eigen::VectorXd bias;  ///< C(q, v) at the state of the last dynamics() call
+  Eigen::VectorXd bias;  ///< C(q, v) at the state of the last dynamics() call (mimic joints)
+  bool articulated;      ///< one body per coordinate: the articulated-body algorithm (else crba + rnea)
 
   ClosedLoopPlant(const Model& m, const BasePose& b0, const Eigen::VectorXd& theta0, const RateLoopGains& g)
       : model(m),
@@ -133,7 +136,8 @@ struct ClosedLoopPlant {
         e(n),
         kp(n),
         ki(n),
-        bias(6 + n) {
+        bias(6 + n),
+        articulated(m.nb() - 1 == m.n()) {
     base0.orientation.normalize();
     crba(model, data, base0, theta0);  // M = H_mm - H_mb H_b^-1 H_bm, its diagonal
     const Eigen::LLT<Matrix6> Hb(data.H.topLeftCorner<6, 6>());
@@ -164,24 +168,35 @@ struct ClosedLoopPlant {
     }
     return sat;
   }
-  /// What of the dynamics does not depend on the command: H (crba), its Cholesky factor (data.L)
-  /// and the bias forces C (rnea) at y. Writes data, theta, v, bias. NumericalError if H is not
+  /// What of the dynamics does not depend on the command, at y. One body per coordinate (no mimic
+  /// joint): the first half of the articulated-body algorithm (detail::aba_velocity_pass: kinematics,
+  /// velocities, articulated inertias). With mimic joints: H (crba), its Cholesky factor (data.L)
+  /// and the bias forces C (rnea). Writes data, theta, v (and bias). NumericalError if H is not
   /// positive definite.
   void dynamics(const Eigen::Ref<const Eigen::VectorXd>& y) {
     const BasePose b = base(y);
     theta = y.segment(6, n);
     v = y.segment(iv(), 6 + n);
+    if (articulated) {
+      aba_velocity_pass(model, data, b, theta, v);
+      return;
+    }
     crba(model, data, b, theta);
     bias = bias_forces(model, data, b, theta, v);
     detail::cholesky(data.H, data.L, "closed loop");
   }
   /// ydot at y with the command u, from the dynamics() of the same y: the forward dynamics
-  /// a = H^-1 (tau - C) (as forward_dynamics computes it) and the rate loops. Reads y, u, bias and
-  /// data.L only. Writes tau, e, a.
+  /// a = H^-1 (tau - C) (the second half of the articulated-body algorithm, or the Cholesky solve
+  /// with mimic joints) and the rate loops. Reads y, u, v and what dynamics() wrote. Writes tau, e,
+  /// a (and data's fields of the articulated-body algorithm).
   void derivative(const Eigen::Ref<const Eigen::VectorXd>& y, Eigen::Ref<Eigen::VectorXd> ydot) {
     torques(y);
-    a = tau - bias;
-    detail::cholesky_solve(data.L, a);
+    if (articulated) {
+      aba_acceleration_pass(model, data, v, tau, a);
+    } else {
+      a = tau - bias;
+      detail::cholesky_solve(data.L, a);
+    }
     ydot.segment<3>(0) = y.segment<3>(iv());
     ydot.segment<3>(3) = rotation_vector_rate(y.segment<3>(3), y.segment<3>(iv() + 3));
     ydot.segment(6, n) = y.segment(iv() + 6, n);

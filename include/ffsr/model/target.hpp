@@ -70,9 +70,47 @@ struct Target {
   /// 1/m_t + (r x u)^T I^-1 (r x u) (the target part of Eq. 14). It does not depend on the attitude.
   double inverse_mass_along_normal() const {
     const Vector3 ru = contact_offset.cross(normal.normalized());
-    return 1.0 / mass + ru.dot(inertia.ldlt().solve(ru));
+    return 1.0 / mass + ru.dot(detail::ldlt_solve3(inertia, ru));
   }
 };
+
+namespace detail {
+
+/// The inverse of a 3x3 matrix by its cofactors, with the operations of Eigen's inverse() for 3x3
+/// in their order (the same numbers without its templates).
+inline Matrix3 inverse3(const Matrix3& m) {
+  auto cof = [&m](int i, int j) {
+    const int i1 = (i + 1) % 3, i2 = (i + 2) % 3, j1 = (j + 1) % 3, j2 = (j + 2) % 3;
+    return m(i1, j1) * m(i2, j2) - m(i1, j2) * m(i2, j1);
+  };
+  const double c00 = cof(0, 0), c10 = cof(1, 0), c20 = cof(2, 0);
+  const double det = (c00 * m(0, 0) + c10 * m(1, 0)) + c20 * m(2, 0);
+  const double invdet = 1.0 / det;
+  Matrix3 r;
+  r(0, 0) = c00 * invdet, r(0, 1) = c10 * invdet, r(0, 2) = c20 * invdet;
+  r(1, 0) = cof(0, 1) * invdet, r(1, 1) = cof(1, 1) * invdet, r(1, 2) = cof(2, 1) * invdet;
+  r(2, 0) = cof(0, 2) * invdet, r(2, 1) = cof(1, 2) * invdet, r(2, 2) = cof(2, 2) * invdet;
+  return r;
+}
+
+/// y = A x with the summation order of Eigen's fixed-size product at -O2 with SSE2 (rows 0 and 1
+/// as one packet, left to right; row 2 by its unrolled reduction, a0 x0 + (a1 x1 + a2 x2)).
+inline void matrix_vector3(const Matrix3& A, const double* x, double* y) {
+  y[0] = (A(0, 0) * x[0] + A(0, 1) * x[1]) + A(0, 2) * x[2];
+  y[1] = (A(1, 0) * x[0] + A(1, 1) * x[1]) + A(1, 2) * x[2];
+  y[2] = A(2, 0) * x[0] + (A(2, 1) * x[1] + A(2, 2) * x[2]);
+}
+
+/// The torque-free Euler equations in the body frame, dw/dt = I^-1 (-w x I w).
+inline void euler_rate(const Matrix3& I, const Matrix3& Iinv, const double* w, double* dw) {
+  double Iw[3];
+  matrix_vector3(I, w, Iw);
+  const double c[3] = {-(w[1] * Iw[2] - w[2] * Iw[1]), -(w[2] * Iw[0] - w[0] * Iw[2]),
+                       -(w[0] * Iw[1] - w[1] * Iw[0])};
+  matrix_vector3(Iinv, c, dw);
+}
+
+}  // namespace detail
 
 /// The target at time t: centre of mass drifting with its velocity, attitude and spin from the
 /// torque-free Euler equations (RK4 with a fine step; exact rotation when the inertia is isotropic).
@@ -80,28 +118,39 @@ inline Target propagate_target(const Target& t0, double t) {
   Target t1 = t0;
   t1.position = t0.position + t0.velocity * t;
   const Matrix3 I = t0.inertia;
-  const bool isotropic = (I - I(0, 0) * Matrix3::Identity()).cwiseAbs().maxCoeff() <= 1e-12 * I(0, 0);
+  bool isotropic = true;
+  const double tol = 1e-12 * I(0, 0);
+  for (int c = 0; c < 3; ++c)
+    for (int r = 0; r < 3; ++r)
+      if (!(std::abs(r == c ? I(r, c) - I(0, 0) : I(r, c)) <= tol)) isotropic = false;
   if (isotropic || t0.angular_velocity.norm() == 0.0) {
-    t1.attitude = Quaternion(t0.rotation() * rotation_from_vector(t0.angular_velocity * t));
+    t1.attitude = detail::quaternion_from_rotation(t0.rotation() * rotation_from_vector(t0.angular_velocity * t));
     return t1;
   }
-  const Matrix3 Iinv = I.inverse();
+  const Matrix3 Iinv = detail::inverse3(I);
   const long nsteps = std::max<long>(1, static_cast<long>(std::ceil(std::abs(t) / 1e-3)));
   if (nsteps > 100000000) throw InputError("propagate_target: time span too long");
-  const double h = t / static_cast<double>(nsteps);
+  const double h = t / static_cast<double>(nsteps), hh = 0.5 * h, h6 = h / 6;
   Matrix3 R = t0.rotation();
-  Vector3 w = t0.angular_velocity;  // body frame
-  auto wdot = [&](const Vector3& x) { return Vector3(Iinv * (-x.cross(I * x))); };
+  double w[3] = {t0.angular_velocity(0), t0.angular_velocity(1), t0.angular_velocity(2)};  // body frame
   for (long k = 0; k < nsteps; ++k) {
-    const Vector3 k1 = wdot(w), k2 = wdot(w + 0.5 * h * k1), k3 = wdot(w + 0.5 * h * k2),
-                  k4 = wdot(w + h * k3);
-    const Vector3 wn = w + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4);
-    R = R * rotation_from_vector(0.5 * h * (w + wn));  // midpoint rotation, body frame
-    w = wn;
+    double k1[3], k2[3], k3[3], k4[3], x[3], wn[3];
+    detail::euler_rate(I, Iinv, w, k1);
+    for (int i = 0; i < 3; ++i) x[i] = w[i] + hh * k1[i];
+    detail::euler_rate(I, Iinv, x, k2);
+    for (int i = 0; i < 3; ++i) x[i] = w[i] + hh * k2[i];
+    detail::euler_rate(I, Iinv, x, k3);
+    for (int i = 0; i < 3; ++i) x[i] = w[i] + h * k3[i];
+    detail::euler_rate(I, Iinv, x, k4);
+    for (int i = 0; i < 3; ++i) wn[i] = w[i] + h6 * (((k1[i] + 2.0 * k2[i]) + 2.0 * k3[i]) + k4[i]);
+    const Vector3 half(hh * (w[0] + wn[0]), hh * (w[1] + wn[1]), hh * (w[2] + wn[2]));
+    R = R * rotation_from_vector(half);  // midpoint rotation, body frame
+    for (int i = 0; i < 3; ++i) w[i] = wn[i];
   }
-  t1.attitude = Quaternion(R);
-  t1.angular_velocity = w;
+  t1.attitude = detail::quaternion_from_rotation(R);
+  t1.angular_velocity = Vector3(w[0], w[1], w[2]);
   return t1;
 }
+
 
 }  // namespace ffsr

@@ -6,7 +6,10 @@
 
 #include <Eigen/Dense>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
+#include <utility>
 
 namespace ffsr {
 
@@ -93,6 +96,112 @@ inline void sin_cos(double x, double& s, double& c) {
   }
 }
 
+/// ldlt_solve3's pivot at step k: the largest diagonal magnitude of the trailing corner (the first of
+/// equals), whose row and column are swapped with k's in the lower triangle. Returns its index.
+inline int ldlt3_pivot(double (&m)[3][3], int k) {
+  int p = k;
+  double big = std::abs(m[k][k]);
+  for (int i = k + 1; i < 3; ++i)
+    if (std::abs(m[i][i]) > big) {
+      big = std::abs(m[i][i]);
+      p = i;
+    }
+  if (p != k) {
+    for (int j = 0; j < k; ++j) std::swap(m[k][j], m[p][j]);
+    for (int i = p + 1; i < 3; ++i) std::swap(m[i][k], m[i][p]);
+    std::swap(m[k][k], m[p][p]);
+    for (int i = k + 1; i < p; ++i) std::swap(m[i][k], m[p][i]);
+  }
+  return p;
+}
+
+/// x = A^-1 b for a symmetric 3x3 matrix A (its lower triangle is read) by the operations of Eigen's
+/// LDLT with diagonal pivoting (Eigen 3.4, A.ldlt().solve(b)) in the same order, so the same
+/// numbers, without instantiating its templates in every translation unit. A zero pivot gives a
+/// zero component, as Eigen's pseudo-inverse of D does.
+inline Vector3 ldlt_solve3(const Matrix3& A, const Vector3& b) {
+  double m[3][3];
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) m[r][c] = A(r, c);
+  int t[3] = {0, 1, 2};
+  for (int k = 0; k < 3; ++k) {
+    t[k] = ldlt3_pivot(m, k);
+    double tmp[2];
+    for (int j = 0; j < k; ++j) tmp[j] = m[j][j] * m[k][j];
+    if (k == 1) {
+      m[1][1] -= m[1][0] * tmp[0];
+      m[2][1] -= m[2][0] * tmp[0];
+    } else if (k == 2) {
+      m[2][2] -= m[2][0] * tmp[0] + m[2][1] * tmp[1];
+    }
+    const double akk = m[k][k];
+    const bool valid = std::abs(akk) > 0.0;
+    if (k == 0 && !valid) {
+      t[0] = 0, t[1] = 1, t[2] = 2;
+      break;
+    }
+    if (valid)
+      for (int i = k + 1; i < 3; ++i) m[i][k] /= akk;
+  }
+  double x[3] = {b(0), b(1), b(2)};
+  for (int k = 0; k < 3; ++k) std::swap(x[k], x[t[k]]);  // P b
+  x[1] -= m[1][0] * x[0];                                 // L^-1
+  x[2] -= m[2][0] * x[0] + m[2][1] * x[1];
+  for (int i = 0; i < 3; ++i) {  // D^-1 (its pseudo-inverse)
+    if (std::abs(m[i][i]) > std::numeric_limits<double>::min())
+      x[i] /= m[i][i];
+    else
+      x[i] = 0.0;
+  }
+  x[1] -= m[2][1] * x[2];  // L^-T
+  x[0] -= m[1][0] * x[1] + m[2][0] * x[2];
+  for (int k = 2; k >= 0; --k) std::swap(x[k], x[t[k]]);  // P^T
+  return {x[0], x[1], x[2]};
+}
+
+/// The unit quaternion of the rotation matrix R by Shoemake's algorithm, with the operations of
+/// Eigen's Quaternion(R) in its order (the same numbers without its templates).
+inline Quaternion quaternion_from_rotation(const Matrix3& R) {
+  double q[4];  // x, y, z, w as Eigen stores them
+  double t = R(0, 0) + (R(1, 1) + R(2, 2));  // Eigen's unrolled trace
+  if (t > 0.0) {
+    t = std::sqrt(t + 1.0);
+    q[3] = 0.5 * t;
+    t = 0.5 / t;
+    q[0] = (R(2, 1) - R(1, 2)) * t;
+    q[1] = (R(0, 2) - R(2, 0)) * t;
+    q[2] = (R(1, 0) - R(0, 1)) * t;
+  } else {
+    int i = 0;
+    if (R(1, 1) > R(0, 0)) i = 1;
+    if (R(2, 2) > R(i, i)) i = 2;
+    const int j = (i + 1) % 3, k = (j + 1) % 3;
+    t = std::sqrt(R(i, i) - R(j, j) - R(k, k) + 1.0);
+    q[i] = 0.5 * t;
+    t = 0.5 / t;
+    q[3] = (R(k, j) - R(j, k)) * t;
+    q[j] = (R(j, i) + R(i, j)) * t;
+    q[k] = (R(k, i) + R(i, k)) * t;
+  }
+  return Quaternion(q[3], q[0], q[1], q[2]);
+}
+
+/// |v| of a 3-vector scaled by its largest magnitude (Eigen's stableNorm for one block, in its order):
+/// no underflow for tiny components.
+inline double stable_norm3(double x, double y, double z) {
+  const double big = std::max(std::max(std::abs(x), std::abs(y)), std::abs(z));
+  if (!(big > 0.0)) return big != big ? big : 0.0;
+  double scale = big, inv = 1.0 / big;
+  if (inv > std::numeric_limits<double>::max()) {
+    inv = std::numeric_limits<double>::max();
+    scale = 1.0 / inv;
+  } else if (big > std::numeric_limits<double>::max()) {
+    inv = 1.0;
+    scale = big;
+  }
+  const double a = x * inv, b = y * inv, c = z * inv;
+  return scale * std::sqrt((a * a + b * b) + c * c);
+}
 }  // namespace detail
 
 /// Rotation by `angle` about the unit vector `axis` (Rodrigues), without allocation.
@@ -116,7 +225,13 @@ inline Matrix3 rotation_from_vector(const Vector3& w) {
 }
 
 /// Angle of the rotation R (radians, in [0, pi]).
-inline double rotation_angle(const Matrix3& R) { return Eigen::AngleAxisd(R).angle(); }
+/// Eigen::AngleAxisd(R).angle() by the same operations, without the templates of its conversions.
+inline double rotation_angle(const Matrix3& R) {
+  const Quaternion q = detail::quaternion_from_rotation(R);
+  double n = std::sqrt((q.x() * q.x() + q.y() * q.y()) + q.z() * q.z());
+  if (n < std::numeric_limits<double>::epsilon()) n = detail::stable_norm3(q.x(), q.y(), q.z());
+  return n != 0.0 ? 2.0 * std::atan2(n, std::abs(q.w())) : 0.0;
+}
 
 /// Spatial cross product for motion vectors, linear first: V x m.
 inline Vector6 cross_motion(const Vector6& V, const Vector6& m) {

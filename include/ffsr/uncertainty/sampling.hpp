@@ -65,6 +65,7 @@
 #pragma once
 
 #include "ffsr/algorithm/effective_mass.hpp"
+#include "ffsr/algorithm/effective_mass_gradient.hpp"
 #include "ffsr/contact/contact_law.hpp"
 #include "ffsr/model/target.hpp"
 

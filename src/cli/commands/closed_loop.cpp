@@ -90,6 +90,11 @@ int run_closed_loop(ClosedLoopCliOptions o, const CLI::App& app) {
                       o.set_from_file(name, text, flag);
                     });
   set_quiet(o.quiet);  // the flag, or the file's quiet key
+  // the controller follows one plan, of the scenario's task: the pose task's keys act on it only
+  if (keys.task != "pose")
+    for (const char* name : {"final-rpy-deg", "orientation-tolerance-deg"})
+      if (keys.overridden.count(name))
+        throw InputError(detail::str("--", name, ": acts on the pose task only, and this plan's task is ", keys.task));
   const Scenario sc = command_scenario(std::move(keys));
   o.loop.noise.attitude = deg2rad(o.attitude_noise_deg);
   o.loop.noise.angular_velocity = deg2rad(o.spin_noise_deg);
@@ -125,7 +130,9 @@ void register_closed_loop(CLI::App& app, Action& action) {
   o->flags.add_groups(*sub,
                       {KeyGroup::Robot, KeyGroup::Start, KeyGroup::Target, KeyGroup::TargetPlace,
                        KeyGroup::Contact, KeyGroup::Planner, KeyGroup::Global, KeyGroup::JointModels},
-                      {"global", "baseline-task"});
+                      // the plan is flown as planned: the base's attitude task of the planner is not
+                      // the controller's
+                      {"global", "baseline-task", "base-attitude"});
   sub->add_option("--plan", o->plan, "The plan the controller follows: paper or global")
       ->capture_default_str();
   sub->add_option("--goal-joints-deg", o->goal_joints_deg,

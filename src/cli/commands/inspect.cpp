@@ -106,6 +106,7 @@ void register_inspect(CLI::App& app, Action& action) {
   // where the target is and the shapes: the distances between them (the clearance constrains plans only)
   std::set<std::string> also = scenario_key_names({KeyGroup::TargetPlace, KeyGroup::Shapes});
   also.erase("clearance");
+  also.erase("contact-exemption");  // the distances are between whole bodies: no contact zone is exempt
   also.insert({"contact-joints", "armature"});  // the joint model of M_ie, m_e and the base's jump
   // the base's jump at the impact depends on the law's damping (model, restitution), not on K or alpha
   opts->subject.add_to(*sub, also, {"stiffness", "exponent"});

@@ -68,7 +68,9 @@ int run_pareto(const ParetoCliOptions& o) {
   Outputs outputs = o.out.outputs();
   check_pareto_job(o.job);
   const plot::Format plot_format = plot::check_request(o.out.plot, o.out.plot_format);
-  Scenario sc = command_scenario(command_scenario_keys(o.config, o.flags));
+  ScenarioKeys keys = command_scenario_keys(o.config, o.flags);
+  refuse_shapes_without_clearance(keys, "pareto");
+  Scenario sc = command_scenario(std::move(keys));
   const ParetoJobResult job = pareto(sc, o.job);  // the main job's runs, then the front
   const ParetoFront& f = job.front;
   const std::vector<ParetoPoint>& runs = job.runs;
@@ -95,7 +97,10 @@ void register_pareto(CLI::App& app, Action& action) {
   // reference's servo keys act with the global run's objective multibody-force only (refused otherwise)
   o->flags.add_groups(*sub, {KeyGroup::Robot, KeyGroup::Start, KeyGroup::Target, KeyGroup::TargetPlace,
                              KeyGroup::Contact, KeyGroup::Planner, KeyGroup::Global, KeyGroup::JointModels,
-                             KeyGroup::Shapes});
+                             KeyGroup::Shapes},
+                      // the front is of M_ie and the base's jump (the impulse of the law's damping): the
+                      // stiffness and the exponent of the law change neither
+                      {"stiffness", "exponent"});
   sub->add_option("--levels", o->job.levels, "Epsilon levels of the sweep between the two ends")
       ->capture_default_str();
   sub->add_option("--starts", o->job.starts, "Random starts of the two single-objective searches")

@@ -176,6 +176,7 @@ int run_merge(const RobustOptions& o) {
 /// is not the global search's seed here (--seed is the Monte Carlo seed): the global runs use seed 1.
 Scenario robust_scenario(ScenarioKeys keys, const RobustOptions& o) {
   o.flags.apply(keys);
+  refuse_shapes_without_clearance(keys, "robust");
   robust_global_seed(keys);
   return command_scenario(std::move(keys));
 }

@@ -44,4 +44,12 @@ void ScenarioFlags::apply(ScenarioKeys& keys) const {
   }
 }
 
+void refuse_shapes_without_clearance(const ScenarioKeys& keys, const std::string& job) {
+  if (keys.clearance > 0) return;
+  for (const ScenarioKey& key : scenario_keys())
+    if (key.group == KeyGroup::Shapes && key.name != "clearance" && keys.overridden.count(key.name))
+      throw InputError(detail::str("--", key.name, ": ", job,
+                                   " uses the shapes through the clearance only, and this run has none (clearance = 0)"));
+}
+
 }  // namespace ffsr::cli

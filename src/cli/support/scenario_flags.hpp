@@ -34,4 +34,8 @@ class ScenarioFlags {
   std::vector<std::pair<const ScenarioKey*, const CLI::Option*>> options_;
 };
 
+/// Refuses a shape key given as a flag (the Shapes group but the clearance) for a job that uses the
+/// shapes through the clearance only, when the clearance is 0: InputError naming the key.
+void refuse_shapes_without_clearance(const ScenarioKeys& keys, const std::string& job);
+
 }  // namespace ffsr::cli
