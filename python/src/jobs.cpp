@@ -156,7 +156,7 @@ void bind_jobs(nb::module_& m) {
       .def_prop_ro("f_max_closed_form", [](const ClosedLoopRun& r) { return r.job.result.f_max_closed_form; },
                    "Eq. 24 at that M_ie, N.")
       .def_prop_ro("max_torque", [](const ClosedLoopRun& r) { return r.job.result.max_torque; }, "Largest |tau_k|, N m.")
-      .def_prop_ro("ticks", [](const ClosedLoopRun& r) { return r.job.result.ticks; })
+      .def_prop_ro("ticks", [](const ClosedLoopRun& r) { return r.job.result.ticks; }, "Control ticks flown.")
       .def("to_dict", [](const ClosedLoopRun& r) { return json_loads(r.json); }, "The command's --json, as a dict.")
       .def("to_json", [](const ClosedLoopRun& r) { return r.json; }, "The command's --json, as text.")
       .def("series_csv", [](const ClosedLoopRun& r) { return closed_loop_series_csv(r.job.result); },
@@ -183,8 +183,9 @@ void bind_jobs(nb::module_& m) {
                               "to_dict() is the command's --json.")
       .def_prop_ro("configurations", [](const RobustRunResult& r) { return r.summary.configurations; },
                    "One per capture configuration evaluated.")
-      .def_prop_ro("samples", [](const RobustRunResult& r) { return r.summary.samples; })
-      .def_prop_ro("seed", [](const RobustRunResult& r) { return r.summary.seed; })
+      .def_prop_ro("samples", [](const RobustRunResult& r) { return r.summary.samples; },
+                   "Samples of the uncertainty table (all shards).")
+      .def_prop_ro("seed", [](const RobustRunResult& r) { return r.summary.seed; }, "The samples' seed.")
       .def("to_dict", [](const RobustRunResult& r) { return json_loads(r.json); }, "The command's --json, as a dict.")
       .def("to_json", [](const RobustRunResult& r) { return r.json; }, "The command's --json, as text.");
 
@@ -203,7 +204,8 @@ void bind_jobs(nb::module_& m) {
       .def_prop_ro("min_rate_end", [](const ParetoRun& r) { return r.job.front.min_rate; }, "The least-base-rate end.")
       .def_prop_ro("runs", [](const ParetoRun& r) { return r.job.runs; },
                    "The plain run, the paper's method and the global run on the same axes.")
-      .def_prop_ro("hypervolume_normalized", [](const ParetoRun& r) { return r.job.front.hypervolume_normalized; })
+      .def_prop_ro("hypervolume_normalized", [](const ParetoRun& r) { return r.job.front.hypervolume_normalized; },
+                   "Area the front dominates up to the nadir of its ends, divided by the nadir box (0..1).")
       .def("to_dict", [](const ParetoRun& r) { return json_loads(r.json); }, "The command's --json, as a dict.")
       .def("to_json", [](const ParetoRun& r) { return r.json; }, "The command's --json, as text.")
       .def("front_csv", [](const ParetoRun& r) { return pareto_csv(r.job.front); }, "The front as the command's --csv.");
