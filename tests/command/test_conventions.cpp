@@ -355,6 +355,42 @@ TEST_CASE("each key a subcommand accepts changes its result, or the subcommand r
   CHECK(problems.empty());
 }
 
+TEST_CASE("a key of one kind of task is refused where no run has that task", "[cli][conventions]") {
+  // the walk above gives the pose task's keys on the 7-DOF position scenario, whose plain run tracks
+  // the pose; here the same keys where both runs track a position (the built-in 3-DOF scenario), and
+  // the position task's axes where both track the pose
+  const std::string pose7 = kSource + "/robots/paper_7dof_pose.toml";
+  struct Where {
+    std::vector<Sub> subs;
+    Args alt;
+    std::string says;
+  };
+  std::vector<Sub> on_pose;
+  for (const Sub& sub : subcommands(true)) {
+    Sub s = sub;
+    for (std::string& a : s.base)
+      if (a == kPosition7) a = pose7;
+    if (std::find(s.base.begin(), s.base.end(), kUncertain7) == s.base.end()) on_pose.push_back(s);
+  }
+  const std::vector<Where> cases = {
+      {subcommands(false), {"--final-rpy-deg", "0,0,10"}, "acts on the pose task only"},
+      {subcommands(false), {"--orientation-tolerance-deg", "1"}, "acts on the pose task only"},
+      {on_pose, {"--task-axes", "xy"}, "acts on the position task only"}};
+  int refusals = 0;
+  for (const Where& w : cases)
+    for (const Sub& sub : w.subs) {
+      if (!accepted_flags(sub.name).count(w.alt[0])) continue;  // the parser refuses it (the walk above)
+      const CommandResult r = cli(command_line(sub, w.alt));
+      INFO((sub.name.empty() ? "main job" : sub.name) << " " << w.alt[0] << ": exit " << r.exit_code << ": " << r.err);
+      CHECK(refused(r, w.alt[0]));
+      CHECK(r.err.find(w.says) != std::string::npos);
+      CHECK(r.out.empty());
+      ++refusals;
+    }
+  // the main job, map, robust and pareto take these keys at least
+  CHECK(refusals >= 8);
+}
+
 TEST_CASE("conventions: --quiet, --json FILE and --json - on every subcommand", "[cli][conventions]") {
   for (const Sub& sub : subcommands()) {
     INFO(sub.name);

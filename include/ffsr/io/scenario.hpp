@@ -126,8 +126,13 @@ struct ScenarioKey {
   /// Writes the key into the resolved scenario of the result (the "scenario" object of
   /// scenario_json); null: the key is not echoed.
   std::function<void(const Scenario&, nlohmann::json&)> echo;
+  /// Where the key acts: "" when it changes the run these keys describe, else why it does not ("acts
+  /// on the global run only, and this run has none (global = false)"); null: everywhere. A key given
+  /// as an override (a flag, a keyword) where it does not act is refused (check_scenario_keys); a
+  /// scenario file may hold it, since a file serves several jobs.
+  std::function<std::string(const ScenarioKeys&)> acts;
 
-  // building the table: key(...).in(KeyGroup::Robot).needed().checked(f).echoed(f)
+  // building the table: key(...).in(KeyGroup::Robot).needed().checked(f).echoed(f).acting(f)
   ScenarioKey& in(KeyGroup g) {
     group = g;
     return *this;
@@ -142,6 +147,10 @@ struct ScenarioKey {
   }
   ScenarioKey& echoed(std::function<void(const Scenario&, nlohmann::json&)> f) {
     echo = std::move(f);
+    return *this;
+  }
+  ScenarioKey& acting(std::function<std::string(const ScenarioKeys&)> f) {
+    acts = std::move(f);
     return *this;
   }
 };

@@ -47,6 +47,33 @@ inline void check_positive_if_given(const ScenarioKeys& k, const char* name, dou
     throw InputError(str("--", name, ": must be positive, got ", value));
 }
 
+// --- where a key acts (ScenarioKey::acts): "" where it does, else why it does not -------------------
+
+inline std::string on_the_global_run(const ScenarioKeys& k) {
+  return k.global ? "" : "acts on the global run only, and this run has none (global = false)";
+}
+
+/// The plain run's task: baseline-task, or the optimized run's.
+inline const std::string& plain_run_task(const ScenarioKeys& k) {
+  return k.baseline_task.empty() ? k.task : k.baseline_task;
+}
+
+/// A key of one kind of task ("pose", "position"): it acts when the optimized or the plain run has it.
+inline std::function<std::string(const ScenarioKeys&)> on_the_task(const char* kind) {
+  return [kind](const ScenarioKeys& k) -> std::string {
+    if (k.task == kind || plain_run_task(k) == kind) return "";
+    return str("acts on the ", kind, " task only, and no run here has it (task = ", k.task,
+               ", baseline-task = ", plain_run_task(k), ")");
+  };
+}
+
+inline std::string on_the_multibody_reference(const ScenarioKeys& k) {
+  return k.global && k.objective == "multibody-force"
+             ? ""
+             : "acts on the multibody reference only: the global run's objective multibody-force (or the "
+               "contact subcommand)";
+}
+
 // --- the keys ------------------------------------------------------------------------------------
 
 #define FFSR_KEY(name, member, ...) \
@@ -142,7 +169,8 @@ inline void add_planner_keys(std::vector<ScenarioKey>& keys) {
   using K = ScenarioKeys;
   keys.push_back(FFSR_KEY("task", task, "Optimized run's task: position or pose").needed());
   keys.push_back(
-      FFSR_KEY("task-axes", task_axes, "Position task: constrained inertial axes, e.g. xy", "xyz"));
+      FFSR_KEY("task-axes", task_axes, "Position task: constrained inertial axes, e.g. xy", "xyz")
+          .acting(on_the_task("position")));
   keys.push_back(FFSR_KEY("baseline-task", baseline_task, "Plain run's task (default: the optimized run's)")
                      .echoed([](const Scenario& sc, nlohmann::json& j) {
                        j["baseline-task"] =
@@ -150,14 +178,16 @@ inline void add_planner_keys(std::vector<ScenarioKey>& keys) {
                      }));
   keys.push_back(FFSR_KEY("final-rpy-deg", final_rpy_deg,
                           "Pose task: final end-effector orientation (default: hold the initial)")
-                     .echoed(echo_given("final-rpy-deg", &K::final_rpy_deg)));
+                     .echoed(echo_given("final-rpy-deg", &K::final_rpy_deg))
+                     .acting(on_the_task("pose")));
   keys.push_back(FFSR_KEY("duration", duration, "Task time T, s").needed());
   keys.push_back(FFSR_KEY("step", step, "RK4 step, s").needed());
   keys.push_back(FFSR_KEY("gain", gain, "rho of Eq. 30 (< 0 lowers the objective)").needed());
   keys.push_back(FFSR_KEY("feedback", feedback, "Tracking feedback gain, 1/s", "1"));
   keys.push_back(FFSR_KEY("tolerance", tolerance, "Required capture-point accuracy, m").needed());
   keys.push_back(FFSR_KEY("orientation-tolerance-deg", orientation_tolerance_deg,
-                          "Pose task: required orientation accuracy, deg", "0.5"));
+                          "Pose task: required orientation accuracy, deg", "0.5")
+                     .acting(on_the_task("pose")));
   keys.push_back(FFSR_KEY(
       "objective", objective,
       "mass (M_ie, the paper's), exact-force, or multibody-force (CVODE peak; global search only, the "
@@ -257,14 +287,16 @@ inline void add_joint_and_shape_keys(std::vector<ScenarioKey>& keys) {
           .echoed([](const Scenario& sc, nlohmann::json& j) {
             if (sc.keys.given.count("joint-stiffness"))
               j["joint-stiffness"] = joint_values_json(sc.joint_stiffness);
-          }));
+          })
+          .acting(on_the_multibody_reference));
   keys.push_back(FFSR_KEY("joint-damping", joint_damping,
                           "Multibody reference: joint PD damping, N m s/rad (one or per joint)", "0")
                      .in(G::JointModels)
                      .echoed([](const Scenario& sc, nlohmann::json& j) {
                        if (sc.keys.given.count("joint-damping"))
                          j["joint-damping"] = joint_values_json(sc.joint_damping);
-                     }));
+                     })
+                     .acting(on_the_multibody_reference));
   keys.push_back(FFSR_KEY("target-shape", target_shape,
                           "Target's collision shape: box, sphere or cylinder (default: none)")
                      .in(G::Shapes)
@@ -312,6 +344,9 @@ inline std::vector<ScenarioKey> build_scenario_keys() {
   add_planner_keys(keys);
   add_global_keys(keys);
   add_joint_and_shape_keys(keys);
+  // every key of the global run but the switch acts on that run only
+  for (ScenarioKey& key : keys)
+    if (key.group == KeyGroup::Global && key.name != "global") key.acting(on_the_global_run);
   return keys;
 }
 
@@ -488,22 +523,18 @@ inline void override_scenario_key(ScenarioKeys& keys, const std::string& name, c
 }
 
 /// Runs the check of every key of the table (ScenarioKey::check), then refuses a flag that would
-/// change nothing (a key given as an override, not by the file: a file may hold keys for other
-/// jobs): a key of the global run without one, the multibody reference's servo gains without the
-/// objective that runs it. InputError naming the key.
+/// change nothing (ScenarioKey::acts; a key given as an override, not by the file: a file may hold
+/// keys for other jobs): a key of the global run without one, a key of the pose task where no run has
+/// it, the multibody reference's servo gains without the objective that runs it. InputError naming
+/// the key.
 inline void check_scenario_keys(const ScenarioKeys& keys) {
   using detail::str;
   for (const ScenarioKey& key : scenario_keys())
     if (key.check) key.check(keys);
   for (const ScenarioKey& key : scenario_keys()) {
-    if (!keys.overridden.count(key.name)) continue;
-    if (key.group == KeyGroup::Global && key.name != "global" && !keys.global)
-      throw InputError(str("--", key.name, ": acts on the global run only, and this run has none (global = false)"));
-    if ((key.name == "joint-stiffness" || key.name == "joint-damping") &&
-        !(keys.global && keys.objective == "multibody-force"))
-      throw InputError(str("--", key.name,
-                           ": acts on the multibody reference only: the global run's objective multibody-force "
-                           "(or the contact subcommand)"));
+    if (!keys.overridden.count(key.name) || !key.acts) continue;
+    const std::string why = key.acts(keys);
+    if (!why.empty()) throw InputError(str("--", key.name, ": ", why));
   }
   if (keys.overridden.count("objective") && !keys.global &&
       (keys.objective == "multibody-force" || keys.objective == "robust-force"))
