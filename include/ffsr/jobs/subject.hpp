@@ -6,8 +6,11 @@
 
 #include "ffsr/algorithm/joint_models.hpp"
 #include "ffsr/contact/contact_law.hpp"
-#include "ffsr/ffsr.hpp"
 #include "ffsr/io/scenario.hpp"
+#include "ffsr/io/urdf.hpp"
+#include "ffsr/model/model.hpp"
+#include "ffsr/model/target.hpp"
+#include "ffsr/optimize/capture_problem.hpp"
 
 #include <functional>
 #include <string>
