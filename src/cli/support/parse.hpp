@@ -35,8 +35,5 @@ Shard parse_shard(const std::string& text);
 double deg2rad(double deg);
 double rad2deg(double rad);
 
-/// Matrix -> JSON array of rows.
-nlohmann::json to_json(const Eigen::MatrixXd& m);
-nlohmann::json to_json(const Eigen::VectorXd& v);
 
 }  // namespace ffsr::cli
