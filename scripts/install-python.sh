@@ -6,6 +6,8 @@
 # the reference of the tests and the bench), then the package itself, built by scikit-build-core in
 # build-python/cmake-* (kept between runs: a rebuild compiles only what changed).
 # Nothing is downloaded at test time: this script is the only step that reaches PyPI.
+# FFSR_PYTHON_CXX_FLAGS, when set, replaces the build's optimization flags (python/pyproject.toml:
+# -O2 -DNDEBUG); .ci/run sets -O1 -DNDEBUG, as in its Release stage, to compile in less time.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 venv=${1:-build-python/venv}
@@ -36,5 +38,9 @@ print("\n".join(dict.fromkeys(pins)))
 PY
 "$py" -m pip install --quiet --disable-pip-version-check -r "$venv/ffsr-requirements.txt"
 # the build requirements are the pinned ones just installed (no isolated build environment)
-"$py" -m pip install --quiet --disable-pip-version-check --no-build-isolation --no-deps ./python
+settings=()
+if [ -n "${FFSR_PYTHON_CXX_FLAGS:-}" ]; then
+  settings+=("--config-settings=cmake.define.CMAKE_CXX_FLAGS_RELEASE=$FFSR_PYTHON_CXX_FLAGS")
+fi
+"$py" -m pip install --quiet --disable-pip-version-check --no-build-isolation --no-deps "${settings[@]}" ./python
 "$py" -c 'import ffsr; print("ffsr: installed the Python package", ffsr.__version__, "in", __import__("sys").prefix)'

@@ -81,6 +81,9 @@ ArrayOut view(const Eigen::MatrixXd& m, nb::handle owner);
 ArrayOut view(const Eigen::VectorXd& v, nb::handle owner);
 /// A new numpy array with a copy of `v` (small fixed-size results: 3- and 6-vectors, 3x3 matrices).
 nb::ndarray<nb::numpy, double> copy_out(const Eigen::Ref<const Eigen::MatrixXd>& m, bool as_vector);
+/// A JSON text (the command's --json) as Python objects: json.loads(text).
+inline nb::object json_loads(const std::string& text) { return nb::module_::import_("json").attr("loads")(text); }
+
 inline nb::ndarray<nb::numpy, double> out(const Vector3& v) { return copy_out(v, true); }
 inline nb::ndarray<nb::numpy, double> out(const Vector6& v) { return copy_out(v, true); }
 inline nb::ndarray<nb::numpy, double> out(const Eigen::VectorXd& v) { return copy_out(v, true); }

@@ -6,6 +6,7 @@
 #include <ffsr/jobs/closed_loop.hpp>
 #include <ffsr/jobs/contact.hpp>
 #include <ffsr/jobs/inspect.hpp>
+#include <ffsr/jobs/map.hpp>
 #include <ffsr/jobs/pareto.hpp>
 #include <ffsr/jobs/robust.hpp>
 
@@ -26,7 +27,6 @@ namespace {
 
 using namespace nb::literals;
 
-nb::object json_loads(const std::string& text) { return nb::module_::import_("json").attr("loads")(text); }
 
 /// inspect's result: the subject it evaluated (the result's Data is made from its model), the
 /// evaluation and the command's JSON, made together.
@@ -57,6 +57,14 @@ struct RobustRunResult {
 /// pareto's result and the command's JSON.
 struct ParetoRun {
   ParetoJobResult job;
+  std::string json;
+};
+
+/// map's points (one row per point of the shard, in the grid's numbering) and the command's JSON.
+struct MapRunResult {
+  std::optional<MapRun> run;
+  Eigen::MatrixXd angles_deg;  ///< points x varied joints
+  Eigen::VectorXd M_ie, f_max;
   std::string json;
 };
 
@@ -210,6 +218,23 @@ void bind_jobs(nb::module_& m) {
       .def("to_json", [](const ParetoRun& r) { return r.json; }, "The command's --json, as text.")
       .def("front_csv", [](const ParetoRun& r) { return pareto_csv(r.job.front); }, "The front as the command's --csv.");
 
+  nb::class_<MapRunResult>(m, "MapResult",
+                           "M_ie (Eq. 14) and the closed-form F_max (Eq. 24) over a grid of joint angles (ffsr-optimize map),\n"
+                           "one row per point of the shard in the grid's numbering (the last varied joint fastest): the rows\n"
+                           "of the command's --csv. to_dict() is the command's --json (the grid and the extremes).")
+      .def_prop_ro("angles_deg", [](nb::handle self) { return view(nb::cast<const MapRunResult&>(self).angles_deg, self); },
+                   "The varied joints' angles of each point, deg, shape (points, varied joints).", nb::rv_policy::automatic)
+      .def_prop_ro("M_ie", [](nb::handle self) { return view(nb::cast<const MapRunResult&>(self).M_ie, self); },
+                   "M_ie of each point under the scenario's joint model (contact-joints), kg.", nb::rv_policy::automatic)
+      .def_prop_ro("f_max", [](nb::handle self) { return view(nb::cast<const MapRunResult&>(self).f_max, self); },
+                   "The closed-form F_max of each point (Eq. 24), N.", nb::rv_policy::automatic)
+      .def_prop_ro("points", [](const MapRunResult& r) { return r.run->plan.grid.size; }, "The points of the whole grid.")
+      .def_prop_ro("first", [](const MapRunResult& r) { return r.run->plan.first; },
+                   "The grid index of the shard's first point (its rows are [first, end)).")
+      .def_prop_ro("end", [](const MapRunResult& r) { return r.run->plan.end; }, "One past the shard's last point.")
+      .def("to_dict", [](const MapRunResult& r) { return json_loads(r.json); }, "The command's --json, as a dict.")
+      .def("to_json", [](const MapRunResult& r) { return r.json; }, "The command's --json, as text.");
+
   nb::handle scenario = nb::type<Scenario>();
   scenario.attr("inspect") = nb::cpp_function(
       [](const Scenario& sc) {
@@ -246,6 +271,52 @@ void bind_jobs(nb::module_& m) {
       "the closed form (Eq. 24), the exact single-body peak (Eq. 16) and the multibody reference (CVODE, robot +\n"
       "target). model: a law of Table 1 or 'all' (default: the scenario's); contact_joints: free, locked, armature\n"
       "or 'all' (default: the scenario's; as --model and --contact-joints); series: keep F(t), delta(t).");
+
+  const MapJobOptions map_defaults;
+  scenario.attr("map") = nb::cpp_function(
+      [](const Scenario& sc, std::vector<int> vary, std::vector<double> range_deg, std::vector<double> step_deg,
+         std::uint64_t shard_k, std::uint64_t shard_n, unsigned threads, std::uint64_t max_points) {
+        MapJobOptions o;
+        o.vary = std::move(vary);
+        o.range_deg = std::move(range_deg);
+        o.step_deg = std::move(step_deg);
+        o.shard_k = shard_k;
+        o.shard_n = shard_n;
+        o.threads = threads;
+        o.max_points = max_points;
+        auto r = std::make_unique<MapRunResult>();
+        {
+          nb::gil_scoped_release release;
+          const Subject s = scenario_subject(sc);
+          const MapPlan plan = plan_map(s, o);
+          const auto rows = static_cast<Eigen::Index>(plan.count());
+          r->angles_deg.resize(rows, static_cast<Eigen::Index>(plan.grid.axes.size()));
+          r->M_ie.resize(rows);
+          r->f_max.resize(rows);
+          MapSink sink;  // each block into its rows, on the thread that computed it (the rows are disjoint)
+          sink.evaluated = [&r, &plan](unsigned, const MapBlock& b) {
+            const size_t k = plan.grid.axes.size();
+            for (std::uint64_t i = 0; i < b.count; ++i) {
+              const auto row = static_cast<Eigen::Index>(b.first - plan.first + i);
+              for (size_t a = 0; a < k; ++a) r->angles_deg(row, static_cast<Eigen::Index>(a)) = b.angles_deg[i * k + a];
+              r->M_ie(row) = b.M_ie[i];
+              r->f_max(row) = b.f_max[i];
+            }
+          };
+          r->run.emplace(evaluate_map(s, plan, sink));
+          r->json = map_json(s, *r->run, FFSR_VERSION).dump();
+        }
+        return r;
+      },
+      nb::is_method(), nb::name("map"), nb::scope(scenario), "vary"_a, "range_deg"_a = map_defaults.range_deg,
+      "step_deg"_a = map_defaults.step_deg, "shard_k"_a = 0, "shard_n"_a = 1, "threads"_a = 0,
+      "max_points"_a = map_defaults.max_points,
+      "The job `map` (ffsr-optimize map --config FILE): M_ie (Eq. 14) under the scenario's joint model and the\n"
+      "closed-form F_max (Eq. 24) over a grid of joint angles, the other joints at the scenario's joints-deg\n"
+      "(the paper's Figures 8 and 9). vary: the joints, 1-based in URDF tree order; range_deg: [lo, hi) of every\n"
+      "varied joint, or one pair per joint; step_deg: one step or one per joint; shard K of N of the points;\n"
+      "threads: 0 for one per core (results do not depend on it); max_points: refuse larger grids. The\n"
+      "keywords are the command's flags (an underscore for a dash).");
 
   const ClosedLoopJobOptions defaults;
   scenario.attr("closed_loop") = nb::cpp_function(

@@ -57,7 +57,6 @@ struct RunResult {
   std::string json;
 };
 
-nb::object json_loads(const std::string& text) { return nb::module_::import_("json").attr("loads")(text); }
 
 }  // namespace
 

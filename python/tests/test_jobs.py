@@ -12,6 +12,7 @@ import os
 import pathlib
 import subprocess
 
+import numpy as np
 import pytest
 
 import ffsr
@@ -188,6 +189,69 @@ def test_pareto_equals_the_command(tmp_path, name):
     assert len(result.front) == len(got["front"])
     with pytest.raises(ffsr.InputError, match="--levels: must be >= 1"):
         ffsr.Scenario.load(str(scenario)).pareto(levels=0)
+
+
+def map_csv(path, header):
+    """The rows of a map CSV as an array (one row per point); header: whether the file starts with one."""
+    return np.loadtxt(path, delimiter=",", skiprows=1 if header else 0, ndmin=2)
+
+
+@pytest.mark.parametrize("name", SCENARIOS)
+def test_map_equals_the_command(tmp_path, name):
+    scenario = ROBOTS / f"{name}.toml"
+    csv = tmp_path / "map.csv"
+    expected = command_json(tmp_path, scenario, "--vary", "1,2", "--step-deg", "40", "--csv", str(csv),
+                            subcommand="map")
+    result = ffsr.Scenario.load(str(scenario)).map([1, 2], step_deg=[40])
+    assert differences(result.to_dict(), expected) == []
+    # every point of the CSV, exactly: the command writes the shortest text that reads back the same double
+    rows = map_csv(csv, header=True)
+    assert result.angles_deg.shape == (81, 2) and rows.shape == (81, 4)
+    assert np.array_equal(result.angles_deg, rows[:, :2])
+    assert np.array_equal(result.M_ie, rows[:, 2])
+    assert np.array_equal(result.f_max, rows[:, 3])
+    assert (result.points, result.first, result.end) == (81, 0, 81)
+    i = int(np.argmax(result.M_ie))
+    assert result.M_ie[i] == expected["max"]["integrated_effective_mass"]
+    assert list(result.angles_deg[i]) == expected["max"]["angles_deg"]
+
+
+def test_map_shard_joint_model_and_threads(tmp_path):
+    scenario = ROBOTS / "paper_7dof_position.toml"
+    csv = tmp_path / "map.csv"
+    flags = ("--vary", "2,4,6", "--range-deg", "-90,90", "--step-deg", "30", "--contact-joints", "locked")
+    expected = command_json(tmp_path, scenario, *flags, "--shard", "1/3", "--csv", str(csv), subcommand="map")
+    sc = ffsr.Scenario.load(str(scenario), contact_joints="locked")
+    part = sc.map([2, 4, 6], range_deg=[-90, 90], step_deg=[30], shard_k=1, shard_n=3, threads=3)
+    assert differences(part.to_dict(), expected) == []
+    rows = map_csv(csv, header=False)  # shard 1 of 3: no header line
+    assert np.array_equal(part.M_ie, rows[:, 3]) and np.array_equal(part.f_max, rows[:, 4])
+    # the shard is its slice of the whole grid, whatever the threads
+    whole = sc.map([2, 4, 6], range_deg=[-90, 90], step_deg=[30], threads=1)
+    assert np.array_equal(whole.M_ie[part.first:part.end], part.M_ie)
+    assert np.array_equal(whole.angles_deg[part.first:part.end], part.angles_deg)
+    # locking the joints can only add inertia at the contact: M_ie at least the free joints' everywhere
+    assert whole.to_dict()["contact_joints"] == "locked"
+    free = ffsr.Scenario.load(str(scenario)).map([2, 4, 6], range_deg=[-90, 90], step_deg=[30])
+    assert np.all(whole.M_ie >= free.M_ie * (1 - 1e-12)) and np.any(whole.M_ie > 1.01 * free.M_ie)
+
+
+def test_map_bad_input():
+    sc = ffsr.Scenario.load(str(ROBOTS / "paper_3dof.toml"))
+    with pytest.raises(ffsr.InputError, match="--vary: joint 4 is not one of 1..3"):
+        sc.map([4])
+    with pytest.raises(ffsr.InputError, match="--vary: joint 1 is given twice"):
+        sc.map([1, 1])
+    with pytest.raises(ffsr.InputError, match="--range-deg: the range of joint 1 is inverted"):
+        sc.map([1], range_deg=[10, 5])
+    with pytest.raises(ffsr.InputError, match="--range-deg: expected 2 numbers, got 3"):
+        sc.map([1], range_deg=[1, 2, 3])
+    with pytest.raises(ffsr.InputError, match="--step-deg: the step must be positive"):
+        sc.map([1], step_deg=[float("nan")])
+    with pytest.raises(ffsr.InputError, match="--max-points: the grid has 27000 points"):
+        sc.map([1, 2, 3], step_deg=[12], max_points=100)
+    with pytest.raises(ffsr.InputError, match="--shard: K must be less than N"):
+        sc.map([1], shard_k=3, shard_n=3)
 
 
 def test_override_equals_the_flag(tmp_path):

@@ -171,6 +171,7 @@ TEST_CASE("c_r = 1 is the pure Hertz limit, continuous as c_r -> 1", "[contact]"
     CHECK(rel(max_force_exact(law, M), K * std::pow(d_hertz, a)) < 1e-15);
     CHECK(exact_peak(law, M).deformation_rate == 0.0);
     CHECK(relative_error(law) == 0.0);
+    CHECK_FALSE(std::signbit(relative_error(law)));  // +0: the outputs print it as 0, not -0
   }
   // c_r = 1 - 1e-12 against c_r = 1: relative agreement 1e-9 (the change is O(f) ~ 1e-12).
   const auto at1 = all_laws({K, a, 1.0}, v0);

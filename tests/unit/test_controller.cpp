@@ -314,6 +314,33 @@ TEST_CASE("controller: bad construction inputs throw InputError naming the contr
                     Catch::Contains("quaternion tolerance"));
 }
 
+TEST_CASE("closed loop: an estimate's noise depends on the seed and the index only, in a fixed order") {
+  // the components of each noise vector are drawn z, y, x from SampleStream(seed, k), whatever order a
+  // compiler gives the arguments of one call (GCC and clang differ): the same seed, the same run
+  Target truth;
+  truth.position = Vector3(1.0, -2.0, 0.5);
+  truth.velocity = Vector3(0.01, 0.02, -0.03);
+  truth.angular_velocity = Vector3(0.1, 0.0, -0.2);
+  ClosedLoopOptions o;
+  o.seed = 11;
+  o.noise.position = 0.01;
+  o.noise.velocity = 0.002;
+  o.noise.angular_velocity = 0.003;
+  const TargetEstimate e = detail::noisy_estimate(truth, o, 5);
+  SampleStream s(11, 5);
+  double d[12];
+  for (double& x : d) x = s.normal();
+  // position: draws 0-2; attitude (sigma 0): 3-5; velocity: 6-8; angular velocity: 9-11
+  CHECK(e.position == Vector3(truth.position.x() + 0.01 * d[2], truth.position.y() + 0.01 * d[1],
+                              truth.position.z() + 0.01 * d[0]));
+  CHECK(e.velocity == Vector3(truth.velocity.x() + 0.002 * d[8], truth.velocity.y() + 0.002 * d[7],
+                              truth.velocity.z() + 0.002 * d[6]));
+  CHECK(e.angular_velocity == Vector3(truth.angular_velocity.x() + 0.003 * d[11],
+                                      truth.angular_velocity.y() + 0.003 * d[10],
+                                      truth.angular_velocity.z() + 0.003 * d[9]));
+  CHECK(e.attitude.angularDistance(truth.attitude) < 1e-12);  // sigma 0: the truth
+}
+
 }  // namespace test_controller
 
 namespace test_controller {

@@ -10,6 +10,11 @@
 #include <cstdlib>
 #include <malloc.h>
 #include <new>
+#if defined(__clang__) && defined(__SSE__)
+// clang's <mm_malloc.h> (through Eigen's SSE intrinsics) declares posix_memalign again without noexcept;
+// clang accepts that after glibc's declaration but not after the definition below, so it comes first
+#include <mm_malloc.h>
+#endif
 
 namespace {
 std::atomic<long> g_news{0}, g_deletes{0};

@@ -422,7 +422,8 @@ double HertzDamped<Damping>::relative_error() const {
                                 ? std::log1p((G0_ - Gs) / Gs)
                                 : std::log(G0_) - detail::contact_log_G_lost(f_, t);
   const double ln_ratio = a / (a + 1.0) * ln_G_ratio - std::log1p(f_ * s);
-  const double xi = -100.0 * std::expm1(ln_ratio);
+  // + 0.0: at c_r = 1 (f = 0) the product is -0, which would print as "-0"; zero has no sign here
+  const double xi = -100.0 * std::expm1(ln_ratio) + 0.0;
   if (!std::isfinite(xi))
     throw NumericalError(detail::str(name, ": xi is not representable for f = ", f_, ", alpha = ", a));
   return xi;

@@ -1,22 +1,14 @@
 // ffsr-optimize map: the integrated effective mass M_ie (Eq. 14) and the closed-form maximum contact
 // force F_max (Eq. 24) over a grid of joint angles (the paper's Figures 8 and 9), the joints not
-// varied held at --joints-deg.
+// varied held at --joints-deg. The grid, its numbering and its shards are the library's job
+// (ffsr/jobs/map.hpp); this file parses the flags and writes what the job hands it.
 //
-// The grid. Varied joint j (1-based, URDF tree order) takes the angles lo_j + i step_j, i = 0, 1, ...,
-// below hi_j: the half-open range [lo_j, hi_j), so that -180,180 in steps of 2 gives 180 angles and
-// no angle twice. Points are numbered row-major: the last varied joint changes fastest; the CSV has
-// one row per point in that order.
-//
-// Shards. --shard K/N evaluates the K-th of N contiguous parts of that numbering (part k holds
-// points [k P/N, (k+1) P/N) up to rounding: the first P mod N parts hold one point more). Only shard
-// 0 writes the header line, so `cat` of the N shard files in the order k = 0..N-1 is, byte for byte,
-// the CSV of the whole grid.
-//
-// Speed. Each thread has its own Data and buffers (no heap allocation per point); blocks of points
-// are claimed in order, formatted with std::to_chars (the shortest text that reads back as the same
-// double) and appended to the output in order, so the output never has to fit in memory. The file
-// is written like every output of the command (StreamingOutput: a temporary next to the
-// destination, renamed at the end: all or nothing).
+// The CSV: one row per point in the grid's numbering. Only shard 0 writes the header line, so `cat` of
+// the N shard files in the order k = 0..N-1 is, byte for byte, the CSV of the whole grid. Each block
+// of points is formatted with std::to_chars (the shortest text that reads back as the same double) on
+// the thread that evaluated it and appended to the output in point order, so the output never has
+// to fit in memory. The file is written like every output of the command (StreamingOutput: a
+// temporary next to the destination, renamed at the end: all or nothing).
 //
 // Pictures (--plot DIR): one varied joint gives M_ie against the angle; two a heat map with contour
 // lines and a colour bar (Figure 9); three the orthogonal slices through --slice-deg (Figure 9's
@@ -30,10 +22,7 @@
 #include "figures/figures.hpp"
 #include "commands/subcommands.hpp"
 
-#include "ffsr/jobs/scenario_run.hpp"
-
-#include "ffsr/detail/parallel.hpp"
-#include "ffsr/optimize/objective.hpp"
+#include "ffsr/jobs/map.hpp"
 
 #include <charconv>
 #include <cstdint>
@@ -61,67 +50,25 @@ struct MapOptions {
   OutputKeys out;  ///< --csv (required: the map), --json (its summary), --plot, --quiet
 };
 
-/// One varied joint: angles lo + i step (degrees), i = 0..count-1.
-struct Axis {
-  int joint = 0;  // 0-based joint index
-  double lo = 0, step = 0;
-  std::uint64_t count = 0;
-  double angle_deg(std::uint64_t i) const { return lo + static_cast<double>(i) * step; }
-};
-
-struct Grid {
-  std::vector<Axis> axes;
-  std::uint64_t size = 0;
-};
-
-/// Parses --vary, --range-deg, --step-deg and checks the size against --max-points.
-Grid parse_grid(const MapOptions& o, const std::string& urdf, int n_joints) {
-  const auto joints = parse_list(o.vary, "--vary");
-  Grid g;
-  for (double j : joints) {
-    if (j != std::floor(j) || j < 1 || j > n_joints)
-      throw InputError(str("--vary: joint ", j, " is not one of 1..", n_joints, " (the robot in ", urdf,
-                           " has ", n_joints, " joints, numbered from 1 in URDF tree order)"));
-    for (const Axis& a : g.axes)
-      if (a.joint == static_cast<int>(j) - 1) throw InputError(str("--vary: joint ", j, " is given twice"));
-    g.axes.push_back({static_cast<int>(j) - 1, 0, 0, 0});
+/// The job's options from the flags' text: the lists parsed, the joints checked to be whole numbers.
+MapJobOptions job_options(const MapOptions& o, const std::string& urdf, int n_joints) {
+  MapJobOptions j;
+  for (double v : parse_list(o.vary, "--vary")) {
+    if (v != std::floor(v) || v < 1 || v > n_joints)
+      throw InputError(str("--vary: joint ", v, " is not one of 1..", n_joints, " (the robot in ", urdf, " has ",
+                           n_joints, " joints, numbered from 1 in URDF tree order)"));
+    j.vary.push_back(static_cast<int>(v));
   }
-  const size_t k = g.axes.size();
-  const auto range =
+  const size_t k = j.vary.size();
+  j.range_deg =
       parse_list(o.range_deg, "--range-deg", k == 1 ? std::vector<size_t>{2} : std::vector<size_t>{2, 2 * k});
-  const auto step =
-      parse_list(o.step_deg, "--step-deg", k == 1 ? std::vector<size_t>{1} : std::vector<size_t>{1, k});
-  double total = 1.0;
-  for (size_t i = 0; i < k; ++i) {
-    Axis& a = g.axes[i];
-    const double lo = range.size() == 2 ? range[0] : range[2 * i],
-                 hi = range.size() == 2 ? range[1] : range[2 * i + 1];
-    a.step = step.size() == 1 ? step[0] : step[i];
-    if (!(a.step > 0)) throw InputError(str("--step-deg: the step must be positive, got ", a.step));
-    if (!(lo < hi))
-      throw InputError(str("--range-deg: the range of joint ", a.joint + 1, " is ",
-                           lo == hi ? "empty" : "inverted", " (from ", lo, " to ", hi,
-                           "; expected lo < hi)"));
-    a.lo = lo;
-    const double r = (hi - lo) / a.step;
-    if (!(r < 9.0e15))
-      throw InputError(str("--step-deg: the step ", a.step, " is too small for the range ", lo, ",", hi));
-    a.count = static_cast<std::uint64_t>(std::ceil(r - 1e-9));  // half-open [lo, hi), tolerant of rounding
-    if (a.count == 0) a.count = 1;
-    total *= static_cast<double>(a.count);
-  }
-  if (total > static_cast<double>(o.max_points))
-    throw InputError(str("--max-points: the grid has ", total, " points, more than the limit ", o.max_points,
-                         "; pass a larger --max-points to run it"));
-  g.size = 1;
-  for (const Axis& a : g.axes) g.size *= a.count;
-  return g;
-}
-
-/// The first point of part j of N of a grid of `size` points (the first size mod N parts hold one
-/// point more).
-std::uint64_t shard_begin(const Shard& s, std::uint64_t size, std::uint64_t j) {
-  return j * (size / s.n) + std::min(j, size % s.n);
+  j.step_deg = parse_list(o.step_deg, "--step-deg", k == 1 ? std::vector<size_t>{1} : std::vector<size_t>{1, k});
+  const Shard shard = parse_shard(o.shard);
+  j.shard_k = shard.k;
+  j.shard_n = shard.n;
+  j.threads = o.threads;
+  j.max_points = o.max_points;
+  return j;
 }
 
 /// Appends the shortest round-trip text of x and a separator.
@@ -131,70 +78,25 @@ inline char* put(char* p, char* end, double x, char sep) {
   return r.ptr + 1;
 }
 
-/// What one thread needs: its own Data and joint vector; evaluates a block of points.
-struct Worker {
-  const Model& model;
-  const Grid& grid;
-  const CaptureEvaluator& objective;  ///< M_ie of the joint model (free: the fast path) and F_max
-  const BasePose base;
-  Data data;
-  Eigen::VectorXd theta;
+/// A block's CSV rows, formatted on the thread that evaluated it (one buffer per thread, no heap
+/// allocation per block).
+struct RowText {
   std::vector<char> text;
-  std::vector<double> angles;
-  double* values = nullptr;  // M_ie by point index - first_point, when the grid is plotted
-  std::uint64_t first_point = 0;
-  // the largest and smallest M_ie seen, and where (smallest point index on ties)
-  double max_M = -1, min_M = std::numeric_limits<double>::infinity();
-  std::uint64_t argmax = 0, argmin = 0;
-
-  Worker(const Model& m, const Grid& g, const CaptureEvaluator& f, const Robot& r, size_t block)
-      : model(m),
-        grid(g),
-        objective(f),
-        base(r.base),
-        data(m),
-        theta(r.theta),
-        text((g.axes.size() + 2) * 32 * block + 1),
-        angles(g.axes.size()) {}
-
-  /// Evaluates points [first, last) and formats their rows into `text`; returns the byte count.
-  size_t run(std::uint64_t first, std::uint64_t last) {
+  size_t bytes = 0;
+  void format(const MapBlock& b, size_t k) {
     char* p = text.data();
     char* const end = text.data() + text.size();
-    const size_t k = grid.axes.size();
-    for (std::uint64_t idx = first; idx < last; ++idx) {
-      std::uint64_t rest = idx;
-      for (size_t a = k; a-- > 0;) {
-        const Axis& ax = grid.axes[a];
-        angles[a] = ax.angle_deg(rest % ax.count);
-        rest /= ax.count;
-        theta(ax.joint) = angles[a] * (M_PI / 180.0);  // as load_robot converts --joints-deg
-      }
-      const double M = objective.mass_fast(data, base, theta);  // Eq. 14
-      const double F = objective.f_max_closed_form(M);          // Eq. 24
-      if (values) values[idx - first_point] = M;
-      if (M > max_M) max_M = M, argmax = idx;
-      if (M < min_M) min_M = M, argmin = idx;
-      for (size_t a = 0; a < k; ++a) p = put(p, end, angles[a], ',');
-      p = put(p, end, M, ',');
-      p = put(p, end, F, '\n');
+    for (std::uint64_t i = 0; i < b.count; ++i) {
+      for (size_t a = 0; a < k; ++a) p = put(p, end, b.angles_deg[i * k + a], ',');
+      p = put(p, end, b.M_ie[i], ',');
+      p = put(p, end, b.f_max[i], '\n');
     }
-    return static_cast<size_t>(p - text.data());
+    bytes = static_cast<size_t>(p - text.data());
   }
 };
 
-/// The angles of point `idx`, deg, one per varied joint.
-std::vector<double> point_angles(const Grid& g, std::uint64_t idx) {
-  std::vector<double> a(g.axes.size());
-  for (size_t i = g.axes.size(); i-- > 0;) {
-    a[i] = g.axes[i].angle_deg(idx % g.axes[i].count);
-    idx /= g.axes[i].count;
-  }
-  return a;
-}
-
-std::string point_deg(const Grid& g, std::uint64_t idx) {
-  const std::vector<double> a = point_angles(g, idx);
+std::string point_deg(const MapGrid& g, std::uint64_t idx) {
+  const std::vector<double> a = g.point_angles(idx);
   std::ostringstream os;
   os << "[";
   for (size_t i = 0; i < a.size(); ++i) os << (i ? ", " : "") << a[i];
@@ -205,10 +107,10 @@ std::string point_deg(const Grid& g, std::uint64_t idx) {
 constexpr std::uint64_t kMaxPlotPoints = 50000000;
 
 /// The figures of a plotted grid (see the top of this file).
-std::vector<plot::Figure> map_figures(const Grid& grid, const std::vector<std::string>& names,
+std::vector<plot::Figure> map_figures(const MapGrid& grid, const std::vector<std::string>& names,
                                       std::vector<double> values, const std::vector<double>& slice_deg) {
   figures::Grid g;
-  for (const Axis& a : grid.axes) {
+  for (const MapAxis& a : grid.axes) {
     g.axis_labels.push_back(str("θ", a.joint + 1, " (deg)"));
     std::vector<double> axis(a.count);
     for (std::uint64_t i = 0; i < a.count; ++i) axis[i] = a.angle_deg(i);
@@ -216,7 +118,7 @@ std::vector<plot::Figure> map_figures(const Grid& grid, const std::vector<std::s
   }
   g.values = std::move(values);
   std::string joints;
-  for (const Axis& a : grid.axes)
+  for (const MapAxis& a : grid.axes)
     joints += (joints.empty() ? "" : ", ") + names[static_cast<size_t>(a.joint)];
   if (grid.axes.size() == 1) {
     plot::Figure fig;
@@ -247,26 +149,9 @@ std::vector<plot::Figure> map_figures(const Grid& grid, const std::vector<std::s
           figures::map_cloud(g, "map_cloud", "M_ie over " + joints + " (Figure 8)")};
 }
 
-/// The contact law at the approach velocity of the flags (Eq. 10-12); InputError when the end-effector
-/// does not approach the target or the law is unknown.
-AnyContactLaw map_law(const Subject& s) {
-  const Target& target = s.target;
-  if (s.law == "all") throw InputError("--model: map evaluates one law; 'all' is for the contact subcommand");
-  const Vector3 u = target.normal_world();
-  const double v_in = approach_velocity(u, Vector3(s.approach_speed * u), target.velocity,
-                                        target.angular_velocity_world(), target.offset_world());  // Eq. 10-12
-  if (!(v_in > 0))
-    throw InputError(str("--approach-speed: the end-effector does not approach the target (delta_dot^- = ",
-                         v_in, " m/s); increase the approach speed"));
-  try {
-    return make_contact_law(s.law, s.params, v_in);
-  } catch (const InputError& e) {
-    throw InputError(std::string("--model: ") + e.what());
-  }
-}
-
 /// The pictures' arguments, checked before the grid is evaluated; returns the slices (deg).
-std::vector<double> check_map_plot(const MapOptions& o, const Grid& grid, const Shard& shard) {
+std::vector<double> check_map_plot(const MapOptions& o, const MapPlan& plan) {
+  const MapGrid& grid = plan.grid;
   std::vector<double> slice_deg(grid.axes.size(), 0.0);
   if (!o.slice_deg.empty()) {
     slice_deg = parse_list(o.slice_deg, "--slice-deg", {grid.axes.size()});
@@ -278,7 +163,7 @@ std::vector<double> check_map_plot(const MapOptions& o, const Grid& grid, const 
   if (grid.axes.size() > 3)
     throw InputError(str("--plot: pictures are drawn for 1 to 3 varied joints, got ", grid.axes.size(),
                          " (the CSV holds every point)"));
-  if (shard.n > 1)
+  if (plan.shard_n > 1)
     throw InputError(
         "--plot: a shard holds part of the grid only; run the whole grid (--shard 0/1) to plot it");
   if (grid.size > kMaxPlotPoints)
@@ -287,92 +172,18 @@ std::vector<double> check_map_plot(const MapOptions& o, const Grid& grid, const 
   return slice_deg;
 }
 
-/// The per-thread workers of a grid run (detail::parallel_chunks hands each thread its own).
-struct GridRun {
-  std::vector<std::unique_ptr<Worker>> workers;
-  unsigned threads = 1;
-};
-
-/// The points [first, last) of the grid in blocks of `block` points on the shared thread pool
-/// (ffsr/detail/parallel.hpp): each block is formatted by a worker and written to `out` once all
-/// blocks before it are, so the CSV does not depend on the thread count.
-void run_workers(GridRun& g, StreamingOutput& out, std::uint64_t first, std::uint64_t last,
-                 std::uint64_t block, bool quiet) {
-  Progress progress("map", quiet);
-  std::vector<size_t> bytes(g.threads, 0);
-  ffsr::detail::ParallelOptions opt;
-  opt.chunk = block;
-  opt.commit = [&](unsigned t, std::uint64_t, std::uint64_t) {
-    out.write(g.workers[t]->text.data(), bytes[t]);
-  };
-  opt.progress = [&](std::uint64_t done) { progress(done, last - first); };
-  opt.progress_every = std::chrono::milliseconds(200);
-  ffsr::detail::parallel_chunks(
-      last - first, g.threads,
-      [&](unsigned t, std::uint64_t lo, std::uint64_t hi) {
-        bytes[t] = g.workers[t]->run(first + lo, first + hi);
-      },
-      opt);
-}
-
-/// The largest and the smallest M_ie of the evaluated points (the first point of a tie).
-struct Extremes {
-  double max_M = 0, min_M = 0;
-  std::uint64_t argmax = 0, argmin = 0;
-};
-
-Extremes extremes(const GridRun& g) {
-  const Worker* hi = g.workers[0].get();
-  const Worker* lo = g.workers[0].get();
-  for (const auto& w : g.workers) {
-    if (w->max_M > hi->max_M || (w->max_M == hi->max_M && w->argmax < hi->argmax)) hi = w.get();
-    if (w->min_M < lo->min_M || (w->min_M == lo->min_M && w->argmin < lo->argmin)) lo = w.get();
-  }
-  return {hi->max_M, lo->min_M, hi->argmax, lo->argmin};
-}
-
-void print_map_summary(std::ostream& os, const MapOptions& o, const Grid& grid, const Shard& shard,
-                       const GridRun& g, std::uint64_t count, double seconds) {
-  os << "map: " << count << " of " << grid.size << " points (shard " << shard.k << "/" << shard.n << ") in "
-     << seconds << " s, " << (seconds > 0 ? static_cast<double>(count) / seconds : 0.0) << " points/s on "
-     << g.threads << " thread" << (g.threads > 1 ? "s" : "") << "\n";
-  if (count > 0) {
-    const Extremes e = extremes(g);
-    os << "max M_ie = " << e.max_M << " kg at " << point_deg(grid, e.argmax) << " deg; min M_ie = " << e.min_M
-       << " kg at " << point_deg(grid, e.argmin) << " deg\n";
+void print_map_summary(std::ostream& os, const MapOptions& o, const MapRun& r) {
+  const MapPlan& p = r.plan;
+  const std::uint64_t count = p.count();
+  os << "map: " << count << " of " << p.grid.size << " points (shard " << p.shard_k << "/" << p.shard_n << ") in "
+     << r.seconds << " s, " << (r.seconds > 0 ? static_cast<double>(count) / r.seconds : 0.0) << " points/s on "
+     << p.threads << " thread" << (p.threads > 1 ? "s" : "") << "\n";
+  if (r.extremes) {
+    const MapExtremes& e = *r.extremes;
+    os << "max M_ie = " << e.max_M << " kg at " << point_deg(p.grid, e.argmax) << " deg; min M_ie = " << e.min_M
+       << " kg at " << point_deg(p.grid, e.argmin) << " deg\n";
   }
   if (!is_stdout_name(o.out.csv)) os << "wrote " << o.out.csv << "\n";
-}
-
-/// The map's summary: the grid, this shard's points and the extremes of M_ie with their closed-form
-/// F_max (the CSV holds every point).
-nlohmann::json map_json(const Subject& subject, const Grid& grid, const Shard& shard, const GridRun& g,
-                        std::uint64_t first, std::uint64_t count, JointModel joints, const AnyContactLaw& law) {
-  const auto names = subject.robot.model.joint_names();
-  nlohmann::json axes = nlohmann::json::array();
-  for (const Axis& a : grid.axes)
-    axes.push_back({{"joint", names[static_cast<size_t>(a.joint)]},
-                    {"from_deg", a.lo},
-                    {"step_deg", a.step},
-                    {"count", a.count}});
-  nlohmann::json j = {{"urdf", subject.keys.urdf},
-                      {"joints_deg", subject.keys.joints_deg},
-                      {"contact_joints", joint_model_name(joints)},
-                      {"axes", axes},
-                      {"points", grid.size},
-                      {"shard", {{"k", shard.k}, {"n", shard.n}, {"first", first}, {"end", first + count}}},
-                      {"version", FFSR_VERSION}};
-  if (count > 0) {
-    const Extremes e = extremes(g);
-    // F_max (Eq. 24) grows with M_ie: its extremes are at the same points
-    j["max"] = {{"integrated_effective_mass", e.max_M},
-                {"f_max_closed_form", max_force_closed_form(law, e.max_M)},
-                {"angles_deg", point_angles(grid, e.argmax)}};
-    j["min"] = {{"integrated_effective_mass", e.min_M},
-                {"f_max_closed_form", max_force_closed_form(law, e.min_M)},
-                {"angles_deg", point_angles(grid, e.argmin)}};
-  }
-  return j;
 }
 
 int run_map(const MapOptions& o) {
@@ -382,55 +193,41 @@ int run_map(const MapOptions& o) {
   if (is_stdout_name(o.out.csv)) outputs.claim_stdout("--csv " + o.out.csv);
   const Subject subject = load_subject(o.subject);
   const Robot& r = subject.robot;
-  const Target& target = subject.target;
-  const AnyContactLaw law = map_law(subject);
-  const Grid grid = parse_grid(o, subject.keys.urdf, r.model.n());
-  const Shard shard = parse_shard(o.shard);
-  const std::uint64_t first = shard_begin(shard, grid.size, shard.k),
-                      last = shard_begin(shard, grid.size, shard.k + 1);
-  const std::uint64_t count = last - first;
+  const MapPlan plan = plan_map(subject, job_options(o, subject.keys.urdf, r.model.n()));
   const bool plotting = !o.out.plot.empty();
   const plot::Format plot_format = plot::parse_format(o.out.plot_format, "--plot-format");
-  const std::vector<double> slice_deg = check_map_plot(o, grid, shard);
-  std::vector<double> values(plotting ? count : 0);
+  const std::vector<double> slice_deg = check_map_plot(o, plan);
+  std::vector<double> values(plotting ? plan.count() : 0);
 
-  if (subject.all_joint_models())
-    throw InputError("--contact-joints: map evaluates one joint model; 'all' is for the contact subcommand");
-  const ContactJoints joints = subject.contact_joints();  // checked before any output
-  StreamingOutput out("--csv", o.out.csv);
-  if (shard.k == 0) {
-    std::string header;
-    const auto names = r.model.joint_names();
-    for (const Axis& a : grid.axes) header += names[static_cast<size_t>(a.joint)] + "_deg,";
-    const JointModel jm = joints.model;
-    header +=
-        jm == JointModel::Free ? "M_ie_kg,F_max_N\n" : str("M_ie_", joint_model_name(jm), "_kg,F_max_N\n");
+  StreamingOutput out("--csv", o.out.csv);  // checked before any point is evaluated
+  if (plan.shard_k == 0) {
+    const std::string header = map_csv_header(subject, plan);
     out.write(header.data(), header.size());
   }
-  constexpr std::uint64_t kBlock = 2048;
-  const std::uint64_t blocks = (count + kBlock - 1) / kBlock;
-  GridRun g;
-  g.threads = o.threads ? o.threads : std::max(1U, std::thread::hardware_concurrency());
-  g.threads = static_cast<unsigned>(std::max<std::uint64_t>(1, std::min<std::uint64_t>(g.threads, blocks)));
-  const CaptureEvaluator objective(r.model, r.end_effector, target, &law, joints);
-  for (unsigned t = 0; t < g.threads; ++t) {
-    g.workers.push_back(std::make_unique<Worker>(r.model, grid, objective, r, kBlock));
-    g.workers.back()->values = plotting ? values.data() : nullptr;
-    g.workers.back()->first_point = first;
-  }
-  const auto t0 = std::chrono::steady_clock::now();
-  run_workers(g, out, first, last, kBlock, o.out.quiet);
+  const size_t k = plan.grid.axes.size();
+  std::vector<RowText> rows(plan.threads);
+  for (RowText& t : rows) t.text.resize((k + 2) * 32 * static_cast<size_t>(plan.block) + 1);
+  Progress progress("map", o.out.quiet);
+  MapSink sink;
+  sink.evaluated = [&](unsigned t, const MapBlock& b) {
+    rows[t].format(b, k);
+    if (plotting) std::copy(b.M_ie, b.M_ie + b.count, values.begin() + static_cast<std::ptrdiff_t>(b.first - plan.first));
+  };
+  sink.commit = [&](unsigned t, const MapBlock&) { out.write(rows[t].text.data(), rows[t].bytes); };
+  sink.progress = [&](std::uint64_t done, std::uint64_t total) { progress(done, total); };
+  MapRun run = evaluate_map(subject, plan, sink);
   // the pictures before the CSV is committed: a failed drawing leaves no CSV behind
   std::vector<std::string> drawn;
+  const auto t0 = std::chrono::steady_clock::now();
   if (plotting)
-    drawn = plot::render(map_figures(grid, r.model.joint_names(), std::move(values), slice_deg), o.out.plot,
+    drawn = plot::render(map_figures(plan.grid, r.model.joint_names(), std::move(values), slice_deg), o.out.plot,
                          plot_format);
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  outputs.set("--json", map_json(subject, grid, shard, g, first, count, joints.model, law).dump(2) + "\n");
+  run.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  outputs.set("--json", map_json(subject, run, FFSR_VERSION).dump(2) + "\n");
   outputs.write();  // the summary first: a failed JSON leaves no CSV behind
   out.commit();
   std::ostream& os = outputs.table();  // standard error when the CSV or the JSON goes to standard output
-  print_map_summary(os, o, grid, shard, g, count, seconds);
+  print_map_summary(os, o, run);
   for (const std::string& f : drawn) os << "wrote " << f << "\n";
   return 0;
 }
