@@ -197,7 +197,7 @@ TEST_CASE("run: --config robots/paper_3dof.toml from another directory finds its
   }
 }
 
-TEST_CASE("map: over the paper's ranges (Figure 8) the maximum is the stretched arm alone", "[map][cli]") {
+TEST_CASE("map: over the paper's ranges (Figure 8) the maximum is the stretched arm alone", "[map][cli][paper]") {
   TempDir dir;
   const CommandResult r =
       cli_sub("map", {"--urdf", kUrdf3, "--joints-deg", "0,0,0", "--vary", "1,2,3", "--range-deg",

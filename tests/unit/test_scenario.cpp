@@ -1,6 +1,9 @@
 // Scenarios through the library (ffsr/io/scenario.hpp, ffsr/jobs/scenario_run.hpp): a scenario file
 // gives the same result as `ffsr-optimize --json`, every shipped scenario loads, bad keys are named.
 #include "ffsr/io/scenario.hpp"
+#include "ffsr/jobs/closed_loop.hpp"
+#include "ffsr/jobs/map.hpp"
+#include "ffsr/jobs/pareto.hpp"
 #include "ffsr/jobs/scenario_run.hpp"
 
 #include "support/run_command.hpp"
@@ -104,6 +107,70 @@ TEST_CASE("scenario: robots/paper_7dof_position.toml through the library gives t
   check_same_numbers(lib, cmd, "result");
   CHECK(lib["optimized"]["integrated_effective_mass"].get<double>() <
         lib["baseline"]["integrated_effective_mass"].get<double>());
+}
+
+TEST_CASE("scenario: map, pareto and closed-loop through the library give the command's --json numbers",
+          "[scenario][jobs]") {
+  // the three jobs in-process (under the sanitizers in the sanitizer stage of .ci/run, whose command is
+  // the Release stage's) against the command, on the 3-DOF paper scenario with small settings
+  const std::string file = kSource + "/robots/paper_3dof.toml";
+  const ffsr::Scenario sc = ffsr::load_scenario(file);
+  TempDir tmp;
+  const auto command_json = [&](std::vector<std::string> args) {
+    const std::string out = (tmp.path / "job.json").string();
+    args.insert(args.begin(), FFSR_CLI);
+    for (const char* a : {"--config", "--quiet", "--json"}) {
+      args.push_back(a);
+      if (std::string(a) == "--config") args.push_back(file);
+    }
+    args.push_back(out);
+    const auto r = ffsr::test::run_command(args);
+    INFO(r.err);
+    REQUIRE(r.exit_code == 0);
+    json j = json::parse(read_text(out));
+    j.erase("version");
+    return j;
+  };
+  const auto library = [](json j) {
+    j.erase("version");
+    return j;
+  };
+
+  SECTION("map: joints 2 and 3 over the full turn in 20 deg steps, two threads") {
+    ffsr::MapJobOptions o;
+    o.vary = {2, 3};
+    o.step_deg = {20};
+    o.threads = 2;
+    const ffsr::Subject subject = ffsr::load_subject(sc.keys);
+    const ffsr::MapPlan plan = ffsr::plan_map(subject, o);
+    REQUIRE(plan.count() == 18 * 18);
+    double largest = 0;
+    std::uint64_t seen = 0;
+    ffsr::MapSink sink;
+    sink.commit = [&](unsigned, const ffsr::MapBlock& b) {
+      REQUIRE(b.first == seen);  // in point order, every point once
+      seen += b.count;
+      for (std::uint64_t i = 0; i < b.count; ++i) largest = std::max(largest, b.M_ie[i]);
+    };
+    const ffsr::MapRun run = ffsr::evaluate_map(subject, plan, sink);
+    CHECK(seen == plan.count());
+    const json lib = library(ffsr::map_json(subject, run, "library"));
+    check_same_numbers(lib, command_json({"map", "--vary", "2,3", "--step-deg", "20", "--threads", "2",
+                                          "--csv", (tmp.path / "map.csv").string()}),
+                       "map");
+    CHECK(lib["max"]["integrated_effective_mass"].get<double>() == largest);  // the blocks' own maximum
+  }
+  SECTION("pareto: 4 levels, 2 starts") {
+    ffsr::ParetoJobOptions o;
+    o.levels = 4;
+    o.starts = 2;
+    const json lib = library(ffsr::pareto_json(sc, ffsr::pareto(sc, o), "library"));
+    check_same_numbers(lib, command_json({"pareto", "--levels", "4", "--starts", "2"}), "pareto");
+  }
+  SECTION("closed-loop: the paper's plan") {
+    const json lib = library(ffsr::closed_loop_json(sc, ffsr::closed_loop(sc, {}), "library"));
+    check_same_numbers(lib, command_json({"closed-loop"}), "closed-loop");
+  }
 }
 
 TEST_CASE("scenario: every robots/*.toml loads through the library", "[scenario]") {
