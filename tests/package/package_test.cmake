@@ -12,4 +12,6 @@ add_test(NAME package_consumer
     -DGENERATOR=${CMAKE_GENERATOR}
     -DCXX_COMPILER=${CMAKE_CXX_COMPILER}
     -P ${CMAKE_CURRENT_LIST_DIR}/run_consumer.cmake)
-set_tests_properties(package_consumer PROPERTIES LABELS package TIMEOUT 600)
+# COST: the longest case of the suite (a configure, install and build of its own), started first so that
+# ctest -j2 runs the other cases beside it instead of waiting for it at the end
+set_tests_properties(package_consumer PROPERTIES LABELS package TIMEOUT 600 COST 10000)
