@@ -191,41 +191,55 @@ struct MapWorker {
 
 }  // namespace detail
 
-inline MapGrid map_grid(const MapJobOptions& o, const std::string& urdf, int n_joints) {
-  using detail::str;
-  MapGrid g;
-  if (o.vary.empty()) throw InputError("--vary: no joint to vary");
-  for (int j : o.vary) {
+namespace detail {
+
+/// The axes of --vary (joints 1-based, each once), their ranges and steps not yet set.
+inline std::vector<MapAxis> map_axes(const std::vector<int>& vary, const std::string& urdf, int n_joints) {
+  std::vector<MapAxis> axes;
+  if (vary.empty()) throw InputError("--vary: no joint to vary");
+  for (int j : vary) {
     if (j < 1 || j > n_joints)
       throw InputError(str("--vary: joint ", j, " is not one of 1..", n_joints, " (the robot in ", urdf, " has ",
                            n_joints, " joints, numbered from 1 in URDF tree order)"));
-    for (const MapAxis& a : g.axes)
+    for (const MapAxis& a : axes)
       if (a.joint == j - 1) throw InputError(str("--vary: joint ", j, " is given twice"));
-    g.axes.push_back({j - 1, 0, 0, 0});
+    axes.push_back({j - 1, 0, 0, 0});
   }
+  return axes;
+}
+
+/// Sets axis `a`'s first angle, step and count from the half-open range [lo, hi) and the step.
+inline void map_axis_range(MapAxis& a, double lo, double hi, double step) {
+  a.step = step;
+  if (!std::isfinite(lo) || !std::isfinite(hi))
+    throw InputError(str("--range-deg: the range of joint ", a.joint + 1, " is not finite (", lo, ",", hi, ")"));
+  if (!(a.step > 0) || !std::isfinite(a.step))
+    throw InputError(str("--step-deg: the step must be positive, got ", a.step));
+  if (!(lo < hi))
+    throw InputError(str("--range-deg: the range of joint ", a.joint + 1, " is ", lo == hi ? "empty" : "inverted",
+                         " (from ", lo, " to ", hi, "; expected lo < hi)"));
+  a.lo = lo;
+  const double r = (hi - lo) / a.step;
+  if (!(r < 9.0e15)) throw InputError(str("--step-deg: the step ", a.step, " is too small for the range ", lo, ",", hi));
+  a.count = static_cast<std::uint64_t>(std::ceil(r - 1e-9));  // half-open [lo, hi), tolerant of rounding
+  if (a.count == 0) a.count = 1;
+}
+
+}  // namespace detail
+
+inline MapGrid map_grid(const MapJobOptions& o, const std::string& urdf, int n_joints) {
+  using detail::str;
+  MapGrid g;
+  g.axes = detail::map_axes(o.vary, urdf, n_joints);
   const size_t k = g.axes.size();
   detail::map_list_size(o.range_deg, "--range-deg", k == 1 ? std::vector<size_t>{2} : std::vector<size_t>{2, 2 * k});
   detail::map_list_size(o.step_deg, "--step-deg", k == 1 ? std::vector<size_t>{1} : std::vector<size_t>{1, k});
+  const bool one_range = o.range_deg.size() == 2, one_step = o.step_deg.size() == 1;
   double total = 1.0;
   for (size_t i = 0; i < k; ++i) {
-    MapAxis& a = g.axes[i];
-    const double lo = o.range_deg.size() == 2 ? o.range_deg[0] : o.range_deg[2 * i],
-                 hi = o.range_deg.size() == 2 ? o.range_deg[1] : o.range_deg[2 * i + 1];
-    a.step = o.step_deg.size() == 1 ? o.step_deg[0] : o.step_deg[i];
-    if (!std::isfinite(lo) || !std::isfinite(hi))
-      throw InputError(str("--range-deg: the range of joint ", a.joint + 1, " is not finite (", lo, ",", hi, ")"));
-    if (!(a.step > 0) || !std::isfinite(a.step))
-      throw InputError(str("--step-deg: the step must be positive, got ", a.step));
-    if (!(lo < hi))
-      throw InputError(str("--range-deg: the range of joint ", a.joint + 1, " is ", lo == hi ? "empty" : "inverted",
-                           " (from ", lo, " to ", hi, "; expected lo < hi)"));
-    a.lo = lo;
-    const double r = (hi - lo) / a.step;
-    if (!(r < 9.0e15))
-      throw InputError(str("--step-deg: the step ", a.step, " is too small for the range ", lo, ",", hi));
-    a.count = static_cast<std::uint64_t>(std::ceil(r - 1e-9));  // half-open [lo, hi), tolerant of rounding
-    if (a.count == 0) a.count = 1;
-    total *= static_cast<double>(a.count);
+    detail::map_axis_range(g.axes[i], o.range_deg[one_range ? 0 : 2 * i], o.range_deg[one_range ? 1 : 2 * i + 1],
+                           o.step_deg[one_step ? 0 : i]);
+    total *= static_cast<double>(g.axes[i].count);
   }
   if (total > static_cast<double>(o.max_points))
     throw InputError(str("--max-points: the grid has ", total, " points, more than the limit ", o.max_points,
