@@ -18,6 +18,7 @@
 
 #include "ffsr/algorithm/aba.hpp"
 #include "ffsr/algorithm/forward_dynamics.hpp"
+#include "ffsr/algorithm/momentum.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -252,6 +253,16 @@ TEST_CASE("aba: the O(n) forward dynamics equals crba + RNEA + Cholesky and inve
       detail::aba_acceleration_pass(model, d, v, tau2, a2);
       aba(model, e, q.base, q.theta, v, tau2, a2_full);
       CHECK(a2 == a2_full);
+      // the momentum from the velocity pass's bodies (sum of I_i V_i, what the closed loop records
+      // per tick) against the body-by-body sum of momentum() and against H v (its first six rows)
+      const Vector6 h_pass = detail::momentum_from_velocity_pass(model, d);
+      forward_kinematics(model, e, q.base, q.theta);
+      const Vector6 h_ref = momentum(model, e, v);
+      const Vector6 h_H = (H * v).head<6>();
+      INFO("momentum from the pass " << h_pass.transpose() << "\nmomentum() " << h_ref.transpose());
+      const double hs = std::max(1.0, h_ref.cwiseAbs().maxCoeff());
+      CHECK((h_pass - h_ref).cwiseAbs().maxCoeff() < 1e-12 * hs);
+      CHECK((h_pass - h_H).cwiseAbs().maxCoeff() < 1e-12 * hs);
     }
   }
   // no velocity, no force, no gravity: at rest, exactly

@@ -42,6 +42,20 @@ inline Vector6 momentum(const Model& model, const Data& data, const Eigen::Ref<c
   return h;
 }
 
+namespace detail {
+
+/// Total momentum [P; L] about the base frame origin (inertial axes) from what the articulated-body
+/// algorithm's velocity pass left: the sum over the bodies of I_i V_i, both about p_0 in inertial axes.
+/// Equals momentum() at the same state to rounding, without the kinematics again. Reads data.Ic (the
+/// bodies alone, as detail::aba_velocity_pass writes it) and data.V.
+inline Vector6 momentum_from_velocity_pass(const Model& model, const Data& data) {
+  Vector6 h = Vector6::Zero();
+  for (int i = 0; i < model.nb(); ++i) h += data.Ic[static_cast<size_t>(i)] * data.V[static_cast<size_t>(i)];
+  return h;
+}
+
+}  // namespace detail
+
 /// Kinetic energy, summed body by body: sum of 1/2 m |v_c|^2 + 1/2 w^T I w.
 /// Reads the kinematics (forward_kinematics) and v.
 inline double kinetic_energy(const Model& model, const Data& data,

@@ -73,11 +73,11 @@ struct ClosedLoopOptions {
   std::uint64_t seed = 1;
   ClosedLoopIntegrator integrator = ClosedLoopIntegrator::RungeKutta;
   /// Local error per step <= rtol |y_i| + atol (weighted RMS; both integrators). The defaults are the
-  /// Runge-Kutta's: on the 7-DOF run they give the capture error, M_ie and largest torque of CVODE
-  /// restarted per tick at 1e-9 and 1e-12 within 2e-11 m, 1e-9 and 0 relative, with less momentum
-  /// drift (docs/controller.md); the CvodeRestart reference was measured at 1e-9 and 1e-12.
+  /// Runge-Kutta's, one step per 1 ms tick on the 7-DOF run: its capture error, M_ie and largest
+  /// torque equal those of CVODE restarted per tick at 1e-9 and 1e-12 within 1e-6 m, 1e-6 and 1e-3
+  /// relative (measured in docs/controller.md); the CvodeRestart reference is run at 1e-9 and 1e-12.
   double rtol = 1e-6;
-  double atol = 1e-9;       ///< m, rad, m/s, rad/s
+  double atol = 1e-8;       ///< m, rad, m/s, rad/s
   double record_every = 0;  ///< s between recorded samples (0: none)
 };
 

@@ -81,6 +81,8 @@ class TickRungeKutta {
       }
     }
   }
+  /// True when the plant's last evaluation (dynamics()) was at the current y: after an accepted step.
+  bool dynamics_at_y() const { return dynamics_at_y_; }
   long steps() const { return steps_; }
   long rejected() const { return rejected_; }
 
@@ -209,8 +211,15 @@ ClosedLoopResult simulate_closed_loop(CaptureController<Policy>& ctrl, const Clo
     if (plant.torques(y)) ++res.saturated_ticks;
     res.max_torque = std::max(res.max_torque, plant.tau.tail(n).cwiseAbs().maxCoeff());
     detail::record_tick(cmd, res);
-    forward_kinematics(model, plant.data, st.base, st.theta);
-    const Vector6 h = momentum(model, plant.data, y.segment(plant.iv(), 6 + n));
+    // the momentum at y: after a Runge-Kutta step the plant's last evaluation was at y (its velocity
+    // pass holds the bodies' inertias and velocities there), else from the kinematics again
+    Vector6 h;
+    if (!cv && plant.articulated && rk.dynamics_at_y()) {
+      h = detail::momentum_from_velocity_pass(model, plant.data);
+    } else {
+      forward_kinematics(model, plant.data, st.base, st.theta);
+      h = momentum(model, plant.data, y.segment(plant.iv(), 6 + n));
+    }
     const double hn = h.head<3>().norm() + h.tail<3>().norm();
     res.max_momentum = std::max(res.max_momentum, hn);
     if (o.record_every > 0 && t >= next_record - 1e-9 * dt) {
