@@ -11,6 +11,8 @@
 #include "support/dynamics_helpers.hpp"
 #include "support/run_command.hpp"
 
+#include "ffsr/io/detail/urdf_document.hpp"
+
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
 

@@ -5,7 +5,7 @@
 #pragma once
 
 #include "ffsr/geometry/shape.hpp"
-#include "ffsr/io/urdf.hpp"
+#include "ffsr/io/detail/urdf_document.hpp"
 
 #include <fstream>
 #include <sstream>
