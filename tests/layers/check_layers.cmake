@@ -4,7 +4,8 @@
 # Every header's `#include "ffsr/<folder>/..."` (and "ffsr/<name>.hpp" at the top) is checked; a
 # folder missing from the table fails the check, so that a new folder is placed on purpose. Files
 # held to a lower layer than their folder's (as includer and as included): the URDF parser
-# (io/urdf.hpp and its internals io/detail/urdf_document.hpp) reads into the model alone, the URDF collision elements into geometry's shapes.
+# (io/urdf.hpp and its internals io/detail/urdf_document.hpp) reads into the model alone, the URDF
+# collision elements into geometry's shapes.
 
 # One layer per entry, the lowest first; names in one entry are one layer. A top-level header
 # "ffsr/<name>.hpp" counts as the folder <name>: errors.hpp lies at the bottom, the umbrella header
