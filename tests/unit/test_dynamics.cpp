@@ -457,6 +457,69 @@ TEST_CASE("inverse effective mass: the articulated-body recursion equals the den
   }
 }
 
+TEST_CASE("forward kinematics: each body's pose is its parent's times tree times the joint's motion",
+          "[dynamics]") {
+  // the definition, composed with Eigen from the Body records (Pose products and rotation_about),
+  // against forward_kinematics, which folds tree.R into Rodrigues' formula for general axes, picks
+  // columns for axes along x, y or z and skips identity joint origins (JointKinematics); the random
+  // tree has rotated joint origins, general revolute and prismatic axes, the paper's robots unit
+  // axes and identity origins, and the chain rotated origins and general axes throughout
+  std::vector<std::pair<std::string, Model>> models;
+  for (const auto& r : robots_under_test()) models.emplace_back(r.name, r.model);
+  models.emplace_back("chain 14", random_chain(14, 14));
+  Rng rng(43);
+  for (const auto& [name, model] : models) {
+    Data d(model);
+    for (int k = 0; k < 5; ++k) {
+      const Config q = random_config(model, rng);
+      forward_kinematics(model, d, q.base, q.theta);
+      std::vector<Pose> X(static_cast<size_t>(model.nb()));
+      X[0] = Pose{q.base.position, q.base.orientation.normalized().toRotationMatrix()};
+      double worst = 0;
+      for (int i = 1; i < model.nb(); ++i) {
+        const Body& b = model.body(i);
+        const double qi = b.joint_position(q.theta);
+        const Pose joint = b.joint.type == JointType::Revolute
+                               ? Pose{Vector3::Zero(), rotation_about(b.joint.axis, qi)}
+                               : Pose{b.joint.axis * qi, Matrix3::Identity()};
+        X[static_cast<size_t>(i)] = X[static_cast<size_t>(b.parent)] * b.tree * joint;
+        worst = std::max({worst, (d.R[static_cast<size_t>(i)] - X[static_cast<size_t>(i)].R).cwiseAbs().maxCoeff(),
+                          (d.p[static_cast<size_t>(i)] - X[static_cast<size_t>(i)].p).cwiseAbs().maxCoeff()});
+      }
+      INFO(name << " config " << k << ": largest difference " << worst);
+      CHECK(worst < 1e-13);
+    }
+  }
+}
+
+TEST_CASE("inverse_quadratic_spd6: x^T A^-1 x against Eigen's LLT solve, refuses indefinite matrices",
+          "[dynamics]") {
+  std::mt19937 gen(17);
+  std::normal_distribution<double> N(0.0, 1.0);
+  double worst = 0;
+  for (int k = 0; k < 200; ++k) {
+    Matrix6 B;
+    for (int e = 0; e < 36; ++e) B.data()[e] = N(gen);
+    const double shift = k % 2 ? 1e-3 : 1.0;  // half of them poorly conditioned
+    const Matrix6 A = B * B.transpose() + shift * Matrix6::Identity();
+    Vector6 x;
+    for (int e = 0; e < 6; ++e) x(e) = N(gen);
+    const double ref = x.dot(A.llt().solve(x));
+    double q = 0;
+    REQUIRE(ffsr::detail::inverse_quadratic_spd6(A, x, q));
+    worst = std::max(worst, std::abs(q - ref) / ref);
+  }
+  INFO("worst relative difference " << worst);
+  CHECK(worst < 1e-10);
+  Matrix6 A = Matrix6::Identity();
+  A(4, 4) = -1;  // indefinite
+  double q = 0;
+  CHECK_FALSE(ffsr::detail::inverse_quadratic_spd6(A, Vector6::Ones(), q));
+  A(4, 4) = std::numeric_limits<double>::quiet_NaN();
+  CHECK_FALSE(ffsr::detail::inverse_quadratic_spd6(A, Vector6::Ones(), q));
+  CHECK_FALSE(ffsr::detail::inverse_quadratic_spd6(Matrix6::Zero(), Vector6::Ones(), q));
+}
+
 TEST_CASE("sin_cos of the kinematics: within 2 units in the last place of std::sin and std::cos",
           "[dynamics]") {
   std::mt19937_64 gen(31);

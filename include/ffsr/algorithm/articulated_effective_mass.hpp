@@ -40,6 +40,37 @@ inline bool solve_spd6(const Matrix6& A, const Vector6& b, Vector6& x) {
   return true;
 }
 
+/// x^T A^-1 x for a symmetric positive definite 6x6 A by the LDL^T factorization with fixed loop
+/// bounds: with A = L D L^T (L unit lower triangular) and L y = x, x^T A^-1 x = sum_j y_j^2 / D_j.
+/// No square root and no back substitution (solve_spd6 needs both for the solution itself): one
+/// division per pivot. Reads the lower triangle. False when A is not positive definite (a pivot
+/// D_j <= 0 or NaN; q is then unspecified).
+inline bool inverse_quadratic_spd6(const Matrix6& A, const Vector6& x, double& q) {
+  double L[6][6], D[6], inv[6], y[6];
+  q = 0.0;
+  for (int j = 0; j < 6; ++j) {
+    double v[6];  // L_jk D_k
+    double d = A(j, j);
+    for (int k = 0; k < j; ++k) {
+      v[k] = L[j][k] * D[k];
+      d -= L[j][k] * v[k];
+    }
+    if (!(d > 0.0)) return false;
+    D[j] = d;
+    inv[j] = 1.0 / d;
+    for (int i = j + 1; i < 6; ++i) {
+      double s = A(i, j);
+      for (int k = 0; k < j; ++k) s -= L[i][k] * v[k];
+      L[i][j] = s * inv[j];
+    }
+    double yj = x(j);
+    for (int k = 0; k < j; ++k) yj -= L[j][k] * y[k];
+    y[j] = yj;
+    q += yj * yj * inv[j];
+  }
+  return true;
+}
+
 /// The unit force u at the origin of `frame` as a spatial force about the base origin p_0 (inertial
 /// axes, linear first): f = [u; (p_e - p_0) x u]. Checks u and the frame index. Reads the kinematics.
 inline Vector6 unit_point_force(const Model& model, const Data& data, int frame, const Vector3& u) {
@@ -86,36 +117,38 @@ inline void articulated_inertias(const Model& model, Data& data, const Eigen::Ve
 
 /// The rest of the articulated-body algorithm for the spatial force f on body `ee` and no joint
 /// torque, after articulated_inertias: the bias forces along the path from `ee` to the base,
-///   pA = -f on ee;  u_i = -S_i^T pA_i,  pA_parent = pA_i + U_i u_i / D_i  (only the path carries one),
-/// the base acceleration a_0 = -IA_0^-1 pA_0 and the accelerations a_i = a_parent + S_i qdd_i,
-/// qdd_i = (u_i - U_i^T a_parent) / D_i, along the path (`all` false) or for every body (`all` true,
-/// with u_i = 0 off the path; then data.y = [a_0; qdd] = (H + diag(0, a))^-1 J^T f). Returns f^T a_ee
-/// = w^T (H + diag(0, a))^-1 w for w the generalized force of f.
-/// Reads data.IA, data.U, data.D, data.S. Writes data.path, data.on_path, data.u, data.A (and data.y
-/// when `all`). Throws NumericalError when IA_0 is not positive definite.
+///   pA = -f on ee;  u_i = -S_i^T pA_i,  pA_parent = pA_i + U_i u_i / D_i  (only the path carries one).
+/// Returns f^T a_ee = w^T (H + diag(0, a))^-1 w for w the generalized force of f (a_ee the
+/// acceleration of body ee). `all` false: as the sum of the squared innovations over their
+/// variances, sum_path u_i^2 / D_i + pA_0^T IA_0^-1 pA_0 (the articulated-body recursion factors
+/// H^-1 as a Kalman filter factors a covariance: Rodriguez, Jain and Kreutz-Delgado 1991), so no
+/// acceleration is formed. `all` true: the base acceleration a_0 = -IA_0^-1 pA_0 and the
+/// accelerations a_i = a_parent + S_i qdd_i, qdd_i = (u_i - U_i^T a_parent) / D_i, of every body
+/// (with u_i = 0 off the path); then data.y = [a_0; qdd] = (H + diag(0, a))^-1 J^T f and the result
+/// is f^T a_ee. Reads data.IA, data.U, data.D, data.S. Writes data.path, data.u (and data.on_path,
+/// data.A and data.y when `all`). Throws NumericalError when IA_0 is not positive definite.
 inline double articulated_solve(const Model& model, Data& data, int ee, const Vector6& f, bool all) {
   const int nb = model.nb();
   int len = 0;
   for (int i = ee; i > 0; i = model.body(i).parent) data.path[static_cast<size_t>(len++)] = i;
   Vector6 pA = -f;
+  double q = 0.0;
   for (int k = 0; k < len; ++k) {  // from ee towards the base
     const int i = data.path[static_cast<size_t>(k)];
     const double ui = -data.S.col(i - 1).dot(pA);
+    const double si = ui / data.D(i - 1);
     data.u(i - 1) = ui;
-    pA.noalias() += data.U[static_cast<size_t>(i)] * (ui / data.D(i - 1));
+    q += ui * si;
+    pA.noalias() += data.U[static_cast<size_t>(i)] * si;
+  }
+  if (!all) {
+    double q0 = 0.0;
+    if (!inverse_quadratic_spd6(data.IA[0].matrix(), pA, q0))
+      throw NumericalError("effective_mass: the articulated inertia of the base is not positive definite");
+    return q + q0;
   }
   if (!solve_spd6(data.IA[0].matrix(), -pA, data.A[0]))
     throw NumericalError("effective_mass: the articulated inertia of the base is not positive definite");
-  if (!all) {
-    for (int k = len - 1; k >= 0; --k) {
-      const int i = data.path[static_cast<size_t>(k)];
-      const auto ui = static_cast<size_t>(i);
-      const Vector6& ap = data.A[static_cast<size_t>(model.body(i).parent)];
-      const double qdd = (data.u(i - 1) - data.U[ui].dot(ap)) / data.D(i - 1);
-      data.A[ui] = ap + data.S.col(i - 1) * qdd;
-    }
-    return f.dot(data.A[static_cast<size_t>(ee)]);
-  }
   std::fill(data.on_path.begin(), data.on_path.end(), char(0));
   for (int k = 0; k < len; ++k) data.on_path[static_cast<size_t>(data.path[static_cast<size_t>(k)])] = 1;
   data.y.head<6>() = data.A[0];
@@ -154,14 +187,15 @@ inline const Eigen::VectorXd* armature_of(const Model& model, const ContactJoint
 /// torques, gives the generalized acceleration qdd = H^-1 J_v^T u, and the point p_e accelerates
 /// along u at u^T J_v qdd, the wanted quantity. The external force is the spatial force
 /// f = [u; (p_e - p_0) x u] on the frame's body; the articulated-body algorithm at zero velocity
-/// finds the body accelerations it causes, and the result is f^T a_e (a_e the spatial acceleration
-/// of that body). All quantities are in inertial axes about the base origin p_0, as in crba, so the
-/// motion subspaces are data.S and inertias add without transforms (detail::articulated_inertias,
-/// detail::articulated_solve): one symmetric rank-one update of a 6x6 articulated inertia (kept as
-/// 3x3 blocks) per body, bias forces only along the path from the frame's body to the base, one 6x6
-/// Cholesky at the base, no n x n matrix.
+/// would find the body accelerations it causes, and the result is f^T a_e (a_e the spatial
+/// acceleration of that body), which its backward pass already gives as a sum of squares (see
+/// detail::articulated_solve). All quantities are in inertial axes about the base origin p_0, as in
+/// crba, so the motion subspaces are data.S and inertias add without transforms
+/// (detail::articulated_inertias, detail::articulated_solve): one symmetric rank-one update of a 6x6
+/// articulated inertia (kept as 3x3 blocks) per body, bias forces only along the path from the
+/// frame's body to the base, one 6x6 LDL^T factorization at the base, no n x n matrix.
 /// Reads the kinematics (data.R, data.p, data.S). Writes data.Ic (composite), data.IA, data.U,
-/// data.D, data.u, data.A, data.path. Allocation-free. Throws InputError for a model with mimic joints
+/// data.D, data.u, data.path. Allocation-free. Throws InputError for a model with mimic joints
 /// (use inverse_effective_mass), NumericalError when an articulated inertia is not positive definite.
 inline double inverse_effective_mass_articulated(const Model& model, Data& data, int frame,
                                                  const Vector3& u) {

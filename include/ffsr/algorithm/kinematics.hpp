@@ -27,14 +27,6 @@ inline void multiply3(const Matrix3& A, const Matrix3& B, Matrix3& C) {
   }
 }
 
-/// 0, 1 or 2 when the unit vector `axis` is +-x, +-y or +-z exactly (as most URDF joint axes are), else -1.
-inline int coordinate_axis(const Vector3& axis) {
-  if (axis.y() == 0.0 && axis.z() == 0.0) return 0;
-  if (axis.x() == 0.0 && axis.z() == 0.0) return 1;
-  if (axis.x() == 0.0 && axis.y() == 0.0) return 2;
-  return -1;
-}
-
 }  // namespace detail
 
 /// Forward kinematics (RBDA 4.1, in the inertial frame).
@@ -51,47 +43,58 @@ inline void forward_kinematics(const Model& model, Data& data, const BasePose& b
   const int nb = model.nb();
   for (int i = 1; i < nb; ++i) {
     const Body& b = model.body(i);
+    const detail::JointKinematics& jk = model.joint_kinematics(i);
     const auto ui = static_cast<size_t>(i);
     const auto pi = static_cast<size_t>(b.parent);
     const Matrix3& Rp = data.R[pi];
-    // the joint frame in o; a joint origin without rotation (rpy 0 0 0, most URDF joints) keeps the
-    // parent's axes as they are (the product with the identity would give the same numbers)
-    Matrix3 Rj;
-    if (b.tree.R == Matrix3::Identity())
-      Rj = Rp;
-    else
-      detail::multiply3(Rp, b.tree.R, Rj);
     const Vector3& t = b.tree.p;
     const Vector3& pp = data.p[pi];
     const Vector3 pj(pp(0) + (Rp(0, 0) * t(0) + Rp(0, 1) * t(1) + Rp(0, 2) * t(2)),
                      pp(1) + (Rp(1, 0) * t(0) + Rp(1, 1) * t(1) + Rp(1, 2) * t(2)),
                      pp(2) + (Rp(2, 0) * t(0) + Rp(2, 1) * t(1) + Rp(2, 2) * t(2)));
-    const Vector3& ax = b.joint.axis;
-    const int a = detail::coordinate_axis(ax);
-    // the joint axis in o: for an axis +-x, +-y or +-z (exactly +-1 after normalization) a column of Rj
+    const int a = jk.axis;
+    const bool revolute = b.joint.type == JointType::Revolute;
+    // the joint frame in o, Rj = Rp tree.R, where it is needed: a joint origin without rotation (rpy
+    // 0 0 0, most URDF joints) keeps the parent's axes; a revolute joint about a general axis folds
+    // tree.R into its constants (JointKinematics)
+    Matrix3 Rj;
+    const Matrix3* J = &Rp;
+    if (!jk.tree_identity && (a >= 0 || !revolute)) {
+      detail::multiply3(Rp, b.tree.R, Rj);
+      J = &Rj;
+    }
+    // the joint axis in o: for an axis +-x, +-y or +-z (exactly +-1) a column of the joint frame, else
+    // Rp (tree.R k)
     Vector3 z;
-    if (a >= 0)
-      z = ax(a) * Rj.col(a);
-    else
-      z = Vector3(Rj(0, 0) * ax(0) + Rj(0, 1) * ax(1) + Rj(0, 2) * ax(2),
-                  Rj(1, 0) * ax(0) + Rj(1, 1) * ax(1) + Rj(1, 2) * ax(2),
-                  Rj(2, 0) * ax(0) + Rj(2, 1) * ax(1) + Rj(2, 2) * ax(2));
+    if (a >= 0) {
+      z = b.joint.axis(a) * J->col(a);
+    } else {
+      const Vector3& zl = jk.z;
+      z = Vector3(Rp(0, 0) * zl(0) + Rp(0, 1) * zl(1) + Rp(0, 2) * zl(2),
+                  Rp(1, 0) * zl(0) + Rp(1, 1) * zl(1) + Rp(1, 2) * zl(2),
+                  Rp(2, 0) * zl(0) + Rp(2, 1) * zl(1) + Rp(2, 2) * zl(2));
+    }
     const double q = b.joint_position(theta), k = b.multiplier;
     double* S = data.S.col(i - 1).data();
-    if (b.joint.type == JointType::Revolute) {
+    if (revolute) {
       Matrix3& R = data.R[ui];
-      if (a >= 0) {  // about +-x, +-y or +-z: a plane rotation of two columns (12 products, not 27 + 15)
-        double s, c;
-        detail::sin_cos(q, s, c);
-        s *= ax(a);
+      double s, c;
+      detail::sin_cos(q, s, c);
+      if (a >= 0) {  // about +-x, +-y or +-z: a plane rotation of two columns (12 products)
+        const Matrix3& Q = *J;
+        s *= b.joint.axis(a);
         const int c1 = (a + 1) % 3, c2 = (a + 2) % 3;
         for (int r = 0; r < 3; ++r) {
-          R(r, a) = Rj(r, a);
-          R(r, c1) = c * Rj(r, c1) + s * Rj(r, c2);
-          R(r, c2) = c * Rj(r, c2) - s * Rj(r, c1);
+          const double q1 = Q(r, c1), q2 = Q(r, c2);
+          R(r, a) = Q(r, a);
+          R(r, c1) = c * q1 + s * q2;
+          R(r, c2) = c * q2 - s * q1;
         }
-      } else {
-        detail::multiply3(Rj, rotation_about(ax, q), R);
+      } else {  // R = Rp (c A + s B + (1 - c) C): Rodrigues' formula with tree.R folded in
+        const double u = 1.0 - c;
+        Matrix3 M;
+        for (int e = 0; e < 9; ++e) M.data()[e] = c * jk.A.data()[e] + s * jk.B.data()[e] + u * jk.C.data()[e];
+        detail::multiply3(Rp, M, R);
       }
       data.p[ui] = pj;
       const double d0 = pj(0) - data.p[0](0), d1 = pj(1) - data.p[0](1), d2 = pj(2) - data.p[0](2);
@@ -102,7 +105,7 @@ inline void forward_kinematics(const Model& model, Data& data, const BasePose& b
       S[4] = k * z(1);
       S[5] = k * z(2);
     } else {
-      data.R[ui] = Rj;
+      data.R[ui] = *J;
       data.p[ui] = pj + z * q;
       S[0] = k * z(0);
       S[1] = k * z(1);

@@ -135,6 +135,42 @@ inline Inertia merged_inertia(const Inertia& a, const Inertia& b) {
 
 }  // namespace detail
 
+namespace detail {
+
+/// What forward_kinematics reads of a body's joint besides Body itself, fixed when the model is built
+/// (ModelBuilder::build): which of its shortcuts apply, and for a revolute joint about a general unit
+/// axis k the constant parts of tree.R rot(k, q) = c A + s B + (1 - c) C (Rodrigues' formula
+/// c 1 + s [k]x + (1 - c) k k^T multiplied by tree.R), so that the rotation of the body costs one
+/// 3x3 product on the chain of the tree, not two plus the formula.
+struct JointKinematics {
+  bool tree_identity = true;  ///< tree.R is exactly the identity (rpy 0 0 0, most URDF joints)
+  int axis = -1;              ///< 0, 1 or 2: the axis is exactly +-x, +-y or +-z; -1 otherwise
+  Matrix3 A = Matrix3::Identity(), B = Matrix3::Zero(), C = Matrix3::Zero();  ///< tree.R, tree.R [k]x, tree.R k k^T
+  Vector3 z = Vector3::UnitZ();  ///< tree.R k: the joint axis in the parent body's axes
+};
+
+/// 0, 1 or 2 when the unit vector `axis` is +-x, +-y or +-z exactly (as most URDF joint axes are), else -1.
+inline int coordinate_axis(const Vector3& axis) {
+  if (axis.y() == 0.0 && axis.z() == 0.0) return 0;
+  if (axis.x() == 0.0 && axis.z() == 0.0) return 1;
+  if (axis.x() == 0.0 && axis.y() == 0.0) return 2;
+  return -1;
+}
+
+inline JointKinematics joint_kinematics(const Body& b) {
+  JointKinematics k;
+  const Vector3& ax = b.joint.axis;
+  k.tree_identity = b.tree.R == Matrix3::Identity();
+  k.axis = coordinate_axis(ax);
+  k.A = b.tree.R;
+  k.B = b.tree.R * skew(ax);
+  k.z = b.tree.R * ax;
+  k.C = k.z * ax.transpose();
+  return k;
+}
+
+}  // namespace detail
+
 class ModelBuilder;
 
 /// A free-floating multibody tree. Constant after it is built (see ModelBuilder).
@@ -154,6 +190,8 @@ class Model {
   const Body& body(int i) const { return bodies_[static_cast<size_t>(i)]; }
   const std::vector<Frame>& frames() const { return frames_; }
   const Frame& frame(int i) const { return frames_[static_cast<size_t>(i)]; }
+  /// The constants of body i's joint that forward_kinematics reads (derived from body(i) by build()).
+  const detail::JointKinematics& joint_kinematics(int i) const { return kin_[static_cast<size_t>(i)]; }
   /// The index of a named frame; throws InputError listing the frames when the name is unknown.
   int frame_index(const std::string& name) const {
     for (size_t i = 0; i < frames_.size(); ++i)
@@ -185,6 +223,7 @@ class Model {
   std::vector<Body> bodies_;
   std::vector<Frame> frames_;
   std::vector<int> coord_body_;
+  std::vector<detail::JointKinematics> kin_;  ///< one per body, from the bodies (build())
   int end_effector_ = -1;
 };
 
@@ -306,6 +345,8 @@ class ModelBuilder {
       m.frames_.push_back({name, ee.body, ee.pose * Pose{ee_offset_, Matrix3::Identity()}});
       m.end_effector_ = static_cast<int>(m.frames_.size()) - 1;
     }
+    m.kin_.clear();
+    for (const Body& b : m.bodies_) m.kin_.push_back(detail::joint_kinematics(b));
     return m;
   }
 
