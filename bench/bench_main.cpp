@@ -7,9 +7,9 @@
 // batches of the mean time per call (std::chrono::steady_clock; a batch lasts about 5 ms), and the
 // heap allocations per call after set-up, of: forward_kinematics, crba, J_f (frame_jacobian +
 // generalized_jacobian), crba + J_f, M_ie (integrated_effective_mass: H, J, the solve), its
-// analytic gradient, and rnea; one point of `ffsr-optimize map` (M_ie, F_max and its CSV row) in
-// points per second. Then the contact benchmarks (bench_contact.hpp), one multibody
-// CVODE contact run per robot, and the paper's capture scenarios (plan_capture, plain and
+// analytic gradient, rnea, and momentum + kinetic_energy; one point of `ffsr-optimize map` (M_ie,
+// F_max and its CSV row) in points per second. Then the contact benchmarks (bench_contact.hpp), one
+// multibody CVODE contact run per robot, and the paper's capture scenarios (plan_capture, plain and
 // optimized). The time targets are printed beside the figures.
 //
 // Allocations are counted by replacing the global operator new/delete and, on glibc, by
@@ -405,6 +405,13 @@ void bench_hot_paths(const Settings& s, const Robot& r, AllocCheck& check) {
   });
   print_row(r.name, "rnea (tau = H a + C)", id, "");
   check.require_zero(r.name, "rnea", id);
+
+  const Timing mom = measure(s, [&](long i) {
+    const Data& d = datas[pick(i)];
+    return momentum(model, d, vs[pick(i)])(3) + kinetic_energy(model, d, vs[pick(i)]);
+  });
+  print_row(r.name, "momentum + kinetic_energy (body by body)", mom, "0 allocs");
+  check.require_zero(r.name, "momentum + kinetic_energy", mom);
 }
 
 /// One point of `ffsr-optimize map` (src/cli/map.cpp): crba, the inverse effective mass, M_ie

@@ -482,9 +482,10 @@ TEST_CASE("forward kinematics: each body's pose is its parent's times tree times
         const Pose joint = b.joint.type == JointType::Revolute
                                ? Pose{Vector3::Zero(), rotation_about(b.joint.axis, qi)}
                                : Pose{b.joint.axis * qi, Matrix3::Identity()};
-        X[static_cast<size_t>(i)] = X[static_cast<size_t>(b.parent)] * b.tree * joint;
-        worst = std::max({worst, (d.R[static_cast<size_t>(i)] - X[static_cast<size_t>(i)].R).cwiseAbs().maxCoeff(),
-                          (d.p[static_cast<size_t>(i)] - X[static_cast<size_t>(i)].p).cwiseAbs().maxCoeff()});
+        const auto ui = static_cast<size_t>(i);
+        X[ui] = X[static_cast<size_t>(b.parent)] * b.tree * joint;
+        worst = std::max(
+            {worst, (d.R[ui] - X[ui].R).cwiseAbs().maxCoeff(), (d.p[ui] - X[ui].p).cwiseAbs().maxCoeff()});
       }
       INFO(name << " config " << k << ": largest difference " << worst);
       CHECK(worst < 1e-13);

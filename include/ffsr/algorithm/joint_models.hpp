@@ -180,6 +180,37 @@ inline double integrated_effective_mass(const Model& model, Data& data, const Ba
   return 1.0 / (inv_me + target.inverse_mass_along_normal());
 }
 
+/// integrated_effective_mass_gradient (below) at the configuration of the last crba (data.H and the
+/// kinematics as crba left them), for a caller that has just run it at (base, theta): the same
+/// numbers, without a second crba.
+/// Writes data.L, data.w, data.y, data.V, data.F and grad (size n). Returns M_ie.
+inline double integrated_effective_mass_gradient_at(const Model& model, Data& data, int frame, const Vector3& u,
+                                                    double target_inverse_mass, const ContactJoints& joints,
+                                                    Eigen::Ref<Eigen::VectorXd> grad) {
+  detail::require_size(grad.size(), model.n(), "integrated_effective_mass_gradient", "grad");
+  detail::check_unit_direction(u, "effective_mass");
+  detail::check_frame(model, frame, "effective_mass");
+  double inv_me;
+  if (joints.model == JointModel::Free) {
+    Vector6 s;
+    s << u, Vector3::Zero();
+    inv_me = inverse_inertia_form_gradient(model, data, frame, s, grad);
+  } else if (joints.model == JointModel::Locked) {
+    Vector6 yb;
+    inv_me = detail::locked_inverse_form(model, data, frame, u, yb);
+    detail::locked_inverse_form_gradient(model, data, frame, u, yb, grad);
+  } else {
+    detail::require_size(joints.armature.size(), model.n(), "effective_mass", "armature");
+    detail::factor_with_armature(data, joints.armature, "effective_mass");
+    Vector6 s;
+    s << u, Vector3::Zero();
+    inv_me = detail::inverse_inertia_form_gradient_factored(model, data, frame, s, grad);
+  }
+  const double M = 1.0 / (inv_me + target_inverse_mass);
+  grad *= -M * M;
+  return M;
+}
+
 /// Analytic gradient of the integrated effective mass in the joint angles under the joint model, at
 /// a fixed base pose (see integrated_effective_mass_gradient of effective_mass.hpp; Free calls it).
 /// Armature: the same gradient formula with H + diag(0, a) factorized (the armature is constant, so
@@ -196,21 +227,7 @@ inline double integrated_effective_mass_gradient(const Model& model, Data& data,
   detail::check_unit_direction(u, "effective_mass");
   detail::check_frame(model, frame, "effective_mass");
   crba(model, data, base, theta);
-  double inv_me;
-  if (joints.model == JointModel::Locked) {
-    Vector6 yb;
-    inv_me = detail::locked_inverse_form(model, data, frame, u, yb);
-    detail::locked_inverse_form_gradient(model, data, frame, u, yb, grad);
-  } else {
-    detail::require_size(joints.armature.size(), model.n(), "effective_mass", "armature");
-    detail::factor_with_armature(data, joints.armature, "effective_mass");
-    Vector6 s;
-    s << u, Vector3::Zero();
-    inv_me = detail::inverse_inertia_form_gradient_factored(model, data, frame, s, grad);
-  }
-  const double M = 1.0 / (inv_me + target_inverse_mass);
-  grad *= -M * M;
-  return M;
+  return integrated_effective_mass_gradient_at(model, data, frame, u, target_inverse_mass, joints, grad);
 }
 
 /// The robot's 6x6 inverse inertia Lambda^-1 at the origin of `frame` under the joint model, at the

@@ -93,7 +93,8 @@ inline void forward_kinematics(const Model& model, Data& data, const BasePose& b
       } else {  // R = Rp (c A + s B + (1 - c) C): Rodrigues' formula with tree.R folded in
         const double u = 1.0 - c;
         Matrix3 M;
-        for (int e = 0; e < 9; ++e) M.data()[e] = c * jk.A.data()[e] + s * jk.B.data()[e] + u * jk.C.data()[e];
+        const double *A = jk.A.data(), *B = jk.B.data(), *C = jk.C.data();
+        for (int e = 0; e < 9; ++e) M.data()[e] = c * A[e] + s * B[e] + u * C[e];
         detail::multiply3(Rp, M, R);
       }
       data.p[ui] = pj;

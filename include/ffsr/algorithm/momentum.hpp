@@ -3,18 +3,29 @@
 
 #include "ffsr/algorithm/crba.hpp"
 
+#include <array>
+#include <vector>
+
 namespace ffsr {
 
 /// Velocity of every body (angular velocity and the velocity of its centre of mass, inertial
 /// frame) by a forward pass over the tree. Reads the kinematics (forward_kinematics) and v.
-/// Calls `visit(i, w_i, vc_i, c_i)` for each body, c_i the centre of mass in o.
+/// Calls `visit(i, w_i, vc_i, c_i)` for each body, c_i the centre of mass in o. Does not allocate for
+/// trees of up to 64 bodies (the velocities are kept on the stack; a larger tree takes one vector).
 template <class Visit>
 void for_each_body_velocity(const Model& model, const Data& data, const Eigen::Ref<const Eigen::VectorXd>& v,
                             Visit&& visit) {
   detail::require_size(v.size(), model.nv(), "body velocities", "v");
   const int nb = model.nb();
   // w_i and the velocity of the body point at the base origin, u_i (a spatial velocity about p0)
-  std::vector<Vector6> Vs(static_cast<size_t>(nb));  // small, off the hot path
+  constexpr int kOnStack = 64;
+  std::array<Vector6, kOnStack> on_stack;
+  std::vector<Vector6> on_heap;
+  Vector6* Vs = on_stack.data();
+  if (nb > kOnStack) {
+    on_heap.resize(static_cast<size_t>(nb));
+    Vs = on_heap.data();
+  }
   Vs[0] = v.head<6>();
   for (int i = 1; i < nb; ++i)
     Vs[static_cast<size_t>(i)] =

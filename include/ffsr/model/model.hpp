@@ -145,7 +145,8 @@ namespace detail {
 struct JointKinematics {
   bool tree_identity = true;  ///< tree.R is exactly the identity (rpy 0 0 0, most URDF joints)
   int axis = -1;              ///< 0, 1 or 2: the axis is exactly +-x, +-y or +-z; -1 otherwise
-  Matrix3 A = Matrix3::Identity(), B = Matrix3::Zero(), C = Matrix3::Zero();  ///< tree.R, tree.R [k]x, tree.R k k^T
+  /// tree.R, tree.R [k]x and tree.R k k^T
+  Matrix3 A = Matrix3::Identity(), B = Matrix3::Zero(), C = Matrix3::Zero();
   Vector3 z = Vector3::UnitZ();  ///< tree.R k: the joint axis in the parent body's axes
 };
 

@@ -220,7 +220,7 @@ struct CaptureRateField {
                                                  : solver.solve(data.Jf, cmd, projector);
     min_singular_value = std::min(min_singular_value, r.sigma_min);
     if (r.damped && damped_steps++ == 0) first_damped_time = t;
-    if (policy.active()) {
+    if (policy.active()) {  // data still holds crba at (base, theta): the policy reads it
       policy(model, data, pb, setup, t, base, theta, solver.projector(), qd_null);
       solver.add_null_space(qd_null, opt.max_joint_rate);
     }

@@ -55,8 +55,9 @@ inline void configuration_error(const Model& model, const Eigen::VectorXd& theta
 /// The paper's policy (Eq. 30-31): rho N phi, phi the analytic gradient of the objective (M_ie of
 /// Eq. 14, or the exact maximum force, a monotone function of it: dF/dtheta = f_scale
 /// M_ie^(-1/(alpha+1)) dM_ie/dtheta) at the current base pose, plus the joint-limit repulsion
-/// (detail::add_joint_limit_repulsion), M_ie under the problem's joint model (pb.joints). Runs
-/// CaptureEvaluator::mass_gradient (crba at (base, theta)). Writes data.H, data.L, data.w, data.y, data.V, data.F, grad and qd_null.
+/// (detail::add_joint_limit_repulsion), M_ie under the problem's joint model (pb.joints). Reads data
+/// at (base, theta) as crba left it (the rate field runs crba there first):
+/// CaptureEvaluator::mass_gradient_at. Writes data.L, data.w, data.y, data.V, data.F, grad and qd_null.
 struct GradientPolicy {
   double gain = 0.0;  ///< rho
   CaptureObjective objective = CaptureObjective::IntegratedEffectiveMass;
@@ -64,10 +65,10 @@ struct GradientPolicy {
   Eigen::VectorXd grad;               ///< phi of the last call (workspace)
   bool active() const { return gain != 0.0; }
   void operator()(const Model& model, Data& data, const CaptureProblem& pb, const CaptureSetup& s,
-                  double /*t*/, const BasePose& base, const Eigen::VectorXd& theta,
+                  double /*t*/, const BasePose& /*base: data is at it*/, const Eigen::VectorXd& theta,
                   const Eigen::MatrixXd& Nproj, Eigen::VectorXd& qd_null) {
     grad.resize(model.n());
-    const double M = CaptureEvaluator(pb, s).mass_gradient(data, base, theta, grad);
+    const double M = CaptureEvaluator(pb, s).mass_gradient_at(data, grad);
     if (objective == CaptureObjective::ExactMaxForce)
       grad *= f_scale * std::pow(M, -1.0 / (alpha + 1));  // dF/dM dM/dtheta
     detail::add_joint_limit_repulsion(model, theta, grad);

@@ -141,6 +141,12 @@ class CaptureEvaluator {
     return integrated_effective_mass_gradient(*model_, data, base, theta, frame_, u_, b_, *joints_, grad);
   }
 
+  /// The same at the configuration of the last crba (integrated_effective_mass_gradient_at): for a
+  /// caller that has just run crba at (base, theta). Writes data.L, data.w, data.y, data.V, data.F, grad.
+  double mass_gradient_at(Data& data, Eigen::Ref<Eigen::VectorXd> grad) const {
+    return integrated_effective_mass_gradient_at(*model_, data, frame_, u_, b_, *joints_, grad);
+  }
+
   /// The closed-form (Eq. 24) and exact (Eq. 16) single-body peaks at a given M_ie, N.
   double f_max_closed_form(double M_ie) const { return max_force_closed_form(law(), M_ie); }
   double f_max_exact(double M_ie) const { return max_force_exact(law(), M_ie); }
