@@ -75,7 +75,7 @@ inline const Eigen::MatrixXd& crba(const Model& model, Data& data, const BasePos
 
   Eigen::MatrixXd& H = data.H;
   const int n = model.n();
-  H.topLeftCorner<6, 6>() = data.Ic[0].matrix();
+  data.Ic[0].store(H.topLeftCorner<6, 6>());
   if (detail::contiguous_subtrees(model, data)) {
     H.bottomLeftCorner(n, 6) = data.Fc.topRows(n);  // the joint rows of the base columns: F_i^T
     for (int j = 1; j < nb; ++j) {
