@@ -133,10 +133,6 @@ inline Inertia merged_inertia(const Inertia& a, const Inertia& b) {
   return {m, c, about_c(a) + about_c(b)};
 }
 
-}  // namespace detail
-
-namespace detail {
-
 /// What forward_kinematics reads of a body's joint besides Body itself, fixed when the model is built
 /// (ModelBuilder::build): which of its shortcuts apply, and for a revolute joint about a general unit
 /// axis k the constant parts of tree.R rot(k, q) = c A + s B + (1 - c) C (Rodrigues' formula
@@ -158,6 +154,7 @@ inline int coordinate_axis(const Vector3& axis) {
   return -1;
 }
 
+/// The JointKinematics of body b (for the base, body 0, unused).
 inline JointKinematics joint_kinematics(const Body& b) {
   JointKinematics k;
   const Vector3& ax = b.joint.axis;
