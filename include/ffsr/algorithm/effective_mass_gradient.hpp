@@ -120,6 +120,22 @@ inline double inverse_inertia_form_gradient_factored(const Model& model, Data& d
 }
 }  // namespace detail
 
+/// integrated_effective_mass_gradient (below) at the configuration of the last crba (data.H and the
+/// kinematics as crba left them), for a caller that has just run it: the same numbers without a
+/// second crba. Writes data.L, data.w, data.y, data.V, data.F and `grad` (size n). Returns M_ie.
+inline double integrated_effective_mass_gradient_at(const Model& model, Data& data, int frame, const Vector3& u,
+                                                    double target_inverse_mass,
+                                                    Eigen::Ref<Eigen::VectorXd> grad) {
+  detail::require_size(grad.size(), model.n(), "integrated_effective_mass_gradient", "grad");
+  detail::check_unit_direction(u, "effective_mass");
+  Vector6 s;
+  s << u, Vector3::Zero();
+  const double inv_me = inverse_inertia_form_gradient(model, data, frame, s, grad);
+  const double M = 1.0 / (inv_me + target_inverse_mass);
+  grad *= -M * M;
+  return M;
+}
+
 /// Analytic gradient of the integrated effective mass with respect to the joint angles, at a fixed
 /// base pose and for a fixed inertial contact direction u and target inverse mass along the normal
 /// (Target::inverse_mass_along_normal): with 1/m_e = q(u) of inverse_inertia_form_gradient for
@@ -132,12 +148,7 @@ inline double integrated_effective_mass_gradient(const Model& model, Data& data,
   detail::require_size(grad.size(), model.n(), "integrated_effective_mass_gradient", "grad");
   detail::check_unit_direction(u, "effective_mass");
   crba(model, data, base, theta);
-  Vector6 s;
-  s << u, Vector3::Zero();
-  const double inv_me = inverse_inertia_form_gradient(model, data, frame, s, grad);
-  const double M = 1.0 / (inv_me + target_inverse_mass);
-  grad *= -M * M;
-  return M;
+  return integrated_effective_mass_gradient_at(model, data, frame, u, target_inverse_mass, grad);
 }
 
 }  // namespace ffsr

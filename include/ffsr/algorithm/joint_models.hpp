@@ -187,15 +187,13 @@ inline double integrated_effective_mass(const Model& model, Data& data, const Ba
 inline double integrated_effective_mass_gradient_at(const Model& model, Data& data, int frame, const Vector3& u,
                                                     double target_inverse_mass, const ContactJoints& joints,
                                                     Eigen::Ref<Eigen::VectorXd> grad) {
+  if (joints.model == JointModel::Free)
+    return integrated_effective_mass_gradient_at(model, data, frame, u, target_inverse_mass, grad);
   detail::require_size(grad.size(), model.n(), "integrated_effective_mass_gradient", "grad");
   detail::check_unit_direction(u, "effective_mass");
   detail::check_frame(model, frame, "effective_mass");
   double inv_me;
-  if (joints.model == JointModel::Free) {
-    Vector6 s;
-    s << u, Vector3::Zero();
-    inv_me = inverse_inertia_form_gradient(model, data, frame, s, grad);
-  } else if (joints.model == JointModel::Locked) {
+  if (joints.model == JointModel::Locked) {
     Vector6 yb;
     inv_me = detail::locked_inverse_form(model, data, frame, u, yb);
     detail::locked_inverse_form_gradient(model, data, frame, u, yb, grad);

@@ -90,10 +90,10 @@ inline void forward_kinematics(const Model& model, Data& data, const BasePose& b
           R(r, c1) = c * q1 + s * q2;
           R(r, c2) = c * q2 - s * q1;
         }
-      } else {  // R = Rp (c A + s B + (1 - c) C): Rodrigues' formula with tree.R folded in
+      } else {  // R = Rp (c tree.R + s B + (1 - c) C): Rodrigues' formula with tree.R folded in
         const double u = 1.0 - c;
         Matrix3 M;
-        const double *A = jk.A.data(), *B = jk.B.data(), *C = jk.C.data();
+        const double *A = b.tree.R.data(), *B = jk.B.data(), *C = jk.C.data();
         for (int e = 0; e < 9; ++e) M.data()[e] = c * A[e] + s * B[e] + u * C[e];
         detail::multiply3(Rp, M, R);
       }

@@ -135,14 +135,13 @@ inline Inertia merged_inertia(const Inertia& a, const Inertia& b) {
 
 /// What forward_kinematics reads of a body's joint besides Body itself, fixed when the model is built
 /// (ModelBuilder::build): which of its shortcuts apply, and for a revolute joint about a general unit
-/// axis k the constant parts of tree.R rot(k, q) = c A + s B + (1 - c) C (Rodrigues' formula
+/// axis k the constant parts of tree.R rot(k, q) = c tree.R + s B + (1 - c) C (Rodrigues' formula
 /// c 1 + s [k]x + (1 - c) k k^T multiplied by tree.R), so that the rotation of the body costs one
 /// 3x3 product on the chain of the tree, not two plus the formula.
 struct JointKinematics {
   bool tree_identity = true;  ///< tree.R is exactly the identity (rpy 0 0 0, most URDF joints)
   int axis = -1;              ///< 0, 1 or 2: the axis is exactly +-x, +-y or +-z; -1 otherwise
-  /// tree.R, tree.R [k]x and tree.R k k^T
-  Matrix3 A = Matrix3::Identity(), B = Matrix3::Zero(), C = Matrix3::Zero();
+  Matrix3 B = Matrix3::Zero(), C = Matrix3::Zero();  ///< tree.R [k]x and tree.R k k^T
   Vector3 z = Vector3::UnitZ();  ///< tree.R k: the joint axis in the parent body's axes
 };
 
@@ -160,7 +159,6 @@ inline JointKinematics joint_kinematics(const Body& b) {
   const Vector3& ax = b.joint.axis;
   k.tree_identity = b.tree.R == Matrix3::Identity();
   k.axis = coordinate_axis(ax);
-  k.A = b.tree.R;
   k.B = b.tree.R * skew(ax);
   k.z = b.tree.R * ax;
   k.C = k.z * ax.transpose();
