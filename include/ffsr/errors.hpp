@@ -65,12 +65,20 @@ inline void require_finite(double value, const char* where, const char* what) {
   if (!std::isfinite(value)) throw InputError(str(where, ": ", what, " must be finite, got ", value));
 }
 
-/// Throws InputError unless every coefficient of an Eigen expression is finite.
+/// The error of require_finite_all, out of line: names the first entry of x[0..size) that is not finite.
+[[noreturn]] inline void throw_not_finite(const double* x, Eigen::Index size, const char* where, const char* what) {
+  Eigen::Index i = 0;
+  while (i + 1 < size && std::isfinite(x[i])) ++i;
+  throw InputError(str(where, ": ", what, " must be finite, entry ", i, " is ", x[i]));
+}
+
+/// Throws InputError unless every coefficient of an Eigen expression is finite (the test inline and
+/// without a branch per entry; the error is built out of line).
 template <class Derived>
 void require_finite_all(const Derived& m, const char* where, const char* what) {
-  for (Eigen::Index i = 0; i < m.size(); ++i)
-    if (!std::isfinite(m.data()[i]))
-      throw InputError(str(where, ": ", what, " must be finite, entry ", i, " is ", m.data()[i]));
+  bool finite = true;
+  for (Eigen::Index i = 0; i < m.size(); ++i) finite &= std::isfinite(m.data()[i]);
+  if (!finite) throw_not_finite(m.data(), m.size(), where, what);
 }
 
 /// Throws InputError("<where>: <what> has <got> entries, expected <expected>").

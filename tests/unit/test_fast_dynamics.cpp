@@ -23,6 +23,7 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -272,6 +273,72 @@ TEST_CASE("aba: the O(n) forward dynamics equals crba + RNEA + Cholesky and inve
   VectorXd a;
   aba(c, dc, qc.base, qc.theta, VectorXd::Zero(c.nv()), VectorXd::Zero(c.nv()), a);
   CHECK(a.cwiseAbs().maxCoeff() == 0.0);
+}
+
+TEST_CASE("the model's subtree numbering equals the ancestry of every body", "[dynamics][fast]") {
+  std::vector<Named> models = models_under_test();
+  models.push_back({"mimic chain", mimic_chain(3)});
+  for (const Named& nm : models) {
+    const Model& m = nm.model;
+    INFO(nm.name);
+    // the reference: the subtree of i is every body that i supports (walking each body's parents)
+    bool contiguous = m.nb() - 1 == m.n();
+    for (int i = 0; i < m.nb(); ++i) {
+      int last = i;
+      for (int j = i; j < m.nb(); ++j)
+        if (supports(m, i, j)) last = j;
+      CHECK(m.subtree_last(i) == last);
+      for (int j = i; j <= last; ++j) contiguous = contiguous && supports(m, i, j);
+    }
+    CHECK(m.depth_first() == contiguous);
+  }
+  // the URDF loader and the builder's chains number depth-first; an interleaved tree and a mimic do not
+  CHECK(models[0].model.depth_first());
+  CHECK(models[2].model.depth_first());
+  CHECK(models[models.size() - 3].model.depth_first());
+  CHECK_FALSE(models[models.size() - 2].model.depth_first());
+  CHECK_FALSE(models.back().model.depth_first());
+}
+
+/// A chain of three joints whose second joint origin is `length` metres from the first.
+Model long_chain(double length) {
+  ModelBuilder b("base", Inertia{100, Vector3::Zero(), Matrix3::Identity()});
+  const Inertia link{2, Vector3(0.1, 0, 0), 0.1 * Matrix3::Identity()};
+  b.add_joint("j1", JointType::Revolute, "base", Pose{}, Vector3::UnitZ(), "l1", link);
+  b.add_joint("j2", JointType::Revolute, "l1", Pose{Vector3(length, 0, 0)}, Vector3::UnitY(), "l2", link);
+  b.add_joint("j3", JointType::Revolute, "l2", Pose{Vector3(0, 0.5, 0)}, Vector3(1, 1, 0), "l3", link);
+  return b.build();
+}
+
+TEST_CASE("crba: a finite H of huge lengths is returned, an H that overflows is refused", "[dynamics][fast]") {
+  const Eigen::VectorXd theta = Eigen::Vector3d(0.3, -0.4, 0.5);
+  BasePose base;
+  base.orientation = Quaternion(Eigen::AngleAxisd(0.2, Vector3(1, 2, 3).normalized()));
+  // 1e100 m: H's entries reach 1e200 (m l^2), finite
+  {
+    const Model m = long_chain(1e100);
+    Data d(m);
+    REQUIRE_NOTHROW(crba(m, d, base, theta));
+    CHECK(d.H.allFinite());
+    CHECK(d.H.cwiseAbs().maxCoeff() > 1e199);
+  }
+  // 1e120 m: F_i stays finite (1e240) but S_j . F_i does not (1e360); 1e200 m: F_i overflows already
+  for (double length : {1e120, 1e200}) {
+    INFO(length);
+    const Model m = long_chain(length);
+    Data d(m);
+    CHECK_THROWS_AS(crba(m, d, base, theta), NumericalError);
+    CHECK_THROWS_WITH(crba(m, d, base, theta), Catch::Contains("inertia matrix H is not finite"));
+  }
+  // a configuration that is not finite names its first bad entry
+  const Model m = long_chain(1.0);
+  Data d(m);
+  Eigen::VectorXd bad = theta;
+  bad(1) = std::numeric_limits<double>::infinity();
+  CHECK_THROWS_WITH(crba(m, d, base, bad), Catch::Contains("theta must be finite, entry 1 is inf"));
+  bad(1) = 0.0;
+  bad(2) = std::nan("");
+  CHECK_THROWS_WITH(crba(m, d, base, bad), Catch::Contains("theta must be finite, entry 2 is nan"));
 }
 
 TEST_CASE("aba refuses mimic joints and bad sizes, naming them", "[dynamics][fast]") {

@@ -22,27 +22,6 @@ inline void body_inertias(const Model& model, Data& data) {
   }
 }
 
-/// The numbering of the tree: data.last[i] (the largest body index in the subtree of i) and
-/// data.nsub[i] (its number of bodies), by one backward pass (a parent comes before its children).
-/// Returns true when every subtree is the contiguous range [i, last[i]] (depth-first numbering, as
-/// the URDF loader makes) and no joint is a mimic (body i drives coordinate i - 1).
-inline bool contiguous_subtrees(const Model& model, Data& data) {
-  const int nb = model.nb();
-  for (int i = 0; i < nb; ++i) {
-    data.last[static_cast<size_t>(i)] = i;
-    data.nsub[static_cast<size_t>(i)] = 1;
-  }
-  for (int i = nb - 1; i > 0; --i) {
-    const auto ui = static_cast<size_t>(i), up = static_cast<size_t>(model.body(i).parent);
-    data.last[up] = std::max(data.last[up], data.last[ui]);
-    data.nsub[up] += data.nsub[ui];
-  }
-  if (nb - 1 != model.n()) return false;
-  for (int i = 0; i < nb; ++i)
-    if (data.nsub[static_cast<size_t>(i)] != data.last[static_cast<size_t>(i)] - i + 1) return false;
-  return true;
-}
-
 }  // namespace detail
 
 /// Joint-space inertia matrix H (Eq. 1) of the free-floating system by the composite rigid body
@@ -50,64 +29,69 @@ inline bool contiguous_subtrees(const Model& model, Data& data) {
 /// so that the base motion subspace is the identity and composite inertias add without transforms.
 ///
 /// The composite inertias are 10-parameter objects (SpatialInertia: m, h, Ibar), summed from the
-/// leaves; F_i = Ic_i S_i is one row of data.Fc, and H's entry between joint j and a joint i of its
-/// subtree is S_j . F_i. With the depth-first numbering of a URDF model (every subtree a contiguous
-/// range of bodies) and no mimic joint, column j of H below the diagonal is one matrix-vector product,
-/// the contiguous rows F_i^T of its subtree times S_j, then zeros, each entry stored into row j too
-/// (Pinocchio's CRBA in the world convention fills one triangle the same way). Other trees walk
+/// leaves; F_i = Ic_i S_i is the base rows of H's column of joint i, and H's entry between joint j and
+/// a joint i of its subtree is S_j . F_i. With the depth-first numbering of a URDF model
+/// (Model::depth_first: every subtree a contiguous range of bodies, no mimic joint), column j of H
+/// below the diagonal is one matrix-vector product, the contiguous columns F_i of its subtree (in
+/// data.Fc) times S_j, then zeros, each entry stored into row j too (Pinocchio's CRBA in the world
+/// convention fills one triangle the same way). Other trees walk
 /// the ancestors of each body. Cost: O(n) spatial operations and n d / 2 six-term dot products (d the
 /// depth); no allocation.
 ///
-/// Reads base, theta. Writes the kinematics (forward_kinematics), data.Ic (composite), data.Fc,
-/// data.last, data.nsub and data.H, the full symmetric (6+n)x(6+n) matrix in the coordinates of
-/// model.hpp (a coordinate that drives several joints through mimics sums their entries:
+/// Reads base, theta. Writes the kinematics (forward_kinematics), data.Ic (composite), data.Fc and
+/// data.H, the full symmetric (6+n)x(6+n) matrix in the coordinates of model.hpp (a coordinate that drives several joints through mimics sums their entries:
 /// H = T^T H_full T). Returns data.H. Throws NumericalError when H overflows (not finite).
 inline const Eigen::MatrixXd& crba(const Model& model, Data& data, const BasePose& base,
                                    const Eigen::Ref<const Eigen::VectorXd>& theta) {
   forward_kinematics(model, data, base, theta);
   detail::body_inertias(model, data);
   const int nb = model.nb();
-  for (int i = nb - 1; i > 0; --i) {  // the children of i come after it: Ic_i is complete here
-    const SpatialInertia& Ic = data.Ic[static_cast<size_t>(i)];
-    data.Fc.row(i - 1) = (Ic * Vector6(data.S.col(i - 1))).transpose();
-    data.Ic[static_cast<size_t>(model.body(i).parent)] += Ic;
-  }
+  for (int i = nb - 1; i > 0; --i)  // the children of i come after it: Ic_i is complete here
+    data.Ic[static_cast<size_t>(model.body(i).parent)] += data.Ic[static_cast<size_t>(i)];
 
   Eigen::MatrixXd& H = data.H;
-  const int n = model.n();
+  const Eigen::Index ld = H.rows();
   data.Ic[0].store(H.topLeftCorner<6, 6>());
-  if (detail::contiguous_subtrees(model, data)) {
-    H.bottomLeftCorner(n, 6) = data.Fc.topRows(n);  // the joint rows of the base columns: F_i^T
+  if (model.depth_first()) {
+    // F_i = Ic_i S_i is the base rows of H's column of joint i and the base columns of its row
+    for (int i = 1; i < nb; ++i) {
+      const Vector6 F = data.Ic[static_cast<size_t>(i)] * Vector6(data.S.col(i - 1));
+      double* col = H.data() + (5 + i) * ld;
+      double* row = H.data() + (5 + i);
+      double* Fi = data.Fc.col(i - 1).data();
+      for (int k = 0; k < 6; ++k) {
+        Fi[k] = F(k);
+        col[k] = F(k);
+        row[k * ld] = F(k);
+      }
+    }
     for (int j = 1; j < nb; ++j) {
       const int cj = 5 + j;  // H's index of joint j (coordinate j - 1)
       const double* Sj = data.S.col(j - 1).data();
       const double s0 = Sj[0], s1 = Sj[1], s2 = Sj[2], s3 = Sj[3], s4 = Sj[4], s5 = Sj[5];
-      const int len = data.last[static_cast<size_t>(j)] - j + 1;  // the subtree of j: bodies j..last
-      // column cj from the diagonal down: S_j . F_i for the subtree (a matrix-vector product over
-      // its contiguous rows of Fc, independent iterations), then zeros for the other branches
-      double* __restrict out = H.col(cj).data() + cj;
-      const Eigen::Index ldf = data.Fc.rows();
-      const double* __restrict F0 = data.Fc.data() + (j - 1);
-      double* __restrict row = H.data() + cj + cj * H.rows();  // row cj from the diagonal on
-      const Eigen::Index ld = H.rows();
-      for (int i = 0; i < len; ++i) {
-        const double h = s0 * F0[i] + s1 * F0[i + ldf] + s2 * F0[i + 2 * ldf] + s3 * F0[i + 3 * ldf] +
-                         s4 * F0[i + 4 * ldf] + s5 * F0[i + 5 * ldf];
+      const int len = model.subtree_last(j) - j + 1;  // the subtree of j: bodies j..last
+      // column cj from the diagonal down: S_j . F_i for the subtree (its contiguous columns of Fc;
+      // independent iterations), then zeros for the other branches
+      double* __restrict out = H.data() + cj + cj * ld;
+      const double* __restrict F = data.Fc.col(j - 1).data();
+      for (int i = 0; i < len; ++i, F += 6) {
+        const double h = s0 * F[0] + s1 * F[1] + s2 * F[2] + s3 * F[3] + s4 * F[4] + s5 * F[5];
         out[i] = h;
-        row[i * ld] = h;
+        out[i * ld] = h;  // row cj from the diagonal on
       }
       for (int i = len; i < nb - j; ++i) {
         out[i] = 0.0;
-        row[i * ld] = 0.0;
+        out[i * ld] = 0.0;
       }
     }
-    H.topRightCorner(6, n) = data.Fc.topRows(n).transpose();  // the base rows: F_i
   } else {
+    const int n = model.n();
     H.bottomRightCorner(n, n).setZero();
     H.topRightCorner(6, n).setZero();
     H.bottomLeftCorner(n, 6).setZero();
     for (int i = 1; i < nb; ++i) {
-      const Vector6 F = data.Fc.row(i - 1).transpose();
+      const Vector6 F = data.Ic[static_cast<size_t>(i)] * Vector6(data.S.col(i - 1));
+      data.Fc.col(i - 1) = F;
       const int ci = 6 + model.body(i).coord;
       H(ci, ci) += data.S.col(i - 1).dot(F);
       for (int j = model.body(i).parent; j > 0; j = model.body(j).parent) {
@@ -121,10 +105,15 @@ inline const Eigen::MatrixXd& crba(const Model& model, Data& data, const BasePos
     }
   }
   // Finite but huge lengths, masses or prismatic positions (a joint origin of 1e186 m in a URDF,
-  // found by fuzz_urdf) overflow to inf/NaN here: an error, never a NaN answer downstream. The sum of
-  // the entries is not finite exactly when an entry is not, or when finite entries sum past 1.8e308
-  // (an overflow too); Eigen's vectorized sum costs a third of the entry-by-entry test.
-  if (!std::isfinite(H.sum()))
+  // found by fuzz_urdf) overflow to inf/NaN here: an error, never a NaN answer downstream. Each entry
+  // of H is an entry of Ic_0, a sum of entries of the F_i, or a sum of products S_j . F_i over distinct
+  // pairs (i, j), each pair at most twice, so |entry| <= 2 sum|S| sum|F|: H is finite when those sums
+  // and Ic_0's are finite and the bound is below the largest double (12 n + 13 numbers, not (6 + n)^2).
+  // A NaN or an infinity makes its sum NaN or infinite, and the comparisons false.
+  const SpatialInertia& I0 = data.Ic[0];
+  const double sum_I0 = std::abs(I0.m) + I0.h.cwiseAbs().sum() + I0.Ibar.cwiseAbs().sum();
+  const double sum_S = data.S.cwiseAbs().sum(), sum_F = data.Fc.cwiseAbs().sum();
+  if (!(sum_I0 <= 1e300 && sum_S <= 1e300 && sum_F <= 1e300 && sum_S * sum_F <= 5e307))
     throw NumericalError(
         detail::str("crba: the inertia matrix H is not finite: the model's lengths, masses or the "
                     "joint positions overflow double precision (",

@@ -7,14 +7,16 @@ namespace ffsr {
 namespace detail {
 
 /// Checks the configuration arguments of a public entry point (sizes, finiteness, quaternion).
-inline void check_configuration(const Model& model, const BasePose& base,
-                                const Eigen::Ref<const Eigen::VectorXd>& theta, const char* where) {
+/// Returns the norm of the base quaternion.
+inline double check_configuration(const Model& model, const BasePose& base,
+                                  const Eigen::Ref<const Eigen::VectorXd>& theta, const char* where) {
   require_size(theta.size(), model.n(), where, "theta");
   require_finite_all(theta, where, "theta");
   require_finite_all(base.position, where, "base position");
   require_finite_all(base.orientation.coeffs(), where, "base orientation");
   const double qn = base.orientation.norm();
   if (qn < 1e-9) throw InputError(str(where, ": base orientation quaternion has zero norm"));
+  return qn;
 }
 
 /// C = A B for 3x3 matrices, written out (27 products; Eigen's lazy product is a call at -O2).
@@ -35,12 +37,17 @@ inline void multiply3(const Matrix3& A, const Matrix3& B, Matrix3& C) {
 /// coordinate: mimic joints carry their multiplier). The base quaternion is normalized.
 inline void forward_kinematics(const Model& model, Data& data, const BasePose& base,
                                const Eigen::Ref<const Eigen::VectorXd>& theta) {
-  detail::check_configuration(model, base, theta, "forward_kinematics");
+  const double qn = detail::check_configuration(model, base, theta, "forward_kinematics");
   data.base.position = base.position;
-  data.base.orientation = base.orientation.normalized();
+  data.base.orientation.coeffs() = base.orientation.coeffs() / qn;  // normalized(), its norm reused
   data.R[0] = data.base.orientation.toRotationMatrix();
   data.p[0] = base.position;
   const int nb = model.nb();
+  for (int i = 1; i < nb; ++i) {
+    const Body& b = model.body(i);
+    if (b.joint.type == JointType::Revolute)
+      detail::sin_cos(b.joint_position(theta), data.sin_q[static_cast<size_t>(i)], data.cos_q[static_cast<size_t>(i)]);
+  }
   for (int i = 1; i < nb; ++i) {
     const Body& b = model.body(i);
     const detail::JointKinematics& jk = model.joint_kinematics(i);
@@ -78,8 +85,7 @@ inline void forward_kinematics(const Model& model, Data& data, const BasePose& b
     double* S = data.S.col(i - 1).data();
     if (revolute) {
       Matrix3& R = data.R[ui];
-      double s, c;
-      detail::sin_cos(q, s, c);
+      double s = data.sin_q[ui], c = data.cos_q[ui];
       if (a >= 0) {  // about +-x, +-y or +-z: a plane rotation of two columns (12 products)
         const Matrix3& Q = *J;
         s *= b.joint.axis(a);
@@ -90,21 +96,23 @@ inline void forward_kinematics(const Model& model, Data& data, const BasePose& b
           R(r, c1) = c * q1 + s * q2;
           R(r, c2) = c * q2 - s * q1;
         }
-      } else {  // R = Rp (c tree.R + s B + (1 - c) C): Rodrigues' formula with tree.R folded in
+      } else {  // R = Rp (tree.R + s B + (1 - c) D): Rodrigues' formula with tree.R folded in
         const double u = 1.0 - c;
         Matrix3 M;
-        const double *A = b.tree.R.data(), *B = jk.B.data(), *C = jk.C.data();
-        for (int e = 0; e < 9; ++e) M.data()[e] = c * A[e] + s * B[e] + u * C[e];
+        const double *A = b.tree.R.data(), *B = jk.B.data(), *D = jk.D.data();
+        for (int e = 0; e < 9; ++e) M.data()[e] = A[e] + (s * B[e] + u * D[e]);
         detail::multiply3(Rp, M, R);
       }
       data.p[ui] = pj;
       const double d0 = pj(0) - data.p[0](0), d1 = pj(1) - data.p[0](1), d2 = pj(2) - data.p[0](2);
-      S[0] = k * (d1 * z(2) - d2 * z(1));  // (p_j - p_0) x z
-      S[1] = k * (d2 * z(0) - d0 * z(2));
-      S[2] = k * (d0 * z(1) - d1 * z(0));
-      S[3] = k * z(0);
-      S[4] = k * z(1);
-      S[5] = k * z(2);
+      S[0] = d1 * z(2) - d2 * z(1);  // (p_j - p_0) x z
+      S[1] = d2 * z(0) - d0 * z(2);
+      S[2] = d0 * z(1) - d1 * z(0);
+      S[3] = z(0);
+      S[4] = z(1);
+      S[5] = z(2);
+      if (k != 1.0)  // a mimic joint's multiplier
+        for (int e = 0; e < 6; ++e) S[e] *= k;
     } else {
       data.R[ui] = *J;
       data.p[ui] = pj + z * q;

@@ -16,10 +16,10 @@ struct Data {
       : R(static_cast<size_t>(model.nb())),
         p(static_cast<size_t>(model.nb())),
         S(6, model.nb() - 1),
+        sin_q(static_cast<size_t>(model.nb())),
+        cos_q(static_cast<size_t>(model.nb())),
         Ic(static_cast<size_t>(model.nb())),
-        Fc(model.nb() - 1, 6),
-        last(static_cast<size_t>(model.nb())),
-        nsub(static_cast<size_t>(model.nb())),
+        Fc(6, model.nb() - 1),
         H(model.nv(), model.nv()),
         L(model.nv(), model.nv()),
         J(6, model.nv()),
@@ -53,12 +53,10 @@ struct Data {
   /// Joint motion subspace columns in the inertial orientation, about the base frame origin:
   /// [ (p_k - p_0) x z_k ; z_k ] (revolute) or [ z_k ; 0 ] (prismatic).
   Eigen::Matrix<double, 6, Eigen::Dynamic> S;
+  std::vector<double> sin_q, cos_q;  ///< sin and cos of each revolute body's joint position
   // --- CRBA --------------------------------------------------------------------------------------
   std::vector<SpatialInertia> Ic;  ///< composite inertias about the base origin, inertial axes
-  Eigen::Matrix<double, Eigen::Dynamic, 6> Fc;  ///< (Ic_i S_i)^T, one row per moving body
-  /// The tree's numbering, written by crba: last[i] is the largest body index in the subtree of i,
-  /// nsub[i] the number of bodies in it (depth-first numbering: the subtree is [i, last[i]]).
-  std::vector<int> last, nsub;
+  Eigen::Matrix<double, 6, Eigen::Dynamic> Fc;  ///< Ic_i S_i, one column per moving body
   Eigen::MatrixXd H;               ///< (6+n)x(6+n) joint-space inertia
   Eigen::MatrixXd L;               ///< Cholesky factor of H (lower), written by the solves
   // --- Jacobians -------------------------------------------------------------------------------

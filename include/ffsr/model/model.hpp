@@ -135,13 +135,13 @@ inline Inertia merged_inertia(const Inertia& a, const Inertia& b) {
 
 /// What forward_kinematics reads of a body's joint besides Body itself, fixed when the model is built
 /// (ModelBuilder::build): which of its shortcuts apply, and for a revolute joint about a general unit
-/// axis k the constant parts of tree.R rot(k, q) = c tree.R + s B + (1 - c) C (Rodrigues' formula
-/// c 1 + s [k]x + (1 - c) k k^T multiplied by tree.R), so that the rotation of the body costs one
+/// axis k the constant parts of tree.R rot(k, q) = tree.R + s B + (1 - c) D (Rodrigues' formula
+/// 1 + s [k]x + (1 - c) [k]x^2 multiplied by tree.R; [k]x^2 = k k^T - 1 for a unit k), so that the rotation of the body costs one
 /// 3x3 product on the chain of the tree, not two plus the formula.
 struct JointKinematics {
   bool tree_identity = true;  ///< tree.R is exactly the identity (rpy 0 0 0, most URDF joints)
   int axis = -1;              ///< 0, 1 or 2: the axis is exactly +-x, +-y or +-z; -1 otherwise
-  Matrix3 B = Matrix3::Zero(), C = Matrix3::Zero();  ///< tree.R [k]x and tree.R k k^T
+  Matrix3 B = Matrix3::Zero(), D = Matrix3::Zero();  ///< tree.R [k]x and tree.R (k k^T - 1)
   Vector3 z = Vector3::UnitZ();  ///< tree.R k: the joint axis in the parent body's axes
 };
 
@@ -161,7 +161,7 @@ inline JointKinematics joint_kinematics(const Body& b) {
   k.axis = coordinate_axis(ax);
   k.B = b.tree.R * skew(ax);
   k.z = b.tree.R * ax;
-  k.C = k.z * ax.transpose();
+  k.D = k.z * ax.transpose() - b.tree.R;
   return k;
 }
 
@@ -188,6 +188,12 @@ class Model {
   const Frame& frame(int i) const { return frames_[static_cast<size_t>(i)]; }
   /// The constants of body i's joint that forward_kinematics reads (derived from body(i) by build()).
   const detail::JointKinematics& joint_kinematics(int i) const { return kin_[static_cast<size_t>(i)]; }
+  /// The largest body index in the subtree of body i (i itself for a leaf).
+  int subtree_last(int i) const { return subtree_last_[static_cast<size_t>(i)]; }
+  /// True when every subtree is the contiguous range of bodies [i, subtree_last(i)] (the depth-first
+  /// numbering the URDF loader makes) and no joint is a mimic (body i drives coordinate i - 1): the
+  /// algorithms then take contiguous blocks of their matrices for a subtree.
+  bool depth_first() const { return depth_first_; }
   /// The index of a named frame; throws InputError listing the frames when the name is unknown.
   int frame_index(const std::string& name) const {
     for (size_t i = 0; i < frames_.size(); ++i)
@@ -220,6 +226,8 @@ class Model {
   std::vector<Frame> frames_;
   std::vector<int> coord_body_;
   std::vector<detail::JointKinematics> kin_;  ///< one per body, from the bodies (build())
+  std::vector<int> subtree_last_;             ///< per body (build())
+  bool depth_first_ = false;                  ///< (build())
   int end_effector_ = -1;
 };
 
@@ -343,6 +351,7 @@ class ModelBuilder {
     }
     m.kin_.clear();
     for (const Body& b : m.bodies_) m.kin_.push_back(detail::joint_kinematics(b));
+    number_subtrees(m);
     return m;
   }
 
@@ -358,6 +367,21 @@ class ModelBuilder {
   }
 
  private:
+  /// Model::subtree_last and Model::depth_first, by one backward pass (a parent before its children).
+  static void number_subtrees(Model& m) {
+    const auto nb = static_cast<size_t>(m.nb());
+    std::vector<int> size(nb, 1);
+    m.subtree_last_.resize(nb);
+    for (size_t i = 0; i < nb; ++i) m.subtree_last_[i] = static_cast<int>(i);
+    for (size_t i = nb - 1; i > 0; --i) {
+      const auto up = static_cast<size_t>(m.bodies_[i].parent);
+      m.subtree_last_[up] = std::max(m.subtree_last_[up], m.subtree_last_[i]);
+      size[up] += size[i];
+    }
+    m.depth_first_ = m.nb() - 1 == m.n();
+    for (size_t i = 0; i < nb; ++i)
+      if (size[i] != m.subtree_last_[i] - static_cast<int>(i) + 1) m.depth_first_ = false;
+  }
   Frame find_parent(const std::string& parent, const std::string& joint) const {
     for (const auto& f : model_.frames_)
       if (f.name == parent) return f;
