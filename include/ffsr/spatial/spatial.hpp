@@ -8,6 +8,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <limits>
 #include <utility>
 
@@ -76,24 +78,18 @@ inline void sin_cos(double x, double& s, double& c) {
                                            z * (-1.0 / 87178291200 + z * (1.0 / 20922789888000 +
                                                                           z * (-1.0 / 6402373705728000)))))));
   const double sr = r + r * z * ps, cr = 1.0 - 0.5 * z + z * z * pc;
-  switch (static_cast<long long>(k) & 3) {
-    case 0:
-      s = sr;
-      c = cr;
-      break;
-    case 1:
-      s = cr;
-      c = -sr;
-      break;
-    case 2:
-      s = -sr;
-      c = -cr;
-      break;
-    default:
-      s = -cr;
-      c = sr;
-      break;
-  }
+  // the quadrant without a branch (random angles mispredict a switch): s = sr, cr, -sr, -cr and
+  // c = cr, -sr, -cr, sr for k mod 4 = 0..3, by selecting and flipping sign bits
+  const auto quadrant = static_cast<std::uint64_t>(static_cast<long long>(k));
+  std::uint64_t bs, bc;
+  std::memcpy(&bs, &sr, sizeof bs);
+  std::memcpy(&bc, &cr, sizeof bc);
+  const std::uint64_t swap = std::uint64_t{0} - (quadrant & 1);  // all ones when odd
+  std::uint64_t os = (bs & ~swap) | (bc & swap), oc = (bc & ~swap) | (bs & swap);
+  os ^= (quadrant >> 1 & 1) << 63;
+  oc ^= ((quadrant + 1) >> 1 & 1) << 63;
+  std::memcpy(&s, &os, sizeof s);
+  std::memcpy(&c, &oc, sizeof c);
 }
 
 /// ldlt_solve3's pivot at step k: the largest diagonal magnitude of the trailing corner (the first of
