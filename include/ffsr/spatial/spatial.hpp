@@ -62,21 +62,19 @@ inline void sin_cos(double x, double& s, double& c) {
   const double k = std::nearbyint(x * kTwoOverPi);
   const double r = ((x - k * kP1) - k * kP2) - k * kP3;
   const double z = r * r;
-  // sin r = r + r z (-1/3! + z (1/5! - ...)), cos r = 1 - z/2 + z^2 (1/4! - z (1/6! - ...))
-  const double ps =
-      -1.0 / 6 +
-      z * (1.0 / 120 +
-           z * (-1.0 / 5040 +
-                z * (1.0 / 362880 +
-                     z * (-1.0 / 39916800 + z * (1.0 / 6227020800 + z * (-1.0 / 1307674368000 +
-                                                                         z * (1.0 / 355687428096000)))))));
-  const double pc =
-      1.0 / 24 +
-      z * (-1.0 / 720 +
-           z * (1.0 / 40320 +
-                z * (-1.0 / 3628800 + z * (1.0 / 479001600 +
-                                           z * (-1.0 / 87178291200 + z * (1.0 / 20922789888000 +
-                                                                          z * (-1.0 / 6402373705728000)))))));
+  // sin r = r + r z (-1/3! + z (1/5! - ...)), cos r = 1 - z/2 + z^2 (1/4! - z (1/6! - ...)): the two
+  // polynomials in z by Horner side by side, lane 0 sin's and lane 1 cos's (the same operations as
+  // one at a time, two per instruction)
+  using Pair = Eigen::Array2d;
+  Pair poly(1.0 / 355687428096000, -1.0 / 6402373705728000);
+  poly = Pair(-1.0 / 1307674368000, 1.0 / 20922789888000) + z * poly;
+  poly = Pair(1.0 / 6227020800, -1.0 / 87178291200) + z * poly;
+  poly = Pair(-1.0 / 39916800, 1.0 / 479001600) + z * poly;
+  poly = Pair(1.0 / 362880, -1.0 / 3628800) + z * poly;
+  poly = Pair(-1.0 / 5040, 1.0 / 40320) + z * poly;
+  poly = Pair(1.0 / 120, -1.0 / 720) + z * poly;
+  poly = Pair(-1.0 / 6, 1.0 / 24) + z * poly;
+  const double ps = poly(0), pc = poly(1);
   const double sr = r + r * z * ps, cr = 1.0 - 0.5 * z + z * z * pc;
   // the quadrant without a branch (random angles mispredict a switch): s = sr, cr, -sr, -cr and
   // c = cr, -sr, -cr, sr for k mod 4 = 0..3, by selecting and flipping sign bits
