@@ -32,9 +32,12 @@ inline void multiply3(const Matrix3& A, const Matrix3& B, Matrix3& C) {
 }  // namespace detail
 
 /// Forward kinematics (RBDA 4.1, in the inertial frame).
-/// Reads base, theta. Writes data.base, data.R, data.p (every body frame in o) and data.S (the joint
+/// Reads base, theta. Writes data.base, data.R, data.p (every body frame in o), data.S (the joint
 /// motion subspaces in inertial axes about the base frame origin, per unit rate of each body's
-/// coordinate: mimic joints carry their multiplier). The base quaternion is normalized.
+/// coordinate: mimic joints carry their multiplier) and data.sin_q, data.cos_q. The base quaternion
+/// is normalized. Every joint's sine and cosine are computed first, in a pass of their own: each is
+/// independent of the others, while the poses form a chain from the base, so the processor overlaps
+/// the long polynomial evaluations instead of waiting for each on the chain.
 inline void forward_kinematics(const Model& model, Data& data, const BasePose& base,
                                const Eigen::Ref<const Eigen::VectorXd>& theta) {
   const double qn = detail::check_configuration(model, base, theta, "forward_kinematics");

@@ -53,7 +53,9 @@ struct Data {
   /// Joint motion subspace columns in the inertial orientation, about the base frame origin:
   /// [ (p_k - p_0) x z_k ; z_k ] (revolute) or [ z_k ; 0 ] (prismatic).
   Eigen::Matrix<double, 6, Eigen::Dynamic> S;
-  std::vector<double> sin_q, cos_q;  ///< sin and cos of each revolute body's joint position
+  /// sin and cos of each revolute body's joint position (entry i for body i; the base's and prismatic
+  /// joints' entries are not written)
+  std::vector<double> sin_q, cos_q;
   // --- CRBA --------------------------------------------------------------------------------------
   std::vector<SpatialInertia> Ic;  ///< composite inertias about the base origin, inertial axes
   Eigen::Matrix<double, 6, Eigen::Dynamic> Fc;  ///< Ic_i S_i, one column per moving body
