@@ -17,11 +17,14 @@
 // 1000 random configurations (fixed seed) and unit directions u for all.
 //
 // Columns: CRBA -- ffsr::crba (the full symmetric H), the frozen code before the rewrite
-// (bench_before.hpp), pinocchio::crba (upper triangle; the default LOCAL convention and WORLD); M_ie --
+// (bench_before.hpp), pinocchio::crba (upper triangle; the default LOCAL convention and WORLD), and
+// "pinL+s": LOCAL followed by the copy of its upper triangle into the lower, the same output as
+// ffsr's (shown beside, with its own ratio "ffsr/s"; the headline ratio ffsr/p is against the faster
+// of crba's two conventions alone); M_ie --
 // ffsr::integrated_effective_mass_fast (the O(n) articulated-body route), the frozen dispatching
 // function, and Pinocchio's crba + computeJointJacobians + getFrameJacobian + LLT solve. Each time is
 // the median over 51 passes of the mean time per call over 200 of the poses, in CPU time of the
-// thread (CLOCK_THREAD_CPUTIME_ID: time while descheduled does not count); every pass times the seven
+// thread (CLOCK_THREAD_CPUTIME_ID: time while descheduled does not count); every pass times the eight
 // loops back to back, so that a change of the machine's load hits them alike. All 1000 poses serve the
 // agreement checks. Ratios are ffsr over Pinocchio
 // (the faster of its two CRBA conventions for CRBA). The last columns check the numbers: H against
@@ -150,7 +153,7 @@ void compare(const std::string& name, const std::string& urdf) {
     dM = std::max(dM, std::abs(a - b) / b);
     dMpin = std::max(dMpin, std::abs(a - p) / p);
   }
-  // Interleaved passes: every pass times the seven loops back to back over the same 200 poses, so a
+  // Interleaved passes: every pass times the eight loops back to back over the same 200 poses, so a
   // change of the machine's load hits them alike; the median over the passes of each.
   auto ffsr_pass = [&](auto&& fn) {
     double acc = 0;
@@ -160,21 +163,23 @@ void compare(const std::string& name, const std::string& urdf) {
     g_sink = g_sink + acc;
     return t / kPassPoses;
   };
-  std::vector<double> t[7];
+  std::vector<double> t[8];
   for (int r = -1; r < kPasses; ++r) {  // pass -1 warms up
-    const double a[7] = {ffsr_pass(crba_now), ffsr_pass(crba_before),
+    const double a[8] = {ffsr_pass(crba_now), ffsr_pass(crba_before),
                          pin.pass(Kind::CrbaLocal, kPassPoses) / kPassPoses,
                          pin.pass(Kind::CrbaWorld, kPassPoses) / kPassPoses, ffsr_pass(mie_now),
-                         ffsr_pass(mie_before), pin.pass(Kind::InverseEffectiveMass, kPassPoses) / kPassPoses};
+                         ffsr_pass(mie_before), pin.pass(Kind::InverseEffectiveMass, kPassPoses) / kPassPoses,
+                         pin.pass(Kind::CrbaLocalFull, kPassPoses) / kPassPoses};
     if (r >= 0)
-      for (int i = 0; i < 7; ++i) t[i].push_back(a[i]);
+      for (int i = 0; i < 8; ++i) t[i].push_back(a[i]);
   }
   const double tcn = median(t[0]), tcb = median(t[1]), tpl = median(t[2]), tpw = median(t[3]);
-  const double tmn = median(t[4]), tmb = median(t[5]), tmp = median(t[6]);
+  const double tmn = median(t[4]), tmb = median(t[5]), tmp = median(t[6]), tpf = median(t[7]);
   const double tcp = std::min(tpl, tpw);
-  std::printf("%-9s %2d | %6.0f %6.0f %6.0f %6.0f %5.2fx %5.2fx | %6.0f %6.0f %6.0f %5.2fx %5.2fx | %7.0e %7.0e %7.0e %7.0e\n",
-              name.c_str(), n, tcn * 1e9, tcb * 1e9, tpl * 1e9, tpw * 1e9, tcn / tcp, tcb / tcp, tmn * 1e9,
-              tmb * 1e9, tmp * 1e9, tmn / tmp, tmb / tmp, dH, dHpin, dM, dMpin);
+  std::printf("%-9s %2d | %6.0f %6.0f %6.0f %6.0f %5.2fx %5.2fx %6.0f %5.2fx | %6.0f %6.0f %6.0f %5.2fx %5.2fx | %7.0e "
+              "%7.0e %7.0e %7.0e\n",
+              name.c_str(), n, tcn * 1e9, tcb * 1e9, tpl * 1e9, tpw * 1e9, tcn / tcp, tcb / tcp, tpf * 1e9,
+              tcn / tpf, tmn * 1e9, tmb * 1e9, tmp * 1e9, tmn / tmp, tmb / tmp, dH, dHpin, dM, dMpin);
   std::fflush(stdout);
 }
 
@@ -185,10 +190,10 @@ int main(int argc, char** argv) {
   try {
     std::printf(
         "ns per call, median of 51 interleaved passes over the same 200 random poses (thread CPU time)\n");
-    std::printf("%-9s %2s | %-48s | %-41s | %s\n", "", "", "CRBA", "M_ie (u^T J_v H^-1 J_v^T u)", "agreement");
-    std::printf("%-9s %2s | %6s %6s %6s %6s %6s %6s | %6s %6s %6s %6s %6s | %7s %7s %7s %7s\n", "robot", "n",
-                "ffsr", "before", "pinL", "pinW", "ffsr/p", "bef/p", "ffsr", "before", "pin", "ffsr/p", "bef/p",
-                "H-bef", "H-pin", "M-bef", "M-pin");
+    std::printf("%-9s %2s | %-62s | %-41s | %s\n", "", "", "CRBA", "M_ie (u^T J_v H^-1 J_v^T u)", "agreement");
+    std::printf("%-9s %2s | %6s %6s %6s %6s %6s %6s %6s %6s | %6s %6s %6s %6s %6s | %7s %7s %7s %7s\n", "robot", "n",
+                "ffsr", "before", "pinL", "pinW", "ffsr/p", "bef/p", "pinL+s", "ffsr/s", "ffsr", "before", "pin",
+                "ffsr/p", "bef/p", "H-bef", "H-pin", "M-bef", "M-pin");
     compare("3-DOF", read_text(dir + "/paper_3dof.urdf"));
     compare("7-DOF", read_text(dir + "/paper_7dof.urdf"));
     for (int n : {3, 7, 14, 28, 56}) compare("chain " + std::to_string(n), chain_urdf(n, static_cast<unsigned>(n)));

@@ -22,12 +22,13 @@ inline double thread_seconds() {
 /// an operational frame) and the poses to evaluate it at.
 class PinocchioBench {
  public:
-  enum class Kind { CrbaLocal, CrbaWorld, InverseEffectiveMass };
+  enum class Kind { CrbaLocal, CrbaLocalFull, CrbaWorld, InverseEffectiveMass };
   PinocchioBench(const ffsr::Model& model, int frame, const std::vector<ffsr::BasePose>& base,
                  const std::vector<Eigen::VectorXd>& theta, const std::vector<Eigen::Vector3d>& u);
   ~PinocchioBench();
   /// One pass over poses [0, count): pinocchio::crba (Convention::LOCAL, the default, or WORLD; upper
-  /// triangle), or u^T J_v M^-1 J_v^T u (crba, computeJointJacobians, getFrameJacobian
+  /// triangle), LOCAL followed by the copy of the upper triangle into the lower (CrbaLocalFull: the
+  /// full symmetric matrix, as ffsr::crba returns it), or u^T J_v M^-1 J_v^T u (crba, computeJointJacobians, getFrameJacobian
   /// LOCAL_WORLD_ALIGNED, LLT solve). Returns the thread CPU time of the pass, seconds.
   double pass(Kind kind, int count);
   /// u^T J_v M^-1 J_v^T u at pose k.

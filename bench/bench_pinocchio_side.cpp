@@ -96,6 +96,13 @@ double PinocchioBench::pass(Kind kind, int count) {
       for (int k = 0; k < count; ++k)
         acc += pinocchio::crba(m.pm, m.pd, m.q[static_cast<size_t>(k)], pinocchio::Convention::LOCAL)(6, 6);
       break;
+    case Kind::CrbaLocalFull:
+      for (int k = 0; k < count; ++k) {
+        pinocchio::crba(m.pm, m.pd, m.q[static_cast<size_t>(k)], pinocchio::Convention::LOCAL);
+        m.pd.M.triangularView<Eigen::StrictlyLower>() = m.pd.M.transpose().triangularView<Eigen::StrictlyLower>();
+        acc += m.pd.M(7, 6);
+      }
+      break;
     case Kind::CrbaWorld:
       for (int k = 0; k < count; ++k)
         acc += pinocchio::crba(m.pm, m.pd, m.q[static_cast<size_t>(k)], pinocchio::Convention::WORLD)(6, 6);
