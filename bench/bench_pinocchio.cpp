@@ -165,10 +165,13 @@ void compare(const std::string& name, const std::string& urdf) {
   };
   std::vector<double> t[8];
   for (int r = -1; r < kPasses; ++r) {  // pass -1 warms up
-    const double a[8] = {ffsr_pass(crba_now), ffsr_pass(crba_before),
+    const double a[8] = {ffsr_pass(crba_now),
+                         ffsr_pass(crba_before),
                          pin.pass(Kind::CrbaLocal, kPassPoses) / kPassPoses,
-                         pin.pass(Kind::CrbaWorld, kPassPoses) / kPassPoses, ffsr_pass(mie_now),
-                         ffsr_pass(mie_before), pin.pass(Kind::InverseEffectiveMass, kPassPoses) / kPassPoses,
+                         pin.pass(Kind::CrbaWorld, kPassPoses) / kPassPoses,
+                         ffsr_pass(mie_now),
+                         ffsr_pass(mie_before),
+                         pin.pass(Kind::InverseEffectiveMass, kPassPoses) / kPassPoses,
                          pin.pass(Kind::CrbaLocalFull, kPassPoses) / kPassPoses};
     if (r >= 0)
       for (int i = 0; i < 8; ++i) t[i].push_back(a[i]);
@@ -176,10 +179,11 @@ void compare(const std::string& name, const std::string& urdf) {
   const double tcn = median(t[0]), tcb = median(t[1]), tpl = median(t[2]), tpw = median(t[3]);
   const double tmn = median(t[4]), tmb = median(t[5]), tmp = median(t[6]), tpf = median(t[7]);
   const double tcp = std::min(tpl, tpw);
-  std::printf("%-9s %2d | %6.0f %6.0f %6.0f %6.0f %5.2fx %5.2fx %6.0f %5.2fx | %6.0f %6.0f %6.0f %5.2fx %5.2fx | %7.0e "
-              "%7.0e %7.0e %7.0e\n",
-              name.c_str(), n, tcn * 1e9, tcb * 1e9, tpl * 1e9, tpw * 1e9, tcn / tcp, tcb / tcp, tpf * 1e9,
-              tcn / tpf, tmn * 1e9, tmb * 1e9, tmp * 1e9, tmn / tmp, tmb / tmp, dH, dHpin, dM, dMpin);
+  std::printf(
+      "%-9s %2d | %6.0f %6.0f %6.0f %6.0f %5.2fx %5.2fx %6.0f %5.2fx | %6.0f %6.0f %6.0f %5.2fx %5.2fx | "
+      "%7.0e %7.0e %7.0e %7.0e\n",
+      name.c_str(), n, tcn * 1e9, tcb * 1e9, tpl * 1e9, tpw * 1e9, tcn / tcp, tcb / tcp, tpf * 1e9, tcn / tpf,
+      tmn * 1e9, tmb * 1e9, tmp * 1e9, tmn / tmp, tmb / tmp, dH, dHpin, dM, dMpin);
   std::fflush(stdout);
 }
 
@@ -190,10 +194,11 @@ int main(int argc, char** argv) {
   try {
     std::printf(
         "ns per call, median of 51 interleaved passes over the same 200 random poses (thread CPU time)\n");
-    std::printf("%-9s %2s | %-62s | %-41s | %s\n", "", "", "CRBA", "M_ie (u^T J_v H^-1 J_v^T u)", "agreement");
-    std::printf("%-9s %2s | %6s %6s %6s %6s %6s %6s %6s %6s | %6s %6s %6s %6s %6s | %7s %7s %7s %7s\n", "robot", "n",
-                "ffsr", "before", "pinL", "pinW", "ffsr/p", "bef/p", "pinL+s", "ffsr/s", "ffsr", "before", "pin",
-                "ffsr/p", "bef/p", "H-bef", "H-pin", "M-bef", "M-pin");
+    std::printf("%-9s %2s | %-62s | %-41s | %s\n", "", "", "CRBA", "M_ie (u^T J_v H^-1 J_v^T u)",
+                "agreement");
+    std::printf("%-9s %2s | %6s %6s %6s %6s %6s %6s %6s %6s | %6s %6s %6s %6s %6s | %7s %7s %7s %7s\n",
+                "robot", "n", "ffsr", "before", "pinL", "pinW", "ffsr/p", "bef/p", "pinL+s", "ffsr/s", "ffsr",
+                "before", "pin", "ffsr/p", "bef/p", "H-bef", "H-pin", "M-bef", "M-pin");
     compare("3-DOF", read_text(dir + "/paper_3dof.urdf"));
     compare("7-DOF", read_text(dir + "/paper_7dof.urdf"));
     for (int n : {3, 7, 14, 28, 56}) compare("chain " + std::to_string(n), chain_urdf(n, static_cast<unsigned>(n)));

@@ -28,8 +28,9 @@ class PinocchioBench {
   ~PinocchioBench();
   /// One pass over poses [0, count): pinocchio::crba (Convention::LOCAL, the default, or WORLD; upper
   /// triangle), LOCAL followed by the copy of the upper triangle into the lower (CrbaLocalFull: the
-  /// full symmetric matrix, as ffsr::crba returns it), or u^T J_v M^-1 J_v^T u (crba, computeJointJacobians, getFrameJacobian
-  /// LOCAL_WORLD_ALIGNED, LLT solve). Returns the thread CPU time of the pass, seconds.
+  /// full symmetric matrix, as ffsr::crba returns it), or u^T J_v M^-1 J_v^T u (crba,
+  /// computeJointJacobians, getFrameJacobian LOCAL_WORLD_ALIGNED, LLT solve). Returns the thread CPU
+  /// time of the pass, seconds.
   double pass(Kind kind, int count);
   /// u^T J_v M^-1 J_v^T u at pose k.
   double inverse_effective_mass(int k);

@@ -99,7 +99,8 @@ double PinocchioBench::pass(Kind kind, int count) {
     case Kind::CrbaLocalFull:
       for (int k = 0; k < count; ++k) {
         pinocchio::crba(m.pm, m.pd, m.q[static_cast<size_t>(k)], pinocchio::Convention::LOCAL);
-        m.pd.M.triangularView<Eigen::StrictlyLower>() = m.pd.M.transpose().triangularView<Eigen::StrictlyLower>();
+        m.pd.M.triangularView<Eigen::StrictlyLower>() =
+            m.pd.M.transpose().triangularView<Eigen::StrictlyLower>();
         acc += m.pd.M(7, 6);
       }
       break;

@@ -65,8 +65,9 @@ inline void require_finite(double value, const char* where, const char* what) {
   if (!std::isfinite(value)) throw InputError(str(where, ": ", what, " must be finite, got ", value));
 }
 
-/// The error of require_finite_all, out of line: names the first entry of x[0..size) that is not finite.
-[[noreturn]] inline void throw_not_finite(const double* x, Eigen::Index size, const char* where, const char* what) {
+/// The error of require_finite_all, out of line: names the first entry of x[0..size) not finite.
+[[noreturn]] inline void throw_not_finite(const double* x, Eigen::Index size, const char* where,
+                                          const char* what) {
   Eigen::Index i = 0;
   while (i + 1 < size && std::isfinite(x[i])) ++i;
   throw InputError(str(where, ": ", what, " must be finite, entry ", i, " is ", x[i]));

@@ -310,7 +310,8 @@ Model long_chain(double length) {
   return b.build();
 }
 
-TEST_CASE("crba: a finite H of huge lengths is returned, an H that overflows is refused", "[dynamics][fast]") {
+TEST_CASE("crba: a finite H of huge lengths is returned, an H that overflows is refused",
+          "[dynamics][fast]") {
   const Eigen::VectorXd theta = Eigen::Vector3d(0.3, -0.4, 0.5);
   BasePose base;
   base.orientation = Quaternion(Eigen::AngleAxisd(0.2, Vector3(1, 2, 3).normalized()));

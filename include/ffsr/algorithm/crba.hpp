@@ -34,13 +34,13 @@ inline void body_inertias(const Model& model, Data& data) {
 /// (Model::depth_first: every subtree a contiguous range of bodies, no mimic joint), column j of H
 /// below the diagonal is one matrix-vector product, the contiguous columns F_i of its subtree (in
 /// data.Fc) times S_j, then zeros, each entry stored into row j too (Pinocchio's CRBA in the world
-/// convention fills one triangle the same way). Other trees walk
-/// the ancestors of each body. Cost: O(n) spatial operations and n d / 2 six-term dot products (d the
-/// depth); no allocation.
+/// convention fills one triangle the same way). Other trees walk the ancestors of each body. Cost:
+/// O(n) spatial operations and n d / 2 six-term dot products (d the depth); no allocation.
 ///
 /// Reads base, theta. Writes the kinematics (forward_kinematics), data.Ic (composite), data.Fc and
-/// data.H, the full symmetric (6+n)x(6+n) matrix in the coordinates of model.hpp (a coordinate that drives several joints through mimics sums their entries:
-/// H = T^T H_full T). Returns data.H. Throws NumericalError when H overflows (not finite).
+/// data.H, the full symmetric (6+n)x(6+n) matrix in the coordinates of model.hpp (a coordinate that
+/// drives several joints through mimics sums their entries: H = T^T H_full T). Returns data.H.
+/// Throws NumericalError when H overflows (not finite).
 inline const Eigen::MatrixXd& crba(const Model& model, Data& data, const BasePose& base,
                                    const Eigen::Ref<const Eigen::VectorXd>& theta) {
   forward_kinematics(model, data, base, theta);

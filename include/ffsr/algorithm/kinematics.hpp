@@ -49,7 +49,8 @@ inline void forward_kinematics(const Model& model, Data& data, const BasePose& b
   for (int i = 1; i < nb; ++i) {
     const Body& b = model.body(i);
     if (b.joint.type == JointType::Revolute)
-      detail::sin_cos(b.joint_position(theta), data.sin_q[static_cast<size_t>(i)], data.cos_q[static_cast<size_t>(i)]);
+      detail::sin_cos(b.joint_position(theta), data.sin_q[static_cast<size_t>(i)],
+                      data.cos_q[static_cast<size_t>(i)]);
   }
   for (int i = 1; i < nb; ++i) {
     const Body& b = model.body(i);

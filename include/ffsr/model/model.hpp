@@ -136,8 +136,8 @@ inline Inertia merged_inertia(const Inertia& a, const Inertia& b) {
 /// What forward_kinematics reads of a body's joint besides Body itself, fixed when the model is built
 /// (ModelBuilder::build): which of its shortcuts apply, and for a revolute joint about a general unit
 /// axis k the constant parts of tree.R rot(k, q) = tree.R + s B + (1 - c) D (Rodrigues' formula
-/// 1 + s [k]x + (1 - c) [k]x^2 multiplied by tree.R; [k]x^2 = k k^T - 1 for a unit k), so that the rotation of the body costs one
-/// 3x3 product on the chain of the tree, not two plus the formula.
+/// 1 + s [k]x + (1 - c) [k]x^2 multiplied by tree.R; [k]x^2 = k k^T - 1 for a unit k), so that the
+/// rotation of the body costs one 3x3 product on the chain of the tree, not two plus the formula.
 struct JointKinematics {
   bool tree_identity = true;  ///< tree.R is exactly the identity (rpy 0 0 0, most URDF joints)
   int axis = -1;              ///< 0, 1 or 2: the axis is exactly +-x, +-y or +-z; -1 otherwise
