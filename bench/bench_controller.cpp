@@ -9,7 +9,7 @@
 // (timer interrupts, a hypervisor's steal): a controller ratio near it is not the controller's tail.
 
 #include "ffsr/control/capture_controller.hpp"
-#include "ffsr/io/scenario.hpp"
+#include "ffsr/scenario/scenario.hpp"
 
 #include <sched.h>
 

@@ -7,7 +7,7 @@
 // (crba included), per call, over random configurations. DIR holds paper_7dof.urdf (default
 // FFSR_SOURCE_DIR/robots).
 #include <ffsr/algorithm/joint_models.hpp>
-#include <ffsr/io/urdf.hpp>
+#include <ffsr/parsers/urdf.hpp>
 
 #include <chrono>
 #include <cstdio>

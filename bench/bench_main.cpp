@@ -21,7 +21,7 @@
 #include <cstdlib>  // first: defines __GLIBC__
 
 #include <ffsr/ffsr.hpp>
-#include <ffsr/io/urdf.hpp>
+#include <ffsr/parsers/urdf.hpp>
 #include <ffsr/optimize/capture.hpp>
 #include <ffsr/simulate/multibody.hpp>
 #ifdef FFSR_HAVE_GLOBAL

@@ -10,7 +10,7 @@
 // scatter of the p95 from disjoint blocks of 1000 samples, both estimators. --quick:
 // 1e4 and 20 samples (a smoke run). DIR holds paper_7dof.urdf (default FFSR_SOURCE_DIR/robots).
 #include <ffsr/ffsr.hpp>
-#include <ffsr/io/urdf.hpp>
+#include <ffsr/parsers/urdf.hpp>
 #include <ffsr/optimize/capture.hpp>
 #include <ffsr/uncertainty/multibody.hpp>
 #include <ffsr/uncertainty/sampling.hpp>

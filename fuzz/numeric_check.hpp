@@ -10,7 +10,7 @@
 
 #include "ffsr/ffsr.hpp"
 #include "ffsr/contact/contact_law.hpp"
-#include "ffsr/io/urdf.hpp"
+#include "ffsr/parsers/urdf.hpp"
 #include "ffsr/optimize/capture.hpp"
 #include "ffsr/simulate/multibody.hpp"
 

@@ -5,7 +5,7 @@
 #include "fuzz_checks.hpp"
 
 #include "ffsr/ffsr.hpp"
-#include "ffsr/io/urdf.hpp"
+#include "ffsr/parsers/urdf.hpp"
 
 #include <string>
 

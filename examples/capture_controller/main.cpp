@@ -5,7 +5,7 @@
 //
 //   capture_controller <path to paper_7dof.urdf>
 #include <ffsr/control/capture_controller.hpp>
-#include <ffsr/io/urdf.hpp>
+#include <ffsr/parsers/urdf.hpp>
 
 #include <cmath>
 #include <cstdio>

@@ -17,7 +17,7 @@
 //                                   M_ie under the contact-joint models (free, locked, armature)
 // Include the rest where it is needed, each with its CMake target (docs/library.md):
 //   ffsr/contact/contact_law.hpp    contact laws, closed-form and exact maxima   (ffsr::ffsr)
-//   ffsr/io/urdf.hpp                the URDF loader                              (ffsr::urdf)
+//   ffsr/parsers/urdf.hpp                the URDF loader                              (ffsr::urdf)
 //   ffsr/optimize/capture.hpp       the paper's planner and its parts            (ffsr::ffsr)
 //   ffsr/control/capture_controller.hpp the onboard controller                  (ffsr::ffsr)
 //   ffsr/simulate/*.hpp             CVODE integrations                           (ffsr::cvode)

@@ -14,7 +14,7 @@
 #include "common.hpp"
 
 #include <ffsr/control/capture_controller.hpp>
-#include <ffsr/io/scenario.hpp>
+#include <ffsr/scenario/scenario.hpp>
 
 #include <nanobind/stl/string.h>
 #include <nanobind/stl/vector.h>

@@ -2,7 +2,7 @@
 // Bus, UrdfReport, Model (Model.from_urdf, Model.from_urdf_string), ModelBuilder, Data and Target.
 #include "common.hpp"
 
-#include <ffsr/io/urdf.hpp>
+#include <ffsr/parsers/urdf.hpp>
 
 #include <nanobind/stl/optional.h>
 #include <nanobind/stl/pair.h>

@@ -10,7 +10,7 @@
 
 #include "ffsr/contact/contact_law.hpp"
 #include "ffsr/ffsr.hpp"
-#include "ffsr/io/urdf.hpp"
+#include "ffsr/parsers/urdf.hpp"
 
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>

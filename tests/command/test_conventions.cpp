@@ -6,7 +6,7 @@
 // Small runs only (the built-in 3-DOF scenario, a few samples, coarse grids): the cases run in CI.
 #include "support/command.hpp"
 
-#include "ffsr/io/scenario.hpp"
+#include "ffsr/scenario/scenario.hpp"
 
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>

@@ -7,7 +7,7 @@
 
 #include "support/command.hpp"
 
-#include "ffsr/io/scenario.hpp"
+#include "ffsr/scenario/scenario.hpp"
 #include "ffsr/jobs/scenario_run.hpp"
 #include "ffsr/optimize/objective.hpp"
 

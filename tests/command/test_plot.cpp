@@ -10,7 +10,7 @@
 #include "support/paper.hpp"
 #include "support/run_command.hpp"
 
-#include "ffsr/io/urdf.hpp"
+#include "ffsr/parsers/urdf.hpp"
 
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>

@@ -11,7 +11,7 @@
 #include "support/dynamics_helpers.hpp"
 #include "support/run_command.hpp"
 
-#include "ffsr/io/detail/urdf_document.hpp"
+#include "ffsr/parsers/detail/urdf_document.hpp"
 
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>

@@ -4,7 +4,7 @@
 # Every header's `#include "ffsr/<folder>/..."` (and "ffsr/<name>.hpp" at the top) is checked; a
 # folder missing from the table fails the check, so that a new folder is placed on purpose. Files
 # held to a lower layer than their folder's (as includer and as included): the URDF parser
-# (io/urdf.hpp and its internals io/detail/urdf_document.hpp) reads into the model alone, the URDF
+# (parsers/urdf.hpp and its internals parsers/detail/urdf_document.hpp) reads into the model alone, the URDF
 # collision elements into geometry's shapes.
 
 # One layer per entry, the lowest first; names in one entry are one layer. A top-level header
@@ -17,21 +17,15 @@ set(FFSR_LAYERS
   "contact"
   "algorithm"
   "geometry"
+  "parsers"
   "simulate"
   "uncertainty"
   "optimize"
   "control"
-  "io"
+  "scenario"
   "jobs"
   "ffsr"
 )
-# "<regex on the path relative to include/ffsr>=<folder whose layer the files keep to>"
-set(FFSR_FILE_LAYERS
-  "^io/urdf\\.hpp$=model"
-  "^io/detail/urdf_document\\.hpp$=model"
-  "^io/urdf_collision\\.hpp$=geometry"
-)
-
 if(NOT FFSR_INCLUDE_DIR)
   message(FATAL_ERROR "check_layers: pass -DFFSR_INCLUDE_DIR=<include/ffsr>")
 endif()
@@ -45,17 +39,9 @@ foreach(entry IN LISTS FFSR_LAYERS)
   math(EXPR rank "${rank} + 1")
 endforeach()
 
-# the layer name of a path relative to include/ffsr: a file rule's, else its first component, or
-# the file's name without .hpp at the top
+# the layer name of a path relative to include/ffsr: its first component, or the file's name without
+# .hpp at the top
 function(layer_name_of path out)
-  foreach(rule IN LISTS FFSR_FILE_LAYERS)
-    string(REGEX MATCH "^(.*)=([a-z_]+)$" _ "${rule}")
-    set(held "${CMAKE_MATCH_2}")
-    if(path MATCHES "${CMAKE_MATCH_1}")
-      set(${out} "${held}" PARENT_SCOPE)
-      return()
-    endif()
-  endforeach()
   if(path MATCHES "^([a-z_]+)/")
     set(${out} "${CMAKE_MATCH_1}" PARENT_SCOPE)
   elseif(path MATCHES "^([a-z_]+)\\.hpp$")

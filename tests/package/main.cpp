@@ -5,7 +5,7 @@
 // link dependencies are exercised. Exit 0 when the numbers are finite and the two models agree.
 #include <ffsr/ffsr.hpp>
 #ifdef FFSR_CONSUMER_URDF
-#include <ffsr/io/urdf.hpp>
+#include <ffsr/parsers/urdf.hpp>
 #endif
 #ifdef FFSR_CONSUMER_CVODE
 #include <ffsr/simulate/single_body.hpp>

@@ -9,7 +9,7 @@
 #include "ffsr/contact/damping.hpp"
 #include "ffsr/errors.hpp"
 #include "ffsr/ffsr.hpp"
-#include "ffsr/io/urdf.hpp"
+#include "ffsr/parsers/urdf.hpp"
 #include "ffsr/simulate/multibody.hpp"
 #include "ffsr/simulate/single_body.hpp"
 

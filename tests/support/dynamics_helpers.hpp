@@ -6,7 +6,7 @@
 #pragma once
 
 #include "ffsr/ffsr.hpp"
-#include "ffsr/io/urdf.hpp"
+#include "ffsr/parsers/urdf.hpp"
 
 #include <cmath>
 #include <functional>

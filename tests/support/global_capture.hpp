@@ -8,7 +8,7 @@
 #include "support/paper.hpp"
 
 #include "ffsr/ffsr.hpp"
-#include "ffsr/io/urdf.hpp"
+#include "ffsr/parsers/urdf.hpp"
 #include "ffsr/optimize/global.hpp"
 
 #include <cstdio>

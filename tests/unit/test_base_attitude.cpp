@@ -6,7 +6,7 @@
 #include "support/paper.hpp"
 
 #include "ffsr/jobs/scenario_run.hpp"
-#include "ffsr/io/urdf.hpp"
+#include "ffsr/parsers/urdf.hpp"
 #include "ffsr/optimize/base_attitude.hpp"
 
 #include <string>

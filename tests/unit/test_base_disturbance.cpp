@@ -6,7 +6,7 @@
 #include "support/paper.hpp"
 
 #include "ffsr/algorithm/base_disturbance.hpp"
-#include "ffsr/io/urdf.hpp"
+#include "ffsr/parsers/urdf.hpp"
 #include "ffsr/simulate/multibody.hpp"
 #include "ffsr/simulate/single_body.hpp"
 

@@ -9,7 +9,7 @@
 #include "support/global_capture.hpp"
 #include "support/paper.hpp"
 
-#include "ffsr/io/scenario.hpp"
+#include "ffsr/scenario/scenario.hpp"
 #include "ffsr/jobs/scenario_run.hpp"
 #include "ffsr/optimize/branches.hpp"
 

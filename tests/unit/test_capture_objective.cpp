@@ -7,7 +7,7 @@
 // armature joints: its branches carry that model's M_ie, ranked by it, and the run ends on the least.
 #include <catch2/catch.hpp>
 
-#include "ffsr/io/scenario.hpp"
+#include "ffsr/scenario/scenario.hpp"
 #include "ffsr/jobs/scenario_run.hpp"
 #include "ffsr/optimize/pareto.hpp"
 

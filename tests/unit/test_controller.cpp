@@ -9,7 +9,7 @@
 
 #include "ffsr/control/capture_controller.hpp"
 #include "ffsr/control/closed_loop.hpp"
-#include "ffsr/io/scenario.hpp"
+#include "ffsr/scenario/scenario.hpp"
 
 #include <cmath>
 #include <fstream>

@@ -75,7 +75,7 @@ void operator delete[](void* p, std::size_t) noexcept { operator delete(p); }
 #include <catch2/catch.hpp>
 
 #include "ffsr/control/capture_controller.hpp"
-#include "ffsr/io/scenario.hpp"
+#include "ffsr/scenario/scenario.hpp"
 
 #include <cmath>
 #include <memory>

@@ -4,8 +4,8 @@
 // section: the distance to a convex set is convex along a segment), the nearest points, and the
 // gradient against central finite differences.
 #include "ffsr/geometry/distance.hpp"
-#include "ffsr/io/urdf.hpp"
-#include "ffsr/io/urdf_collision.hpp"
+#include "ffsr/parsers/urdf.hpp"
+#include "ffsr/parsers/urdf_collision.hpp"
 
 #include <catch2/catch.hpp>
 

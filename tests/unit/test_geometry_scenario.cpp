@@ -1,4 +1,4 @@
-// Scenario keys of the shapes and the clearance (io/scenario_geometry.hpp): each bad input gives one
+// Scenario keys of the shapes and the clearance (scenario/geometry.hpp): each bad input gives one
 // line naming the key; every run of the clearance scenarios (plain, paper's method through the clearance
 // barrier, global) keeps the clearance along its path; the barrier's free-floating distance rate
 // against central differences.

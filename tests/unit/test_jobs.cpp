@@ -1,7 +1,7 @@
 // The job layer from C++ (ffsr/jobs/): the robust job on a scenario, its summary read back from its
 // JSON, and shards merged by the library alone -- what `ffsr-optimize robust --merge` prints is
 // this. Small runs: the built-in-like 3-DOF scenario, a given configuration, a few dozen samples.
-#include "ffsr/io/scenario.hpp"
+#include "ffsr/scenario/scenario.hpp"
 #include "ffsr/jobs/robust.hpp"
 
 #include <catch2/catch.hpp>

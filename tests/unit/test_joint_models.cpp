@@ -15,7 +15,7 @@
 #include <catch2/catch.hpp>
 
 #include "ffsr/algorithm/joint_models.hpp"
-#include "ffsr/io/scenario.hpp"
+#include "ffsr/scenario/scenario.hpp"
 #include "ffsr/jobs/scenario_run.hpp"
 #include "ffsr/simulate/multibody.hpp"
 #include "support/command.hpp"

@@ -6,7 +6,7 @@
 #include <string>
 
 #include "ffsr/jobs/scenario_run.hpp"
-#include "ffsr/io/urdf.hpp"
+#include "ffsr/parsers/urdf.hpp"
 #include "ffsr/optimize/pareto.hpp"
 
 namespace test_pareto {

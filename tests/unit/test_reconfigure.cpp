@@ -4,7 +4,7 @@
 // the bad inputs of the reconfigure keys.
 #include <catch2/catch.hpp>
 
-#include "ffsr/io/scenario.hpp"
+#include "ffsr/scenario/scenario.hpp"
 #include "ffsr/jobs/scenario_run.hpp"
 #include "ffsr/optimize/global.hpp"
 #include "ffsr/optimize/reconfigure.hpp"

@@ -1,6 +1,6 @@
-// Scenarios through the library (ffsr/io/scenario.hpp, ffsr/jobs/scenario_run.hpp): a scenario file
+// Scenarios through the library (ffsr/scenario/scenario.hpp, ffsr/jobs/scenario_run.hpp): a scenario file
 // gives the same result as `ffsr-optimize --json`, every shipped scenario loads, bad keys are named.
-#include "ffsr/io/scenario.hpp"
+#include "ffsr/scenario/scenario.hpp"
 #include "ffsr/jobs/closed_loop.hpp"
 #include "ffsr/jobs/map.hpp"
 #include "ffsr/jobs/pareto.hpp"

@@ -5,7 +5,7 @@
 #include "support/paper.hpp"
 
 #include "ffsr/ffsr.hpp"
-#include "ffsr/io/urdf.hpp"
+#include "ffsr/parsers/urdf.hpp"
 #include "ffsr/simulate/multibody.hpp"
 
 #include <cstdio>

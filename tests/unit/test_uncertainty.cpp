@@ -6,7 +6,7 @@
 #include "support/paper.hpp"
 
 #include "ffsr/ffsr.hpp"
-#include "ffsr/io/urdf.hpp"
+#include "ffsr/parsers/urdf.hpp"
 #include "ffsr/uncertainty/multibody.hpp"
 #include "ffsr/uncertainty/robust_objective.hpp"
 #include "ffsr/uncertainty/sampling.hpp"

@@ -3,7 +3,7 @@
 // inertia repairs (each one reported), the document checks; and the steps of the contact
 // simulations (scaled right-hand side, Hertz time, running maxima). Expected values come from identities
 // and from sums computed here independently, never from the code under test.
-#include "ffsr/io/detail/urdf_document.hpp"
+#include "ffsr/parsers/detail/urdf_document.hpp"
 #include "ffsr/simulate/multibody.hpp"
 #include "ffsr/simulate/single_body.hpp"
 

@@ -6,7 +6,7 @@
 //   cylinder  `radius`, `length` along the pose's z axis, centred (as URDF's <cylinder>);
 //   capsule   `radius`, `length` of its centre segment along the pose's z axis, centred.
 // RobotGeometry gives every body of a Model (body 0 is the base, or the bus it is mounted on) its
-// shapes: the URDF's <collision> primitives where a body has them (io/urdf_collision.hpp), else a
+// shapes: the URDF's <collision> primitives where a body has them (parsers/urdf_collision.hpp), else a
 // capsule of `link_radius` along each centre line between the body's joint origin and the joint
 // origins of its children (and the end-effector point on the end-effector's body). The base gets
 // only its URDF primitives or a box of the scenario (the bus). Distances between the shapes need FCL:
@@ -153,7 +153,7 @@ struct RobotGeometry {
   std::vector<double> line_radius;
 };
 
-/// A URDF <collision> primitive of a link (io/urdf_collision.hpp reads them).
+/// A URDF <collision> primitive of a link (parsers/urdf_collision.hpp reads them).
 struct LinkShape {
   std::string link;
   Shape shape;        ///< pose in the link frame

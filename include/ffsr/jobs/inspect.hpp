@@ -71,7 +71,7 @@ inline std::optional<AnyContactLaw> inspect_law(const Subject& s) {
 }
 
 /// The distances of the configuration to the target at t = 0 (and to the bus, between the links) when
-/// the scenario gives shapes (io/scenario_geometry.hpp), else nothing.
+/// the scenario gives shapes (scenario/geometry.hpp), else nothing.
 inline std::optional<ClearanceReport> inspect_clearance(const Subject& s, const EmbeddedUrdf* embedded) {
   const std::shared_ptr<const SceneGeometry> g =
       scene_geometry(s.keys, s.robot.model, s.target.contact_offset, embedded);

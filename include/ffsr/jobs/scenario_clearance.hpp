@@ -1,10 +1,10 @@
 // ffsr/jobs/scenario_clearance.hpp -- the runs of a scenario with shapes and a clearance
-// (the scene of ffsr/io/scenario_geometry.hpp): the global run's constraints and path check, the
+// (the scene of ffsr/scenario/geometry.hpp): the global run's constraints and path check, the
 // clearance barrier of the plain and the paper's-method runs, and the smallest distances of a run.
 // Without ffsr::geometry (FFSR_HAVE_GEOMETRY undefined) a scenario has no scene and these do nothing.
 #pragma once
 
-#include "ffsr/io/scenario.hpp"
+#include "ffsr/scenario/scenario.hpp"
 
 #ifdef FFSR_HAVE_GEOMETRY
 #include "ffsr/optimize/clearance.hpp"

@@ -1,13 +1,13 @@
-// ffsr/jobs/scenario_run.hpp -- the main job of a scenario (ffsr/io/scenario.hpp): the plain run
+// ffsr/jobs/scenario_run.hpp -- the main job of a scenario (ffsr/scenario/scenario.hpp): the plain run
 // (rho = 0, the baseline task), the paper's method (the optimized run, Eq. 29-31) and the global run,
 // as one result struct, and that result as JSON (the keys and values of `ffsr-optimize --json`; the
 // schema is written in jobs/detail/result_json.hxx). Component ffsr::scenario. Never prints; progress
 // goes to the callbacks of ScenarioRunOptions.
 //
-// jobs/ is the layer above the scenario keys (io/): it runs what a scenario describes.
+// jobs/ is the layer above the scenario keys (scenario/): it runs what a scenario describes.
 #pragma once
 
-#include "ffsr/io/scenario.hpp"
+#include "ffsr/scenario/scenario.hpp"
 #include "ffsr/jobs/scenario_clearance.hpp"
 #include "ffsr/optimize/branches.hpp"
 #include "ffsr/optimize/pareto.hpp"
@@ -56,7 +56,7 @@ struct ScenarioResult {
   std::shared_ptr<RobustForceObjective> robust;
   UncertaintySpec robust_spec;
   std::vector<RobustRow> robust_rows;
-  /// with shapes (io/scenario_geometry.hpp, jobs/scenario_clearance.hpp): each run's smallest
+  /// with shapes (scenario/geometry.hpp, jobs/scenario_clearance.hpp): each run's smallest
   /// distances along its path
   std::vector<std::pair<std::string, ClearanceReport>> clearances;  ///< baseline, optimized, global
 };

@@ -1,13 +1,13 @@
 // ffsr/jobs/subject.hpp -- what the one-configuration jobs evaluate (inspect, contact, map): a robot
 // at one configuration, the target and the contact law, built from a scenario's keys (the keys of a
-// file or of a built-in scenario, then the overrides) by the library's reader (ffsr/io/scenario.hpp).
+// file or of a built-in scenario, then the overrides) by the library's reader (ffsr/scenario/scenario.hpp).
 // Component ffsr::scenario. Never prints: the loader's repairs are handed to a callback.
 #pragma once
 
 #include "ffsr/algorithm/joint_models.hpp"
 #include "ffsr/contact/contact_law.hpp"
-#include "ffsr/io/scenario.hpp"
-#include "ffsr/io/urdf.hpp"
+#include "ffsr/scenario/scenario.hpp"
+#include "ffsr/parsers/urdf.hpp"
 #include "ffsr/model/model.hpp"
 #include "ffsr/model/target.hpp"
 #include "ffsr/optimize/capture_problem.hpp"
@@ -46,7 +46,7 @@ struct Subject {
 };
 
 /// Builds the subject of `keys` (the robot and its start state, the bus and the loader, the target,
-/// the contact law); `embedded`: the URDF of a built-in scenario (io/scenario.hpp). `on_load` is
+/// the contact law); `embedded`: the URDF of a built-in scenario (scenario/scenario.hpp). `on_load` is
 /// called with the loader's report as soon as the robot is loaded (the command warns about every
 /// repair there). InputError naming the key (located in the file when the file gave it) or the file,
 /// ModelError from the loader.

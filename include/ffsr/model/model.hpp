@@ -231,7 +231,7 @@ class Model {
   int end_effector_ = -1;
 };
 
-/// Builds a Model in code, or from a URDF (io/urdf.hpp uses it).
+/// Builds a Model in code, or from a URDF (parsers/urdf.hpp uses it).
 ///
 ///   Model m = ModelBuilder("base", {500, {0,0,0}, 200 * Matrix3::Identity()})
 ///                 .add_joint("j1", JointType::Revolute, "base", Pose{{0.6,0,0}}, Vector3::UnitZ(),

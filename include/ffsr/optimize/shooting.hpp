@@ -54,7 +54,7 @@ struct GlobalCaptureResult {
   bool reconfigured = false;  ///< `run` begins with a reconfiguration
   int goals_rejected = 0;     ///< reached goals whose run check_run rejected
   std::string rejection;      ///< the last rejection's message
-  /// With a clearance (io/scenario_geometry.hpp): the distance bound of the searches, m (the
+  /// With a clearance (scenario/geometry.hpp): the distance bound of the searches, m (the
   /// clearance plus the margin of the round that planned the run); manifold_optimum is the optimum
   /// under it. 0: no distance bound.
   double search_distance_bound = 0;

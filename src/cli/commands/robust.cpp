@@ -5,7 +5,7 @@
 // into the job's options and prints the summary.
 //
 // The scenario file (its keys and its [uncertainty] table) is read by the library's one reader
-// (ffsr/io/scenario.hpp); a flag overrides a key of the file.
+// (ffsr/scenario/scenario.hpp); a flag overrides a key of the file.
 #include "support/output.hpp"
 #include "support/parse.hpp"
 #include "support/progress.hpp"

@@ -1,7 +1,7 @@
 // ffsr-optimize [--config SCENARIO.toml] [flags]: the main job. Plans the approach of the robot to
 // the tumbling target twice -- plain (rho = 0) and optimized (rho of the scenario) -- and, unless
 // global = false, globally; reports how much the capture configuration lowers M_ie and the maximum
-// contact force (Tables 4 and 7). The scenario and the runs are the library's (ffsr/io/scenario.hpp,
+// contact force (Tables 4 and 7). The scenario and the runs are the library's (ffsr/scenario/scenario.hpp,
 // ffsr/jobs/scenario_run.hpp); this file turns flags into overrides and writes the outputs.
 #include "support/baseline.hpp"
 #include "support/output.hpp"

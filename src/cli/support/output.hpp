@@ -2,7 +2,7 @@
 // the one writer of files and standard output (atomic, all or nothing).
 #pragma once
 
-#include "ffsr/io/scenario.hpp"
+#include "ffsr/scenario/scenario.hpp"
 
 #include <nlohmann/json.hpp>
 

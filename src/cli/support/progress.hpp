@@ -2,7 +2,7 @@
 // progress line of a long run and the loader's warnings; --quiet silences both.
 #pragma once
 
-#include "ffsr/io/urdf.hpp"
+#include "ffsr/parsers/urdf.hpp"
 
 #include <chrono>
 #include <string>

@@ -1,8 +1,8 @@
 // src/cli/support/scenario_flags.hpp -- the scenario keys as flags (one per key of the library's key
-// table, ffsr/io/scenario.hpp: its parsers and checks).
+// table, ffsr/scenario/scenario.hpp: its parsers and checks).
 #pragma once
 
-#include "ffsr/io/scenario.hpp"
+#include "ffsr/scenario/scenario.hpp"
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>

@@ -6,7 +6,7 @@
 #include "support/scenario_flags.hpp"
 
 #include "ffsr/ffsr.hpp"
-#include "ffsr/io/scenario.hpp"
+#include "ffsr/scenario/scenario.hpp"
 #include "ffsr/jobs/subject.hpp"
 
 #include <CLI/CLI.hpp>
@@ -29,7 +29,7 @@ Scenario command_scenario(ScenarioKeys keys);
 /// The robot at one configuration, the target and the contact law that inspect, contact and map
 /// evaluate: the keys of a scenario file (--config) or of the built-in scenario, then the scenario
 /// keys given as flags (the robot and its start state, the bus, the target, the contact law), read,
-/// checked and built by the library (ffsr/io/scenario.hpp) as for the main job. --urdf replaces the
+/// checked and built by the library (ffsr/scenario/scenario.hpp) as for the main job. --urdf replaces the
 /// robot: its joint angles (--joints-deg, then required) and end-effector come from the flags alone.
 struct SubjectOptions {
   std::string config;

@@ -1,4 +1,4 @@
-// ffsr/io/detail/scenario.hxx -- bodies of ffsr/io/scenario.hpp: the model's load keys and the
+// ffsr/scenario/detail/scenario.hxx -- bodies of ffsr/scenario/scenario.hpp: the model's load keys and the
 // validation that builds the problem. The value parsers are in scenario_values.hxx, the key table and
 // the reader in scenario_keys.hxx, the [uncertainty] table in uncertainty_table.hxx.
 #pragma once

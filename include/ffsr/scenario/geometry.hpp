@@ -1,17 +1,17 @@
-// ffsr/io/scenario_geometry.hpp -- a scenario's shapes and clearance (the keys target-shape,
+// ffsr/scenario/geometry.hpp -- a scenario's shapes and clearance (the keys target-shape,
 // target-size, target-shape-offset, link-radius, bus-box, clearance, contact-exemption): the
 // collision model built with the scenario, its checks (the contact point on the target's surface, the
 // start configuration within the clearance). The runs that use it are in ffsr/jobs/scenario_clearance.hpp.
-// Included by io/scenario.hpp; needs ffsr::geometry (FCL) when a
+// Included by scenario/scenario.hpp; needs ffsr::geometry (FCL) when a
 // scenario uses the keys: without it (FFSR_HAVE_GEOMETRY undefined) such a scenario is refused.
 #pragma once
 
 #include "ffsr/geometry/shape.hpp"
-#include "ffsr/io/scenario.hpp"
+#include "ffsr/scenario/scenario.hpp"
 
 #ifdef FFSR_HAVE_GEOMETRY
 #include "ffsr/geometry/clearance.hpp"
-#include "ffsr/io/urdf_collision.hpp"
+#include "ffsr/parsers/urdf_collision.hpp"
 #endif
 
 #include <algorithm>

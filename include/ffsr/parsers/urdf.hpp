@@ -1,4 +1,4 @@
-// ffsr/io/urdf.hpp -- URDF -> Model, through urdfdom. Link with ffsr::urdf.
+// ffsr/parsers/urdf.hpp -- URDF -> Model, through urdfdom. Link with ffsr::urdf.
 //
 // The root link is the free-floating base, or (UrdfOptions::bus) the URDF is mounted on a
 // spacecraft bus that becomes the base, its root link and every link fixed to it merged into the bus.
@@ -11,9 +11,9 @@
 // the element, or the option.
 //
 // The loader's bodies are compiled once, in the library of the CMake target ffsr::urdf
-// (src/urdf/loader.cpp, with urdfdom), so that a program that loads a URDF does not compile the
+// (src/parsers/urdf.cpp, with urdfdom), so that a program that loads a URDF does not compile the
 // parser: this header declares the entry points and includes neither urdfdom nor the parser's
-// internals (those are in io/detail/urdf_document.hpp).
+// internals (those are in parsers/detail/urdf_document.hpp).
 #pragma once
 
 #include "ffsr/model/model.hpp"

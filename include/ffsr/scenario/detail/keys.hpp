@@ -1,4 +1,4 @@
-// ffsr/io/detail/scenario_keys.hxx -- the key table of ffsr/io/scenario.hpp (every key in one entry:
+// ffsr/scenario/detail/keys.hpp -- the key table of ffsr/scenario/scenario.hpp (every key in one entry:
 // name, kind, help, group, required, check, echo) and the reader of a scenario file. Adding a key is
 // one entry here, its member in ScenarioKeys and its line in docs/scenario-keys.md.
 #pragma once
@@ -255,7 +255,7 @@ inline void add_global_keys(std::vector<ScenarioKey>& keys) {
 }
 
 /// The joints during the contact (algorithm/joint_models.hpp) and the multibody reference's servo;
-/// shapes and clearance (io/scenario_geometry.hpp, docs/geometry.md).
+/// shapes and clearance (scenario/geometry.hpp, docs/geometry.md).
 inline void add_joint_and_shape_keys(std::vector<ScenarioKey>& keys) {
   using G = KeyGroup;
   using K = ScenarioKeys;

@@ -1,6 +1,6 @@
-// src/urdf/loader.cpp -- the entry points of the URDF loader (io/urdf.hpp), compiled once into the
-// library of the CMake target ffsr::urdf. Their documentation is in io/urdf.hpp.
-#include "ffsr/io/detail/urdf_document.hpp"
+// src/parsers/urdf.cpp -- the entry points of the URDF loader (parsers/urdf.hpp), compiled once into the
+// library of the CMake target ffsr::urdf. Their documentation is in parsers/urdf.hpp.
+#include "ffsr/parsers/detail/urdf_document.hpp"
 
 #include <filesystem>
 #include <fstream>

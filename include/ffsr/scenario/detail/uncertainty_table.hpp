@@ -1,5 +1,5 @@
-// ffsr/io/detail/uncertainty_table.hxx -- the [uncertainty] table of a scenario file
-// (ffsr/io/scenario.hpp: uncertainty_spec), read into the sampler's laws (uncertainty/sampling.hpp).
+// ffsr/scenario/detail/uncertainty_table.hpp -- the [uncertainty] table of a scenario file
+// (ffsr/scenario/scenario.hpp: uncertainty_spec), read into the sampler's laws (uncertainty/sampling.hpp).
 #pragma once
 
 namespace ffsr {

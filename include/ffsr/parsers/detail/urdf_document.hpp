@@ -1,11 +1,11 @@
-// ffsr/io/detail/urdf_document.hpp -- the URDF loader's internals, through urdfdom: the parse of the
+// ffsr/parsers/detail/urdf_document.hpp -- the URDF loader's internals, through urdfdom: the parse of the
 // text (parse_urdf_document) and the model of a parsed document (model_from_urdf_document), with
-// their checks. Compiled into the library of ffsr::urdf (src/urdf/loader.cpp); included by the URDF
-// collision elements (io/urdf_collision.hpp) and by tests. A program that loads a URDF includes
-// io/urdf.hpp instead.
+// their checks. Compiled into the library of ffsr::urdf (src/parsers/urdf.cpp); included by the URDF
+// collision elements (parsers/urdf_collision.hpp) and by tests. A program that loads a URDF includes
+// parsers/urdf.hpp instead.
 #pragma once
 
-#include "ffsr/io/urdf.hpp"
+#include "ffsr/parsers/urdf.hpp"
 
 #include <console_bridge/console.h>
 #include <tinyxml.h>

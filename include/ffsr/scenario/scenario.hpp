@@ -1,4 +1,4 @@
-// ffsr/io/scenario.hpp -- a capture scenario as a value: its keys, one TOML reader (toml++, the
+// ffsr/scenario/scenario.hpp -- a capture scenario as a value: its keys, one TOML reader (toml++, the
 // [uncertainty] table included), overrides given as text (a command line), one validation, and the
 // problem it describes. Component ffsr::scenario (urdfdom, SUNDIALS, NLopt, toml++, nlohmann/json).
 //
@@ -13,7 +13,7 @@
 #pragma once
 
 #include "ffsr/errors.hpp"
-#include "ffsr/io/urdf.hpp"
+#include "ffsr/parsers/urdf.hpp"
 #include "ffsr/optimize/capture.hpp"
 #include "ffsr/optimize/global.hpp"
 #include "ffsr/uncertainty/sampling.hpp"
@@ -81,7 +81,7 @@ struct ScenarioKeys {
   std::shared_ptr<const toml::table> document;  ///< the file as read (its [uncertainty] table)
   // the spacecraft's side: the reaction-null-space approach
   std::string base_attitude = "free";  ///< free or hold (the optimized run keeps w_0 = 0)
-  // shapes and clearance (io/scenario_geometry.hpp)
+  // shapes and clearance (scenario/geometry.hpp)
   std::string target_shape;  ///< box, sphere, cylinder; empty: none
   std::vector<double> target_size, target_shape_offset, link_radius{0.05}, bus_box;
   double clearance = 0, contact_exemption = 0.2;
@@ -186,7 +186,7 @@ long scenario_key_line(const ScenarioKeys& keys, const std::string& name);
 /// gave that key: "scenario FILE:LINE: --duration: ...". Unchanged otherwise.
 std::string located_key_message(const ScenarioKeys& keys, const std::string& message);
 
-struct SceneGeometry;  // io/scenario_geometry.hpp
+struct SceneGeometry;  // scenario/geometry.hpp
 
 /// A validated scenario: the robot, the capture problem, the tasks of the optimized and the plain
 /// run, the optimized run's options (the plain run uses gain 0) and the global run's settings.
@@ -230,8 +230,8 @@ UncertaintySpec uncertainty_spec(const ScenarioKeys& keys, std::optional<std::ui
 
 }  // namespace ffsr
 
-#include "ffsr/io/scenario_geometry.hpp"
-#include "ffsr/io/detail/scenario_values.hxx"
-#include "ffsr/io/detail/scenario_keys.hxx"
-#include "ffsr/io/detail/scenario.hxx"
-#include "ffsr/io/detail/uncertainty_table.hxx"
+#include "ffsr/scenario/geometry.hpp"
+#include "ffsr/scenario/detail/values.hpp"
+#include "ffsr/scenario/detail/keys.hpp"
+#include "ffsr/scenario/detail/scenario.hxx"
+#include "ffsr/scenario/detail/uncertainty_table.hpp"

@@ -1,6 +1,6 @@
-// ffsr/io/detail/scenario_values.hxx -- the value parsers of the scenario keys (one per kind of
+// ffsr/scenario/detail/values.hpp -- the value parsers of the scenario keys (one per kind of
 // value, from a TOML node and from text), the constructor of a key-table entry and the checks of one
-// value. Part of ffsr/io/scenario.hpp.
+// value. Part of ffsr/scenario/scenario.hpp.
 #pragma once
 
 #include <algorithm>

@@ -1,11 +1,11 @@
-// ffsr/io/urdf_collision.hpp -- the <collision> primitives of a URDF (box, sphere, cylinder), for
+// ffsr/parsers/urdf_collision.hpp -- the <collision> primitives of a URDF (box, sphere, cylinder), for
 // geometry/shape.hpp's robot_geometry. Meshes are not read (the files do not ship them); each is
 // listed as a mesh, so that its body also gets capsules along its centre lines (a Panda's hand body
 // has the finger pads' boxes, and its meshes are the hand itself). Component ffsr::urdf.
 #pragma once
 
 #include "ffsr/geometry/shape.hpp"
-#include "ffsr/io/detail/urdf_document.hpp"
+#include "ffsr/parsers/detail/urdf_document.hpp"
 
 #include <fstream>
 #include <sstream>
