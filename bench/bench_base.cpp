@@ -7,8 +7,8 @@
 // base pose (optimize/pareto.hpp, default options), and prints its size, ends, knee, hypervolume
 // and evaluations, the ends against the global search's manifold optimum, and the optimized run
 // with base-attitude = hold beside the free one. Target: the front in < 10 s on one core.
-#include <ffsr/jobs/scenario_run.hpp>
-#include <ffsr/optimize/pareto.hpp>
+#include "ffsr/jobs/scenario_run.hpp"
+#include "ffsr/optimize/pareto.hpp"
 
 #include <chrono>
 #include <cstdio>

@@ -7,7 +7,7 @@
 // of ffsr::Data cannot change them. The argument checks are kept (they are part of the old cost).
 #pragma once
 
-#include <ffsr/model/model.hpp>
+#include "ffsr/model/model.hpp"
 
 #include <cmath>
 #include <vector>

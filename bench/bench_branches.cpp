@@ -15,8 +15,8 @@
 // orientation the task alone cannot reach.
 // Wall and process CPU time are printed; the CPU time is the one-core cost on a shared machine.
 // Target: the global plan under 2 s for each scenario in Release.
-#include <ffsr/scenario/scenario.hpp>
-#include <ffsr/optimize/branches.hpp>
+#include "ffsr/scenario/scenario.hpp"
+#include "ffsr/optimize/branches.hpp"
 
 #include <algorithm>
 #include <chrono>

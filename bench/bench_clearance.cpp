@@ -8,9 +8,9 @@
 // robots/paper_3dof_clearance.toml; the plain and the paper's runs are made first and not timed.
 // Best of 3, with the search's evaluations and the reaching runs. Target for the 7-DOF scenario:
 // < 5 s in Release. DIR holds the scenario files (default FFSR_SOURCE_DIR/robots).
-#include <ffsr/scenario/scenario.hpp>
-#include <ffsr/jobs/scenario_clearance.hpp>
-#include <ffsr/jobs/scenario_run.hpp>
+#include "ffsr/scenario/scenario.hpp"
+#include "ffsr/jobs/scenario_clearance.hpp"
+#include "ffsr/jobs/scenario_run.hpp"
 
 #include <algorithm>
 #include <chrono>

@@ -6,8 +6,8 @@
 // Targets: closed form < 1 µs, exact < 20 µs.
 #pragma once
 
-#include <ffsr/contact/contact_law.hpp>
-#include <ffsr/simulate/single_body.hpp>
+#include "ffsr/contact/contact_law.hpp"
+#include "ffsr/simulate/single_body.hpp"
 
 #include <algorithm>
 #include <chrono>

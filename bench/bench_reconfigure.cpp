@@ -9,8 +9,8 @@
 // takes the reconfiguration whatever the search finds. The plain and the paper's runs are made
 // first and not timed. Best of 3. Target: < 2 s in Release. DIR holds paper_7dof_pose.toml (default
 // FFSR_SOURCE_DIR/robots).
-#include <ffsr/scenario/scenario.hpp>
-#include <ffsr/jobs/scenario_run.hpp>
+#include "ffsr/scenario/scenario.hpp"
+#include "ffsr/jobs/scenario_run.hpp"
 
 #include <algorithm>
 #include <chrono>
