@@ -1,12 +1,4 @@
 // bench/bench_base.cpp -- ffsr-bench-base: the spacecraft's side on robots/paper_7dof_position.toml.
-//
-//   ffsr-bench-base [SCENARIO] [--csv FILE]
-//
-// Runs the main job once (plain, optimized, global; not timed), then times (steady_clock, wall, one
-// thread) the front of (M_ie, base angular rate jump) on the capture manifold at the global run's
-// base pose (optimize/pareto.hpp, default options), and prints its size, ends, knee, hypervolume
-// and evaluations, the ends against the global search's manifold optimum, and the optimized run
-// with base-attitude = hold beside the free one. Target: the front in < 10 s on one core.
 #include "ffsr/jobs/scenario_run.hpp"
 #include "ffsr/optimize/pareto.hpp"
 
@@ -14,6 +6,14 @@
 #include <cstdio>
 #include <fstream>
 #include <string>
+
+//   ffsr-bench-base [SCENARIO] [--csv FILE]
+//
+// Runs the main job once (plain, optimized, global; not timed), then times (steady_clock, wall, one
+// thread) the front of (M_ie, base angular rate jump) on the capture manifold at the global run's
+// base pose (optimize/pareto.hpp, default options), and prints its size, ends, knee, hypervolume
+// and evaluations, the ends against the global search's manifold optimum, and the optimized run
+// with base-attitude = hold beside the free one. Target: the front in < 10 s on one core.
 
 namespace {
 

@@ -1,9 +1,6 @@
 // bench/bench_contact.hpp -- benchmarks of the contact hot paths (included by bench_main.cpp):
 //   the closed-form F_max (Eq. 24), the exact single-body F_max (bracketed Newton on Eq. 19),
 //   and one CVODE run of the single-body model Eq. 16 from first touch to separation.
-// Each reports the median over several batches of the time per call (std::chrono::steady_clock);
-// the results feed a volatile sink and the inputs vary per call so nothing is optimized away.
-// Targets: closed form < 1 µs, exact < 20 µs.
 #pragma once
 
 #include "ffsr/contact/contact_law.hpp"
@@ -14,6 +11,10 @@
 #include <cstdio>
 #include <ostream>
 #include <vector>
+
+// Each reports the median over several batches of the time per call (std::chrono::steady_clock);
+// the results feed a volatile sink and the inputs vary per call so nothing is optimized away.
+// Targets: closed form < 1 µs, exact < 20 µs.
 
 namespace ffsr::bench {
 

@@ -1,14 +1,4 @@
 // bench/bench_robust.cpp -- ffsr-bench-robust: the Monte Carlo of uncertain targets on the 7-DOF robot.
-//
-//   ffsr-bench-robust [--quick] [DIR]
-//
-// Times (steady_clock, wall) drawing and evaluating 1e5 samples with the exact single-body F_max,
-// and 1e3 samples with the multibody CVODE model, both on 2 threads, with the spreads of
-// robots/paper_7dof_position_uncertain.toml around the paper's 7-DOF position scenario at the
-// capture configuration given below, the percentiles conditional on the stiffness as the CLI computes
-// them (summary included in the time). Targets: < 2 s and < 30 s on 2 cores. Then the
-// scatter of the p95 from disjoint blocks of 1000 samples, both estimators. --quick:
-// 1e4 and 20 samples (a smoke run). DIR holds paper_7dof.urdf (default FFSR_SOURCE_DIR/robots).
 #include "ffsr/detail/parallel.hpp"
 #include "ffsr/ffsr.hpp"
 #include "ffsr/parsers/urdf.hpp"
@@ -22,6 +12,16 @@
 #include <cstdio>
 #include <string>
 #include <vector>
+
+//   ffsr-bench-robust [--quick] [DIR]
+//
+// Times (steady_clock, wall) drawing and evaluating 1e5 samples with the exact single-body F_max,
+// and 1e3 samples with the multibody CVODE model, both on 2 threads, with the spreads of
+// robots/paper_7dof_position_uncertain.toml around the paper's 7-DOF position scenario at the
+// capture configuration given below, the percentiles conditional on the stiffness as the CLI computes
+// them (summary included in the time). Targets: < 2 s and < 30 s on 2 cores. Then the
+// scatter of the p95 from disjoint blocks of 1000 samples, both estimators. --quick:
+// 1e4 and 20 samples (a smoke run). DIR holds paper_7dof.urdf (default FFSR_SOURCE_DIR/robots).
 
 namespace {
 
