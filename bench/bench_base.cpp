@@ -1,5 +1,12 @@
 // bench/bench_base.cpp -- ffsr-bench-base: the spacecraft's side on robots/paper_7dof_position.toml.
-//
+#include "ffsr/jobs/scenario_run.hpp"
+#include "ffsr/optimize/pareto.hpp"
+
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <string>
+
 //   ffsr-bench-base [SCENARIO] [--csv FILE]
 //
 // Runs the main job once (plain, optimized, global; not timed), then times (steady_clock, wall, one
@@ -7,13 +14,6 @@
 // base pose (optimize/pareto.hpp, default options), and prints its size, ends, knee, hypervolume
 // and evaluations, the ends against the global search's manifold optimum, and the optimized run
 // with base-attitude = hold beside the free one. Target: the front in < 10 s on one core.
-#include <ffsr/jobs/scenario_run.hpp>
-#include <ffsr/optimize/pareto.hpp>
-
-#include <chrono>
-#include <cstdio>
-#include <fstream>
-#include <string>
 
 namespace {
 

@@ -1,16 +1,16 @@
 // bench/bench_before.hpp -- the CRBA and the M_ie paths as they were before the allocation-free
 // fixed-size rewrite (ffsr 0.1.0 at commit 5e16f05), frozen here so that ffsr-bench-pinocchio times
 // the current code, this code and Pinocchio in one run: a regression shows at every size.
-//
-// Copied from include/ffsr/algorithm/{kinematics,crba,effective_mass,articulated_effective_mass}.hpp
-// and spatial/spatial.hpp of that commit, with their own workspace (BeforeData) so that later changes
-// of ffsr::Data cannot change them. The argument checks are kept (they are part of the old cost).
 #pragma once
 
-#include <ffsr/model/model.hpp>
+#include "ffsr/model/model.hpp"
 
 #include <cmath>
 #include <vector>
+
+// Copied from include/ffsr/algorithm/{kinematics,crba,effective_mass,articulated_effective_mass}.hpp
+// and spatial/spatial.hpp of that commit, with their own workspace (BeforeData) so that later changes
+// of ffsr::Data cannot change them. The argument checks are kept (they are part of the old cost).
 
 namespace ffsr_bench::before {
 

@@ -1,5 +1,17 @@
 // bench/bench_branches.cpp -- ffsr-bench-branches: the branch search of the capture manifold.
-//
+#include "ffsr/scenario/scenario.hpp"
+#include "ffsr/optimize/branches.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <ctime>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
 //   ffsr-bench-branches [--quick]
 //
 // For the UR5 pose scenario (tests/data/ur5_pose.toml; skipped with a line when the URDF sample is
@@ -15,18 +27,6 @@
 // orientation the task alone cannot reach.
 // Wall and process CPU time are printed; the CPU time is the one-core cost on a shared machine.
 // Target: the global plan under 2 s for each scenario in Release.
-#include <ffsr/scenario/scenario.hpp>
-#include <ffsr/optimize/branches.hpp>
-
-#include <algorithm>
-#include <chrono>
-#include <ctime>
-#include <cstdio>
-#include <cstring>
-#include <filesystem>
-#include <functional>
-#include <string>
-#include <vector>
 
 namespace {
 

@@ -1,21 +1,21 @@
 // bench/bench_clearance.cpp -- ffsr-bench-clearance: the global plan with a clearance, as the main
 // job makes it (run_global: the search with the distance constraints, the reaching runs checked
 // along their paths, the later rounds), on the paper's clearance scenarios.
-//
+#include "ffsr/scenario/scenario.hpp"
+#include "ffsr/jobs/scenario_clearance.hpp"
+#include "ffsr/jobs/scenario_run.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <string>
+
 //   ffsr-bench-clearance [DIR]
 //
 // Times (steady_clock, wall, one thread) run_global on robots/paper_7dof_position_clearance.toml and
 // robots/paper_3dof_clearance.toml; the plain and the paper's runs are made first and not timed.
 // Best of 3, with the search's evaluations and the reaching runs. Target for the 7-DOF scenario:
 // < 5 s in Release. DIR holds the scenario files (default FFSR_SOURCE_DIR/robots).
-#include <ffsr/scenario/scenario.hpp>
-#include <ffsr/jobs/scenario_clearance.hpp>
-#include <ffsr/jobs/scenario_run.hpp>
-
-#include <algorithm>
-#include <chrono>
-#include <cstdio>
-#include <string>
 
 namespace {
 

@@ -1,17 +1,6 @@
 // The closed loop of the capture controller (control/closed_loop.hpp) over seeds: capture error
 // and M_ie against the open-loop plan, the global plan's servo (its capture configuration read from
 // the stored baseline tests/data/baselines/<scenario>.json) on a paper scenario.
-// Run (Release): build/bench/ffsr-bench-closed-loop [--scenario paper_7dof_position] [--seeds 20]
-//   [--control-rate 1000] [--estimate-rate 5] [--position-noise 0.005] [--attitude-noise-deg 0.5]
-//   [--spin-noise-deg 0] [--policy servo|gradient] [--bandwidth 50] [--torque-limit 100] [--window 1]
-//   [--first-seed 1] [--no-exact] [--integrator rk|cvode] [--rtol 1e-9] [--atol 1e-12] [--reference]
-// Prints the exact-target run, one line per seed, then the worst and the median. Seeds first-seed to
-// first-seed + seeds - 1: split a long study into processes run side by side (e.g. GNU parallel).
-// --reference runs the exact target a second time with CVODE restarted at every tick
-// (ClosedLoopIntegrator::CvodeRestart) at the default rtol and atol (--rtol and --atol set the
-// measured run's) and prints the differences of capture error, M_ie and largest
-// torque and the ratio of the two wall times. Times are wall clock of the simulation alone (the plan
-// and the controller's construction are outside).
 
 #include "support/baselines.hpp"
 
@@ -25,6 +14,18 @@
 #include <cstdlib>
 #include <string>
 #include <vector>
+
+// Run (Release): build/bench/ffsr-bench-closed-loop [--scenario paper_7dof_position] [--seeds 20]
+//   [--control-rate 1000] [--estimate-rate 5] [--position-noise 0.005] [--attitude-noise-deg 0.5]
+//   [--spin-noise-deg 0] [--policy servo|gradient] [--bandwidth 50] [--torque-limit 100] [--window 1]
+//   [--first-seed 1] [--no-exact] [--integrator rk|cvode] [--rtol 1e-9] [--atol 1e-12] [--reference]
+// Prints the exact-target run, one line per seed, then the worst and the median. Seeds first-seed to
+// first-seed + seeds - 1: split a long study into processes run side by side (e.g. GNU parallel).
+// --reference runs the exact target a second time with CVODE restarted at every tick
+// (ClosedLoopIntegrator::CvodeRestart) at the default rtol and atol (--rtol and --atol set the
+// measured run's) and prints the differences of capture error, M_ie and largest
+// torque and the ratio of the two wall times. Times are wall clock of the simulation alone (the plan
+// and the controller's construction are outside).
 
 namespace {
 

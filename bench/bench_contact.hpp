@@ -1,19 +1,20 @@
 // bench/bench_contact.hpp -- benchmarks of the contact hot paths (included by bench_main.cpp):
 //   the closed-form F_max (Eq. 24), the exact single-body F_max (bracketed Newton on Eq. 19),
 //   and one CVODE run of the single-body model Eq. 16 from first touch to separation.
-// Each reports the median over several batches of the time per call (std::chrono::steady_clock);
-// the results feed a volatile sink and the inputs vary per call so nothing is optimized away.
-// Targets: closed form < 1 µs, exact < 20 µs.
 #pragma once
 
-#include <ffsr/contact/contact_law.hpp>
-#include <ffsr/simulate/single_body.hpp>
+#include "ffsr/contact/contact_law.hpp"
+#include "ffsr/simulate/single_body.hpp"
 
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <ostream>
 #include <vector>
+
+// Each reports the median over several batches of the time per call (std::chrono::steady_clock);
+// the results feed a volatile sink and the inputs vary per call so nothing is optimized away.
+// Targets: closed form < 1 µs, exact < 20 µs.
 
 namespace ffsr::bench {
 

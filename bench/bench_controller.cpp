@@ -1,12 +1,6 @@
 // Timings of the capture controller (control/capture_controller.hpp): step() per tick, median and
-// 99.9th percentile over 1e5 calls, and update_target() median, on the paper's 3-DOF robot and the
-// 7-DOF robot (position and pose tasks), paper's gradient policy and the servo. One thread, pinned
-// to one core when the system allows it. Run (Release): build/bench/ffsr-bench-controller [robots/]
-// [--calls N] [--cpu K]. Prints one line per case; exit status 1 when a step median exceeds its budget
-// (3-DOF 5 us, 7-DOF 20 us) or the 99.9th percentile exceeds 3x the median.
-// First line: a reference workload timed the same way (a fixed chain of 6x6 products, no branch, no
-// memory beyond the stack, about as long as a 3-DOF step). Its p99.9 / median is the machine's
-// (timer interrupts, a hypervisor's steal): a controller ratio near it is not the controller's tail.
+// 99.9th percentile over 1e5 calls, and update_target() median, on the paper's 3-DOF and 7-DOF robots.
+// Exit status 1 when a step exceeds its budget (details after the includes).
 
 #include "ffsr/control/capture_controller.hpp"
 #include "ffsr/scenario/scenario.hpp"
@@ -20,6 +14,16 @@
 #include <cstdlib>
 #include <string>
 #include <vector>
+
+// Timings of the capture controller (control/capture_controller.hpp): step() per tick, median and
+// 99.9th percentile over 1e5 calls, and update_target() median, on the paper's 3-DOF robot and the
+// 7-DOF robot (position and pose tasks), paper's gradient policy and the servo. One thread, pinned
+// to one core when the system allows it. Run (Release): build/bench/ffsr-bench-controller [robots/]
+// [--calls N] [--cpu K]. Prints one line per case; exit status 1 when a step median exceeds its budget
+// (3-DOF 5 us, 7-DOF 20 us) or the 99.9th percentile exceeds 3x the median.
+// First line: a reference workload timed the same way (a fixed chain of 6x6 products, no branch, no
+// memory beyond the stack, about as long as a 3-DOF step). Its p99.9 / median is the machine's
+// (timer interrupts, a hypervisor's steal): a controller ratio near it is not the controller's tail.
 
 namespace {
 

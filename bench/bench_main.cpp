@@ -20,12 +20,12 @@
 // skipped there; each simulation and capture run happens once).
 #include <cstdlib>  // first: defines __GLIBC__
 
-#include <ffsr/ffsr.hpp>
-#include <ffsr/parsers/urdf.hpp>
-#include <ffsr/optimize/capture.hpp>
-#include <ffsr/simulate/multibody.hpp>
+#include "ffsr/ffsr.hpp"
+#include "ffsr/parsers/urdf.hpp"
+#include "ffsr/optimize/capture.hpp"
+#include "ffsr/simulate/multibody.hpp"
 #ifdef FFSR_HAVE_GLOBAL
-#include <ffsr/optimize/global.hpp>
+#include "ffsr/optimize/global.hpp"
 #endif
 
 #include "bench_contact.hpp"

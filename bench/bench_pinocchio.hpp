@@ -2,7 +2,7 @@
 // compiled apart so that Pinocchio's include folder never meets ffsr's URDF loader.
 #pragma once
 
-#include <ffsr/model/model.hpp>
+#include "ffsr/model/model.hpp"
 
 #include <ctime>
 #include <memory>

@@ -1,6 +1,14 @@
 // bench/bench_reconfigure.cpp -- ffsr-bench-reconfigure: the whole global plan of the paper's 7-DOF
 // pose scenario (robots/paper_7dof_pose.toml) with the reconfiguration before the approach.
-//
+#include "ffsr/scenario/scenario.hpp"
+#include "ffsr/jobs/scenario_run.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <string>
+
 //   ffsr-bench-reconfigure [DIR]
 //
 // Times (steady_clock, wall, one thread) plan_capture_global as the scenario's global run calls it
@@ -9,14 +17,6 @@
 // takes the reconfiguration whatever the search finds. The plain and the paper's runs are made
 // first and not timed. Best of 3. Target: < 2 s in Release. DIR holds paper_7dof_pose.toml (default
 // FFSR_SOURCE_DIR/robots).
-#include <ffsr/scenario/scenario.hpp>
-#include <ffsr/jobs/scenario_run.hpp>
-
-#include <algorithm>
-#include <chrono>
-#include <cmath>
-#include <cstdio>
-#include <string>
 
 namespace {
 

@@ -1,5 +1,18 @@
 // bench/bench_robust.cpp -- ffsr-bench-robust: the Monte Carlo of uncertain targets on the 7-DOF robot.
-//
+#include "ffsr/detail/parallel.hpp"
+#include "ffsr/ffsr.hpp"
+#include "ffsr/parsers/urdf.hpp"
+#include "ffsr/optimize/capture.hpp"
+#include "ffsr/uncertainty/multibody.hpp"
+#include "ffsr/uncertainty/sampling.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
 //   ffsr-bench-robust [--quick] [DIR]
 //
 // Times (steady_clock, wall) drawing and evaluating 1e5 samples with the exact single-body F_max,
@@ -9,18 +22,6 @@
 // them (summary included in the time). Targets: < 2 s and < 30 s on 2 cores. Then the
 // scatter of the p95 from disjoint blocks of 1000 samples, both estimators. --quick:
 // 1e4 and 20 samples (a smoke run). DIR holds paper_7dof.urdf (default FFSR_SOURCE_DIR/robots).
-#include <ffsr/ffsr.hpp>
-#include <ffsr/parsers/urdf.hpp>
-#include <ffsr/optimize/capture.hpp>
-#include <ffsr/uncertainty/multibody.hpp>
-#include <ffsr/uncertainty/sampling.hpp>
-
-#include <algorithm>
-#include <chrono>
-#include <cmath>
-#include <cstdio>
-#include <string>
-#include <vector>
 
 namespace {
 
@@ -142,7 +143,7 @@ int main(int argc, char** argv) {
     run.f.resize(n_exact);
     Data data(model);
     const Matrix6 G = robot_inverse_inertia(model, data, base, theta, frame);
-    parallel_for(0, n_exact, 2, [&](std::uint64_t i) {
+    detail::parallel_for(n_exact, 2, [&](std::uint64_t i) {
       run.samples[i] = draw_sample(spec, nominal, i);
       run.f[i] = sample_force(G, run.samples[i], law, ForceModel::Exact).f_max;
     });
@@ -160,7 +161,7 @@ int main(int argc, char** argv) {
     print_block_scatter(run, k_law, nominal.contact.K);
     t = clock_type::now();
     std::vector<double> fm(n_mb);
-    parallel_for(0, n_mb, 2, [&](std::uint64_t i) {
+    detail::parallel_for(n_mb, 2, [&](std::uint64_t i) {
       fm[i] = sample_force_multibody(model, base, theta, frame, run.samples[i], law).f_max;
     });
     const double t_mb = seconds_since(t);

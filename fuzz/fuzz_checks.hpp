@@ -1,9 +1,4 @@
 // fuzz/fuzz_checks.hpp -- what every fuzz target asserts, shared with tests/test_fuzz_regressions.cpp.
-//
-// The contract under test: for any input the library either returns finite numbers or throws an
-// ffsr::Error subclass. A check that fails throws Finding (deliberately not an ffsr::Error); the
-// libFuzzer entry points turn it into abort() (a crash libFuzzer records), the Catch2 regression test
-// into a failed assertion. Any other exception type escaping the library is a Finding too.
 #pragma once
 
 #include "ffsr/errors.hpp"
@@ -19,6 +14,11 @@
 #include <stdexcept>
 #include <string>
 #include <typeinfo>
+
+// The contract under test: for any input the library either returns finite numbers or throws an
+// ffsr::Error subclass. A check that fails throws Finding (deliberately not an ffsr::Error); the
+// libFuzzer entry points turn it into abort() (a crash libFuzzer records), the Catch2 regression test
+// into a failed assertion. Any other exception type escaping the library is a Finding too.
 
 namespace ffsr_fuzz {
 

@@ -1,9 +1,6 @@
 // fuzz/numeric_check.hpp -- the fuzz_numeric check: raw doubles (NaN, inf, zero, denormals, huge values)
 // into the numeric entry points on the paper's robots. Each call returns finite numbers or throws an
 // ffsr::Error.
-//
-// Input layout: one selector byte (entry point and robot), then the arguments as 8-byte doubles and a
-// few bytes, in the order they are read below. Missing values take the paper's (Section 5.1 / 5.2).
 #pragma once
 
 #include "fuzz_checks.hpp"
@@ -15,6 +12,9 @@
 #include "ffsr/simulate/multibody.hpp"
 
 #include <string>
+
+// Input layout: one selector byte (entry point and robot), then the arguments as 8-byte doubles and a
+// few bytes, in the order they are read below. Missing values take the paper's (Section 5.1 / 5.2).
 
 namespace ffsr_fuzz {
 

@@ -1,17 +1,6 @@
 // fuzz/scenario_check.hpp -- the fuzz_scenario check, shared by the libFuzzer harness (which runs the
 // command's code in-process, fuzz_scenario.cpp) and tests/test_fuzz_regressions.cpp (which runs the
 // built ffsr-optimize on each reproducer).
-//
-// A scenario text is run as `ffsr-optimize [robust] --config DIR/scenario.toml` plus the rest of
-// scenario_arguments() (robust when the text has an [uncertainty] table): a short bounded run (command-line flags override the file) whose outputs go to DIR. The URDFs the
-// seed scenarios name (paper_3dof.urdf, paper_7dof.urdf) are copied into DIR. Asserted afterwards:
-//  - the exit code is 0, 4 (written; differs from an --expect baseline), 2 (bad input) or 3 (numerical
-//    failure): 1 means an exception that is not an
-//    ffsr::Error or a CLI11 parse error reached main;
-//  - a failed run leaves no output file and no temporary file behind;
-//  - a successful run's JSON parses and has no null (nlohmann writes NaN and inf as null; only the
-//    reductions against a run that failed, {"error": message}, are null) and no non-finite number,
-//    its CSV and its terminal table contain no nan or inf.
 #pragma once
 
 #include "fuzz_checks.hpp"
@@ -25,6 +14,17 @@
 #include <sstream>
 #include <string>
 #include <vector>
+
+// A scenario text is run as `ffsr-optimize [robust] --config DIR/scenario.toml` plus the rest of
+// scenario_arguments() (robust when the text has an [uncertainty] table): a short bounded run
+// (command-line flags override the file) whose outputs go to DIR. The URDFs the seed scenarios name
+// (paper_3dof.urdf, paper_7dof.urdf) are copied into DIR. Asserted afterwards:
+//  - the exit code is 0, 4 (written; differs from an --expect baseline), 2 (bad input) or 3 (numerical
+//    failure): 1 means an exception that is not an ffsr::Error or a CLI11 parse error reached main;
+//  - a failed run leaves no output file and no temporary file behind;
+//  - a successful run's JSON parses and has no null (nlohmann writes NaN and inf as null; only the
+//    reductions against a run that failed, {"error": message}, are null) and no non-finite number,
+//    its CSV and its terminal table contain no nan or inf.
 
 namespace ffsr_fuzz {
 

@@ -1,11 +1,4 @@
 // ffsr/errors.hpp -- the exception hierarchy of the library.
-//
-// The library never prints and never exits: every failure is thrown as one of these types.
-//   InputError       -- a caller's argument is wrong (size, non-finite value, range, unknown name)
-//   ModelError       -- a URDF file or a programmatically built tree is malformed or unphysical
-//   NumericalError   -- a computation cannot give an answer (singular matrix, no convergence)
-//   IntegrationError -- SUNDIALS CVODE reported a failure (the message names the flag)
-// Messages name the function and the offending argument, what was expected and what came.
 #pragma once
 
 #include <Eigen/Core>
@@ -14,6 +7,13 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+
+// The library never prints and never exits: every failure is thrown as one of these types.
+//   InputError       -- a caller's argument is wrong (size, non-finite value, range, unknown name)
+//   ModelError       -- a URDF file or a programmatically built tree is malformed or unphysical
+//   NumericalError   -- a computation cannot give an answer (singular matrix, no convergence)
+//   IntegrationError -- SUNDIALS CVODE reported a failure (the message names the flag)
+// Messages name the function and the offending argument, what was expected and what came.
 
 namespace ffsr {
 

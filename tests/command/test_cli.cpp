@@ -2,10 +2,6 @@
 // scenario), their JSON/CSV outputs against the paper (Tables 3 and 4), and a catalogue of bad
 // inputs, each of which must give exit code 2 (3 for a capture point out of reach) and one error
 // line on stderr naming the offending input, print no result and leave no output file behind.
-//
-// The command is run without a shell (tests/support/run_command.hpp), from a fresh temporary
-// directory, with absolute paths to the repository's files, so nothing depends on the working
-// directory of the test runner.
 #include "support/command.hpp"
 
 #include "ffsr/contact/contact_law.hpp"
@@ -24,6 +20,10 @@
 #include <sstream>
 #include <string>
 #include <vector>
+
+// The command is run without a shell (tests/support/run_command.hpp), from a fresh temporary
+// directory, with absolute paths to the repository's files, so nothing depends on the working
+// directory of the test runner.
 
 namespace test_cli {
 

@@ -3,7 +3,6 @@
 // --json FILE and --json - everywhere (standard output then holds one JSON document and nothing
 // else); a bad value in a scenario file names the file, the key and its line; an unknown key names
 // the nearest known one; --config with --urdf keeps the file's other keys in every subcommand.
-// Small runs only (the built-in 3-DOF scenario, a few samples, coarse grids): the cases run in CI.
 #include "support/command.hpp"
 
 #include "ffsr/scenario/scenario.hpp"
@@ -22,6 +21,8 @@
 #include <string>
 #include <thread>
 #include <vector>
+
+// Small runs only (the built-in 3-DOF scenario, a few samples, coarse grids): the cases run in CI.
 
 namespace test_conventions {
 

@@ -1,10 +1,6 @@
 // Replays every input the fuzz targets of fuzz/ ever failed on (tests/data/fuzz_regressions/<target>/)
 // and their seed corpus (fuzz/corpus/<target>/) through the same checks as the targets, with the
 // normal compiler and without libFuzzer, so a fixed finding stays fixed in the ordinary test suite.
-//   fuzz_urdf, fuzz_numeric: the checks of fuzz/urdf_check.hpp and fuzz/numeric_check.hpp, in-process;
-//   fuzz_scenario: the built ffsr-optimize is run on the scenario with the harness's arguments and
-//   its exit code and outputs are checked (fuzz/scenario_check.hpp).
-// A broken contract shows as an ffsr_fuzz::Finding naming what was wrong.
 #include "../fuzz/numeric_check.hpp"
 #include "../fuzz/scenario_check.hpp"
 #include "../fuzz/urdf_check.hpp"
@@ -16,6 +12,11 @@
 #include <filesystem>
 #include <string>
 #include <vector>
+
+//   fuzz_urdf, fuzz_numeric: the checks of fuzz/urdf_check.hpp and fuzz/numeric_check.hpp, in-process;
+//   fuzz_scenario: the built ffsr-optimize is run on the scenario with the harness's arguments and
+//   its exit code and outputs are checked (fuzz/scenario_check.hpp).
+// A broken contract shows as an ffsr_fuzz::Finding naming what was wrong.
 
 namespace test_fuzz_regressions {
 

@@ -5,9 +5,9 @@
 // byte for byte; bad inputs give one error line naming the flag and leave no file behind.
 #include "support/command.hpp"
 
-#include <ffsr/contact/contact_law.hpp>
-#include <ffsr/ffsr.hpp>
-#include <ffsr/parsers/urdf.hpp>
+#include "ffsr/contact/contact_law.hpp"
+#include "ffsr/ffsr.hpp"
+#include "ffsr/parsers/urdf.hpp"
 
 #include <catch2/catch.hpp>
 

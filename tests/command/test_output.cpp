@@ -3,13 +3,6 @@
 // FIFOs and devices are written directly and never replaced, a symbolic link is followed and its
 // target replaced atomically, and every write error -- a full disk, a reader that closed the pipe --
 // is one error line naming the output, exit 2 and no partial regular file.
-//
-// Then the regression runs (--expect BASELINE.json, --rtol, --atol): a result compared with itself
-// passes, a moved, missing or extra value gives exit 4 and one line per difference, a bad baseline
-// gives exit 2 naming the file.
-//
-// Every child process runs with a timeout (tests/support/run_command.hpp, or the helpers below), so
-// a FIFO nobody reads or a blocked pipe fails a test instead of hanging the suite.
 #include "support/command.hpp"
 
 #include <catch2/catch.hpp>
@@ -34,6 +27,13 @@
 #include <string>
 #include <thread>
 #include <vector>
+
+// Then the regression runs (--expect BASELINE.json, --rtol, --atol): a result compared with itself
+// passes, a moved, missing or extra value gives exit 4 and one line per difference, a bad baseline
+// gives exit 2 naming the file.
+//
+// Every child process runs with a timeout (tests/support/run_command.hpp, or the helpers below), so
+// a FIFO nobody reads or a blocked pipe fails a test instead of hanging the suite.
 
 namespace test_output {
 

@@ -1,9 +1,5 @@
-// Figures (--plot): the plotting module and the pictures of the command. Every picture made here
-// is decoded (PNG: size from IHDR, more than one colour, the long dark lines of the axes box) or
-// parsed (SVG as XML). The drawings are checked against independent computations: the arm drawn at
-// T ends where the planner's end-effector is, the attitude-drift curve ends at the planner's drift,
-// the map's maximum sits at the stretched arm (Section 5.1), xi from the closed form against the
-// exact peak. Bad inputs: a missing plot folder and an unknown format, one error line each.
+// Figures (--plot): the plotting module and the pictures of the command, each picture decoded (PNG)
+// or parsed (SVG) and checked against independent computations.
 #include "cli/figures/figures.hpp"
 #include "cli/figures/plot.hpp"
 #include "support/image_check.hpp"
@@ -19,6 +15,13 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+
+// Figures (--plot): the plotting module and the pictures of the command. Every picture made here
+// is decoded (PNG: size from IHDR, more than one colour, the long dark lines of the axes box) or
+// parsed (SVG as XML). The drawings are checked against independent computations: the arm drawn at
+// T ends where the planner's end-effector is, the attitude-drift curve ends at the planner's drift,
+// the map's maximum sits at the stretched arm (Section 5.1), xi from the closed form against the
+// exact peak. Bad inputs: a missing plot folder and an unknown format, one error line each.
 
 namespace test_plot {
 

@@ -1,13 +1,6 @@
 // tests/test_real_robots.cpp -- URDFs of real arms as the community ships them (Panda, UR5,
 // Kinova Jaco2 in ../shared/urdf-samples), mounted on a spacecraft bus, with mimic and locked joints,
 // inertia repairs and the contact point at the gripper.
-//
-// The samples are read from FFSR_URDF_SAMPLES or FFSR_SOURCE_DIR/../shared/urdf-samples; the tests
-// that need them say "skipped" and pass when the folder is absent. References are independent of
-// the code under test: RNEA (body coordinates) against CRBA; finite differences of forward
-// kinematics (tests/support/dynamics_helpers.hpp, h = 1e-5, O(h^2)) for energy, momentum and
-// Jacobians; the full model (mimic tag removed) for the mimic reduction; closed forms for the repairs
-// and for the mount split.
 #include "support/dynamics_helpers.hpp"
 #include "support/run_command.hpp"
 
@@ -21,6 +14,13 @@
 #include <fstream>
 #include <limits>
 #include <sstream>
+
+// The samples are read from FFSR_URDF_SAMPLES or FFSR_SOURCE_DIR/../shared/urdf-samples; the tests
+// that need them say "skipped" and pass when the folder is absent. References are independent of
+// the code under test: RNEA (body coordinates) against CRBA; finite differences of forward
+// kinematics (tests/support/dynamics_helpers.hpp, h = 1e-5, O(h^2)) for energy, momentum and
+// Jacobians; the full model (mimic tag removed) for the mimic reduction; closed forms for the repairs
+// and for the mount split.
 
 namespace test_real_robots {
 

@@ -2,9 +2,6 @@
 // shards merged reproduce the unsharded summary exactly, sample i does not depend on the sample
 // count, the 95th percentile of 1e3 samples against 2e4, the CSV, flags over the file, and the bad
 // inputs (one error line naming the key, exit 2, no output file).
-//
-// To stay fast, the runs evaluate one given capture configuration (--capture-joints-deg) with the
-// exact single-body F_max instead of planning.
 #include "support/command.hpp"
 
 #include <catch2/catch.hpp>
@@ -18,6 +15,9 @@
 #include <sstream>
 #include <string>
 #include <vector>
+
+// To stay fast, the runs evaluate one given capture configuration (--capture-joints-deg) with the
+// exact single-body F_max instead of planning.
 
 namespace test_robust {
 

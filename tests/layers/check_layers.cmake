@@ -2,10 +2,7 @@
 # (docs/library.md draws it). Run by ctest (case `layers`):
 #   cmake -DFFSR_INCLUDE_DIR=<include/ffsr> -P check_layers.cmake
 # Every header's `#include "ffsr/<folder>/..."` (and "ffsr/<name>.hpp" at the top) is checked; a
-# folder missing from the table fails the check, so that a new folder is placed on purpose. Files
-# held to a lower layer than their folder's (as includer and as included): the URDF parser
-# (parsers/urdf.hpp and its internals parsers/detail/urdf_document.hpp) reads into the model alone, the URDF
-# collision elements into geometry's shapes.
+# folder missing from the table fails the check, so that a new folder is placed on purpose.
 
 # One layer per entry, the lowest first; names in one entry are one layer. A top-level header
 # "ffsr/<name>.hpp" counts as the folder <name>: errors.hpp lies at the bottom, the umbrella header

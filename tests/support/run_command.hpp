@@ -1,11 +1,5 @@
 // tests/support/run_command.hpp -- run a command (no shell) and capture its stdout, stderr and exit
 // code, for the end-to-end tests of ffsr-optimize.
-//
-// fork + execv: the arguments go to the program exactly as given (no quoting problems with
-// "--joints-deg=-2.29,..."), the child can run in another working directory, stdin is /dev/null,
-// stdout and stderr go to two unlinked temporary files that are read back after the child exits.
-// A child that runs longer than `timeout_s` is killed (SIGKILL) so a hanging command fails a test
-// instead of blocking the suite.
 #pragma once
 
 #include <fcntl.h>
@@ -25,6 +19,12 @@
 #include <system_error>
 #include <thread>
 #include <vector>
+
+// fork + execv: the arguments go to the program exactly as given (no quoting problems with
+// "--joints-deg=-2.29,..."), the child can run in another working directory, stdin is /dev/null,
+// stdout and stderr go to two unlinked temporary files that are read back after the child exits.
+// A child that runs longer than `timeout_s` is killed (SIGKILL) so a hanging command fails a test
+// instead of blocking the suite.
 
 namespace ffsr::test {
 

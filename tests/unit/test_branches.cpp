@@ -1,9 +1,6 @@
 // The branches of the capture manifold (optimize/global.hpp, optimize/branches.hpp,
-// docs/branches.md): the orientation residual (the rotation vector of R_end R_e^T, zero only at the
-// wanted orientation) and its Jacobian against central differences, a half-turned gripper off the
-// manifold, every optimum of a pose-task search within the orientation tolerance, and for the UR5
-// with a pose task (no null space) the inverse-kinematics branches against an enumeration written
-// here (a Gauss-Newton on the 12 rows [p - x_cap; R - R_end], finite-difference Jacobian).
+// docs/branches.md): the orientation residual and its Jacobian, the optima of a pose-task search,
+// and the UR5's inverse-kinematics branches against an enumeration written here.
 #include <catch2/catch.hpp>
 
 #include "support/global_capture.hpp"
@@ -17,6 +14,13 @@
 #include <nlohmann/json.hpp>
 #include <filesystem>
 #include <random>
+
+// The branches of the capture manifold (optimize/global.hpp, optimize/branches.hpp,
+// docs/branches.md): the orientation residual (the rotation vector of R_end R_e^T, zero only at the
+// wanted orientation) and its Jacobian against central differences, a half-turned gripper off the
+// manifold, every optimum of a pose-task search within the orientation tolerance, and for the UR5
+// with a pose task (no null space) the inverse-kinematics branches against an enumeration written
+// here (a Gauss-Newton on the 12 rows [p - x_cap; R - R_end], finite-difference Jacobian).
 
 namespace test_branches {
 

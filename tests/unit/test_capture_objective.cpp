@@ -1,10 +1,5 @@
 // The capture objective (optimize/objective.hpp): one evaluator of M_ie and of the objective kinds
 // under the joint model of the contact, called by every path. References are independent of it:
-// the locked robot as one composite rigid body summed over the bodies (mass, centre of mass and
-// inertia from the bodies' poses, not through H), the armature by a dense solve of
-// (H + diag(0, a)) x = J_v^T u, the rigid body's jump of angular velocity for the locked base
-// disturbance, central differences for the gradients. Then the UR5 pose scenario under locked and
-// armature joints: its branches carry that model's M_ie, ranked by it, and the run ends on the least.
 #include <catch2/catch.hpp>
 
 #include "ffsr/scenario/scenario.hpp"
@@ -13,6 +8,12 @@
 
 #include <filesystem>
 #include <random>
+
+// the locked robot as one composite rigid body summed over the bodies (mass, centre of mass and
+// inertia from the bodies' poses, not through H), the armature by a dense solve of
+// (H + diag(0, a)) x = J_v^T u, the rigid body's jump of angular velocity for the locked base
+// disturbance, central differences for the gradients. Then the UR5 pose scenario under locked and
+// armature joints: its branches carry that model's M_ie, ranked by it, and the run ends on the least.
 
 namespace test_capture_objective {
 

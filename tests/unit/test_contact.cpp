@@ -1,11 +1,11 @@
 // Tests of the contact laws (Table 1, Eq. 15-27, 32), the CVODE wrapper and the single-body
 // simulation of Eq. 16 (Zhang et al. 2022, Aerospace 9, 69). Every check names its tolerance and
 // where the expected value comes from.
-#include <ffsr/contact/contact_law.hpp>
-#include <ffsr/contact/damping.hpp>
-#include <ffsr/errors.hpp>
-#include <ffsr/simulate/cvode.hpp>
-#include <ffsr/simulate/single_body.hpp>
+#include "ffsr/contact/contact_law.hpp"
+#include "ffsr/contact/damping.hpp"
+#include "ffsr/errors.hpp"
+#include "ffsr/simulate/cvode.hpp"
+#include "ffsr/simulate/single_body.hpp"
 
 #include <catch2/catch.hpp>
 

@@ -1,10 +1,7 @@
 // The capture controller does not touch the heap after its construction: global operator new and
 // delete are replaced by counting versions, and so are malloc, calloc, realloc, free and the aligned
 // allocations (glibc: interposed, forwarding to __libc_malloc and friends), since Eigen allocates
-// with malloc, not new (which is why this is an executable of its own). 1e5 calls of step() on the
-// paper's 3-DOF and 7-DOF robots (gradient and servo policies, position and pose tasks, a few faults
-// among them) must count zero allocations and zero frees. A control case checks that the counters
-// see both a `new` and an Eigen allocation.
+// with malloc, not new (which is why this is an executable of its own).
 
 #include <atomic>
 #include <cstdlib>
@@ -15,6 +12,10 @@
 // clang accepts that after glibc's declaration but not after the definition below, so it comes first
 #include <mm_malloc.h>
 #endif
+
+// 1e5 calls of step() on the paper's 3-DOF and 7-DOF robots (gradient and servo policies, position
+// and pose tasks, a few faults among them) must count zero allocations and zero frees. A control case
+// checks that the counters see both a `new` and an Eigen allocation.
 
 namespace {
 std::atomic<long> g_news{0}, g_deletes{0};

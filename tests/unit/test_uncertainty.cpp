@@ -5,6 +5,7 @@
 
 #include "support/paper.hpp"
 
+#include "ffsr/detail/parallel.hpp"
 #include "ffsr/ffsr.hpp"
 #include "ffsr/parsers/urdf.hpp"
 #include "ffsr/uncertainty/multibody.hpp"
@@ -315,13 +316,13 @@ TEST_CASE("summary: nearest-rank percentiles, mean and deviation of 1..100 -- pa
   spec[Quantity::TargetMass] = law(Spread::Law::Normal, 0.1, true);
   const UncertainNominal nom = paper_nominal();
   std::vector<double> serial(500), threaded(500);
-  parallel_for(0, 500, 1, [&](std::uint64_t i) { serial[i] = draw_sample(spec, nom, i).target.mass; });
-  parallel_for(0, 500, 2, [&](std::uint64_t i) { threaded[i] = draw_sample(spec, nom, i).target.mass; });
+  detail::parallel_for(500, 1, [&](std::uint64_t i) { serial[i] = draw_sample(spec, nom, i).target.mass; });
+  detail::parallel_for(500, 2, [&](std::uint64_t i) { threaded[i] = draw_sample(spec, nom, i).target.mass; });
   CHECK(serial == threaded);
-  CHECK_THROWS_AS(parallel_for(0, 100, 2,
-                               [](std::uint64_t i) {
-                                 if (i == 37) throw InputError("x");
-                               }),
+  CHECK_THROWS_AS(detail::parallel_for(100, 2,
+                                       [](std::uint64_t i) {
+                                         if (i == 37) throw InputError("x");
+                                       }),
                   InputError);
 }
 

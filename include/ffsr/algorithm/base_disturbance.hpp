@@ -1,6 +1,11 @@
 // ffsr/algorithm/base_disturbance.hpp -- the jump of the base's velocity caused by the contact impulse
 // of a capture (the impact disturbance of the spacecraft's bus).
-//
+#pragma once
+
+#include "ffsr/algorithm/joint_models.hpp"
+#include "ffsr/algorithm/jacobian.hpp"
+#include "ffsr/contact/contact_law.hpp"
+
 // The contact lasts milliseconds, so over it the configuration stays put and only the impulse
 // P = integral of F dt matters: the robot receives -P u at its contact point p_e + rho, and its
 // generalized velocity jumps by
@@ -19,11 +24,6 @@
 // (contact_law.hpp, detail::contact_G): it depends only on the damping factor f(c_r) of the law, not
 // on K, alpha, M_ie or delta_dot^- (f = 0: e = 1). simulate_single_body measures the same number
 // (SingleBodyResult::restitution); a test compares them.
-#pragma once
-
-#include "ffsr/algorithm/joint_models.hpp"
-#include "ffsr/algorithm/jacobian.hpp"
-#include "ffsr/contact/contact_law.hpp"
 
 namespace ffsr {
 

@@ -1,7 +1,24 @@
 // ffsr/contact/contact_law.hpp -- the Hertz contact law with hysteresis damping (Eq. 15) and its
 // maximum force: the closed forms of Eq. 20, 23-25 and the exact maximum of the single-body model
 // Eq. 16 (Zhang et al. 2022, Aerospace 9, 69, Section 3).
-//
+#pragma once
+
+#include "ffsr/contact/damping.hpp"
+#include "ffsr/errors.hpp"
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>  // cross
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstddef>
+#include <limits>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <variant>
+
 // Notation (the paper's): K stiffness, α exponent, c_r coefficient of restitution, δ deformation,
 // δ̇ its rate, δ̇⁻ > 0 the approach velocity at first touch, M_ie the integrated effective mass
 // (Eq. 14), λ = f(c_r) K / δ̇⁻ (Eq. 22) with f from a damping policy of damping.hpp.
@@ -18,23 +35,6 @@
 //     (α+1) g(s) - α f s = 0,   i.e.  φ(s) = (α+1) f G(s) - α s = 0.
 // φ(0) = (α+1) f G(0) > 0, φ(1) = -α < 0, and φ is decreasing and concave on [0, 1], so the root
 // is unique; it is found by a bracketed Newton iteration in s or in t = 1 - s (detail::contact_peak).
-#pragma once
-
-#include <ffsr/contact/damping.hpp>
-#include <ffsr/errors.hpp>
-
-#include <Eigen/Core>
-#include <Eigen/Geometry>  // cross
-
-#include <algorithm>
-#include <array>
-#include <cmath>
-#include <cstddef>
-#include <limits>
-#include <string>
-#include <string_view>
-#include <utility>
-#include <variant>
 
 namespace ffsr {
 

@@ -1,5 +1,9 @@
 // ffsr/contact/damping.hpp -- the hysteresis damping factors of Table 1 as compile-time policies.
-//
+#pragma once
+
+#include <cmath>
+#include <string_view>
+
 // Every classical damping factor of Table 1 (Zhang et al. 2022, Aerospace 9, 69) has the form
 // of Eq. 22,
 //     λ = f(c_r) · K / δ̇⁻,
@@ -8,10 +12,6 @@
 // ContactParams (contact_law.hpp) checks 0 < c_r <= 1 before any factor is evaluated.
 //
 // Adding a law: one struct here with `name` and `factor`, one entry in AnyContactLaw.
-#pragma once
-
-#include <cmath>
-#include <string_view>
 
 namespace ffsr {
 

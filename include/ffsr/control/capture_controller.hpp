@@ -1,46 +1,5 @@
 // ffsr/control/capture_controller.hpp -- the capture approach as an onboard controller: one call per
 // control tick, no heap allocation, no exception.
-//
-// The controller runs the planner's rate law (Eq. 30-31) on the measured state instead of
-// integrating it: at every tick, from the measured base pose and joint angles,
-//   theta_dot = J_t^+ (x_d_dot + k_p (x_d - p_e)) + alpha qd_null,
-// with the line reference x_d(t), the task solver and the null-space policy of the planner. It is
-// literally the planner's joint-rate field (detail::CaptureRateField of optimize/capture.hpp), held
-// with its workspace: driven by the planner's RK4 with the exact state, the controller reproduces
-// plan_capture's series (tests/unit/test_controller.cpp checks it to 1e-12).
-//
-// The tick, step(t, state, estimate, out):
-//   1. checks every input (time, base position, base quaternion, joint angles and limits, the target
-//      estimate): the first bad field gives status Fault, the field in out.fault (fault_name), the
-//      joint or component index in out.fault_index, zero joint rates and zero base velocity;
-//   2. evaluates the rate law; writes the joint rates, the base velocity that zero momentum gives
-//      with them (what the base will do), the reference and the end-effector position;
-//   3. reports Damped (the smallest task singular value is below the threshold: damped least
-//      squares, the arm is near a singularity) or RateLimited (the null-space term was scaled down,
-//      or the task alone asks more than the joint-rate limit: the task keeps priority and is not
-//      clamped), else Ok.
-// step() does not re-plan from the estimate (a propagation of the target; update_target does it at
-// the estimate's rate); it checks it, so that a diverged estimate stops the arm.
-//
-// Re-planning, update_target(t, estimate): the target's state measured at t is propagated to T with
-// propagate_target (the planner's torque-free propagation), which gives the new capture point and
-// contact normal. The line reference is re-anchored: from t on, its position part is the quintic
-// polynomial that has the position, velocity and acceleration of the old reference at t and
-// reaches the new capture point at T with zero velocity and acceleration (LineReference with
-// start = t, x0, v0, a0; six conditions, one quintic). Reference position, velocity and acceleration
-// are continuous; with an unchanged capture point the reference is unchanged, so the feedback
-// k_p (x_d - p_e) keeps acting on the tracking error. (Measured in the closed loop on the 7-DOF
-// robot, exact target, estimates at 5 Hz, 100 Hz control: re-anchoring at the end-effector's
-// position left 11.3 mm at T, and a re-anchor continuous in position and velocity only 5.6 mm,
-// since each one bends the time law of the rest of the approach.) The orientation
-// reference of a pose task does not depend on the target and is left as it was. The cost is one
-// propagation of the target over T - t (closed form for an isotropic inertia, RK4 with
-// a 1 ms step otherwise), and is measured by bench/bench_controller.cpp. With
-// ControllerOptions::prediction_window > 1 the capture point (and normal) is the mean of the last
-// predictions: a simple filter of independent estimate noise.
-//
-// Storage: everything (the model's Data, the SVD, the policy's workspace) is sized at construction;
-// the controller lives behind one heap block so that it can be moved. Model must outlive it.
 #pragma once
 
 #include "ffsr/optimize/capture.hpp"
@@ -213,7 +172,17 @@ inline ControlFault check_state(const Model& model, const ControllerState& s, do
 
 }  // namespace detail
 
-/// The capture controller (see the top of this file). Policy: GradientPolicy (the paper's method)
+// The controller runs the planner's rate law (Eq. 30-31) on the measured state instead of
+// integrating it: at every tick, from the measured base pose and joint angles,
+//   theta_dot = J_t^+ (x_d_dot + k_p (x_d - p_e)) + alpha qd_null,
+// with the line reference x_d(t), the task solver and the null-space policy of the planner. It is
+// literally the planner's joint-rate field (detail::CaptureRateField of optimize/capture.hpp), held
+// with its workspace: driven by the planner's RK4 with the exact state, the controller reproduces
+// plan_capture's series (tests/unit/test_controller.cpp checks it to 1e-12).
+//
+// Storage: everything (the model's Data, the SVD, the policy's workspace) is sized at construction;
+// the controller lives behind one heap block so that it can be moved. Model must outlive it.
+/// The capture controller. Policy: GradientPolicy (the paper's method)
 /// or ServoPolicy (servo to a chosen capture configuration, e.g. the global plan's).
 template <class Policy>
 class CaptureController {
@@ -240,7 +209,19 @@ class CaptureController {
     return c;
   }
 
-  /// One control tick (see the top of the file). Writes `out`; never throws, never allocates.
+  // The tick, step(t, state, estimate, out):
+  //   1. checks every input (time, base position, base quaternion, joint angles and limits, the target
+  //      estimate): the first bad field gives status Fault, the field in out.fault (fault_name), the
+  //      joint or component index in out.fault_index, zero joint rates and zero base velocity;
+  //   2. evaluates the rate law; writes the joint rates, the base velocity that zero momentum gives
+  //      with them (what the base will do), the reference and the end-effector position;
+  //   3. reports Damped (the smallest task singular value is below the threshold: damped least
+  //      squares, the arm is near a singularity) or RateLimited (the null-space term was scaled down,
+  //      or the task alone asks more than the joint-rate limit: the task keeps priority and is not
+  //      clamped), else Ok.
+  // step() does not re-plan from the estimate (a propagation of the target; update_target does it at
+  // the estimate's rate); it checks it, so that a diverged estimate stops the arm.
+  /// One control tick. Writes `out`; never throws, never allocates.
   void step(double t, const ControllerState& state, const TargetEstimate& estimate,
             ControlCommand& out) noexcept {
     Core& c = *core_;
@@ -271,7 +252,23 @@ class CaptureController {
     report(t, out);
   }
 
-  /// Re-plans from a new target estimate measured at t (see the top of the file): the capture point
+  // Re-planning, update_target(t, estimate): the target's state measured at t is propagated to T with
+  // propagate_target (the planner's torque-free propagation), which gives the new capture point and
+  // contact normal. The line reference is re-anchored: from t on, its position part is the quintic
+  // polynomial that has the position, velocity and acceleration of the old reference at t and
+  // reaches the new capture point at T with zero velocity and acceleration (LineReference with
+  // start = t, x0, v0, a0; six conditions, one quintic). Reference position, velocity and acceleration
+  // are continuous; with an unchanged capture point the reference is unchanged, so the feedback
+  // k_p (x_d - p_e) keeps acting on the tracking error. (Measured in the closed loop on the 7-DOF
+  // robot, exact target, estimates at 5 Hz, 100 Hz control: re-anchoring at the end-effector's
+  // position left 11.3 mm at T, and a re-anchor continuous in position and velocity only 5.6 mm,
+  // since each one bends the time law of the rest of the approach.) The orientation
+  // reference of a pose task does not depend on the target and is left as it was. The cost is one
+  // propagation of the target over T - t (closed form for an isotropic inertia, RK4 with
+  // a 1 ms step otherwise), and is measured by bench/bench_controller.cpp. With
+  // ControllerOptions::prediction_window > 1 the capture point (and normal) is the mean of the last
+  // predictions: a simple filter of independent estimate noise.
+  /// Re-plans from a new target estimate measured at t: the capture point
   /// at T from the propagated estimate, the line re-anchored at the reference's position and
   /// velocity at t. Returns the fault of a bad input (time outside
   /// [0, T), a bad estimate, a failed propagation) and then leaves the plan as it was; None on success.

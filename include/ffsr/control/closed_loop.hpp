@@ -1,6 +1,15 @@
 // ffsr/control/closed_loop.hpp -- the capture controller in a closed loop with the robot's full
 // dynamics and a noisy target estimate. Component ffsr::cvode (SUNDIALS).
-//
+#pragma once
+
+#include "ffsr/algorithm/aba.hpp"
+#include "ffsr/control/capture_controller.hpp"
+#include "ffsr/simulate/multibody.hpp"
+#include "ffsr/uncertainty/sampling.hpp"
+
+#include <cstdint>
+#include <vector>
+
 // Plant: the free-floating robot, forward dynamics of Eq. 1 (H a = tau - C by the articulated-body
 // algorithm, algorithm/aba.hpp; CRBA + RNEA + Cholesky for a model with mimic joints; no external
 // force, no gravity unless the model has some), with the state
@@ -30,15 +39,6 @@
 // tracking lag |u_k - theta_dot_k| at the end of a control period (the command held over it), the largest end-effector distance from the reference, the base's
 // attitude change, and the largest |total momentum| (it is zero at the start and no external force
 // acts, so anything else is integration error).
-#pragma once
-
-#include "ffsr/algorithm/aba.hpp"
-#include "ffsr/control/capture_controller.hpp"
-#include "ffsr/simulate/multibody.hpp"
-#include "ffsr/uncertainty/sampling.hpp"
-
-#include <cstdint>
-#include <vector>
 
 namespace ffsr {
 
@@ -59,7 +59,7 @@ struct EstimateNoise {
   double angular_velocity = 0;  ///< rad/s (target frame)
 };
 
-/// How the plant is integrated from tick to tick (see the top of the file).
+/// How the plant is integrated from tick to tick (see the notes after the includes).
 enum class ClosedLoopIntegrator {
   RungeKutta,    ///< Dormand-Prince 5(4), one continuous integration, steps ending on the ticks
   CvodeRestart,  ///< CVODE (BDF, Newton, dense) restarted at every tick: the reference, slow
@@ -111,7 +111,8 @@ struct ClosedLoopResult {
 
 namespace detail {
 
-/// The plant of the closed loop: the robot's dynamics with the PI rate loops (see the top of the file).
+/// The plant of the closed loop: the robot's dynamics with the PI rate loops (see the notes after the
+/// includes).
 struct ClosedLoopPlant {
   const Model& model;
   Data data;
@@ -265,7 +266,7 @@ inline void record_tick(const ControlCommand& cmd, ClosedLoopResult& res) {
 
 }  // namespace detail
 
-/// Runs the closed loop of `ctrl` (see the top of the file) from the problem's initial state at rest
+/// Runs the closed loop of `ctrl` (see the notes after the includes) from the problem's initial state at rest
 /// over [0, T]. InputError for bad options; IntegrationError from CVODE; NumericalError when the
 /// controller faults. The controller's plan is changed by the estimates (update_target).
 template <class Policy>

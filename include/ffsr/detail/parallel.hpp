@@ -1,6 +1,20 @@
 // ffsr/detail/parallel.hpp -- the one thread pool of ffsr: indices [0, count) in fixed chunks on a
 // few threads, with per-thread workspaces, an optional in-order commit and progress reports.
-//
+#pragma once
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <cstdint>
+#include <exception>
+#include <functional>
+#include <limits>
+#include <mutex>
+#include <thread>
+#include <utility>
+#include <vector>
+
 // Determinism. The chunk boundaries depend on `count` and `options.chunk` only, never on the
 // number of threads: chunk c is [c * chunk, min(count, (c + 1) * chunk)). The threads take chunks
 // from an atomic counter, in increasing order. So
@@ -29,20 +43,6 @@
 //   detail::parallel_chunks(count, threads,
 //                           [&](unsigned t, std::uint64_t lo, std::uint64_t hi) { workers[t]->run(lo, hi); },
 //                           opt);
-#pragma once
-
-#include <algorithm>
-#include <atomic>
-#include <chrono>
-#include <condition_variable>
-#include <cstdint>
-#include <exception>
-#include <functional>
-#include <limits>
-#include <mutex>
-#include <thread>
-#include <utility>
-#include <vector>
 
 namespace ffsr::detail {
 

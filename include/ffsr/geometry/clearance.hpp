@@ -1,9 +1,8 @@
 // ffsr/geometry/clearance.hpp -- the clearance of a configuration: its smallest distances as a
 // report (overall and per kind of pair), the free-floating rate of a pair's distance, and the
 // message of a report below a clearance. Needs the model and its kinematics only; the planner's uses
-// of a clearance (the search's constraints, the path check, the barrier of a capture run) are in
-// optimize/clearance.hpp. Pairs and the contact exemption: geometry/distance.hpp.
-// Component ffsr::geometry.
+// of a clearance are in optimize/clearance.hpp, the pairs and the contact exemption in
+// geometry/distance.hpp. Component ffsr::geometry.
 #pragma once
 
 #include "ffsr/algorithm/crba.hpp"

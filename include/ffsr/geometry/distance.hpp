@@ -1,6 +1,24 @@
 // ffsr/geometry/distance.hpp -- distances between the robot, its bus and the target (FCL), with the
 // nearest points, and their gradient with respect to the joint angles.
-//
+#pragma once
+
+#include "ffsr/algorithm/kinematics.hpp"
+#include "ffsr/geometry/shape.hpp"
+
+#include <fcl/narrowphase/distance.h>
+#include <fcl/geometry/shape/box.h>
+#include <fcl/geometry/shape/capsule.h>
+#include <fcl/geometry/shape/cylinder.h>
+#include <fcl/geometry/shape/sphere.h>
+
+#include <algorithm>
+#include <array>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
 // Pairs (CollisionChecker::pairs), each between two bodies with shapes (geometry/shape.hpp):
 //   arm-target  every body (the base/bus included) against the target's shape;
 //   arm-bus     every moving body whose parent is not the base, against the base;
@@ -30,24 +48,6 @@
 // the Jacobian of the body-fixed point p: for each joint k supporting the body,
 // S_k,lin + S_k,ang x (p - p_0) (data.S of forward_kinematics). The base and the target do not move
 // with theta there, so their J is 0. Component ffsr::geometry (FCL, Debian libfcl-dev).
-#pragma once
-
-#include "ffsr/algorithm/kinematics.hpp"
-#include "ffsr/geometry/shape.hpp"
-
-#include <fcl/narrowphase/distance.h>
-#include <fcl/geometry/shape/box.h>
-#include <fcl/geometry/shape/capsule.h>
-#include <fcl/geometry/shape/cylinder.h>
-#include <fcl/geometry/shape/sphere.h>
-
-#include <algorithm>
-#include <array>
-#include <limits>
-#include <memory>
-#include <optional>
-#include <string>
-#include <vector>
 
 namespace ffsr {
 
@@ -323,7 +323,7 @@ class CollisionChecker {
     return best;
   }
 
-  /// d(distance)/d(theta) of `d` with the base pose and the target fixed (see the top of this file).
+  /// d(distance)/d(theta) of `d` with the base pose and the target fixed (see the notes after the includes).
   /// Reads data.p, data.S (forward_kinematics at the configuration of d). Writes grad (n).
   void distance_gradient(const Model& model, const Data& data, const PairDistance& d,
                          Eigen::Ref<Eigen::VectorXd> grad) const {
@@ -397,7 +397,7 @@ class CollisionChecker {
     return s.kind == Shape::Kind::Capsule || s.kind == Shape::Kind::Sphere;
   }
 
-  /// The contact exemption (see the top of the file): walks from the contact point back along the
+  /// The contact exemption (see the notes after the includes): walks from the contact point back along the
   /// chain's centre lines, marking the bodies it covers and cutting the capsule of the one it ends on.
   void make_exemption(const Model& model) {
     const size_t nb = static_cast<size_t>(model.nb());

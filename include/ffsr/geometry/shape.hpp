@@ -1,5 +1,15 @@
 // ffsr/geometry/shape.hpp -- collision shapes of the robot, the bus and the target (Eigen only).
-//
+#pragma once
+
+#include "ffsr/errors.hpp"
+#include "ffsr/model/model.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <vector>
+
 // A Shape is a convex primitive with a pose in the frame of the body that carries it:
 //   box       full edge lengths `size` (x, y, z), centred on its pose;
 //   sphere    `radius`, centred on its pose;
@@ -11,16 +21,6 @@
 // origins of its children (and the end-effector point on the end-effector's body). The base gets
 // only its URDF primitives or a box of the scenario (the bus). Distances between the shapes need FCL:
 // geometry/distance.hpp (component ffsr::geometry).
-#pragma once
-
-#include "ffsr/errors.hpp"
-#include "ffsr/model/model.hpp"
-
-#include <algorithm>
-#include <cmath>
-#include <limits>
-#include <string>
-#include <vector>
 
 namespace ffsr {
 

@@ -1,14 +1,13 @@
-// ffsr/jobs/closed_loop.hpp -- the job `closed-loop`: the capture controller
-// (ffsr/control/capture_controller.hpp) in a closed loop with the robot's full dynamics and a noisy
-// target estimate (ffsr/control/closed_loop.hpp), beside the open-loop plan it follows: the paper's
-// method (plan "paper"), the global run's servo (plan "global": the global search of the main job
-// first) or the servo to a given capture configuration (goal_joints_deg); and that result as JSON
-// (the keys and values of `ffsr-optimize closed-loop --json`) and its series as CSV (`--csv`).
-// Component ffsr::scenario. Never prints.
+// ffsr/jobs/closed_loop.hpp -- the job `closed-loop`: the capture controller in a closed loop with the
+// robot's full dynamics and a noisy target estimate (ffsr/control/closed_loop.hpp), beside the open-loop
+// plan it follows: the paper's method (plan "paper"), the global run's servo (plan "global") or the servo
+// to a given capture configuration (goal_joints_deg); the result as JSON (`ffsr-optimize closed-loop
+// --json`) and its series as CSV (`--csv`). Component ffsr::scenario. Never prints.
 #pragma once
 
 #include "ffsr/control/capture_controller.hpp"
 #include "ffsr/control/closed_loop.hpp"
+#include "ffsr/jobs/detail/json_values.hpp"
 #include "ffsr/jobs/scenario_run.hpp"
 
 #include <algorithm>

@@ -6,6 +6,7 @@
 #pragma once
 
 #include "ffsr/algorithm/base_disturbance.hpp"
+#include "ffsr/jobs/detail/json_values.hpp"
 #include "ffsr/jobs/inspect.hpp"
 #include "ffsr/jobs/subject.hpp"
 #include "ffsr/optimize/objective.hpp"

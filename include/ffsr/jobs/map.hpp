@@ -3,19 +3,6 @@
 // (the paper's Figures 8 and 9), the joints not varied held at the subject's configuration; and the
 // run's summary as JSON (the keys and values of `ffsr-optimize map --json`). Component
 // ffsr::scenario. Never prints.
-//
-// The grid. Varied joint j (1-based, URDF tree order) takes the angles lo_j + i step_j, i = 0, 1, ...,
-// below hi_j: the half-open range [lo_j, hi_j), so that -180,180 in steps of 2 gives 180 angles and
-// no angle twice. Points are numbered row-major: the last varied joint changes fastest.
-//
-// Shards. Shard K of N evaluates the K-th of N contiguous parts of that numbering (part k holds points
-// [k P/N, (k+1) P/N) up to rounding: the first P mod N parts hold one point more).
-//
-// The points go to a sink in blocks (MapSink): each block is handed to `evaluated` on the thread that
-// computed it (the command formats its CSV rows there, in parallel) and then to `commit` in point
-// order, one block at a time (the command appends the rows to its file: the output does not depend
-// on the thread count and never has to fit in memory). Each thread has its own Data and buffers: no
-// heap allocation per point.
 #pragma once
 
 #include "ffsr/detail/parallel.hpp"
@@ -36,6 +23,19 @@
 #include <thread>
 #include <utility>
 #include <vector>
+
+// The grid. Varied joint j (1-based, URDF tree order) takes the angles lo_j + i step_j, i = 0, 1, ...,
+// below hi_j: the half-open range [lo_j, hi_j), so that -180,180 in steps of 2 gives 180 angles and
+// no angle twice. Points are numbered row-major: the last varied joint changes fastest.
+//
+// Shards. Shard K of N evaluates the K-th of N contiguous parts of that numbering (part k holds points
+// [k P/N, (k+1) P/N) up to rounding: the first P mod N parts hold one point more).
+//
+// The points go to a sink in blocks (MapSink): each block is handed to `evaluated` on the thread that
+// computed it (the command formats its CSV rows there, in parallel) and then to `commit` in point
+// order, one block at a time (the command appends the rows to its file: the output does not depend
+// on the thread count and never has to fit in memory). Each thread has its own Data and buffers: no
+// heap allocation per point.
 
 namespace ffsr {
 
@@ -88,7 +88,7 @@ struct MapBlock {
   const double* f_max = nullptr;
 };
 
-/// Where the points go (see the top of this file). Any member may be empty.
+/// Where the points go (see the notes after the includes). Any member may be empty.
 struct MapSink {
   /// on the thread `thread` (0 .. plan.threads-1) that computed the block, blocks in any order
   std::function<void(unsigned thread, const MapBlock&)> evaluated;

@@ -5,6 +5,7 @@
 // Component ffsr::scenario. Never prints.
 #pragma once
 
+#include "ffsr/jobs/detail/json_values.hpp"
 #include "ffsr/jobs/scenario_run.hpp"
 #include "ffsr/optimize/pareto.hpp"
 

@@ -3,16 +3,6 @@
 // configurations to evaluate, the run over the samples of one shard (RobustRun), its summary
 // (RobustSummary: percentiles, tail, every sample's F_max; to_json() is the command's --json) and
 // the exact merge of shard summaries (merge_shards). Component ffsr::scenario. Never prints.
-//
-// Samples depend on (seed, index) only and are common to all configurations, so a shard's summary
-// keeps every sample's F_max and merge_shards concatenates them by index and recomputes the summary:
-// the merged percentiles, mean and tail are those of the unsharded run, bit for bit.
-//
-//   ffsr::Scenario sc = ffsr::load_scenario("robots/paper_7dof_position_uncertain.toml");
-//   ffsr::RobustJobOptions o;                        // exact F_max, all samples
-//   ffsr::RobustSummary s = ffsr::robust_summary(sc, ffsr::run_robust(sc, ffsr::uncertainty_spec(sc.keys),
-//                                                                     ffsr::planned_robust_configurations(sc), o));
-//   double p95 = s.configurations.front().summary.p95;
 #pragma once
 
 #include "ffsr/jobs/scenario_run.hpp"
@@ -27,6 +17,17 @@
 #include <optional>
 #include <string>
 #include <vector>
+
+// Samples depend on (seed, index) only and are common to all configurations, so a shard's summary
+// keeps every sample's F_max and merge_shards concatenates them by index and recomputes the summary:
+// the merged percentiles, mean and tail are those of the unsharded run, bit for bit.
+//
+//   ffsr::Scenario sc = ffsr::load_scenario("robots/paper_7dof_position_uncertain.toml");
+//   ffsr::RobustJobOptions o;                        // exact F_max, all samples
+//   ffsr::RobustRun run = ffsr::run_robust(sc, ffsr::uncertainty_spec(sc.keys),
+//                                          ffsr::planned_robust_configurations(sc), o);
+//   ffsr::RobustSummary s = ffsr::robust_summary(sc, run, "uncertain.toml", "0.1.0");
+//   double p95 = s.configurations.front().summary.p95;
 
 namespace ffsr {
 

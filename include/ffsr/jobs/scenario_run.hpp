@@ -1,10 +1,8 @@
 // ffsr/jobs/scenario_run.hpp -- the main job of a scenario (ffsr/scenario/scenario.hpp): the plain run
 // (rho = 0, the baseline task), the paper's method (the optimized run, Eq. 29-31) and the global run,
 // as one result struct, and that result as JSON (the keys and values of `ffsr-optimize --json`; the
-// schema is written in jobs/detail/result_json.hxx). Component ffsr::scenario. Never prints; progress
+// schema is written in jobs/detail/result_json.hpp). Component ffsr::scenario. Never prints; progress
 // goes to the callbacks of ScenarioRunOptions.
-//
-// jobs/ is the layer above the scenario keys (scenario/): it runs what a scenario describes.
 #pragma once
 
 #include "ffsr/scenario/scenario.hpp"
@@ -21,6 +19,8 @@
 #include <thread>
 #include <utility>
 #include <vector>
+
+// jobs/ is the layer above the scenario keys (scenario/): it runs what a scenario describes.
 
 namespace ffsr {
 
@@ -120,6 +120,6 @@ inline double reduction_percent(double before, double after) { return 100.0 * (b
 }  // namespace ffsr
 
 #include "ffsr/jobs/detail/scenario_run.hxx"
-#include "ffsr/jobs/detail/result_json.hxx"
-#include "ffsr/jobs/detail/base_disturbance_json.hxx"
-#include "ffsr/jobs/detail/scenario_series.hxx"
+#include "ffsr/jobs/detail/base_disturbance_json.hpp"
+#include "ffsr/jobs/detail/scenario_series.hpp"
+#include "ffsr/jobs/detail/result_json.hpp"

@@ -1,5 +1,14 @@
 // ffsr/model/model.hpp -- the free-floating robot: a tree of rigid bodies on a 6-DoF base.
-//
+#pragma once
+
+#include "ffsr/errors.hpp"
+#include "ffsr/spatial/spatial.hpp"
+
+#include <limits>
+#include <string>
+#include <utility>
+#include <vector>
+
 // Coordinates (the one place they are fixed; see also README "Conventions"):
 //  - Configuration: the base pose (position of the base link frame origin and its attitude,
 //    both in the inertial frame o) and the joint positions theta (radians or metres), one per
@@ -19,15 +28,6 @@
 //    origin acting on the base, both in the inertial frame.
 //
 // A Model is constant once built. Algorithms write only into a Data (model/data.hpp).
-#pragma once
-
-#include "ffsr/errors.hpp"
-#include "ffsr/spatial/spatial.hpp"
-
-#include <limits>
-#include <string>
-#include <utility>
-#include <vector>
 
 namespace ffsr {
 

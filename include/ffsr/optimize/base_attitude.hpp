@@ -1,6 +1,12 @@
 // ffsr/optimize/base_attitude.hpp -- the reaction-null-space approach (Yoshida and Nenchev): the
 // capture approach that keeps the base's angular velocity zero.
-//
+#pragma once
+
+#include "ffsr/algorithm/jacobian.hpp"
+#include "ffsr/errors.hpp"
+
+#include <Eigen/SVD>
+
 // Under zero total momentum the base velocity is a linear function of the joint rates,
 // [v_0; w_0] = -H_b^-1 H_bm theta_dot (Eq. 2), so w_0 = -A theta_dot with A the three angular rows of
 // H_b^-1 H_bm (data.HbInv_Hbm of generalized_jacobian). Holding the base attitude keeps Q^T A theta_dot
@@ -15,12 +21,6 @@
 // Freedom: the task's m rows plus the r attitude rows must leave at least one joint for the
 // objective (m + r < n; m + r <= n for pure tracking, gain 0). The 7-DOF arm on a position task has
 // 3 + 3 = 6 < 7; the planar 3-DOF arm has 2 + 1 = 3 = n: no freedom for the objective.
-#pragma once
-
-#include "ffsr/algorithm/jacobian.hpp"
-#include "ffsr/errors.hpp"
-
-#include <Eigen/SVD>
 
 namespace ffsr {
 

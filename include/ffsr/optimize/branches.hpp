@@ -2,7 +2,14 @@
 // distinct local optimum of a manifold search (search_capture_manifold, global.hpp) with its M_ie,
 // its objective, its orientation error and whether the approach reaches it from the initial
 // configuration without a reconfiguration (docs/branches.md).
-//
+#pragma once
+
+#include "ffsr/detail/parallel.hpp"
+#include "ffsr/optimize/global.hpp"
+
+#include <optional>
+#include <vector>
+
 // Reachable without reconfiguration: the reaching run of the global planner (the straight-line
 // approach with the null space servoing to the branch, ServoPolicy, with the joint-rate limit of the
 // options) from the initial configuration ends within 0.5 rad (every joint, configuration_distance)
@@ -11,13 +18,6 @@
 // manifold (or, without a null space, on another inverse-kinematics solution) ends far from it.
 // Cost: one integrate_capture per branch tested (the best `max_tested` branches; the rest are
 // reported as not tested), on `threads` threads.
-#pragma once
-
-#include "ffsr/detail/parallel.hpp"
-#include "ffsr/optimize/global.hpp"
-
-#include <optional>
-#include <vector>
 
 namespace ffsr {
 
@@ -32,7 +32,7 @@ struct CaptureBranch {
   std::optional<bool> reachable_without_reconfiguration;
 };
 
-/// Does the reaching run (see the top of this file) from pb.theta end on `goal`? Runs
+/// Does the reaching run (see the notes after the includes) from pb.theta end on `goal`? Runs
 /// integrate_capture once (series off); joint-limit and tracking failures count as not reached.
 inline bool reaches_without_reconfiguration(const CaptureProblem& pb, const CaptureTask& task,
                                             const CaptureOptions& opt, const CaptureSetup& setup,

@@ -1,5 +1,27 @@
 // ffsr/optimize/capture.hpp -- the capture approach and its null-space optimization (Section 4).
-//
+#pragma once
+
+#include "ffsr/algorithm/effective_mass.hpp"
+#include "ffsr/algorithm/jacobian.hpp"
+#include "ffsr/algorithm/momentum.hpp"
+#include "ffsr/contact/contact_law.hpp"
+#include "ffsr/model/target.hpp"
+#include "ffsr/optimize/base_attitude.hpp"
+#include "ffsr/optimize/capture_problem.hpp"
+#include "ffsr/optimize/free_floating_step.hpp"
+#include "ffsr/optimize/line_reference.hpp"
+#include "ffsr/optimize/null_space.hpp"
+#include "ffsr/optimize/objective.hpp"
+#include "ffsr/optimize/run_monitors.hpp"
+#include "ffsr/optimize/task_solver.hpp"
+
+#include <algorithm>
+#include <limits>
+#include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
+
 // The free-floating robot moves its end-effector along a straight line in the inertial frame, from
 // its initial position to the capture point (the target's contact point at the capture time T),
 // with a quintic time law (zero velocity and acceleration at both ends) and a proportional feedback
@@ -29,28 +51,6 @@
 //   run_monitors.hpp        momentum, centre of mass, tracking error, quaternion, joint limits
 // Here: the checks of the input (prepare_capture), the joint-rate field that joins the first three
 // (detail::CaptureRateField), and integrate_capture, which steps it and watches the monitors.
-#pragma once
-
-#include "ffsr/algorithm/effective_mass.hpp"
-#include "ffsr/algorithm/jacobian.hpp"
-#include "ffsr/algorithm/momentum.hpp"
-#include "ffsr/contact/contact_law.hpp"
-#include "ffsr/model/target.hpp"
-#include "ffsr/optimize/base_attitude.hpp"
-#include "ffsr/optimize/capture_problem.hpp"
-#include "ffsr/optimize/free_floating_step.hpp"
-#include "ffsr/optimize/line_reference.hpp"
-#include "ffsr/optimize/null_space.hpp"
-#include "ffsr/optimize/objective.hpp"
-#include "ffsr/optimize/run_monitors.hpp"
-#include "ffsr/optimize/task_solver.hpp"
-
-#include <algorithm>
-#include <limits>
-#include <sstream>
-#include <string>
-#include <utility>
-#include <vector>
 
 namespace ffsr {
 
@@ -322,7 +322,7 @@ inline long capture_steps(const CaptureOptions& opt) {
 
 }  // namespace detail
 
-/// The free-floating RK4 integration of the capture run with its checks (see the top of the file).
+/// The free-floating RK4 integration of the capture run with its checks (see the notes after the includes).
 /// Joint rates theta_dot = J_t^+ (x_d_dot + k_p e) + alpha qd_null (Eq. 30), qd_null from `policy`
 /// (null_space.hpp), alpha in [0, 1] the largest factor that keeps every |theta_dot_k| <=
 /// opt.max_joint_rate (1 when not limited; TaskSolver); the base velocity from zero momentum. Each
@@ -393,7 +393,7 @@ inline GradientPolicy gradient_policy(const CaptureProblem& pb, const CaptureOpt
   return policy;
 }
 
-/// Plans the approach with the paper's method (see the top of this file): the line reference, the
+/// Plans the approach with the paper's method (see the notes after the includes): the line reference, the
 /// gradient policy with gain rho, the RK4 integration. Throws InputError for bad arguments
 /// (including rho != 0 on a task without a null space), NumericalError when the capture point is not
 /// reached within the tolerance or a joint leaves its limits.

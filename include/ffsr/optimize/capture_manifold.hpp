@@ -2,24 +2,24 @@
 // end-effector on the capture point at a fixed base pose, the residual that defines it, the
 // projection onto it, and the inequality constraints a search on it may carry (the base-rate
 // constraint here; the clearance, optimize/clearance.hpp).
-//
-// With the base at a given pose B (the pose at T), the capture manifold is
-//   C(B) = { theta : c(theta) = 0, theta within the URDF's joint limits },
-// c the task rows of [p_e(theta) - x_cap ; log(R_end R_e(theta)^T)], log the rotation vector (angle
-// in [0, pi] times the axis): zero only at the wanted orientation, of norm pi for a gripper turned
-// half a turn. The base is fixed there, so the constraint Jacobian is the task rows of J_m (the joint
-// columns of J_bm, Eq. 2); for the orientation rows d log(R)/d omega = -J_r^-1(log R), the inverse
-// right Jacobian of SO(3) (detail::rotation_log_rate, manifold_sampling.hxx). docs/branches.md.
 #pragma once
 
 #include "ffsr/optimize/capture.hpp"
-#include "ffsr/optimize/detail/manifold_sampling.hxx"
+#include "ffsr/optimize/detail/manifold_sampling.hpp"
 #include "ffsr/optimize/objective.hpp"
 
 #include <functional>
 #include <limits>
 #include <memory>
 #include <vector>
+
+// With the base at a given pose B (the pose at T), the capture manifold is
+//   C(B) = { theta : c(theta) = 0, theta within the URDF's joint limits },
+// c the task rows of [p_e(theta) - x_cap ; log(R_end R_e(theta)^T)], log the rotation vector (angle
+// in [0, pi] times the axis): zero only at the wanted orientation, of norm pi for a gripper turned
+// half a turn. The base is fixed there, so the constraint Jacobian is the task rows of J_m (the joint
+// columns of J_bm, Eq. 2); for the orientation rows d log(R)/d omega = -J_r^-1(log R), the inverse
+// right Jacobian of SO(3) (detail::rotation_log_rate, manifold_sampling.hpp). docs/branches.md.
 
 namespace ffsr {
 
@@ -58,7 +58,7 @@ inline std::shared_ptr<const ManifoldInequalities> combine_inequalities(
   return q;
 }
 
-/// The task residual c(theta) at a fixed base pose and its Jacobian (see the top of this file).
+/// The task residual c(theta) at a fixed base pose and its Jacobian (see the notes after the includes).
 /// Runs crba and frame_jacobian. Writes r (task rows) and, if J is given, J (rows x n).
 inline void capture_residual(const Model& model, Data& data, const CaptureProblem& pb,
                              const CaptureTask& task, const CaptureSetup& s, const BasePose& base,

@@ -1,16 +1,16 @@
 // ffsr/optimize/free_floating_step.hpp -- one classical RK4 step of the free-floating robot's
 // kinematic state x = (p_0, q_0, theta) (base position, unit quaternion, joint angles).
-//
-// The rates come from a rate field f(t, base, theta, theta_dot, xb) that writes the joint rates
-// theta_dot and the base velocity xb = [v_0; omega_0] (inertial frame, v_0 of the base frame origin;
-// the capture planner takes xb from zero total momentum, xb = -H_b^-1 H_bm theta_dot, Eq. 2 and 29).
-// The quaternion rate is q_dot = 1/2 [0, omega_0] (x) q. After the step the quaternion is
-// renormalized; its norm error before that is returned so that a monitor can watch it.
 #pragma once
 
 #include "ffsr/model/model.hpp"
 
 #include <cmath>
+
+// The rates come from a rate field f(t, base, theta, theta_dot, xb) that writes the joint rates
+// theta_dot and the base velocity xb = [v_0; omega_0] (inertial frame, v_0 of the base frame origin;
+// the capture planner takes xb from zero total momentum, xb = -H_b^-1 H_bm theta_dot, Eq. 2 and 29).
+// The quaternion rate is q_dot = 1/2 [0, omega_0] (x) q. After the step the quaternion is
+// renormalized; its norm error before that is returned so that a monitor can watch it.
 
 namespace ffsr {
 

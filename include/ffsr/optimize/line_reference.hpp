@@ -1,15 +1,15 @@
 // ffsr/optimize/line_reference.hpp -- the straight-line reference of the capture approach (Section 4).
-//
-// The end-effector goes from its initial position x0 to the capture point x_cap along a straight
-// line in the inertial frame with the quintic time law s(t/T) (zero velocity and acceleration at
-// both ends); for a pose task its orientation turns from R0 to R_end about one fixed axis with the
-// same law (a slerp: rot_total = log(R_end R0^T)). This is x_d(t) and x_d_dot(t) of Eq. 30.
-// Eigen only; reads nothing but its own fields.
 #pragma once
 
 #include "ffsr/spatial/spatial.hpp"
 
 #include <algorithm>
+
+// The end-effector goes from its initial position x0 to the capture point x_cap along a straight
+// line in the inertial frame with the quintic time law s(t/T) (zero velocity and acceleration at
+// both ends); for a pose task its orientation turns from R0 to R_end about one fixed axis with the
+// same law (a slerp: rot_total = log(R_end R0^T)). This is x_d(t) and x_d_dot(t) of Eq. 30.
+// Eigen only; reads nothing but its own fields.
 
 namespace ffsr {
 

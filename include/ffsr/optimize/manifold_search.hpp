@@ -2,7 +2,20 @@
 // the configuration of least objective (docs/branches.md): the SLSQP adapter, the one local-optimum
 // routine the searches share (the global search here, the Pareto front in pareto.hpp), and the
 // multistart with its branch stage.
-//
+#pragma once
+
+#include "ffsr/optimize/capture_manifold.hpp"
+#include "ffsr/optimize/multibody_objective.hpp"
+
+#include <nlopt.hpp>
+
+#include <chrono>
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <random>
+
 // Multistart: `starts` configurations drawn uniformly within the limits ([-pi, pi] for a continuous
 // joint) by std::mt19937_64 with our own mapping to [0, 1) (so a seed gives the same draws on every
 // platform), each put on C(B) by damped Newton on c, then NLopt's SLSQP minimizes the capture
@@ -20,19 +33,6 @@
 // optimum is M_ie's. robust-force: SLSQP minimizes CVaR_95 of the exact F_max over a fixed set of
 // uncertain samples with its analytic gradient, under the same constraints; the optima are compared
 // by that value. Needs NLopt (ffsr::global).
-#pragma once
-
-#include "ffsr/optimize/capture_manifold.hpp"
-#include "ffsr/optimize/multibody_objective.hpp"
-
-#include <nlopt.hpp>
-
-#include <chrono>
-#include <cstdint>
-#include <limits>
-#include <memory>
-#include <optional>
-#include <random>
 
 namespace ffsr {
 

@@ -1,5 +1,12 @@
 // ffsr/optimize/null_space.hpp -- the null-space policies: the second term of Eq. 30.
-//
+#pragma once
+
+#include "ffsr/algorithm/effective_mass.hpp"
+#include "ffsr/optimize/capture_problem.hpp"
+#include "ffsr/optimize/objective.hpp"
+
+#include <cmath>
+
 // A policy gives the joint rates the robot moves with inside the null space of its task,
 // qd_null = N v (N the projector of task_solver.hpp), on top of the task rates J_t^+ (x_d_dot + k_p e).
 // The capture run calls it at every evaluation of the joint-rate field, after crba, frame_jacobian
@@ -10,13 +17,6 @@
 //                   Eigen::VectorXd& qd_null);
 // It writes qd_null (size n, N applied) and must leave data.H that of (base, theta) (the base
 // velocity from zero momentum reads it afterwards).
-#pragma once
-
-#include "ffsr/algorithm/effective_mass.hpp"
-#include "ffsr/optimize/capture_problem.hpp"
-#include "ffsr/optimize/objective.hpp"
-
-#include <cmath>
 
 namespace ffsr {
 

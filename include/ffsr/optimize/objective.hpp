@@ -3,7 +3,13 @@
 // checks, the paper's planner's reports, the Pareto front and the base-rate constraint, the robust
 // samples, the closed loop's report and the command's subcommands), so that the joint model of the
 // contact and the objective kind reach all of them.
-//
+#pragma once
+
+#include "ffsr/algorithm/articulated_effective_mass.hpp"
+#include "ffsr/algorithm/base_disturbance.hpp"
+#include "ffsr/optimize/capture_problem.hpp"
+#include "ffsr/uncertainty/robust_objective.hpp"
+
 // At a capture configuration (the base pose at T and the joint angles theta), with u the target's
 // contact normal at T and b the target's inverse mass along it (Target::inverse_mass_along_normal):
 //   M_ie = 1 / (u^T Lambda_v^-1 u + b)                                           (Eq. 14)
@@ -23,12 +29,6 @@
 //
 // CaptureEvaluator is a view (pointers to the problem, the law, the joint model, the options): cheap
 // to make, allocation-free to call for M_ie and its gradient (Data holds the workspace).
-#pragma once
-
-#include "ffsr/algorithm/articulated_effective_mass.hpp"
-#include "ffsr/algorithm/base_disturbance.hpp"
-#include "ffsr/optimize/capture_problem.hpp"
-#include "ffsr/uncertainty/robust_objective.hpp"
 
 namespace ffsr {
 
@@ -64,7 +64,7 @@ class MultibodyPeak {
   virtual double operator()(const BasePose& base, const Eigen::VectorXd& theta) const = 0;
 };
 
-/// The capture objective (see the top of this file) of one contact: a robot and its contact frame,
+/// The capture objective (see the notes after the includes) of one contact: a robot and its contact frame,
 /// the target at the capture (normal u and inverse mass b), the law, the joint model and the kind.
 class CaptureEvaluator {
  public:
@@ -180,7 +180,7 @@ class CaptureEvaluator {
     return robust().value(inverse_inertia(data, base, theta));
   }
 
-  /// The value a search compares (see the top of this file): M_ie, or CVaR_95 for robust-force.
+  /// The value a search compares (see the notes after the includes): M_ie, or CVaR_95 for robust-force.
   /// Writes M (M_ie). Runs crba.
   double search_value(Data& data, const BasePose& base, const Eigen::Ref<const Eigen::VectorXd>& theta,
                       double& M) const {

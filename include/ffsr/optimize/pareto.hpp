@@ -1,6 +1,14 @@
 // ffsr/optimize/pareto.hpp -- the trade-off between the contact force and the base disturbance on
 // the capture manifold: the non-dominated set of (M_ie, |Delta w_0|) at a fixed base pose.
-//
+#pragma once
+
+#include "ffsr/algorithm/base_disturbance.hpp"
+#include "ffsr/optimize/manifold_search.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <vector>
+
 // M_ie (Eq. 14) sets the peak contact force; |Delta w_0| is the jump of the base's angular velocity
 // caused by the contact impulse (algorithm/base_disturbance.hpp): |Delta w_0| = P |b_w|, with
 // P = M_ie delta_dot^- (1 + e) and b_w the angular base rows of H^-1 J^T [u; 0] per unit impulse.
@@ -27,14 +35,6 @@
 // (M_ie of the rate end, rate of the M_ie end), in kg deg/s and normalized by the nadir box; the
 // knee, the point farthest from the line through the two ends in the normalized objectives.
 // Needs NLopt: CMake target ffsr::global.
-#pragma once
-
-#include "ffsr/algorithm/base_disturbance.hpp"
-#include "ffsr/optimize/manifold_search.hpp"
-
-#include <algorithm>
-#include <chrono>
-#include <vector>
 
 namespace ffsr {
 
@@ -159,7 +159,7 @@ inline void pareto_measures(ParetoFront& f) {
 
 }  // namespace detail
 
-/// The front of (M_ie, |Delta w_0|) on C(base) (see the top of this file). `extra_starts` join the
+/// The front of (M_ie, |Delta w_0|) on C(base) (see the notes after the includes). `extra_starts` join the
 /// random starts (e.g. the capture configurations of the other runs). Throws InputError for bad
 /// options or when no start reaches the manifold, NumericalError when the two ends coincide (no
 /// trade-off to show).

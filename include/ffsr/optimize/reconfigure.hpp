@@ -1,5 +1,11 @@
 // ffsr/optimize/reconfigure.hpp -- a reconfiguration of the arm before the capture approach.
-//
+#pragma once
+
+#include "ffsr/optimize/capture.hpp"
+
+#include <string>
+#include <vector>
+
 // The approach of capture.hpp starts at the initial configuration, so the capture configuration it
 // can reach lies on the same component of the self-motion manifold as that configuration (for an
 // arm without a null space: the same inverse-kinematics branch). A reconfiguration phase puts the
@@ -31,12 +37,6 @@
 //
 // Neither phase looks at shapes: with a clearance the global run checks each joined run's path
 // (GlobalCaptureOptions::check_run) and rejects a run that comes closer than the clearance.
-#pragma once
-
-#include "ffsr/optimize/capture.hpp"
-
-#include <string>
-#include <vector>
 
 namespace ffsr {
 
@@ -120,8 +120,8 @@ inline double reconfiguration_peak_rate(const Model& model, const Eigen::VectorX
   return kQuinticPeakRate * peak / t_r;
 }
 
-/// The joint-rate field of the reconfiguration: theta_dot of the quintic move (see the top of this
-/// file) and the base velocity from zero momentum. Runs crba at (base, theta); data then holds its
+/// The joint-rate field of the reconfiguration: theta_dot of the quintic move (see the notes after
+/// the includes) and the base velocity from zero momentum. Runs crba at (base, theta); data then holds its
 /// kinematics and data.H. Records the largest |theta_dot_k|.
 struct ReconfigurationField {
   const Model& model;
@@ -265,7 +265,7 @@ inline double default_reconfiguration_duration(const Model& model, const Eigen::
   return t_r;
 }
 
-/// A capture run with a reconfiguration (see the top of this file): the quintic joint-space move to
+/// A capture run with a reconfiguration (see the notes after the includes): the quintic joint-space move to
 /// theta_pre over [0, t_r] with the base reacting, then the approach over [t_r, T] (T =
 /// opt.duration) with `policy` (e.g. ServoPolicy to the capture configuration) toward the capture of
 /// `setup` (prepare_capture(pb, task, opt)). Checks t_r and the joint rate first

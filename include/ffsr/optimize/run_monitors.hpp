@@ -1,13 +1,4 @@
 // ffsr/optimize/run_monitors.hpp -- the checks a free-floating capture run makes at every step.
-//
-// Independent checks of the integration and of the approach: the total momentum of the commanded
-// motion (zero by construction of the base velocity, Eq. 2 with h = 0), the body momenta for scale,
-// the system centre of mass (it must not move when the momentum is zero: an independent check of the
-// integrated state), the tracking error of the end-effector against the line reference (a run
-// falling more than `divergence` behind it cannot reach the capture point), the quaternion norm
-// before renormalization, finiteness of the state and the joint limits. The maxima are kept here and
-// copied into the result by record(). The checks throw NumericalError (JointLimitError for a joint
-// outside its limits) with messages that start with `where`.
 #pragma once
 
 #include "ffsr/algorithm/momentum.hpp"
@@ -16,6 +7,15 @@
 #include <algorithm>
 #include <cmath>
 #include <vector>
+
+// Independent checks of the integration and of the approach: the total momentum of the commanded
+// motion (zero by construction of the base velocity, Eq. 2 with h = 0), the body momenta for scale,
+// the system centre of mass (it must not move when the momentum is zero: an independent check of the
+// integrated state), the tracking error of the end-effector against the line reference (a run
+// falling more than `divergence` behind it cannot reach the capture point), the quaternion norm
+// before renormalization, finiteness of the state and the joint limits. The maxima are kept here and
+// copied into the result by record(). The checks throw NumericalError (JointLimitError for a joint
+// outside its limits) with messages that start with `where`.
 
 namespace ffsr {
 

@@ -1,12 +1,6 @@
 // ffsr/optimize/shooting.hpp -- the reaching planner of the global capture optimization
 // (plan_capture_global): the capture configuration is chosen first on the capture manifold
 // (manifold_search.hpp), then the approach is planned to reach it.
-//
-// The same line reference and time law as the paper's method, the task first, and the null space
-// servoing to the chosen configuration (ServoPolicy in null_space.hpp), with the joint-rate limit.
-// The base pose at T depends on the path, so it shoots: search at the base pose reached, plan again
-// to the new optimum, until the reached objective is within `gap_percent` of the manifold optimum at
-// the reached base pose. Needs NLopt (ffsr::global).
 #pragma once
 
 #include "ffsr/optimize/manifold_search.hpp"
@@ -16,6 +10,12 @@
 #include <optional>
 #include <string>
 #include <vector>
+
+// The same line reference and time law as the paper's method, the task first, and the null space
+// servoing to the chosen configuration (ServoPolicy in null_space.hpp), with the joint-rate limit.
+// The base pose at T depends on the path, so it shoots: search at the base pose reached, plan again
+// to the new optimum, until the reached objective is within `gap_percent` of the manifold optimum at
+// the reached base pose. Needs NLopt (ffsr::global).
 
 namespace ffsr {
 
@@ -322,7 +322,7 @@ inline NumericalError no_goal_reached(const GlobalCaptureResult& res, const char
 
 }  // namespace detail
 
-/// Global capture planning (see the top of this file). Goals are the local optima of the search at
+/// Global capture planning (see the notes after the includes). Goals are the local optima of the search at
 /// the base pose of the task-only run, best first. For each goal: plan the reaching run, re-optimize
 /// the goal locally at the reached base pose, repeat until the reached objective is within
 /// gap_percent of that local optimum (the goal is then reached) or the run ends away from it (the

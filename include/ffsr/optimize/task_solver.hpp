@@ -1,19 +1,4 @@
 // ffsr/optimize/task_solver.hpp -- the rate law of the capture approach (Eq. 30-31), one tick.
-//
-//   theta_dot = J_t^+ (x_d_dot + k_p e) + alpha N qd_free,   N = E - J_t^+ J_t,
-//
-// J_t the task rows of the generalized Jacobian J_f (Eq. 29: x_dot = J_f theta_dot under zero
-// momentum), J_t^+ its pseudo-inverse from the SVD J_t = U Sigma V^T: 1/sigma_i on the singular
-// values above 1e-12, and damped least squares sigma_i / (sigma_i^2 + lambda^2) on all of them when
-// the smallest falls below the threshold sigma_t, with lambda^2 = (1 - (sigma_min/sigma_t)^2)
-// lambda_max^2 (zero at the threshold, lambda_max^2 at a singularity). N projects on the null space
-// of J_t (E minus v_i v_i^T for every sigma_i > 1e-12), so J_t N = 0 and N N = N. alpha in [0, 1] is
-// the largest factor that keeps every |theta_dot_k| <= the joint-rate limit (the task part is never
-// scaled; alpha = 0 when the task part alone breaks the limit).
-//
-// TaskSolver holds its workspace, sized at construction (n joints, m task rows); solve() and
-// add_null_space() then run without heap allocation (JacobiSVD on its preallocated storage), so an
-// onboard controller can call them once per control tick.
 #pragma once
 
 #include "ffsr/spatial/spatial.hpp"
@@ -28,6 +13,21 @@
 #include <limits>
 #include <utility>
 #include <vector>
+
+//   theta_dot = J_t^+ (x_d_dot + k_p e) + alpha N qd_free,   N = E - J_t^+ J_t,
+//
+// J_t the task rows of the generalized Jacobian J_f (Eq. 29: x_dot = J_f theta_dot under zero
+// momentum), J_t^+ its pseudo-inverse from the SVD J_t = U Sigma V^T: 1/sigma_i on the singular
+// values above 1e-12, and damped least squares sigma_i / (sigma_i^2 + lambda^2) on all of them when
+// the smallest falls below the threshold sigma_t, with lambda^2 = (1 - (sigma_min/sigma_t)^2)
+// lambda_max^2 (zero at the threshold, lambda_max^2 at a singularity). N projects on the null space
+// of J_t (E minus v_i v_i^T for every sigma_i > 1e-12), so J_t N = 0 and N N = N. alpha in [0, 1] is
+// the largest factor that keeps every |theta_dot_k| <= the joint-rate limit (the task part is never
+// scaled; alpha = 0 when the task part alone breaks the limit).
+//
+// TaskSolver holds its workspace, sized at construction (n joints, m task rows); solve() and
+// add_null_space() then run without heap allocation (JacobiSVD on its preallocated storage), so an
+// onboard controller can call them once per control tick.
 
 namespace ffsr {
 
@@ -74,7 +74,7 @@ struct TaskRates {
   double null_scale = 1;      ///< alpha, the factor applied to the null-space rates (1: not scaled)
 };
 
-/// The task solver of Eq. 30-31 (see the top of this file).
+/// The task solver of Eq. 30-31 (see the notes after the includes).
 class TaskSolver {
  public:
   /// n joints; `rows` the rows of J_f (0-2 linear, 3-5 angular) the task constrains;

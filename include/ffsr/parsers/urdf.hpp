@@ -1,5 +1,13 @@
 // ffsr/parsers/urdf.hpp -- URDF -> Model, through urdfdom. Link with ffsr::urdf.
-//
+#pragma once
+
+#include "ffsr/model/model.hpp"
+
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
 // The root link is the free-floating base, or (UrdfOptions::bus) the URDF is mounted on a
 // spacecraft bus that becomes the base, its root link and every link fixed to it merged into the bus.
 // Revolute, continuous and prismatic joints move; fixed joints merge their child's inertia into the
@@ -14,14 +22,6 @@
 // (src/parsers/urdf.cpp, with urdfdom), so that a program that loads a URDF does not compile the
 // parser: this header declares the entry points and includes neither urdfdom nor the parser's
 // internals (those are in parsers/detail/urdf_document.hpp).
-#pragma once
-
-#include "ffsr/model/model.hpp"
-
-#include <optional>
-#include <string>
-#include <utility>
-#include <vector>
 
 namespace ffsr {
 

@@ -1,9 +1,8 @@
-// ffsr/scenario/geometry.hpp -- a scenario's shapes and clearance (the keys target-shape,
-// target-size, target-shape-offset, link-radius, bus-box, clearance, contact-exemption): the
-// collision model built with the scenario, its checks (the contact point on the target's surface, the
-// start configuration within the clearance). The runs that use it are in ffsr/jobs/scenario_clearance.hpp.
-// Included by scenario/scenario.hpp; needs ffsr::geometry (FCL) when a
-// scenario uses the keys: without it (FFSR_HAVE_GEOMETRY undefined) such a scenario is refused.
+// ffsr/scenario/geometry.hpp -- a scenario's shapes and clearance (the keys target-shape, target-size,
+// target-shape-offset, link-radius, bus-box, clearance, contact-exemption): the collision model built
+// with the scenario and its checks; the runs that use it are in ffsr/jobs/scenario_clearance.hpp.
+// Needs ffsr::geometry (FCL) when a scenario uses the keys: without it (FFSR_HAVE_GEOMETRY undefined)
+// such a scenario is refused.
 #pragma once
 
 #include "ffsr/geometry/shape.hpp"

@@ -1,15 +1,6 @@
 // ffsr/scenario/scenario.hpp -- a capture scenario as a value: its keys, one TOML reader (toml++, the
 // [uncertainty] table included), overrides given as text (a command line), one validation, and the
 // problem it describes. Component ffsr::scenario (urdfdom, SUNDIALS, NLopt, toml++, nlohmann/json).
-//
-// A scenario file is a flat TOML table: every key of `scenario_keys()` (robot, start state, target,
-// contact, tasks, planner, global run) and an optional [uncertainty] table. Messages name the file
-// ("scenario FILE: missing key 'duration'") or the key ("--duration: must be positive, got -1"): the
-// keys are spelled as the command's flags, so a message reads the same for a file and a flag.
-//
-//   ffsr::Scenario sc = ffsr::load_scenario("robots/paper_7dof_position.toml");
-//   ffsr::ScenarioResult r = ffsr::run_scenario(sc);          // scenario_run.hpp
-//   nlohmann::json j = ffsr::scenario_json(sc, r, "0.1.0");   // what `ffsr-optimize --json` writes
 #pragma once
 
 #include "ffsr/errors.hpp"
@@ -29,6 +20,15 @@
 #include <set>
 #include <string>
 #include <vector>
+
+// A scenario file is a flat TOML table: every key of `scenario_keys()` (robot, start state, target,
+// contact, tasks, planner, global run) and an optional [uncertainty] table. Messages name the file
+// ("scenario FILE: missing key 'duration'") or the key ("--duration: must be positive, got -1"): the
+// keys are spelled as the command's flags, so a message reads the same for a file and a flag.
+//
+//   ffsr::Scenario sc = ffsr::load_scenario("robots/paper_7dof_position.toml");
+//   ffsr::ScenarioResult r = ffsr::run_scenario(sc);          // scenario_run.hpp
+//   nlohmann::json j = ffsr::scenario_json(sc, r, "0.1.0");   // what `ffsr-optimize --json` writes
 
 namespace ffsr {
 

@@ -1,23 +1,7 @@
 // ffsr/simulate/cvode.hpp -- an RAII wrapper over SUNDIALS (6.x) CVODE for y' = f(t, y).
-//
-// Method: BDF with Newton iteration, a dense SUNMatrix and the dense direct linear solver, the
-// Jacobian by CVODE's difference quotients. Optional root functions g(t, y) with directions
-// (CVodeRootInit, CVodeSetRootDirection). Integration is forward in time.
-//
-// Ownership: the SUNContext, the N_Vectors, the SUNMatrix, the SUNLinearSolver and the CVODE memory
-// live in one heap-allocated state owned by a std::unique_ptr, each with its own deleter, so the
-// Integrator is move-only, moves never invalidate the pointer CVODE holds as user data, and
-// everything is freed in the right order (CVODE memory first, the context last).
-//
-// Errors: every SUNDIALS return flag is checked; a failure throws ffsr::IntegrationError naming the
-// call, the flag (CVodeGetReturnFlagName), the time and CVODE's own message, which an error handler
-// stores instead of printing it (the library never prints). The callbacks catch every C++
-// exception, return -1 (unrecoverable) and the wrapper rethrows the original exception once CVODE
-// has returned. A non-finite entry in f or g is an IntegrationError too. CVODE's step limit
-// (Options::max_num_steps, per call of advance) is always finite, so nothing hangs.
 #pragma once
 
-#include <ffsr/errors.hpp>
+#include "ffsr/errors.hpp"
 
 #include <Eigen/Core>
 
@@ -37,6 +21,22 @@
 #include <type_traits>
 #include <utility>
 #include <vector>
+
+// Method: BDF with Newton iteration, a dense SUNMatrix and the dense direct linear solver, the
+// Jacobian by CVODE's difference quotients. Optional root functions g(t, y) with directions
+// (CVodeRootInit, CVodeSetRootDirection). Integration is forward in time.
+//
+// Ownership: the SUNContext, the N_Vectors, the SUNMatrix, the SUNLinearSolver and the CVODE memory
+// live in one heap-allocated state owned by a std::unique_ptr, each with its own deleter, so the
+// Integrator is move-only, moves never invalidate the pointer CVODE holds as user data, and
+// everything is freed in the right order (CVODE memory first, the context last).
+//
+// Errors: every SUNDIALS return flag is checked; a failure throws ffsr::IntegrationError naming the
+// call, the flag (CVodeGetReturnFlagName), the time and CVODE's own message, which an error handler
+// stores instead of printing it (the library never prints). The callbacks catch every C++
+// exception, return -1 (unrecoverable) and the wrapper rethrows the original exception once CVODE
+// has returned. A non-finite entry in f or g is an IntegrationError too. CVODE's step limit
+// (Options::max_num_steps, per call of advance) is always finite, so nothing hangs.
 
 namespace ffsr::cvode {
 

@@ -1,6 +1,18 @@
 // ffsr/simulate/multibody.hpp -- the full robot-plus-target contact simulation (Figure 2), the
 // "classical numerical integration method" that the paper uses as its reference (Tables 3 and 6).
-//
+#pragma once
+
+#include "ffsr/algorithm/effective_mass.hpp"
+#include "ffsr/algorithm/forward_dynamics.hpp"
+#include "ffsr/algorithm/joint_models.hpp"
+#include "ffsr/algorithm/jacobian.hpp"
+#include "ffsr/algorithm/momentum.hpp"
+#include "ffsr/contact/contact_law.hpp"
+#include "ffsr/simulate/cvode.hpp"
+
+#include <string>
+#include <vector>
+
 // The free-floating robot (joints passive: zero torque, unless MultibodyContactOptions gives a joint PD
 // servo holding the pre-contact rates and an armature; gravity model.gravity, zero by default) and
 // the target (a free rigid body) touch at one point. The target's surface near the contact is the
@@ -20,18 +32,6 @@
 // Integration: SUNDIALS CVODE (BDF, Newton, dense), tight tolerances, on displacements from the
 // initial state so that the ~0.1 mm deformation is resolved; separation (delta back to zero) and the
 // force peak (dF/dt = 0) are located by CVODE's root finding.
-#pragma once
-
-#include "ffsr/algorithm/effective_mass.hpp"
-#include "ffsr/algorithm/forward_dynamics.hpp"
-#include "ffsr/algorithm/joint_models.hpp"
-#include "ffsr/algorithm/jacobian.hpp"
-#include "ffsr/algorithm/momentum.hpp"
-#include "ffsr/contact/contact_law.hpp"
-#include "ffsr/simulate/cvode.hpp"
-
-#include <string>
-#include <vector>
 
 namespace ffsr {
 
@@ -404,7 +404,7 @@ inline void record_separation(MultibodyContactResult& res, ContactSystem& sys, c
 
 }  // namespace detail
 
-/// The full multibody contact simulation (see the top of this file). `theta` is the capture
+/// The full multibody contact simulation (see the notes after the includes). `theta` is the capture
 /// configuration; the target is placed so that its contact point touches the end-effector
 /// (its `position` is ignored). Throws InputError for bad arguments or receding bodies,
 /// IntegrationError for a CVODE failure, NumericalError if the bodies do not separate.

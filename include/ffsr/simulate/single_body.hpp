@@ -3,7 +3,18 @@
 // from first touch (δ = 0, δ̇ = δ̇⁻) to separation (δ back to 0), located by CVODE root finding
 // (Zhang et al. 2022, Section 3). It is the time-stepping reference for the closed forms
 // (Eq. 20, 23-25) and for the exact maximum of contact_law.hpp.
-//
+#pragma once
+
+#include "ffsr/contact/contact_law.hpp"
+#include "ffsr/errors.hpp"
+#include "ffsr/simulate/cvode.hpp"
+
+#include <Eigen/Core>
+
+#include <cmath>
+#include <variant>
+#include <vector>
+
 // Scaling: the contact lasts milliseconds and δ is micrometres, so the integration runs in the
 // natural units of the problem: length δ_ref = δ_max (Eq. 20), velocity δ̇⁻, time T = δ_ref/δ̇⁻.
 // The scaled state y = (δ/δ_ref, δ̇/δ̇⁻) is O(1) along the whole contact, so plain relative and
@@ -15,17 +26,6 @@
 //             is F(δ, δ̇) of the integrated state (first order insensitive to the time error);
 //   δ̇      -- the maximum deformation;
 //   δ      -- separation.
-#pragma once
-
-#include <ffsr/contact/contact_law.hpp>
-#include <ffsr/errors.hpp>
-#include <ffsr/simulate/cvode.hpp>
-
-#include <Eigen/Core>
-
-#include <cmath>
-#include <variant>
-#include <vector>
 
 namespace ffsr {
 

@@ -386,6 +386,18 @@ struct ArticulatedInertia {
     f(5) = la(0, 2) * v0 + la(1, 2) * v1 + la(2, 2) * v2 + aa(2, 0) * w0 + aa(2, 1) * w1 + aa(2, 2) * w2;
     return f;
   }
+  /// One symmetric 3x3 block M (column-major) of add_projected: M += C - s u^T with s = u / D, the upper
+  /// triangle computed and mirrored.
+  static void add_symmetric_projected(double* M, const double* C, double u0, double u1, double u2, double s0,
+                                      double s1, double s2) {
+    M[0] += C[0] - s0 * u0;
+    M[3] += C[3] - s0 * u1;
+    M[6] += C[6] - s0 * u2;
+    M[4] += C[4] - s1 * u1;
+    M[7] += C[7] - s1 * u2;
+    M[8] += C[8] - s2 * u2;
+    M[1] = M[3], M[2] = M[6], M[5] = M[7];
+  }
   /// This += c - U U^T / D (the articulated inertia a child passes to its parent across a joint
   /// with U = IA_c S, D = S^T U, RBDA 7.3). The symmetric blocks get their upper triangle computed
   /// and mirrored, so they stay exactly symmetric.
@@ -393,29 +405,13 @@ struct ArticulatedInertia {
     const double inv = 1.0 / D;
     const double u0 = U(0), u1 = U(1), u2 = U(2), u3 = U(3), u4 = U(4), u5 = U(5);
     const double s0 = u0 * inv, s1 = u1 * inv, s2 = u2 * inv, s3 = u3 * inv, s4 = u4 * inv, s5 = u5 * inv;
-    double* L = ll.data();
-    const double* cL = c.ll.data();
-    L[0] += cL[0] - s0 * u0;
-    L[3] += cL[3] - s0 * u1;
-    L[6] += cL[6] - s0 * u2;
-    L[4] += cL[4] - s1 * u1;
-    L[7] += cL[7] - s1 * u2;
-    L[8] += cL[8] - s2 * u2;
-    L[1] = L[3], L[2] = L[6], L[5] = L[7];
+    add_symmetric_projected(ll.data(), c.ll.data(), u0, u1, u2, s0, s1, s2);
     double* X = la.data();
     const double* cX = c.la.data();
     X[0] += cX[0] - s0 * u3, X[1] += cX[1] - s1 * u3, X[2] += cX[2] - s2 * u3;
     X[3] += cX[3] - s0 * u4, X[4] += cX[4] - s1 * u4, X[5] += cX[5] - s2 * u4;
     X[6] += cX[6] - s0 * u5, X[7] += cX[7] - s1 * u5, X[8] += cX[8] - s2 * u5;
-    double* A = aa.data();
-    const double* cA = c.aa.data();
-    A[0] += cA[0] - s3 * u3;
-    A[3] += cA[3] - s3 * u4;
-    A[6] += cA[6] - s3 * u5;
-    A[4] += cA[4] - s4 * u4;
-    A[7] += cA[7] - s4 * u5;
-    A[8] += cA[8] - s5 * u5;
-    A[1] = A[3], A[2] = A[6], A[5] = A[7];
+    add_symmetric_projected(aa.data(), c.aa.data(), u3, u4, u5, s3, s4, s5);
   }
   Matrix6 matrix() const {
     Matrix6 M;

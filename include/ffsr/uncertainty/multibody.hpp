@@ -1,8 +1,7 @@
 // ffsr/uncertainty/multibody.hpp -- F_max of an uncertain sample from the multibody CVODE reference
-// (simulate/multibody.hpp, Figure 2): the robot at the capture configuration meets the sample's
-// target (nominal attitude at the capture, the sample's mass, inertia, contact offset, normal,
-// spin and velocity) at the sample's contact point p_e + rho, which moves at the sample's approach
-// speed along u.
+// (simulate/multibody.hpp, Figure 2): the robot at the capture configuration meets the sample's target
+// (nominal attitude at the capture; the sample's mass, inertia, contact offset, normal, spin, velocity)
+// at the sample's contact point p_e + rho, moving at the sample's approach speed along u.
 // Needs ffsr::cvode (SUNDIALS).
 #pragma once
 

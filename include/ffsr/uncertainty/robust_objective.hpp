@@ -1,7 +1,17 @@
 // ffsr/uncertainty/robust_objective.hpp -- a tail measure of the maximum contact force over a fixed
 // set of uncertain samples, with its gradient in the joint angles: the objective "robust-force" of
 // the global capture search (optimize/global.hpp). Eigen only.
-//
+#pragma once
+
+#include "ffsr/algorithm/joint_models.hpp"
+#include "ffsr/uncertainty/sampling.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <string>
+#include <vector>
+
 // The measure. For a capture configuration (base pose and joint angles at T) and samples i = 1..N
 // (uncertainty/sampling.hpp), F_i is the exact single-body peak (Eq. 16) of sample i. The objective
 // is the conditional value at risk at 95 % (CVaR_95): the mean of the k = ceil(N / 20) largest F_i.
@@ -25,20 +35,10 @@
 // W is a symmetric 6x6 matrix: with its eigen-decomposition W = sum_j l_j e_j e_j^T the gradient is
 // sum_j l_j d(e_j^T Lambda^-1 e_j), six analytic form gradients (effective_mass.hpp,
 // inverse_inertia_form_gradient) whatever the number of samples.
-#pragma once
-
-#include "ffsr/algorithm/joint_models.hpp"
-#include "ffsr/uncertainty/sampling.hpp"
-
-#include <algorithm>
-#include <array>
-#include <cmath>
-#include <string>
-#include <vector>
 
 namespace ffsr {
 
-/// CVaR_95 of the exact F_max over a fixed sample set (see the top of this file). Holds scratch
+/// CVaR_95 of the exact F_max over a fixed sample set (see the notes after the includes). Holds scratch
 /// buffers: one object per thread.
 class RobustForceObjective {
  public:

@@ -1,67 +1,5 @@
 // ffsr/uncertainty/sampling.hpp -- uncertain targets: distributions of the target and contact
 // quantities, a reproducible sampler, and the maximum contact force per sample (Eigen only).
-//
-// What is uncertain. The capture configuration (joint angles and base pose at the capture time T)
-// is planned for the nominal target; what is not known is the target as it is met at T and the
-// contact. A sample is the target at the capture -- its mass, inertia, contact offset r_tp, normal
-// u_n, spin omega_t (target frame), linear velocity v_t -- and the contact: where the bodies touch,
-// approach speed, stiffness K, restitution c_r, exponent alpha. The target's attitude at T is the
-// nominal one (propagated from t = 0 by the planner), so u = R_t u_n and r = R_t r_tp change
-// through u_n and r_tp only.
-//
-// Two quantities move the contact point, and they differ in what they move:
-//   contact-offset  e: the lever arm r_tp + e from the target's centre of mass to the contact point
-//                   (the centre of mass is not where it was estimated); the point where the bodies
-//                   touch is the planned one, the end-effector's point p_e.
-//   contact-point   d: the point where the bodies touch is displaced by d (target frame) from the
-//                   planned one -- the grasp feature is not where it was seen, so it meets another
-//                   point of the end-effector's contact surface. Both bodies see it: the lever arm is
-//                   r_tp + d and the robot is struck at p_e + rho, rho = R_t d. The robot's inverse
-//                   effective mass there is s^T Lambda^-1 s with s = [u; rho x u] and Lambda^-1 =
-//                   J H^-1 J^T its 6x6 inverse inertia at p_e: the end-effector's rotational
-//                   compliance enters, which depends on the configuration (the nominal M_ie does not
-//                   see it).
-// Per sample (Eq. 10-14, 20-25):
-//   M_ie = 1 / (s^T Lambda^-1 s + 1/m_t + (r_tp x u_n)^T I_t^-1 (r_tp x u_n)),  s = [u; rho x u]
-//          (rho = 0 without contact-point: s^T Lambda^-1 s = u^T G u, G = J_v H^-1 J_v^T),
-//   delta_dot^- = v_a - u . (v_t + omega x r)   (the robot's contact point moves at v_a along u,
-//                                                Eq. 10-12),
-//   F_max = closed form (Eq. 24) or the exact peak of Eq. 16, or a multibody CVODE run
-//   (uncertainty/multibody.hpp).
-// Lambda^-1 is a property of the configuration, computed once (robot_inverse_inertia); a sample
-// then costs a 6-vector quadratic form and the peak of Eq. 16 -- 1e5 samples take well under a
-// second.
-//
-// The laws (Spread), with x0 the nominal value:
-//   normal      x = x0 + s z          s = std, or relative-std |x0|   z ~ N(0, 1)
-//   uniform     x ~ U[min, max], or U[x0 - h, x0 + h] with h = half-width, or relative |x0|
-//   log-normal  x = x0 exp(sigma z)   (median x0; the law for K, which is known to a decade)
-//   cone        the normal u_n: uniform on the spherical cap of half-angle a <= 90 deg about the
-//               nominal normal (cos of the angle uniform in [cos a, 1], azimuth uniform)
-// Any scalar law may carry bounds `min`/`max` (a bounded law: values outside are redrawn, i.e. the
-// law is truncated). Vectors (contact offset, contact point, spin, velocity) take normal or uniform laws per
-// component, added to the nominal vector, with absolute spreads. The inertia takes a relative
-// spread of its principal moments (each scaled by 1 + e, e normal or uniform) and, optionally, a
-// rotation of its principal axes by an angle uniform in [0, axes] about a uniformly random axis.
-//
-// Physical or redrawn -- the redraw rule of every quantity (a sample that breaks one rule draws
-// that quantity again from the same sample stream, at most kMaxRedraws times, then NumericalError):
-//   target-mass     m_t > 0 (and within min/max)
-//   target-inertia  principal moments > 0 and the triangle inequality I_max <= I_mid + I_min
-//   normal          unit by construction (renormalized), within the cone
-//   approach-speed  v_a > 0;  stiffness K > 0;  exponent alpha > 0;  restitution 0 < c_r <= 1
-//   the sample      delta_dot^- > 0 (the bodies approach): otherwise the whole sample is redrawn
-//                   (it depends on the target attitude only, not on the configuration, so the
-//                   sample set stays common to all configurations)
-//
-// Reproducible randomness. Sample i uses its own std::mt19937_64 seeded with
-// splitmix64(seed + splitmix64(i)), so it depends on (seed, i) only: shards, threads and
-// configurations draw the same numbers (common random numbers). mt19937_64 and its seeding are
-// fully specified by the C++ standard; the uniform and normal transforms are ours (53-bit
-// uniforms; Marsaglia's polar method; azimuths by rejection in the unit disc), because the
-// std:: distributions are implementation-defined. Only std::log, std::exp and std::sqrt are used
-// on the draws (sqrt is exact in IEEE 754; log and exp of a quality libm agree to the last bit on
-// the platforms we know, not by a guarantee).
 #pragma once
 
 #include "ffsr/algorithm/effective_mass.hpp"
@@ -73,21 +11,25 @@
 
 #include <algorithm>
 #include <array>
-#include <atomic>
-#include <chrono>
 #include <cmath>
 #include <cstdint>
-#include <functional>
 #include <limits>
 #include <optional>
 #include <random>
 #include <string>
 #include <string_view>
-#include <thread>
 #include <tuple>
 #include <vector>
 
 namespace ffsr {
+
+// What is uncertain. The capture configuration (joint angles and base pose at the capture time T)
+// is planned for the nominal target; what is not known is the target as it is met at T and the
+// contact. A sample is the target at the capture -- its mass, inertia, contact offset r_tp, normal
+// u_n, spin omega_t (target frame), linear velocity v_t -- and the contact: where the bodies touch,
+// approach speed, stiffness K, restitution c_r, exponent alpha. The target's attitude at T is the
+// nominal one (propagated from t = 0 by the planner), so u = R_t u_n and r = R_t r_tp change
+// through u_n and r_tp only.
 
 /// The uncertain quantities, in the order they are drawn.
 enum class Quantity {
@@ -109,7 +51,19 @@ inline constexpr std::array<std::string_view, kNumQuantities> kQuantityNames{
     "target-mass",    "target-inertia", "contact-offset", "normal",   "spin",         "target-velocity",
     "approach-speed", "stiffness",      "restitution",    "exponent", "contact-point"};
 
-/// The law of one uncertain quantity (see the top of this file). Units are the quantity's own, SI,
+// The laws (Spread), with x0 the nominal value:
+//   normal      x = x0 + s z          s = std, or relative-std |x0|   z ~ N(0, 1)
+//   uniform     x ~ U[min, max], or U[x0 - h, x0 + h] with h = half-width, or relative |x0|
+//   log-normal  x = x0 exp(sigma z)   (median x0; the law for K, which is known to a decade)
+//   cone        the normal u_n: uniform on the spherical cap of half-angle a <= 90 deg about the
+//               nominal normal (cos of the angle uniform in [cos a, 1], azimuth uniform)
+// Any scalar law may carry bounds `min`/`max` (a bounded law: values outside are redrawn, i.e. the
+// law is truncated). Vectors (contact offset, contact point, spin, velocity) take normal or uniform laws per
+// component, added to the nominal vector, with absolute spreads. The inertia takes a relative
+// spread of its principal moments (each scaled by 1 + e, e normal or uniform) and, optionally, a
+// rotation of its principal axes by an angle uniform in [0, axes] about a uniformly random axis.
+
+/// The law of one uncertain quantity (the laws above). Units are the quantity's own, SI,
 /// except `spin` (rad/s here; the CLI takes deg/s) and the angles (rad).
 struct Spread {
   enum class Law { Fixed, Normal, Uniform, LogNormal, Cone };
@@ -163,6 +117,15 @@ struct UncertainSample {
   std::array<double, kNumQuantities> score{};
 };
 
+// Physical or redrawn -- the redraw rule of every quantity (a sample that breaks one rule draws
+// that quantity again from the same sample stream, at most kMaxRedraws times, then NumericalError):
+//   target-mass     m_t > 0 (and within min/max)
+//   target-inertia  principal moments > 0 and the triangle inequality I_max <= I_mid + I_min
+//   normal          unit by construction (renormalized), within the cone
+//   approach-speed  v_a > 0;  stiffness K > 0;  exponent alpha > 0;  restitution 0 < c_r <= 1
+//   the sample      delta_dot^- > 0 (the bodies approach): otherwise the whole sample is redrawn
+//                   (it depends on the target attitude only, not on the configuration, so the
+//                   sample set stays common to all configurations)
 inline constexpr int kMaxRedraws = 1000;
 
 namespace detail {
@@ -177,8 +140,17 @@ constexpr std::uint64_t splitmix64(std::uint64_t x) {
 
 }  // namespace detail
 
+// Reproducible randomness. Sample i uses its own std::mt19937_64 seeded with
+// splitmix64(seed + splitmix64(i)), so it depends on (seed, i) only: shards, threads and
+// configurations draw the same numbers (common random numbers). mt19937_64 and its seeding are
+// fully specified by the C++ standard; the uniform and normal transforms are ours (53-bit
+// uniforms; Marsaglia's polar method; azimuths by rejection in the unit disc), because the
+// std:: distributions are implementation-defined. Only std::log, std::exp and std::sqrt are used
+// on the draws (sqrt is exact in IEEE 754; log and exp of a quality libm agree to the last bit on
+// the platforms we know, not by a guarantee).
+
 /// The random stream of sample `index`: mt19937_64 seeded from (seed, index) only, with our own
-/// transforms (same numbers on every platform, see the top of this file).
+/// transforms (same numbers on every platform, see above).
 class SampleStream {
  public:
   SampleStream(std::uint64_t seed, std::uint64_t index)
@@ -220,8 +192,8 @@ class SampleStream {
   std::mt19937_64 engine_;
 };
 
-/// Draws the sample `index` of `spec` around `nominal` (see the top of this file for the laws and
-/// the redraw rules). Reads spec, nominal. Pure: the same (spec, nominal, index) gives the same
+/// Draws the sample `index` of `spec` around `nominal` (the laws at Spread, the redraw rules at
+/// kMaxRedraws). Reads spec, nominal. Pure: the same (spec, nominal, index) gives the same
 /// sample. NumericalError when a rule still fails after kMaxRedraws draws.
 inline UncertainSample draw_sample(const UncertaintySpec& spec, const UncertainNominal& nominal,
                                    std::uint64_t index);
@@ -237,6 +209,29 @@ inline Matrix3 robot_inverse_mass_matrix(const Model& model, Data& data, const B
 /// s^T Lambda^-1 s with s = UncertainSample::wrench (its top-left block is G). Runs crba. Writes data.
 inline Matrix6 robot_inverse_inertia(const Model& model, Data& data, const BasePose& base,
                                      const Eigen::Ref<const Eigen::VectorXd>& theta, int frame);
+
+// Two quantities move the contact point, and they differ in what they move:
+//   contact-offset  e: the lever arm r_tp + e from the target's centre of mass to the contact point
+//                   (the centre of mass is not where it was estimated); the point where the bodies
+//                   touch is the planned one, the end-effector's point p_e.
+//   contact-point   d: the point where the bodies touch is displaced by d (target frame) from the
+//                   planned one -- the grasp feature is not where it was seen, so it meets another
+//                   point of the end-effector's contact surface. Both bodies see it: the lever arm is
+//                   r_tp + d and the robot is struck at p_e + rho, rho = R_t d. The robot's inverse
+//                   effective mass there is s^T Lambda^-1 s with s = [u; rho x u] and Lambda^-1 =
+//                   J H^-1 J^T its 6x6 inverse inertia at p_e: the end-effector's rotational
+//                   compliance enters, which depends on the configuration (the nominal M_ie does not
+//                   see it).
+// Per sample (Eq. 10-14, 20-25):
+//   M_ie = 1 / (s^T Lambda^-1 s + 1/m_t + (r_tp x u_n)^T I_t^-1 (r_tp x u_n)),  s = [u; rho x u]
+//          (rho = 0 without contact-point: s^T Lambda^-1 s = u^T G u, G = J_v H^-1 J_v^T),
+//   delta_dot^- = v_a - u . (v_t + omega x r)   (the robot's contact point moves at v_a along u,
+//                                                Eq. 10-12),
+//   F_max = closed form (Eq. 24) or the exact peak of Eq. 16, or a multibody CVODE run
+//   (uncertainty/multibody.hpp).
+// Lambda^-1 is a property of the configuration, computed once (robot_inverse_inertia); a sample
+// then costs a 6-vector quadratic form and the peak of Eq. 16 -- 1e5 samples take well under a
+// second.
 
 /// How F_max is computed per sample: Eq. 24 (closed), the exact peak of Eq. 16 (exact), or the
 /// multibody CVODE reference (uncertainty/multibody.hpp; not available from this header).
@@ -356,13 +351,6 @@ inline QuantileRanks quantile_interval(std::size_t n, double q, double confidenc
 /// The nearest-rank percentile of `sorted` (ascending): the ceil(percent n / 100)-th smallest value,
 /// in integer arithmetic (no rounding question at p n = integer). percent in [1, 100].
 inline double nearest_rank(const std::vector<double>& sorted, int percent);
-
-/// Runs f(i) for i in [begin, end) on `threads` threads (an atomic counter hands out the
-/// indices). Exceptions are rethrown on the calling thread (the first by index). `progress`, if
-/// set, is called on the calling thread with the count done, about every 50 ms.
-inline void parallel_for(std::uint64_t begin, std::uint64_t end, int threads,
-                         const std::function<void(std::uint64_t)>& f,
-                         const std::function<void(std::uint64_t)>& progress = {});
 
 /// The robust objective: the 95th percentile (nearest rank) of the exact F_max over a fixed sample
 /// set, for the capture configuration (base, theta). Cost: one crba and the samples' peaks.

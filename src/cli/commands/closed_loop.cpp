@@ -1,9 +1,8 @@
-// ffsr-optimize closed-loop [--config SCENARIO.toml] [flags]: the capture controller
-// (ffsr/control/capture_controller.hpp) in a closed loop with the robot's full dynamics and a noisy
-// target estimate (ffsr/control/closed_loop.hpp), beside the open-loop plan it follows. The plan is
-// the paper's method (--plan paper), the global run's servo (--plan global: the global search of the
-// main job first) or the servo to a given capture configuration (--goal-joints-deg). A flag overrides
-// the scenario file's key. The job is the library's (ffsr/jobs/closed_loop.hpp).
+// ffsr-optimize closed-loop [--config SCENARIO.toml] [flags]: the capture controller in a closed loop
+// with the robot's full dynamics and a noisy target estimate, beside the open-loop plan it follows:
+// the paper's method (--plan paper), the global run's servo (--plan global) or the servo to a given
+// capture configuration (--goal-joints-deg). A flag overrides the scenario file's key. The job is the
+// library's (ffsr/jobs/closed_loop.hpp).
 #include "support/output.hpp"
 #include "support/parse.hpp"
 #include "support/progress.hpp"

@@ -2,19 +2,6 @@
 // force F_max (Eq. 24) over a grid of joint angles (the paper's Figures 8 and 9), the joints not
 // varied held at --joints-deg. The grid, its numbering and its shards are the library's job
 // (ffsr/jobs/map.hpp); this file parses the flags and writes what the job hands it.
-//
-// The CSV: one row per point in the grid's numbering. Only shard 0 writes the header line, so `cat` of
-// the N shard files in the order k = 0..N-1 is, byte for byte, the CSV of the whole grid. Each block
-// of points is formatted with std::to_chars (the shortest text that reads back as the same double) on
-// the thread that evaluated it and appended to the output in point order, so the output never has
-// to fit in memory. The file is written like every output of the command (StreamingOutput: a
-// temporary next to the destination, renamed at the end: all or nothing).
-//
-// Pictures (--plot DIR): one varied joint gives M_ie against the angle; two a heat map with contour
-// lines and a colour bar (Figure 9); three the orthogonal slices through --slice-deg (Figure 9's
-// theta_i = 0 slices) and the grid as coloured points in 3-D (Figure 8). The values are kept in memory
-// for that (8 bytes a point), so a plotted grid is limited to kMaxPlotPoints; a shard holds part of
-// the grid only and is not plotted.
 #include "support/output.hpp"
 #include "support/parse.hpp"
 #include "support/progress.hpp"
@@ -32,6 +19,19 @@
 #include <memory>
 #include <sstream>
 #include <thread>
+
+// The CSV: one row per point in the grid's numbering. Only shard 0 writes the header line, so `cat` of
+// the N shard files in the order k = 0..N-1 is, byte for byte, the CSV of the whole grid. Each block
+// of points is formatted with std::to_chars (the shortest text that reads back as the same double) on
+// the thread that evaluated it and appended to the output in point order, so the output never has
+// to fit in memory. The file is written like every output of the command (StreamingOutput: a
+// temporary next to the destination, renamed at the end: all or nothing).
+//
+// Pictures (--plot DIR): one varied joint gives M_ie against the angle; two a heat map with contour
+// lines and a colour bar (Figure 9); three the orthogonal slices through --slice-deg (Figure 9's
+// theta_i = 0 slices) and the grid as coloured points in 3-D (Figure 8). The values are kept in memory
+// for that (8 bytes a point), so a plotted grid is limited to kMaxPlotPoints; a shard holds part of
+// the grid only and is not plotted.
 
 namespace ffsr::cli {
 namespace map_impl {  // named, not anonymous: the command is one unity translation unit
@@ -106,7 +106,7 @@ std::string point_deg(const MapGrid& g, std::uint64_t idx) {
 
 constexpr std::uint64_t kMaxPlotPoints = 50000000;
 
-/// The figures of a plotted grid (see the top of this file).
+/// The figures of a plotted grid (see the notes after the includes).
 std::vector<plot::Figure> map_figures(const MapGrid& grid, const std::vector<std::string>& names,
                                       std::vector<double> values, const std::vector<double>& slice_deg) {
   figures::Grid g;

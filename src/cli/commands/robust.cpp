@@ -3,9 +3,6 @@
 // configurations of the main job or one given with --capture-joints-deg. The job, its summary and
 // the exact merge of shards (--merge) are the library's (ffsr/jobs/robust.hpp); this file turns flags
 // into the job's options and prints the summary.
-//
-// The scenario file (its keys and its [uncertainty] table) is read by the library's one reader
-// (ffsr/scenario/scenario.hpp); a flag overrides a key of the file.
 #include "support/output.hpp"
 #include "support/parse.hpp"
 #include "support/progress.hpp"
@@ -27,6 +24,9 @@
 #include <set>
 #include <sstream>
 #include <thread>
+
+// The scenario file (its keys and its [uncertainty] table) is read by the library's one reader
+// (ffsr/scenario/scenario.hpp); a flag overrides a key of the file.
 
 namespace ffsr::cli {
 namespace {

@@ -1,6 +1,12 @@
 // src/cli/figures/plot.hpp -- figures: a small description of what to draw (panels of curves, 3-D curves,
 // heat maps, 3-D point clouds) and a renderer that hands it to PLplot.
-//
+#pragma once
+
+#include <array>
+#include <string>
+#include <variant>
+#include <vector>
+
 // The description is plain data, built by figures.cpp from the same result structs the JSON and CSV
 // are written from, so a picture and the numbers never disagree. PLplot draws the axes, ticks,
 // legends and colour bars. Rendering runs in a forked child process: PLplot may print to stdout or
@@ -10,12 +16,6 @@
 //
 // Built without PLplot (FFSR_WITH_PLOT=OFF), available() is false and require_available() throws
 // the one-line error every --plot gives.
-#pragma once
-
-#include <array>
-#include <string>
-#include <variant>
-#include <vector>
 
 namespace ffsr::cli::plot {
 

@@ -152,6 +152,38 @@ inline ClosedLoopSample closed_loop_sample(ClosedLoopPlant& p, const Eigen::Vect
   return s;
 }
 
+/// The number of control ticks over [0, T]; InputError when the run would take too many.
+inline long closed_loop_ticks(double T, const ClosedLoopOptions& o) {
+  if (T * o.control_rate > 1e8 || T * o.estimate_rate > 1e7)
+    throw InputError(str("closed loop: ", T * o.control_rate, " ticks and ", T * o.estimate_rate,
+                         " estimates over T = ", T, " s: too many (at most 1e8 and 1e7)"));
+  return std::max(1L, static_cast<long>(std::ceil(T * o.control_rate - 1e-9)));
+}
+
+/// ClosedLoopIntegrator::CvodeRestart: CVODE over the plant, restarted at each tick of length dt.
+inline void start_cvode(std::optional<cvode::Integrator>& cv, ClosedLoopPlant& plant,
+                        const Eigen::VectorXd& y, double dt, const ClosedLoopOptions& o) {
+  cvode::Options co;
+  co.rtol = o.rtol;
+  co.atol = o.atol;
+  co.max_step = dt;
+  co.initial_step = 0.1 * dt;  // each tick restarts CVODE: no step-size estimate from scratch
+  ClosedLoopPlant* pl = &plant;
+  cv.emplace([pl](double, const Eigen::Ref<const Eigen::VectorXd>& yy,
+                  Eigen::Ref<Eigen::VectorXd> yd) { pl->rhs(yy, yd); },
+             y, 0.0, co);
+}
+
+/// The momentum at the state y (configuration st). After a Runge-Kutta step of the articulated plant
+/// (`from_last_pass`) its last evaluation was at y, and its velocity pass holds the bodies' inertias and
+/// velocities there; else from the kinematics again.
+inline Vector6 tick_momentum(const Model& model, ClosedLoopPlant& plant, bool from_last_pass,
+                             const ControllerState& st, const Eigen::VectorXd& y) {
+  if (from_last_pass) return momentum_from_velocity_pass(model, plant.data);
+  forward_kinematics(model, plant.data, st.base, st.theta);
+  return momentum(model, plant.data, y.segment(plant.iv(), 6 + model.n()));
+}
+
 }  // namespace detail
 
 template <class Policy>
@@ -165,23 +197,11 @@ ClosedLoopResult simulate_closed_loop(CaptureController<Policy>& ctrl, const Clo
   detail::ClosedLoopPlant plant(model, pb.base, pb.theta, o.loop);
   Eigen::VectorXd y = Eigen::VectorXd::Zero(12 + 3 * n);
   y.segment(6, n) = pb.theta;
-  if (T * o.control_rate > 1e8 || T * o.estimate_rate > 1e7)
-    throw InputError(str("closed loop: ", T * o.control_rate, " ticks and ", T * o.estimate_rate,
-                         " estimates over T = ", T, " s: too many (at most 1e8 and 1e7)"));
-  const long ticks = std::max(1L, static_cast<long>(std::ceil(T * o.control_rate - 1e-9)));
+  const long ticks = detail::closed_loop_ticks(T, o);
   const double dt = T / static_cast<double>(ticks);
   detail::TickRungeKutta<detail::DormandPrince54> rk(y.size(), o.rtol, o.atol, dt);
   std::optional<cvode::Integrator> cv;  // CvodeRestart
-  if (o.integrator == ClosedLoopIntegrator::CvodeRestart) {
-    cvode::Options co;
-    co.rtol = o.rtol;
-    co.atol = o.atol;
-    co.max_step = dt;
-    co.initial_step = 0.1 * dt;  // each tick restarts CVODE: no step-size estimate from scratch
-    cv.emplace([&](double, const Eigen::Ref<const Eigen::VectorXd>& yy,
-                   Eigen::Ref<Eigen::VectorXd> yd) { plant.rhs(yy, yd); },
-               y, 0.0, co);
-  }
+  if (o.integrator == ClosedLoopIntegrator::CvodeRestart) detail::start_cvode(cv, plant, y, dt, o);
   ClosedLoopResult res;
   ControlCommand cmd = ctrl.make_command();
   ControllerState st{pb.base, pb.theta};
@@ -211,15 +231,8 @@ ClosedLoopResult simulate_closed_loop(CaptureController<Policy>& ctrl, const Clo
     if (plant.torques(y)) ++res.saturated_ticks;
     res.max_torque = std::max(res.max_torque, plant.tau.tail(n).cwiseAbs().maxCoeff());
     detail::record_tick(cmd, res);
-    // the momentum at y: after a Runge-Kutta step the plant's last evaluation was at y (its velocity
-    // pass holds the bodies' inertias and velocities there), else from the kinematics again
-    Vector6 h;
-    if (!cv && plant.articulated && rk.dynamics_at_y()) {
-      h = detail::momentum_from_velocity_pass(model, plant.data);
-    } else {
-      forward_kinematics(model, plant.data, st.base, st.theta);
-      h = momentum(model, plant.data, y.segment(plant.iv(), 6 + n));
-    }
+    const Vector6 h =
+        detail::tick_momentum(model, plant, !cv && plant.articulated && rk.dynamics_at_y(), st, y);
     const double hn = h.head<3>().norm() + h.tail<3>().norm();
     res.max_momentum = std::max(res.max_momentum, hn);
     if (o.record_every > 0 && t >= next_record - 1e-9 * dt) {

@@ -68,17 +68,18 @@ inline RobustRun run_robust(const Scenario& sc, const UncertaintySpec& spec,
   run.samples.resize(count);
   const std::uint64_t total_work = count * (1 + configs.size());
   std::atomic<std::uint64_t> work_done{0};
-  auto report = [&](std::uint64_t) {
-    if (options.progress) options.progress(work_done.load(), total_work);
-  };
+  detail::ParallelOptions each_options;  // one index per chunk: the first error by index is rethrown
+  if (options.progress)
+    each_options.progress = [&](std::uint64_t) { options.progress(work_done.load(), total_work); };
+  const unsigned threads = static_cast<unsigned>(std::max(1, options.threads));
   auto each = [&](const std::function<void(std::uint64_t)>& f) {
-    parallel_for(
-        0, count, options.threads,
+    detail::parallel_for(
+        count, threads,
         [&](std::uint64_t i) {
           f(i);
           work_done.fetch_add(1);
         },
-        report);
+        each_options);
   };
   each([&](std::uint64_t i) { run.samples[i] = draw_sample(spec, run.nominal, run.first + i); });
   Data data(model);

@@ -1,6 +1,11 @@
 // ffsr/jobs/detail/scenario_run.hxx -- bodies of ffsr/jobs/scenario_run.hpp: the runs of the main job.
 #pragma once
 
+#include "ffsr/detail/parallel.hpp"
+
+#include <algorithm>
+#include <thread>
+
 namespace ffsr {
 
 namespace detail {
@@ -48,8 +53,8 @@ inline std::shared_ptr<RobustForceObjective> scenario_robust_objective(const Sce
   UncertaintySpec s = spec;
   s.seed = robust_objective_seed(spec);
   std::vector<UncertainSample> samples(s.samples);
-  const int threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  parallel_for(0, s.samples, threads, [&](std::uint64_t i) { samples[i] = draw_sample(s, nominal, i); });
+  const unsigned threads = std::max(1u, std::thread::hardware_concurrency());
+  detail::parallel_for(s.samples, threads, [&](std::uint64_t i) { samples[i] = draw_sample(s, nominal, i); });
   return std::make_shared<RobustForceObjective>(std::move(samples), sc.problem.law);
 }
 

@@ -1,12 +1,59 @@
 // ffsr/scenario/detail/keys.hpp -- the key table of ffsr/scenario/scenario.hpp (every key in one entry:
-// name, kind, help, group, required, check, echo) and the reader of a scenario file. Adding a key is
-// one entry here, its member in ScenarioKeys and its line in docs/scenario-keys.md.
+// name, kind, help, group, required, check, echo), its entries' constructor and the reader of a file.
+// Adding a key is one entry here, its member in ScenarioKeys and its line in docs/scenario-keys.md.
 #pragma once
+
+#include "ffsr/scenario/scenario.hpp"
+#include "ffsr/scenario/detail/values.hpp"
+
+#include <nlohmann/json.hpp>
+#include <toml++/toml.h>
 
 #include <fstream>
 
 namespace ffsr {
 namespace detail {
+
+// --- the constructor of a key-table entry --------------------------------------------------------------
+
+template <class T>
+constexpr KeyKind kind_of() {
+  if constexpr (std::is_same_v<T, std::string>) return KeyKind::Text;
+  if constexpr (std::is_same_v<T, std::vector<std::string>>) return KeyKind::Texts;
+  if constexpr (std::is_same_v<T, double>) return KeyKind::Number;
+  if constexpr (std::is_same_v<T, std::vector<double>>) return KeyKind::Numbers;
+  if constexpr (std::is_same_v<T, int>) return KeyKind::Integer;
+  return KeyKind::Boolean;
+}
+
+/// A key of member type T reached by `get`: its setters parse, store and mark the key as given; its
+/// echo writes the value as stored (ScenarioKey::echoed replaces it).
+template <class T>
+ScenarioKey make_key(const char* name, T& (*get)(ScenarioKeys&), const char* help, const char* shown = "") {
+  const std::string n = name, flag = std::string("--") + name;
+  auto mark = [n](ScenarioKeys& k) {
+    k.given.insert(n);
+    k.load.given.insert(n);
+  };
+  ScenarioKey key;
+  key.name = n;
+  key.kind = kind_of<T>();
+  key.help = help;
+  key.default_text = shown;
+  key.from_toml = [get, flag, mark](ScenarioKeys& k, const toml::node& node) {
+    get(k) = value_from_toml<T>(node, flag);
+    mark(k);
+  };
+  key.from_text = [get, flag, mark](ScenarioKeys& k, const std::string& text) {
+    get(k) = value_from_text<T>(text, flag);
+    mark(k);
+  };
+  // the keys are read-only here: `get` takes a mutable reference only to share one accessor
+  key.echo = [get, n](const Scenario& sc, nlohmann::json& j) {
+    j[n] = get(const_cast<ScenarioKeys&>(sc.keys));
+  };
+  return key;
+}
 
 // --- echoes of the resolved scenario that are not the value as stored -------------------------------
 
@@ -80,8 +127,8 @@ inline std::string on_the_multibody_reference(const ScenarioKeys& k) {
   make_key(                         \
       name, +[](ScenarioKeys& k) -> decltype(k.member)& { return k.member; }, __VA_ARGS__)
 
-/// The robot, its start state, the target and the contact law: what inspect, contact and map evaluate.
-inline void add_subject_keys(std::vector<ScenarioKey>& keys) {
+/// The robot: its URDF, the bus it is mounted on, the loader's repairs and the contact point.
+inline void add_robot_keys(std::vector<ScenarioKey>& keys) {
   using G = KeyGroup;
   using K = ScenarioKeys;
   using L = ModelLoadKeys;
@@ -131,6 +178,11 @@ inline void add_subject_keys(std::vector<ScenarioKey>& keys) {
                        const auto& v = sc.keys.load.end_effector_offset;
                        if (!v.empty()) j["end-effector-offset"] = v;
                      }));
+}
+
+/// The robot's start state, the target and the contact law.
+inline void add_state_and_contact_keys(std::vector<ScenarioKey>& keys) {
+  using G = KeyGroup;
   keys.push_back(FFSR_KEY("joints-deg", joints_deg, "Initial joint angles, deg").in(G::Start).needed());
   keys.push_back(FFSR_KEY("base-position", base_position, "Initial base position, m").in(G::Start));
   keys.push_back(
@@ -162,6 +214,12 @@ inline void add_subject_keys(std::vector<ScenarioKey>& keys) {
       FFSR_KEY("approach-speed", approach_speed, "End-effector speed along the normal at the capture, m/s")
           .in(G::Contact)
           .needed());
+}
+
+/// The robot, its start state, the target and the contact law: what inspect, contact and map evaluate.
+inline void add_subject_keys(std::vector<ScenarioKey>& keys) {
+  add_robot_keys(keys);
+  add_state_and_contact_keys(keys);
 }
 
 /// The plain and the paper's-method runs.

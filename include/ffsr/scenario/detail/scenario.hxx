@@ -1,6 +1,6 @@
 // ffsr/scenario/detail/scenario.hxx -- bodies of ffsr/scenario/scenario.hpp: the model's load keys and the
-// validation that builds the problem. The value parsers are in scenario_values.hxx, the key table and
-// the reader in scenario_keys.hxx, the [uncertainty] table in uncertainty_table.hxx.
+// validation that builds the problem. The value parsers are in values.hpp, the key table and
+// the reader in keys.hpp, the [uncertainty] table in uncertainty_table.hpp.
 #pragma once
 
 namespace ffsr {

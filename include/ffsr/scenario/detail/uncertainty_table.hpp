@@ -2,6 +2,18 @@
 // (ffsr/scenario/scenario.hpp: uncertainty_spec), read into the sampler's laws (uncertainty/sampling.hpp).
 #pragma once
 
+#include "ffsr/errors.hpp"
+#include "ffsr/scenario/scenario.hpp"
+#include "ffsr/uncertainty/sampling.hpp"
+
+#include <toml++/toml.h>
+
+#include <cmath>
+#include <cstdint>
+#include <optional>
+#include <set>
+#include <string>
+
 namespace ffsr {
 
 namespace detail {
@@ -27,7 +39,8 @@ inline void one_of(const std::string& key, const std::string& law,
   if (count != 1) throw InputError(str(key, ": the ", law, " law takes exactly one of ", names));
 }
 
-inline Spread spread_of(Quantity q, const toml::table& t, const std::string& key) {
+/// Refuses a parameter of a law's table that no law takes.
+inline void check_spread_parameter_names(const toml::table& t, const std::string& key) {
   static const std::set<std::string> known{"law", "std", "relative-std", "half-width", "relative",
                                            "min", "max", "sigma",        "angle-deg",  "axes-deg"};
   for (const auto& [k, v] : t)
@@ -35,57 +48,84 @@ inline Spread spread_of(Quantity q, const toml::table& t, const std::string& key
       throw InputError(str(key, ".", k.str(),
                            ": unknown parameter; expected law, std, relative-std, half-width, ",
                            "relative, min, max, sigma, angle-deg or axes-deg"));
-  const auto law = t["law"].value<std::string>();
-  if (!law) throw InputError(str(key, ": missing law (normal, uniform, log-normal or cone)"));
+}
+
+/// The numbers of a law's table, as given (units of the file); the spreads checked non-negative.
+struct SpreadParameters {
+  std::optional<double> sd, rsd, hw, rel, lo, hi, sigma, angle, axes;
+};
+
+inline SpreadParameters spread_parameters(const toml::table& t, const std::string& key) {
   auto get = [&](const char* name) -> std::optional<double> {
     if (const toml::node* n = t.get(name)) return spread_number(*n, str(key, ".", name));
     return std::nullopt;
   };
-  const auto sd = get("std"), rsd = get("relative-std"), hw = get("half-width"), rel = get("relative"),
-             lo = get("min"), hi = get("max"), sigma = get("sigma"), angle = get("angle-deg"),
-             axes = get("axes-deg");
-  for (const auto& [name, v] : {std::pair{"std", sd},
-                                {"relative-std", rsd},
-                                {"half-width", hw},
-                                {"relative", rel},
-                                {"sigma", sigma},
-                                {"angle-deg", angle},
-                                {"axes-deg", axes}})
+  SpreadParameters p;
+  p.sd = get("std");
+  p.rsd = get("relative-std");
+  p.hw = get("half-width");
+  p.rel = get("relative");
+  p.lo = get("min");
+  p.hi = get("max");
+  p.sigma = get("sigma");
+  p.angle = get("angle-deg");
+  p.axes = get("axes-deg");
+  for (const auto& [name, v] : {std::pair{"std", p.sd},
+                                {"relative-std", p.rsd},
+                                {"half-width", p.hw},
+                                {"relative", p.rel},
+                                {"sigma", p.sigma},
+                                {"angle-deg", p.angle},
+                                {"axes-deg", p.axes}})
     if (v && *v < 0)
       throw InputError(str(key, ".", name, ": a spread must be non-negative, got ", short_number(*v)));
+  return p;
+}
+
+/// The law named `law` and its scale from the parameters (`unit`: file unit to SI of the scale).
+inline Spread spread_law(const std::string& law, const SpreadParameters& p, const std::string& key,
+                         double unit) {
+  Spread sp;
+  if (law == "normal") {
+    sp.law = Spread::Law::Normal;
+    one_of(key, law, {{"std", p.sd}, {"relative-std", p.rsd}});
+    sp.relative = p.rsd.has_value();
+    sp.scale = p.sd ? *p.sd * unit : *p.rsd;
+  } else if (law == "uniform") {
+    sp.law = Spread::Law::Uniform;
+    const bool range = p.lo.has_value() && p.hi.has_value() && !p.hw && !p.rel;
+    if (!range) one_of(key, law, {{"half-width", p.hw}, {"relative", p.rel}});
+    sp.has_range = range;
+    sp.relative = p.rel.has_value();
+    sp.scale = p.hw ? *p.hw * unit : p.rel ? *p.rel : 0.0;
+  } else if (law == "log-normal") {
+    sp.law = Spread::Law::LogNormal;
+    if (!p.sigma) throw InputError(str(key, ": the log-normal law needs sigma (standard deviation of ln x)"));
+    sp.scale = *p.sigma;
+  } else if (law == "cone") {
+    sp.law = Spread::Law::Cone;
+    if (!p.angle) throw InputError(str(key, ": the cone law needs angle-deg (half-angle)"));
+    sp.scale = *p.angle * M_PI / 180.0;
+  } else {
+    throw InputError(str(key, ".law: unknown law '", law, "'; expected normal, uniform, log-normal or cone"));
+  }
+  return sp;
+}
+
+inline Spread spread_of(Quantity q, const toml::table& t, const std::string& key) {
+  check_spread_parameter_names(t, key);
+  const auto law = t["law"].value<std::string>();
+  if (!law) throw InputError(str(key, ": missing law (normal, uniform, log-normal or cone)"));
+  const SpreadParameters p = spread_parameters(t, key);
   // spin is given in deg/s, the library takes rad/s
   const double unit = q == Quantity::Spin ? M_PI / 180.0 : 1.0;
-  Spread sp;
-  if (*law == "normal") {
-    sp.law = Spread::Law::Normal;
-    one_of(key, *law, {{"std", sd}, {"relative-std", rsd}});
-    sp.relative = rsd.has_value();
-    sp.scale = sd ? *sd * unit : *rsd;
-  } else if (*law == "uniform") {
-    sp.law = Spread::Law::Uniform;
-    const bool range = lo.has_value() && hi.has_value() && !hw && !rel;
-    if (!range) one_of(key, *law, {{"half-width", hw}, {"relative", rel}});
-    sp.has_range = range;
-    sp.relative = rel.has_value();
-    sp.scale = hw ? *hw * unit : rel ? *rel : 0.0;
-  } else if (*law == "log-normal") {
-    sp.law = Spread::Law::LogNormal;
-    if (!sigma) throw InputError(str(key, ": the log-normal law needs sigma (standard deviation of ln x)"));
-    sp.scale = *sigma;
-  } else if (*law == "cone") {
-    sp.law = Spread::Law::Cone;
-    if (!angle) throw InputError(str(key, ": the cone law needs angle-deg (half-angle)"));
-    sp.scale = *angle * M_PI / 180.0;
-  } else {
-    throw InputError(
-        str(key, ".law: unknown law '", *law, "'; expected normal, uniform, log-normal or cone"));
-  }
+  Spread sp = spread_law(*law, p, key, unit);
   if (q == Quantity::TargetInertia && sp.law != Spread::Law::Cone && !sp.relative)
     throw InputError(str(key, ": the inertia takes a relative spread (relative-std or relative)"));
-  if (lo) sp.min = *lo * unit;
-  if (hi) sp.max = *hi * unit;
-  if (axes) sp.axes = *axes * M_PI / 180.0;
-  if (axes && q != Quantity::TargetInertia)
+  if (p.lo) sp.min = *p.lo * unit;
+  if (p.hi) sp.max = *p.hi * unit;
+  if (p.axes) sp.axes = *p.axes * M_PI / 180.0;
+  if (p.axes && q != Quantity::TargetInertia)
     throw InputError(str(key, ".axes-deg: only the inertia takes it"));
   return sp;
 }

@@ -1,16 +1,24 @@
 // ffsr/scenario/detail/values.hpp -- the value parsers of the scenario keys (one per kind of
-// value, from a TOML node and from text), the constructor of a key-table entry and the checks of one
-// value. Part of ffsr/scenario/scenario.hpp.
+// value, from a TOML node and from text) and the checks of one value. Part of
+// ffsr/scenario/scenario.hpp.
 #pragma once
+
+#include "ffsr/errors.hpp"
+
+#include <toml++/toml.h>
 
 #include <algorithm>
 #include <cerrno>
 #include <climits>
+#include <cstdint>
 #include <cmath>
 #include <cstdlib>
 #include <iomanip>
+#include <optional>
 #include <sstream>
+#include <string>
 #include <type_traits>
+#include <vector>
 
 namespace ffsr {
 namespace detail {
@@ -142,45 +150,6 @@ T value_from_toml(const toml::node& n, const std::string& key) {
   const auto t = text_of(n);
   if (!t) throw InputError(str(key, ": expected a single value"));
   return value_from_text<T>(*t, key);
-}
-
-template <class T>
-constexpr KeyKind kind_of() {
-  if constexpr (std::is_same_v<T, std::string>) return KeyKind::Text;
-  if constexpr (std::is_same_v<T, std::vector<std::string>>) return KeyKind::Texts;
-  if constexpr (std::is_same_v<T, double>) return KeyKind::Number;
-  if constexpr (std::is_same_v<T, std::vector<double>>) return KeyKind::Numbers;
-  if constexpr (std::is_same_v<T, int>) return KeyKind::Integer;
-  return KeyKind::Boolean;
-}
-
-/// A key of member type T reached by `get`: its setters parse, store and mark the key as given; its
-/// echo writes the value as stored (ScenarioKey::echoed replaces it).
-template <class T>
-ScenarioKey make_key(const char* name, T& (*get)(ScenarioKeys&), const char* help, const char* shown = "") {
-  const std::string n = name, flag = std::string("--") + name;
-  auto mark = [n](ScenarioKeys& k) {
-    k.given.insert(n);
-    k.load.given.insert(n);
-  };
-  ScenarioKey key;
-  key.name = n;
-  key.kind = kind_of<T>();
-  key.help = help;
-  key.default_text = shown;
-  key.from_toml = [get, flag, mark](ScenarioKeys& k, const toml::node& node) {
-    get(k) = value_from_toml<T>(node, flag);
-    mark(k);
-  };
-  key.from_text = [get, flag, mark](ScenarioKeys& k, const std::string& text) {
-    get(k) = value_from_text<T>(text, flag);
-    mark(k);
-  };
-  // the keys are read-only here: `get` takes a mutable reference only to share one accessor
-  key.echo = [get, n](const Scenario& sc, nlohmann::json& j) {
-    j[n] = get(const_cast<ScenarioKeys&>(sc.keys));
-  };
-  return key;
 }
 
 // --- checks of one value ------------------------------------------------------------------------------

@@ -1,8 +1,6 @@
 // ffsr/uncertainty/detail/sampling.hxx -- bodies of ffsr/uncertainty/sampling.hpp.
 #pragma once
 
-#include "ffsr/detail/parallel.hpp"
-
 #include <iomanip>
 #include <sstream>
 
@@ -135,52 +133,67 @@ inline Vector3 draw_normal(const Spread& sp, const Vector3& n0, SampleStream& rn
   return (ct * n + st * (c * e1 + s * e2)).normalized();
 }
 
+/// The checks every law of `key` passes: a finite non-negative scale, min <= max, a range's bounds finite.
+inline void validate_spread_scale(const Spread& sp, const std::string& key) {
+  if (!std::isfinite(sp.scale) || sp.scale < 0)
+    throw InputError(
+        str(key, ": the spread must be a non-negative finite number, got ", short_number(sp.scale)));
+  if (std::isnan(sp.min) || std::isnan(sp.max) || sp.min > sp.max)
+    throw InputError(
+        str(key, ": min (", short_number(sp.min), ") is greater than max (", short_number(sp.max), ")"));
+  if (sp.has_range && (!std::isfinite(sp.min) || !std::isfinite(sp.max)))
+    throw InputError(str(key, ": a uniform law needs finite min and max"));
+}
+
+/// The normal: a cone of half-angle at most 90 deg.
+inline void validate_normal_spread(const Spread& sp, const std::string& key) {
+  if (sp.law != Spread::Law::Cone)
+    throw InputError(str(key, ": the normal takes the law 'cone' (angle-deg)"));
+  if (sp.scale > M_PI / 2 * (1 + 1e-15))
+    throw InputError(str(key, ": the cone half-angle must be at most 90 deg, got ",
+                         short_number(sp.scale * 180 / M_PI), " deg"));
+}
+
+/// The inertia: a relative normal or uniform law that keeps the moments positive, axes in [0, 180] deg.
+inline void validate_inertia_spread(const Spread& sp, const std::string& key) {
+  if (sp.law != Spread::Law::Normal && sp.law != Spread::Law::Uniform)
+    throw InputError(str(key, ": the inertia takes a 'normal' or 'uniform' law with a relative spread"));
+  if (!(sp.axes >= 0 && sp.axes <= M_PI))
+    throw InputError(str(key, ": axes-deg must be in [0, 180], got ", short_number(sp.axes * 180 / M_PI)));
+  if (sp.scale >= 1.0 && sp.law == Spread::Law::Uniform)
+    throw InputError(str(key, ": a relative half-width of ", short_number(sp.scale),
+                         " allows non-positive moments (must be < 1)"));
+}
+
+/// A vector quantity: a normal or uniform law with an absolute spread.
+inline void validate_vector_spread(const Spread& sp, const std::string& key) {
+  if (sp.law == Spread::Law::LogNormal)
+    throw InputError(str(key, ": a vector takes a 'normal' or 'uniform' law"));
+  if (sp.relative || sp.has_range)
+    throw InputError(
+        str(key, ": a vector takes an absolute spread (std or half-width), not relative or min/max"));
+}
+
 }  // namespace detail
 
 inline void validate(const UncertaintySpec& spec) {
-  using detail::short_number;
-  using detail::str;
   if (spec.samples < 1) throw InputError("uncertainty.samples: must be at least 1, got 0");
   for (std::size_t i = 0; i < kNumQuantities; ++i) {
     const Quantity q = static_cast<Quantity>(i);
     const Spread& sp = spec.spread[i];
     const std::string key = detail::quantity_key(q);
     if (sp.law == Spread::Law::Fixed) continue;
-    if (!std::isfinite(sp.scale) || sp.scale < 0)
-      throw InputError(
-          str(key, ": the spread must be a non-negative finite number, got ", short_number(sp.scale)));
-    if (std::isnan(sp.min) || std::isnan(sp.max) || sp.min > sp.max)
-      throw InputError(
-          str(key, ": min (", short_number(sp.min), ") is greater than max (", short_number(sp.max), ")"));
-    if (sp.has_range && (!std::isfinite(sp.min) || !std::isfinite(sp.max)))
-      throw InputError(str(key, ": a uniform law needs finite min and max"));
+    detail::validate_spread_scale(sp, key);
     if (q == Quantity::Normal) {
-      if (sp.law != Spread::Law::Cone)
-        throw InputError(str(key, ": the normal takes the law 'cone' (angle-deg)"));
-      if (sp.scale > M_PI / 2 * (1 + 1e-15))
-        throw InputError(str(key, ": the cone half-angle must be at most 90 deg, got ",
-                             short_number(sp.scale * 180 / M_PI), " deg"));
+      detail::validate_normal_spread(sp, key);
       continue;
     }
-    if (sp.law == Spread::Law::Cone) throw InputError(str(key, ": the law 'cone' is for the normal only"));
-    if (q == Quantity::TargetInertia) {
-      if (sp.law != Spread::Law::Normal && sp.law != Spread::Law::Uniform)
-        throw InputError(str(key, ": the inertia takes a 'normal' or 'uniform' law with a relative spread"));
-      if (!(sp.axes >= 0 && sp.axes <= M_PI))
-        throw InputError(
-            str(key, ": axes-deg must be in [0, 180], got ", short_number(sp.axes * 180 / M_PI)));
-      if (sp.scale >= 1.0 && sp.law == Spread::Law::Uniform)
-        throw InputError(str(key, ": a relative half-width of ", short_number(sp.scale),
-                             " allows non-positive moments (must be < 1)"));
-      continue;
-    }
-    if (detail::is_vector_quantity(q)) {
-      if (sp.law == Spread::Law::LogNormal)
-        throw InputError(str(key, ": a vector takes a 'normal' or 'uniform' law"));
-      if (sp.relative || sp.has_range)
-        throw InputError(
-            str(key, ": a vector takes an absolute spread (std or half-width), not relative or min/max"));
-    }
+    if (sp.law == Spread::Law::Cone)
+      throw InputError(detail::str(key, ": the law 'cone' is for the normal only"));
+    if (q == Quantity::TargetInertia)
+      detail::validate_inertia_spread(sp, key);
+    else if (detail::is_vector_quantity(q))
+      detail::validate_vector_spread(sp, key);
   }
 }
 
@@ -560,17 +573,6 @@ inline PercentileRatio compare_p95_stiffness_conditional(const std::vector<doubl
   r.hi = r.ratio * std::exp(detail::kZ975 * r.log_standard_error);
   r.has_interval = true;
   return r;
-}
-
-inline void parallel_for(std::uint64_t begin, std::uint64_t end, int threads,
-                         const std::function<void(std::uint64_t)>& f,
-                         const std::function<void(std::uint64_t)>& progress) {
-  if (end <= begin) return;
-  detail::ParallelOptions options;  // one index per chunk: the first error by index is rethrown
-  options.progress = progress;
-  detail::parallel_for(
-      end - begin, static_cast<unsigned>(std::max(1, threads)), [&](std::uint64_t i) { f(begin + i); },
-      options);
 }
 
 inline double robust_force_p95(const Model& model, Data& data, const BasePose& base,

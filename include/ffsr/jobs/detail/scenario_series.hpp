@@ -1,9 +1,12 @@
-// ffsr/jobs/detail/scenario_series.hxx -- the main job's time series (the CSV of `ffsr-optimize
+// ffsr/jobs/detail/scenario_series.hpp -- the main job's time series (the CSV of `ffsr-optimize
 // --csv`) and the scene that a picture or a 3-D view of it needs (the "scene" key of the JSON):
 // per sample the joint angles, the base's, every body's and the target's pose, the end-effector,
 // M_ie, the F_max estimate and the phase; once the bodies' tree, their shapes, the target's shape,
 // the capture instant and the contact normal there.
 #pragma once
+
+#include "ffsr/jobs/scenario_run.hpp"
+#include "ffsr/jobs/detail/json_values.hpp"
 
 #include "ffsr/algorithm/kinematics.hpp"
 
@@ -60,8 +63,8 @@ inline std::string scenario_series_csv(const Scenario& sc, const ScenarioResult&
       c << label << "," << s.t;
       for (Eigen::Index i = 0; i < s.theta.size(); ++i) c << "," << s.theta(i) * 180.0 / M_PI;
       detail::pose_csv(c, s.base.position, s.base.orientation);
-      c << "," << s.end_effector.x() << "," << s.end_effector.y() << "," << s.end_effector.z() << "," << s.M_ie
-        << "," << s.f_max_estimate;
+      c << "," << s.end_effector.x() << "," << s.end_effector.y() << "," << s.end_effector.z() << ","
+        << s.M_ie << "," << s.f_max_estimate;
       target = propagate_target(target, s.t - target_t);
       target_t = s.t;
       detail::pose_csv(c, target.position, target.attitude.normalized());

@@ -1,14 +1,5 @@
-// ffsr/optimize/detail/manifold_sampling.hxx -- the pieces of the capture-manifold search that do
+// ffsr/optimize/detail/manifold_sampling.hpp -- the pieces of the capture-manifold search that do
 // not depend on the residual (included by optimize/global.hpp; see docs/branches.md):
-//
-// - the Jacobian of the orientation residual log(R_end R_e^T) (the rotation vector, angle in
-//   [0, pi]): its zero set is the wanted orientation alone;
-// - Halton points over the joint box (the low-discrepancy starts of the branch stage);
-// - postures: two configurations that differ by whole turns of revolute joints put every link in
-//   the same place (same M_ie); a posture is represented by the configuration within the limits
-//   nearest to a reference (the initial configuration).
-//
-// Eigen only; every function reads its arguments and writes only its outputs.
 #pragma once
 
 #include "ffsr/model/model.hpp"
@@ -17,6 +8,15 @@
 #include <cmath>
 #include <cstdint>
 #include <vector>
+
+// - the Jacobian of the orientation residual log(R_end R_e^T) (the rotation vector, angle in
+//   [0, pi]): its zero set is the wanted orientation alone;
+// - Halton points over the joint box (the low-discrepancy starts of the branch stage);
+// - postures: two configurations that differ by whole turns of revolute joints put every link in
+//   the same place (same M_ie); a posture is represented by the configuration within the limits
+//   nearest to a reference (the initial configuration).
+//
+// Eigen only; every function reads its arguments and writes only its outputs.
 
 namespace ffsr::detail {
 

@@ -1,6 +1,9 @@
-// ffsr/jobs/detail/base_disturbance_json.hxx -- the impact disturbance of the base
+// ffsr/jobs/detail/base_disturbance_json.hpp -- the impact disturbance of the base
 // (algorithm/base_disturbance.hpp) of each run of the main job, as JSON.
 #pragma once
+
+#include "ffsr/jobs/scenario_run.hpp"
+#include "ffsr/jobs/detail/json_values.hpp"
 
 #include "ffsr/algorithm/base_disturbance.hpp"
 

@@ -1,16 +1,20 @@
-// ffsr/jobs/detail/result_json.hxx -- the result schema: the main job's result (ffsr/jobs/scenario_run.hpp)
+// ffsr/jobs/detail/result_json.hpp -- the result schema: the main job's result (ffsr/jobs/scenario_run.hpp)
 // as JSON, the keys and values of `ffsr-optimize --json`.
 #pragma once
+
+#include "ffsr/jobs/scenario_run.hpp"
+#include "ffsr/jobs/detail/base_disturbance_json.hpp"
+#include "ffsr/jobs/detail/json_values.hpp"
+#include "ffsr/jobs/detail/scenario_series.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <string>
+#include <vector>
 
 namespace ffsr {
 
 namespace detail {
-
-inline nlohmann::json vector_json(const Eigen::VectorXd& v) {
-  nlohmann::json a = nlohmann::json::array();
-  for (Eigen::Index i = 0; i < v.size(); ++i) a.push_back(v(i));
-  return a;
-}
 
 inline nlohmann::json run_json(const CaptureResult& r, const CaptureTask& task, double gain) {
   const Eigen::Vector4d q = r.base.orientation.coeffs();
@@ -181,9 +185,9 @@ inline void add_clearance_json(nlohmann::json& j, const ScenarioResult& r) {
 }  // namespace detail
 
 namespace detail {
-/// Defined in base_disturbance_json.hxx (the impact disturbance of each run).
+// Declared here too: scenario_run.hpp includes this file after the two below, but a translation unit
+// that opens with one of them reaches this file first.
 inline void add_base_disturbance_json(nlohmann::json& j, const Scenario& sc, const ScenarioResult& r);
-/// Defined in scenario_series.hxx (the bodies, shapes, capture instant and normal).
 inline nlohmann::json scene_json(const Scenario& sc);
 }  // namespace detail
 
