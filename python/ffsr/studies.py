@@ -64,9 +64,10 @@ def _check_cover(spans: List[tuple], total: int, what: str, name: str) -> None:
     """spans: (first, end) sorted by first; ValueError naming a gap, an overlap or a short cover."""
     nxt = 0
     for first, end in spans:
-        if first != nxt:
-            state = "missing" if first > nxt else "in two parts"
-            raise ValueError(f"{name}: {what} {nxt} to {first} are {state}")
+        if first > nxt:
+            raise ValueError(f"{name}: {what} {nxt} to {first} are missing")
+        if first < nxt:
+            raise ValueError(f"{name}: {what} {first} to {min(nxt, end)} are in two parts")
         nxt = end
     if nxt != total:
         raise ValueError(f"{name}: the parts cover {what} 0 to {nxt} of {total}")
