@@ -24,7 +24,9 @@ NO_GLOBAL = {"global": False}  # the plain and the paper's runs: planned in abou
 
 @pytest.fixture(scope="module")
 def client(tmp_path_factory):
-    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None,
+    # on the loopback address only; the scheduler's HTTP server on a free port, not 8787
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
+                      dashboard_address="127.0.0.1:0",
                       local_directory=str(tmp_path_factory.mktemp("dask")),
                       silence_logs=logging.ERROR) as cluster:
         with Client(cluster) as c:
