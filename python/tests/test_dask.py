@@ -113,3 +113,12 @@ def test_robust_shards_merged_equal_one_run(robust_runs):
     assert merged == whole  # every double bit for bit: the percentiles, the mean, the tails
     with pytest.raises(ValueError, match="merge_robust: .*samples 20 to 40 are missing"):
         studies.merge_robust([parts[0], parts[2]], command=command())
+
+
+def test_merge_robust_names_what_it_lacks(monkeypatch, tmp_path):
+    with pytest.raises(ValueError, match="merge_robust: no shard to merge"):
+        studies.merge_robust([])
+    monkeypatch.delenv("FFSR_OPTIMIZE", raising=False)
+    monkeypatch.setenv("PATH", str(tmp_path))  # no ffsr-optimize there
+    with pytest.raises(FileNotFoundError, match="merge_robust: the command ffsr-optimize is needed"):
+        studies.merge_robust(['{"kind": "ffsr-robust"}'])
