@@ -3,7 +3,8 @@
 # folder given as $1), made with Debian 12's python3: first the Debian packages it needs (python3-dev,
 # python3-venv and those of the C++ build, scripts/install-deps.sh), then every PyPI package pinned in
 # python/pyproject.toml (build requirements, numpy, and the test extra: pytest and Pinocchio's `pin`,
-# the reference of the tests and the bench), then the package itself, built by scikit-build-core in
+# the reference of the tests and the bench; dask, nbclient and matplotlib for the studies and the
+# notebooks), then the package itself, built by scikit-build-core in
 # build-python/cmake-* (kept between runs: a rebuild compiles only what changed).
 # Nothing is downloaded at test time: this script is the only step that reaches PyPI.
 # FFSR_PYTHON_CXX_FLAGS, when set, replaces the build's optimization flags (python/pyproject.toml:
