@@ -140,9 +140,7 @@ Row compare(const std::string& name, const std::string& urdf) {
     const auto uk = static_cast<size_t>(k);
     return 1.0 / before::integrated_effective_mass_fast(fm, bd, P.base[uk], P.theta[uk], fee, P.u[uk], 0.0);
   };
-  Row row;
-  row.name = name;
-  row.n = n;
+  Row row{name, n, {}, {}};
   double* d = row.agree;  // H-before, H-pin, M-before, M-dense, M-Delassus, Delassus-dense
   for (int k = 0; k < kPoses; ++k) {
     const auto uk = static_cast<size_t>(k);
