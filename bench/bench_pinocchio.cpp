@@ -1,35 +1,34 @@
 // bench/bench_pinocchio.cpp -- ffsr-bench-pinocchio: the joint-space inertia matrix H (CRBA) and the
 // inverse effective mass u^T J_v H^-1 J_v^T u of the integrated effective mass (Eq. 14), per call,
-// ffsr now, ffsr before the fixed-size rewrite and Pinocchio in the same run.
+// ffsr now, ffsr before the fixed-size rewrite and Pinocchio's fastest routes in the same run.
 //
 //   ffsr-bench-pinocchio [DIR]     DIR: the robots folder (default FFSR_SOURCE_DIR/robots)
 //
 // Built only with -DFFSR_BENCH_PINOCCHIO=ON (bench/CMakeLists.txt), against Pinocchio's C++ headers
 // and libraries, e.g. those of the PyPI package `pin` (pip install pin==4.1.0). Nothing else in the
-// project needs Pinocchio.
+// project needs Pinocchio. Pinocchio's templates are instantiated in the bench's own unit at the
+// bench's compiler and flags (bench_pinocchio_side.cpp; its precompiled library is timed beside).
 //
 // Robots: the paper's 3-DOF and 7-DOF robots (joint axes along x or z) and serial chains of 3, 7, 14,
 // 28 and 56 revolute joints on a floating base (random axes, offsets and inertias from a fixed seed),
 // each loaded from the same URDF text by both libraries: ffsr's model from URDF, Pinocchio's built
 // from it joint by joint with a free-flyer root, RX/RY/RZ joints for axes along x, y, z and the
-// unaligned revolute joint otherwise (bench_pinocchio_side.cpp: Pinocchio's URDF parser and the
-// system urdfdom headers that ffsr's loader uses do not mix in one translation unit). Poses: the same
-// 1000 random configurations (fixed seed) and unit directions u for all.
+// unaligned revolute joint otherwise. Poses: the same 1000 random configurations (fixed seed) and
+// unit directions u for all.
 //
-// Columns: CRBA -- ffsr::crba (the full symmetric H), the frozen code before the rewrite
-// (bench_before.hpp), pinocchio::crba (upper triangle; the default LOCAL convention and WORLD), and
-// "pinL+s": LOCAL followed by the copy of its upper triangle into the lower, the same output as
-// ffsr's (shown beside, with its own ratio "ffsr/s"; the headline ratio ffsr/p is against the faster
-// of crba's two conventions alone); M_ie --
-// ffsr::integrated_effective_mass_fast (the O(n) articulated-body route), the frozen dispatching
-// function, and Pinocchio's crba + computeJointJacobians + getFrameJacobian + LLT solve. Each time is
-// the median over 51 passes of the mean time per call over 200 of the poses, in CPU time of the
-// thread (CLOCK_THREAD_CPUTIME_ID: time while descheduled does not count); every pass times the eight
-// loops back to back, so that a change of the machine's load hits them alike. All 1000 poses serve the
-// agreement checks. Ratios are ffsr over Pinocchio
-// (the faster of its two CRBA conventions for CRBA). The last columns check the numbers: H against
-// the frozen code (largest entry difference over the largest entry), H's joint block against
-// Pinocchio's, and the inverse effective mass against both (relative).
+// Routes: CRBA -- ffsr::crba (the full symmetric H), the frozen code before the rewrite
+// (bench_before.hpp), pinocchio::crba in its LOCAL and WORLD conventions (upper triangle; the ratio is
+// against the faster of the two) and LOCAL followed by the copy of its upper triangle into the lower
+// (the same output as ffsr's); M_ie -- ffsr::integrated_effective_mass_fast (the O(n)
+// articulated-body route), the frozen function, Pinocchio's crba + computeJointJacobians +
+// getFrameJacobian + LLT solve ("dense") and its computeDelassusMatrix of a 3-D contact at the frame
+// ("Delassus", O(n)); the ratio is against the faster of the two. Each time is the minimum over 51
+// passes of the mean time per call over 200 of the poses, in CPU time of the thread
+// (CLOCK_THREAD_CPUTIME_ID); every pass times all the loops back to back, so that a change of the
+// machine's load hits them alike. All 1000 poses serve the agreement checks: H against the frozen
+// code (largest entry difference over the largest entry), H's joint block against Pinocchio's, and
+// the inverse effective mass against the frozen code and both Pinocchio routes (relative).
+// The output is the two Markdown tables of docs/performance.md.
 #include "ffsr/algorithm/articulated_effective_mass.hpp"
 #include "ffsr/parsers/urdf.hpp"
 
@@ -111,15 +110,16 @@ Poses random_poses(int n, int count, unsigned seed) {
   return p;
 }
 
-/// The median of v.
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
+struct Row {
+  std::string name;
+  int n = 0;
+  double t[15] = {};  // the routes' times, in the order of compare's loops
+  double agree[6] = {};
+};
 
-void compare(const std::string& name, const std::string& urdf) {
+Row compare(const std::string& name, const std::string& urdf) {
   namespace before = ffsr_bench::before;
-  using Kind = ffsr_bench::PinocchioBench::Kind;
+  using Kind = ffsr_bench::PinocchioRoutes::Kind;
   const ffsr::Model fm = ffsr::model_from_urdf_string(urdf, name, "ee");
   const int fee = fm.frame_index("ee");
   ffsr::Data fd(fm);
@@ -127,7 +127,8 @@ void compare(const std::string& name, const std::string& urdf) {
   const int n = fm.n();
   constexpr int kPoses = 1000, kBlocks = 20, kPassPoses = 200, kPasses = 51;
   const Poses P = random_poses(n, kPoses, 1234u + static_cast<unsigned>(n));
-  ffsr_bench::PinocchioBench pin(fm, fee, P.base, P.theta, P.u);
+  const auto pin = ffsr_bench::make_pinocchio_inline(fm, fee, P.base, P.theta, P.u);
+  const auto lib = ffsr_bench::make_pinocchio_library(fm, fee, P.base, P.theta, P.u);
 
   auto crba_now = [&](int k) { return ffsr::crba(fm, fd, P.base[size_t(k)], P.theta[size_t(k)])(6, 6); };
   auto crba_before = [&](int k) { return before::crba(fm, bd, P.base[size_t(k)], P.theta[size_t(k)])(6, 6); };
@@ -139,22 +140,26 @@ void compare(const std::string& name, const std::string& urdf) {
     const auto uk = static_cast<size_t>(k);
     return 1.0 / before::integrated_effective_mass_fast(fm, bd, P.base[uk], P.theta[uk], fee, P.u[uk], 0.0);
   };
-  double dH = 0, dHpin = 0, dM = 0, dMpin = 0;
+  Row row{name, n, {}, {}};
+  double* d = row.agree;  // H-before, H-pin, M-before, M-dense, M-Delassus, Delassus-dense
   for (int k = 0; k < kPoses; ++k) {
     const auto uk = static_cast<size_t>(k);
     const Eigen::MatrixXd& Hb = before::crba(fm, bd, P.base[uk], P.theta[uk]);
     const Eigen::MatrixXd& Hn = ffsr::crba(fm, fd, P.base[uk], P.theta[uk]);
-    dH = std::max(dH, (Hn - Hb).cwiseAbs().maxCoeff() / Hb.cwiseAbs().maxCoeff());
+    d[0] = std::max(d[0], (Hn - Hb).cwiseAbs().maxCoeff() / Hb.cwiseAbs().maxCoeff());
     if (k < kBlocks) {
-      const Eigen::MatrixXd Hp = pin.joint_block(k);
-      dHpin = std::max(dHpin, (Hn.bottomRightCorner(n, n) - Hp).cwiseAbs().maxCoeff() / Hp.cwiseAbs().maxCoeff());
+      const Eigen::MatrixXd Hp = pin->joint_block(k);
+      const double dp = (Hn.bottomRightCorner(n, n) - Hp).cwiseAbs().maxCoeff();
+      d[1] = std::max(d[1], dp / Hp.cwiseAbs().maxCoeff());
     }
-    const double a = mie_now(k), b = mie_before(k), p = pin.inverse_effective_mass(k);
-    dM = std::max(dM, std::abs(a - b) / b);
-    dMpin = std::max(dMpin, std::abs(a - p) / p);
+    const double a = mie_now(k), b = mie_before(k);
+    const double p = pin->inverse_effective_mass(Kind::Dense, k);
+    const double q = pin->inverse_effective_mass(Kind::Delassus, k);
+    d[2] = std::max(d[2], std::abs(a - b) / b);
+    d[3] = std::max(d[3], std::abs(a - p) / p);
+    d[4] = std::max(d[4], std::abs(a - q) / q);
+    d[5] = std::max(d[5], std::abs(q - p) / p);
   }
-  // Interleaved passes: every pass times the eight loops back to back over the same 200 poses, so a
-  // change of the machine's load hits them alike; the median over the passes of each.
   auto ffsr_pass = [&](auto&& fn) {
     double acc = 0;
     const double t0 = ffsr_bench::thread_seconds();
@@ -163,28 +168,59 @@ void compare(const std::string& name, const std::string& urdf) {
     g_sink = g_sink + acc;
     return t / kPassPoses;
   };
-  std::vector<double> t[8];
-  for (int r = -1; r < kPasses; ++r) {  // pass -1 warms up
-    const double a[8] = {ffsr_pass(crba_now),
-                         ffsr_pass(crba_before),
-                         pin.pass(Kind::CrbaLocal, kPassPoses) / kPassPoses,
-                         pin.pass(Kind::CrbaWorld, kPassPoses) / kPassPoses,
-                         ffsr_pass(mie_now),
-                         ffsr_pass(mie_before),
-                         pin.pass(Kind::InverseEffectiveMass, kPassPoses) / kPassPoses,
-                         pin.pass(Kind::CrbaLocalFull, kPassPoses) / kPassPoses};
+  auto pin_pass = [&](ffsr_bench::PinocchioRoutes& r, Kind kind) {
+    return r.pass(kind, kPassPoses) / kPassPoses;
+  };
+  for (double& x : row.t) x = 1e300;
+  for (int r = -1; r < kPasses; ++r) {  // pass -1 warms up; the minimum over the others
+    const double a[15] = {ffsr_pass(crba_now),
+                          ffsr_pass(crba_before),
+                          pin_pass(*pin, Kind::CrbaLocal),
+                          pin_pass(*pin, Kind::CrbaWorld),
+                          pin_pass(*pin, Kind::CrbaLocalFull),
+                          pin_pass(*lib, Kind::CrbaLocal),
+                          pin_pass(*lib, Kind::CrbaWorld),
+                          ffsr_pass(mie_now),
+                          ffsr_pass(mie_before),
+                          pin_pass(*pin, Kind::Dense),
+                          pin_pass(*pin, Kind::Delassus),
+                          pin_pass(*lib, Kind::Dense),
+                          pin_pass(*lib, Kind::Delassus),
+                          ffsr_pass(crba_now),
+                          ffsr_pass(mie_now)};
     if (r >= 0)
-      for (int i = 0; i < 8; ++i) t[i].push_back(a[i]);
+      for (int i = 0; i < 15; ++i) row.t[i] = std::min(row.t[i], a[i]);
   }
-  const double tcn = median(t[0]), tcb = median(t[1]), tpl = median(t[2]), tpw = median(t[3]);
-  const double tmn = median(t[4]), tmb = median(t[5]), tmp = median(t[6]), tpf = median(t[7]);
-  const double tcp = std::min(tpl, tpw);
+  row.t[0] = std::min(row.t[0], row.t[13]);  // ffsr timed twice a pass, at both ends
+  row.t[7] = std::min(row.t[7], row.t[14]);
+  return row;
+}
+
+void print_tables(const std::vector<Row>& rows) {
   std::printf(
-      "%-9s %2d | %6.0f %6.0f %6.0f %6.0f %5.2fx %5.2fx %6.0f %5.2fx | %6.0f %6.0f %6.0f %5.2fx %5.2fx | "
-      "%7.0e %7.0e %7.0e %7.0e\n",
-      name.c_str(), n, tcn * 1e9, tcb * 1e9, tpl * 1e9, tpw * 1e9, tcn / tcp, tcb / tcp, tpf * 1e9, tcn / tpf,
-      tmn * 1e9, tmb * 1e9, tmp * 1e9, tmn / tmp, tmb / tmp, dH, dHpin, dM, dMpin);
-  std::fflush(stdout);
+      "ns per call, minimum over 51 interleaved passes of the mean over the same 200 random poses "
+      "(thread CPU time); Pinocchio's templates instantiated at the bench's flags, \"library\" its "
+      "precompiled libpinocchio_default\n\n");
+  std::printf(
+      "| robot | n | CRBA ffsr / Pinocchio | before | Pinocchio LOCAL / WORLD | LOCAL + sym | library | "
+      "M_ie ffsr | before | Pinocchio dense | Pinocchio Delassus | ffsr / better | library dense / "
+      "Delassus |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+  for (const Row& w : rows) {
+    const double* t = w.t;
+    const double pc = std::min(t[2], t[3]), pm = std::min(t[9], t[10]);
+    std::printf(
+        "| %s | %d | %.0f / %.0f ns = %.2fx | %.0f | %.0f / %.0f | %.0f | %.0f | %.0f ns | %.0f | %.0f | "
+        "%.0f | %.2fx | %.0f / %.0f |\n",
+        w.name.c_str(), w.n, t[0] * 1e9, pc * 1e9, t[0] / pc, t[1] * 1e9, t[2] * 1e9, t[3] * 1e9, t[4] * 1e9,
+        std::min(t[5], t[6]) * 1e9, t[7] * 1e9, t[8] * 1e9, t[9] * 1e9, t[10] * 1e9, t[7] / pm, t[11] * 1e9,
+        t[12] * 1e9);
+  }
+  std::printf(
+      "\n| robot | H - before | H - Pinocchio | M_ie - before | M_ie - Pinocchio dense | M_ie - Delassus | "
+      "Delassus - dense |\n|---|---|---|---|---|---|---|\n");
+  for (const Row& w : rows)
+    std::printf("| %s | %.0e | %.0e | %.0e | %.0e | %.0e | %.0e |\n", w.name.c_str(), w.agree[0], w.agree[1],
+                w.agree[2], w.agree[3], w.agree[4], w.agree[5]);
 }
 
 }  // namespace
@@ -192,16 +228,12 @@ void compare(const std::string& name, const std::string& urdf) {
 int main(int argc, char** argv) {
   const std::string dir = argc > 1 ? argv[1] : std::string(FFSR_SOURCE_DIR) + "/robots";
   try {
-    std::printf(
-        "ns per call, median of 51 interleaved passes over the same 200 random poses (thread CPU time)\n");
-    std::printf("%-9s %2s | %-62s | %-41s | %s\n", "", "", "CRBA", "M_ie (u^T J_v H^-1 J_v^T u)",
-                "agreement");
-    std::printf("%-9s %2s | %6s %6s %6s %6s %6s %6s %6s %6s | %6s %6s %6s %6s %6s | %7s %7s %7s %7s\n",
-                "robot", "n", "ffsr", "before", "pinL", "pinW", "ffsr/p", "bef/p", "pinL+s", "ffsr/s", "ffsr",
-                "before", "pin", "ffsr/p", "bef/p", "H-bef", "H-pin", "M-bef", "M-pin");
-    compare("3-DOF", read_text(dir + "/paper_3dof.urdf"));
-    compare("7-DOF", read_text(dir + "/paper_7dof.urdf"));
-    for (int n : {3, 7, 14, 28, 56}) compare("chain " + std::to_string(n), chain_urdf(n, static_cast<unsigned>(n)));
+    std::vector<Row> rows;
+    rows.push_back(compare("3-DOF paper", read_text(dir + "/paper_3dof.urdf")));
+    rows.push_back(compare("7-DOF paper", read_text(dir + "/paper_7dof.urdf")));
+    for (int n : {3, 7, 14, 28, 56})
+      rows.push_back(compare("chain " + std::to_string(n), chain_urdf(n, static_cast<unsigned>(n))));
+    print_tables(rows);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "ffsr-bench-pinocchio: error: %s\n", e.what());
     return 1;

@@ -521,6 +521,47 @@ TEST_CASE("inverse_quadratic_spd6: x^T A^-1 x against Eigen's LLT solve, refuses
   CHECK_FALSE(ffsr::detail::inverse_quadratic_spd6(Matrix6::Zero(), Vector6::Ones(), q));
 }
 
+TEST_CASE("inverse_quadratic_articulated: the base's x^T A^-1 x by adjugates against Eigen's LLT solve",
+          "[dynamics]") {
+  std::mt19937 gen(23);
+  std::normal_distribution<double> N(0.0, 1.0);
+  double worst = 0;
+  for (int k = 0; k < 200; ++k) {
+    Matrix6 B;
+    for (int e = 0; e < 36; ++e) B.data()[e] = N(gen);
+    const double shift = k % 2 ? 1e-3 : 1.0;  // half of them poorly conditioned
+    const double scale = k % 3 ? 1.0 : 1e3;   // and a third with a heavy body's scale
+    const Matrix6 A = scale * (B * B.transpose() + shift * Matrix6::Identity());
+    ffsr::ArticulatedInertia IA;
+    IA.ll = A.topLeftCorner<3, 3>();
+    IA.la = A.topRightCorner<3, 3>();
+    IA.aa = A.bottomRightCorner<3, 3>();
+    Vector6 x;
+    for (int e = 0; e < 6; ++e) x(e) = N(gen);
+    const double ref = x.dot(A.llt().solve(x));
+    double q = 0;
+    REQUIRE(ffsr::detail::inverse_quadratic_articulated(IA, x, q));
+    worst = std::max(worst, std::abs(q - ref) / ref);
+  }
+  INFO("worst relative difference " << worst);
+  CHECK(worst < 1e-10);
+  ffsr::ArticulatedInertia IA;
+  const Matrix3 I_com = Vector3(1, 2, 3).asDiagonal();
+  IA.set(ffsr::SpatialInertia::from_com(2.0, Vector3(0.1, -0.2, 0.3), I_com));
+  double q = 0;
+  REQUIRE(ffsr::detail::inverse_quadratic_articulated(IA, Vector6::Ones(), q));
+  CHECK(std::abs(q - Vector6::Ones().dot(IA.matrix().llt().solve(Vector6::Ones()))) < 1e-12 * q);
+  IA.aa(1, 1) = -1;  // indefinite
+  CHECK_FALSE(ffsr::detail::inverse_quadratic_articulated(IA, Vector6::Ones(), q));
+  IA.aa(1, 1) = std::numeric_limits<double>::quiet_NaN();
+  CHECK_FALSE(ffsr::detail::inverse_quadratic_articulated(IA, Vector6::Ones(), q));
+  IA.set(ffsr::SpatialInertia::from_com(1e120, Vector3(0.1, -0.2, 0.3), 1e120 * Matrix3::Identity()));
+  // |P| |S'| overflows: the LDL^T decides
+  REQUIRE(ffsr::detail::inverse_quadratic_articulated(IA, Vector6::Ones(), q));
+  CHECK(std::abs(q - Vector6::Ones().dot(IA.matrix().llt().solve(Vector6::Ones()))) < 1e-12 * q);
+  CHECK_FALSE(ffsr::detail::inverse_quadratic_articulated(ffsr::ArticulatedInertia(), Vector6::Ones(), q));
+}
+
 TEST_CASE("sin_cos of the kinematics: within 2 units in the last place of std::sin and std::cos",
           "[dynamics]") {
   std::mt19937_64 gen(31);

@@ -71,12 +71,66 @@ inline bool inverse_quadratic_spd6(const Matrix6& A, const Vector6& x, double& q
   return true;
 }
 
+/// The adjugate of the symmetric 3x3 matrix with upper triangle m00 m01 m02 m11 m12 m22, as its upper
+/// triangle a[0..5] (same order); returns the determinant. Sets `pd` false unless the leading minors
+/// m00, m00 m11 - m01^2 and the determinant are positive (Sylvester's criterion).
+inline double adjugate_sym3(double m00, double m01, double m02, double m11, double m12, double m22,
+                            double (&a)[6], bool& pd) {
+  a[0] = m11 * m22 - m12 * m12;
+  a[1] = m02 * m12 - m01 * m22;
+  a[2] = m01 * m12 - m02 * m11;
+  a[3] = m00 * m22 - m02 * m02;
+  a[4] = m01 * m02 - m00 * m12;
+  a[5] = m00 * m11 - m01 * m01;
+  const double det = (m00 * a[0] + m01 * a[1]) + m02 * a[2];
+  pd = pd && m00 > 0.0 && a[5] > 0.0 && det > 0.0;
+  return det;
+}
+
+/// x^T A^-1 x for the articulated inertia A = [P X; X^T C] of the base (3x3 blocks, P and C
+/// symmetric) and x = [a; b], by block elimination with adjugates and one division: with
+/// S' = |P| C - X^T adj(P) X (|P| times the Schur complement of P) and y' = |P| b - X^T adj(P) a,
+///   x^T A^-1 x = (a^T adj(P) a |S'| + y'^T adj(S') y') / (|P| |S'|).
+/// inverse_quadratic_spd6's LDL^T takes six dependent divisions and a 6x6 copy; this is a third of
+/// the recursion's time on the 3-DOF robot. When a leading minor is not positive (A not positive
+/// definite, or NaN) or the determinants leave the normal range of doubles, the LDL^T decides.
+inline bool inverse_quadratic_articulated(const ArticulatedInertia& A, const Vector6& x, double& q) {
+  const Matrix3 &P = A.ll, &X = A.la, &C = A.aa;
+  bool pd = true;
+  double aP[6];
+  const double dP = adjugate_sym3(P(0, 0), P(0, 1), P(0, 2), P(1, 1), P(1, 2), P(2, 2), aP, pd);
+  const double G[3][3] = {{aP[0], aP[1], aP[2]}, {aP[1], aP[3], aP[4]}, {aP[2], aP[4], aP[5]}};
+  double GX[3][3];  // adj(P) X, by columns
+  for (int c = 0; c < 3; ++c)
+    for (int r = 0; r < 3; ++r) GX[c][r] = (G[r][0] * X(0, c) + G[r][1] * X(1, c)) + G[r][2] * X(2, c);
+  auto sp = [&](int i, int j) {  // S'_ij
+    return dP * C(i, j) - ((X(0, i) * GX[j][0] + X(1, i) * GX[j][1]) + X(2, i) * GX[j][2]);
+  };
+  double ya[3];  // adj(P) a
+  for (int r = 0; r < 3; ++r) ya[r] = (G[r][0] * x(0) + G[r][1] * x(1)) + G[r][2] * x(2);
+  const double t1 = (x(0) * ya[0] + x(1) * ya[1]) + x(2) * ya[2];
+  double yp[3];
+  for (int i = 0; i < 3; ++i) yp[i] = dP * x(3 + i) - ((X(0, i) * ya[0] + X(1, i) * ya[1]) + X(2, i) * ya[2]);
+  double aS[6];
+  const double dS = adjugate_sym3(sp(0, 0), sp(0, 1), sp(0, 2), sp(1, 1), sp(1, 2), sp(2, 2), aS, pd);
+  const double t2 = yp[0] * (aS[0] * yp[0] + 2.0 * (aS[1] * yp[1] + aS[2] * yp[2])) +
+                    yp[1] * (aS[3] * yp[1] + 2.0 * aS[4] * yp[2]) + aS[5] * yp[2] * yp[2];
+  const double den = dP * dS;
+  if (pd && den >= std::numeric_limits<double>::min() && den <= std::numeric_limits<double>::max()) {
+    q = (t1 * dS + t2) / den;
+    if (q >= 0.0 && q <= std::numeric_limits<double>::max()) return true;
+  }
+  return inverse_quadratic_spd6(A.matrix(), x, q);
+}
+
 /// The unit force u at the origin of `frame` as a spatial force about the base origin p_0 (inertial
 /// axes, linear first): f = [u; (p_e - p_0) x u]. Checks u and the frame index. Reads the kinematics.
 inline Vector6 unit_point_force(const Model& model, const Data& data, int frame, const Vector3& u) {
   check_unit_direction(u, "effective_mass");
   check_frame(model, frame, "effective_mass");
-  const Vector3 pe = frame_pose(model, data, frame).p;
+  const Frame& fr = model.frame(frame);
+  const auto b = static_cast<size_t>(fr.body);
+  const Vector3 pe = data.p[b] + data.R[b] * fr.pose.p;  // frame_pose's position, without its rotation
   if (!pe.allFinite())
     throw NumericalError(str("effective_mass: the position of frame '", model.frame(frame).name,
                              "' overflows double precision"));
@@ -98,7 +152,13 @@ inline Vector6 unit_point_force(const Model& model, const Data& data, int frame,
 inline void articulated_inertias(const Model& model, Data& data, const Eigen::VectorXd* armature) {
   body_inertias(model, data);
   const int nb = model.nb();
-  for (int i = 0; i < nb; ++i) data.IA[static_cast<size_t>(i)].set(data.Ic[static_cast<size_t>(i)]);
+  // On a depth-first model a body's articulated inertia starts at its first child reached (the last
+  // child, whose subtree ends the body's): set_projected, without setting it first; leaves start
+  // as their rigid inertia. Other trees set every body first.
+  const bool df = model.depth_first();
+  for (int i = 0; i < nb; ++i)
+    if (!df || model.subtree_last(i) == i)
+      data.IA[static_cast<size_t>(i)].set(data.Ic[static_cast<size_t>(i)]);
   for (int i = nb - 1; i > 0; --i) {
     const auto ui = static_cast<size_t>(i);
     const auto up = static_cast<size_t>(model.body(i).parent);
@@ -110,7 +170,10 @@ inline void articulated_inertias(const Model& model, Data& data, const Eigen::Ve
           str("effective_mass: the articulated inertia is not positive definite (joint ", i, ")"));
     data.U[ui] = U;
     data.D(i - 1) = D;
-    data.IA[up].add_projected(data.IA[ui], U, D);
+    if (df && model.subtree_last(i) == model.subtree_last(model.body(i).parent))
+      data.IA[up].set_projected(data.Ic[up], data.IA[ui], U, D);  // data.Ic[up] is still the body alone
+    else
+      data.IA[up].add_projected(data.IA[ui], U, D);
     data.Ic[up] += data.Ic[ui];
   }
 }
@@ -143,7 +206,7 @@ inline double articulated_solve(const Model& model, Data& data, int ee, const Ve
   }
   if (!all) {
     double q0 = 0.0;
-    if (!inverse_quadratic_spd6(data.IA[0].matrix(), pA, q0))
+    if (!inverse_quadratic_articulated(data.IA[0], pA, q0))
       throw NumericalError("effective_mass: the articulated inertia of the base is not positive definite");
     return q + q0;
   }
