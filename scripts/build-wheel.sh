@@ -41,7 +41,7 @@ settings=("--config-settings=build-dir=$PWD/$out/cmake")
 if [ -n "${FFSR_WHEEL_CXX_FLAGS:-}" ]; then
   settings+=("--config-settings=cmake.define.CMAKE_CXX_FLAGS_RELEASE=$FFSR_WHEEL_CXX_FLAGS")
 fi
-"$py" -m pip wheel --quiet --disable-pip-version-check --no-build-isolation --no-deps "${settings[@]}" \
+"$py" -m pip wheel --disable-pip-version-check --no-build-isolation --no-deps "${settings[@]}" \
   -w "$out/dist" ./python
 echo "build-wheel.sh: compiled in $((SECONDS - start)) s: $(ls "$out"/dist)"
 
