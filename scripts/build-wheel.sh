@@ -2,14 +2,15 @@
 # Builds a wheel of the Python package for x86-64 Linux with glibc >= Debian 12's (2.36) that needs no
 # compiler and no -dev package: scikit-build-core compiles it (pyproject.toml's -O2, build-wheel/cmake),
 # then auditwheel copies the shared libraries it links into it and tags it manylinux (the tag it
-# verifies). Output: build-wheel/wheelhouse/ffsr-*.whl and `auditwheel show` in build-wheel/auditwheel-show.txt.
+# verifies). Output: build-wheel/wheelhouse/ffsr-*.whl, `auditwheel show` in build-wheel/auditwheel-show.txt.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 out=build-wheel
 # the libraries the module links (Debian packages), python3-venv and npm
 bash scripts/install-deps.sh
 missing=()
-dpkg-query -W -f='${Status}' python3-venv 2>/dev/null | grep -q "install ok installed" || missing+=(python3-venv)
+dpkg-query -W -f='${Status}' python3-venv 2>/dev/null | grep -q "install ok installed" ||
+  missing+=(python3-venv)
 command -v npm >/dev/null || missing+=(npm)   # the build fetches three.js with it (python/three.sha256)
 if [ ${#missing[@]} -gt 0 ]; then
   SUDO=""

@@ -14,7 +14,7 @@ list(GET ffsr_three_pin 0 FFSR_THREE_SHA256)
 list(GET ffsr_three_pin 1 ffsr_three_file)
 list(GET ffsr_three_pin 2 FFSR_THREE_VERSION)
 
-set(FFSR_THREE_TARBALL "" CACHE FILEPATH "npm's tarball of three (${ffsr_three_file}) to use instead of downloading it")
+set(FFSR_THREE_TARBALL "" CACHE FILEPATH "npm's tarball of three (${ffsr_three_file}), not downloaded")
 set(ffsr_three_dir ${CMAKE_CURRENT_BINARY_DIR}/three-npm)
 set(ffsr_three_tgz ${ffsr_three_dir}/${ffsr_three_file})
 
@@ -39,13 +39,15 @@ if(NOT ffsr_three_have)
   else()
     find_program(FFSR_NPM npm)
     if(NOT FFSR_NPM)
-      message(FATAL_ERROR "ffsr: the package build fetches three.js ${FFSR_THREE_VERSION} (the 3-D view's) with "
-                          "npm, which is not installed (Debian: apt-get install npm; or -DFFSR_THREE_TARBALL=FILE)")
+      message(FATAL_ERROR "ffsr: the package build fetches three.js ${FFSR_THREE_VERSION} (the 3-D view's) "
+                          "with npm, which is not installed (Debian: apt-get install npm; or "
+                          "-DFFSR_THREE_TARBALL=FILE)")
     endif()
     message(STATUS "ffsr: npm pack three@${FFSR_THREE_VERSION}")
     execute_process(COMMAND ${FFSR_NPM} pack three@${FFSR_THREE_VERSION} --pack-destination ${ffsr_three_dir}
                             --silent
-                    WORKING_DIRECTORY ${ffsr_three_dir} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+                    WORKING_DIRECTORY ${ffsr_three_dir}
+                    RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
     if(NOT rc EQUAL 0 OR NOT EXISTS ${ffsr_three_tgz})
       message(FATAL_ERROR "ffsr: npm pack three@${FFSR_THREE_VERSION} failed (exit ${rc}), so the 3-D view's "
                           "three.js is missing:\n${err}${out}")

@@ -23,8 +23,8 @@ From Python: ``ffsr.view.capture(result, "capture.html", series)`` where ``resul
 result (an object with ``to_dict()``, or the dict of the command's ``--json``) and ``series`` the
 time series (a path to the ``--csv`` file, its text, or a mapping of its columns; by default
 ``result.series``); it returns a :class:`CaptureView`, which Jupyter shows inline (the page in an
-iframe), and writes the file when given a path. Bad input raises :class:`ViewInputError` naming the file (or argument); nothing
-is written then. This module needs the Python standard library only.
+iframe), and writes the file when given a path. Bad input raises :class:`ViewInputError` naming
+the file (or argument); nothing is written then. This module needs the Python standard library only.
 """
 
 from __future__ import annotations
@@ -312,9 +312,9 @@ def page_data(result: Any, series: Any = None, *, run: Optional[str] = None, fra
 def _asset(name: str) -> str:
     path = ASSETS / name
     if name.startswith("three/") and not path.is_file():
-        raise RuntimeError(f"ffsr.view: {path} is missing: three.js is not in this copy of the package (its build "
-                           f"fetches it from the npm registry; install the package: scripts/install-python.sh or "
-                           f"pip install ./python)")
+        raise RuntimeError(f"ffsr.view: {path} is missing: three.js is not in this copy of the package "
+                           f"(its build fetches it from the npm registry; install the package: "
+                           f"scripts/install-python.sh or pip install ./python)")
     return path.read_text(encoding="utf-8")
 
 
@@ -398,12 +398,13 @@ class CaptureView:
 
     def _repr_html_(self) -> str:
         return (f'<iframe srcdoc="{html.escape(self.html, quote=True)}" title="ffsr.view" '
-                f'style="width: 100%; height: {self.height}px; border: 1px solid #d5d9de; border-radius: 4px">'
-                f'</iframe>')
+                f'style="width: 100%; height: {self.height}px; border: 1px solid #d5d9de; '
+                f'border-radius: 4px"></iframe>')
 
     def __fspath__(self) -> str:
         if self.path is None:
-            raise TypeError("CaptureView: the page was not written to a file (capture(..., path) or save(path))")
+            raise TypeError("CaptureView: the page was not written to a file "
+                            "(capture(..., path) or save(path))")
         return os.fspath(self.path)
 
     def __repr__(self) -> str:

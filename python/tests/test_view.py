@@ -135,7 +135,8 @@ NOTEBOOK = """<!doctype html><html><head><meta charset="utf-8"><title>notebook</
 const copy = () => {
   const doc = document.querySelector('iframe').contentDocument;
   const inner = doc && doc.getElementById('ffsr-view-summary');
-  if (inner && inner.textContent) document.getElementById('ffsr-view-summary').textContent = inner.textContent;
+  const outer = document.getElementById('ffsr-view-summary');
+  if (inner && inner.textContent) outer.textContent = inner.textContent;
   else setTimeout(copy, 50);
 };
 copy();
