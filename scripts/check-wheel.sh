@@ -13,7 +13,8 @@ wheels=("$out"/wheelhouse/ffsr-*.whl)
 wheel=${wheels[0]}
 py="$out/venv/bin/python"   # build-wheel.sh's venv (the host side: pip download)
 command -v debootstrap >/dev/null || {
-  apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends debootstrap; }
+  apt-get update -qq &&
+    DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends debootstrap; }
 start=$SECONDS
 
 # --- the Debian 12 root, from the mirror apt uses here (or FFSR_DEBIAN_MIRROR), cached as a tarball --
@@ -41,7 +42,8 @@ if [ ! -f "$cache" ] || [ "$(cat "$cache.key" 2>/dev/null)" != "$key" ]; then
   rm -rf "$out/debootstrap" "$cache" "$cache.key"
   t0=$SECONDS
   debootstrap --variant=minbase --include=python3,python3-venv bookworm "$out/debootstrap" "$mirror" \
-    > "$out/debootstrap.log" 2>&1 || { tail -20 "$out/debootstrap.log"; echo "check-wheel.sh: debootstrap failed"; exit 1; }
+    > "$out/debootstrap.log" 2>&1 ||
+    { tail -20 "$out/debootstrap.log"; echo "check-wheel.sh: debootstrap failed" >&2; exit 1; }
   echo "check-wheel.sh: debootstrap: $((SECONDS - t0)) s, $(du -sh "$out/debootstrap" | cut -f1)"
   tar -C "$out/debootstrap" -cf "$cache" .
   echo "$key" > "$cache.key"
@@ -68,9 +70,10 @@ dev=$(chroot "$root" dpkg-query -W -f '${Package}\n' | grep -E -- '-dev(:|$)' ||
 work=$root/opt/ffsr-check
 mkdir -p "$work/wheels"
 cp "$wheel" "$work/wheels/"
-numpy=$("$py" -c 'import sys, tomllib; d = tomllib.load(open(sys.argv[1], "rb")); print(*d["project"]["dependencies"])' \
-        python/pyproject.toml)
-"$py" -m pip download --quiet --disable-pip-version-check --only-binary=:all: --no-deps -d "$work/wheels" $numpy
+numpy=$("$py" -c 'import sys, tomllib
+print(*tomllib.load(open(sys.argv[1], "rb"))["project"]["dependencies"])' python/pyproject.toml)
+"$py" -m pip download --quiet --disable-pip-version-check --only-binary=:all: --no-deps \
+  -d "$work/wheels" $numpy
 cp -r robots "$work/robots"
 # the README's example (the first python block of its section "Python") and the numbers the README
 # gives for it (the parenthesis after the block)
@@ -102,7 +105,9 @@ print(\"three.js in the package:\", sum(len(v._asset(\"three/\" + f)) for f in v
   venv/bin/python example.py > example.out
   cat example.out
 ' || { echo "check-wheel.sh: the wheel failed in the Debian 12 root" >&2; exit 1; }
-missing=$(grep -vxF -f <(grep -oE '[0-9]+\.[0-9]+ (kg|kN|%)' "$work/example.out") "$work/expected.txt" || true)
+printed=$(grep -oE '[0-9]+\.[0-9]+ (kg|kN|%)' "$work/example.out" || true)
+missing=$(grep -vxF -f <(echo "$printed") "$work/expected.txt" || true)
 [ -z "$missing" ] || { echo "check-wheel.sh: the example did not print the README's" $missing >&2; exit 1; }
-echo "check-wheel.sh: $(basename "$wheel") ($(du -k "$wheel" | cut -f1) KiB) installed and ran the README's example" \
-     "in a Debian 12 root without compilers, offline: $((SECONDS - t0)) s inside, $((SECONDS - start)) s in all"
+echo "check-wheel.sh: $(basename "$wheel") ($(du -k "$wheel" | cut -f1) KiB) installed and ran the README's" \
+     "example in a Debian 12 root without compilers, offline: $((SECONDS - t0)) s inside," \
+     "$((SECONDS - start)) s in all"
