@@ -181,6 +181,22 @@ def test_inline_view_in_a_notebook(paper_3dof, tmp_path):
     assert variance < 1, variance
 
 
+def test_three_js_is_the_pinned_release_and_not_in_git():
+    """The package holds three.js at the version python/three.sha256 pins (its build fetched it; the
+    module's REVISION constant is the minor version); the repository holds none of its files."""
+    pinned = (ROOT / "python" / "three.sha256").read_text().split()[1]
+    version = re.fullmatch(r"three-(\d+)\.(\d+)\.(\d+)\.tgz", pinned)
+    assert version, pinned
+    module = (view.ASSETS / "three" / view.THREE_FILES[0]).read_text(encoding="utf-8")
+    assert module.startswith("/**\n * @license\n * Copyright 2010-") and "Three.js Authors" in module[:200]
+    assert f'const t="{version.group(2)}"' in module[:300]
+    assert "OrbitControls" in (view.ASSETS / "three" / view.THREE_FILES[1]).read_text(encoding="utf-8")
+    listed = subprocess.run(["git", "ls-files", "python/ffsr"], cwd=ROOT, capture_output=True, text=True)
+    if listed.returncode != 0:
+        pytest.skip("not a git checkout")
+    assert [f for f in listed.stdout.split() if "three" in f.lower()] == []
+
+
 # --- the series the command writes for the view: identities, not values pasted back ---------------------
 
 
