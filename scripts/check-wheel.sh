@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# Checks the wheel of scripts/build-wheel.sh on a machine without compilers: a minimal Debian 12 root
-# (debootstrap --variant=minbase with python3 and python3-venv only), where, offline (no network
-# namespace, pip --no-index), a venv gets the wheel and numpy from a folder, imports ffsr and runs the
+# Checks the wheel of scripts/build-wheel.sh on a machine without compilers: in a minimal Debian 12 root
+# (debootstrap --variant=minbase, python3 and python3-venv only), offline (a network namespace without
+# interfaces, pip --no-index), a venv gets the wheel and numpy from a folder, imports ffsr and runs the
 # README's Python example. Needs root (chroot). The root is cached as build-wheel/bookworm-minbase.tar.
 set -euo pipefail
 cd "$(dirname "$0")/.."
