@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Installs the Python package ffsr (python/) into a virtual environment, build-python/venv (or the
 # folder given as $1), made with Debian 12's python3: first the Debian packages it needs (python3-dev,
-# python3-venv and those of the C++ build, scripts/install-deps.sh), then every PyPI package pinned in
+# python3-venv, npm and those of the C++ build, scripts/install-deps.sh), then every PyPI package pinned in
 # python/pyproject.toml (build requirements, numpy, and the test extra: pytest and Pinocchio's `pin`,
 # the reference of the tests and the bench; dask, nbclient and matplotlib for the studies and the
 # notebooks), then the package itself, built by scikit-build-core in
@@ -17,6 +17,8 @@ missing=()
 for p in python3-dev python3-venv; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
 done
+# npm: the package's build fetches the 3-D view's three.js from the npm registry (python/three.sha256)
+command -v npm >/dev/null || missing+=(npm)
 if [ ${#missing[@]} -gt 0 ]; then
   echo "ffsr: installing missing Debian packages: ${missing[*]}"
   SUDO=""

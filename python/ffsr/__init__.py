@@ -9,7 +9,7 @@ names as in C++. See docs/python.md.
 try:
     from ._ffsr import *  # noqa: F401,F403
     from ._ffsr import __doc__ as _ext_doc  # noqa: F401
-except ImportError as _error:  # no compiled extension (a source tree): ffsr.view still works from files
+except ImportError as _error:  # no compiled extension: ffsr.view still reads and checks the command's files
     _missing_extension = _error
 
     def __getattr__(name):  # AttributeError, so that `from ffsr import view` still finds the submodule

@@ -10,9 +10,9 @@ chosen; the page opens on the global run at the capture instant.
 
 Forward kinematics is not redone here: the command's series holds the pose of every body at every
 sample (``body<i>_*`` columns), the target's pose (``target_*``) and the phase, and its JSON result
-holds the bodies' tree and shapes (``scene``). three.js is vendored in ``view_assets/three`` (npm
-``three`` 0.170.0, MIT) and written into the page: the file opens offline, from disk, with no
-server and nothing fetched.
+holds the bodies' tree and shapes (``scene``). three.js (npm ``three``, MIT; the package's build
+fetches it at the version pinned in python/three.sha256 into ``view_assets/three``) is written into
+the page: the file opens offline, from disk, with no server and nothing fetched.
 
 From the command's outputs::
 
@@ -22,8 +22,9 @@ From the command's outputs::
 From Python: ``ffsr.view.capture(result, "capture.html", series)`` where ``result`` is the job's
 result (an object with ``to_dict()``, or the dict of the command's ``--json``) and ``series`` the
 time series (a path to the ``--csv`` file, its text, or a mapping of its columns; by default
-``result.series``). Bad input raises :class:`ViewInputError` naming the file (or argument); nothing
-is written then. This module needs the Python standard library only.
+``result.series``); it returns a :class:`CaptureView`, which Jupyter shows inline (the page in an
+iframe), and writes the file when given a path. Bad input raises :class:`ViewInputError` naming
+the file (or argument); nothing is written then. This module needs the Python standard library only.
 """
 
 from __future__ import annotations
@@ -40,9 +41,10 @@ import tempfile
 from pathlib import Path
 from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
 
-__all__ = ["ViewInputError", "capture", "page", "page_data", "main"]
+__all__ = ["ViewInputError", "CaptureView", "capture", "page", "page_data", "main"]
 
 ASSETS = Path(__file__).resolve().parent / "view_assets"
+THREE_FILES = ("three.module.min.js", "OrbitControls.js")  # written into view_assets/three by the build
 RUNS = ("baseline", "optimized", "global")  # the result's keys and the series' run labels
 RUN_LABELS = {"baseline": "Without optimization", "optimized": "With optimization", "global": "Global"}
 POSE = ("x", "y", "z", "qw", "qx", "qy", "qz")
@@ -308,7 +310,12 @@ def page_data(result: Any, series: Any = None, *, run: Optional[str] = None, fra
 
 
 def _asset(name: str) -> str:
-    return (ASSETS / name).read_text(encoding="utf-8")
+    path = ASSETS / name
+    if name.startswith("three/") and not path.is_file():
+        raise RuntimeError(f"ffsr.view: {path} is missing: three.js is not in this copy of the package "
+                           f"(its build fetches it from the npm registry; install the package: "
+                           f"scripts/install-python.sh or pip install ./python)")
+    return path.read_text(encoding="utf-8")
 
 
 def _raw_script(text: str, what: str) -> str:
@@ -334,8 +341,8 @@ def page(data: Dict[str, Any]) -> str:
         ("@@FFSR_HEADING@@", html.escape(f"Capture: {name}")),
         ("@@FFSR_SUBTITLE@@", html.escape(subtitle)),
         ("@@FFSR_DATA@@", blob),
-        ("@@FFSR_THREE@@", _raw_script(_asset("three/three.module.min.js"), "three.module.min.js")),
-        ("@@FFSR_ORBIT@@", _raw_script(_asset("three/OrbitControls.js"), "OrbitControls.js")),
+        ("@@FFSR_THREE@@", _raw_script(_asset(f"three/{THREE_FILES[0]}"), THREE_FILES[0])),
+        ("@@FFSR_ORBIT@@", _raw_script(_asset(f"three/{THREE_FILES[1]}"), THREE_FILES[1])),
         ("@@FFSR_VIEWER@@", _raw_script(_asset("viewer.js"), "viewer.js")),
     ):
         out = out.replace(key, value, 1)
@@ -373,24 +380,62 @@ def _write_atomically(path: Union[str, os.PathLike], text: str) -> Path:
     return target
 
 
-def capture(result: Any, path: Union[str, os.PathLike], series: Any = None, *, run: Optional[str] = None,
-            frames: int = DEFAULT_FRAMES) -> Path:
-    """Writes the 3-D view of a capture to `path` (one HTML file; returns its path).
+class CaptureView:
+    """The 3-D view of a capture: the page (``html``, one self-contained HTML text) and the file it was
+    written to (``path``, None when not written). In Jupyter it shows itself inline: ``_repr_html_`` is
+    an iframe whose ``srcdoc`` is the whole page (three.js included), so it needs no server, no file
+    and no network, and a notebook's saved output still holds it."""
 
+    def __init__(self, html_text: str, path: Optional[Path] = None, height: int = 600) -> None:
+        self.html = html_text
+        self.path = path
+        self.height = height
+
+    def save(self, path: Union[str, os.PathLike]) -> Path:
+        """Writes the page to `path` (all or nothing) and returns it; ``self.path`` becomes it."""
+        self.path = _write_atomically(path, self.html)
+        return self.path
+
+    def _repr_html_(self) -> str:
+        return (f'<iframe srcdoc="{html.escape(self.html, quote=True)}" title="ffsr.view" '
+                f'style="width: 100%; height: {self.height}px; border: 1px solid #d5d9de; '
+                f'border-radius: 4px"></iframe>')
+
+    def __fspath__(self) -> str:
+        if self.path is None:
+            raise TypeError("CaptureView: the page was not written to a file "
+                            "(capture(..., path) or save(path))")
+        return os.fspath(self.path)
+
+    def __repr__(self) -> str:
+        where = f"'{self.path}'" if self.path is not None else "not written"
+        return f"CaptureView({where}, {len(self.html.encode('utf-8')) / 1e6:.2f} MB)"
+
+
+def capture(result: Any, path: Optional[Union[str, os.PathLike]] = None, series: Any = None, *,
+            run: Optional[str] = None, frames: int = DEFAULT_FRAMES, height: int = 600) -> CaptureView:
+    """The 3-D view of a capture (a CaptureView, shown inline in Jupyter), written to `path` if given.
+
+    path: the HTML file to write (one self-contained file); None: nothing is written.
     result: the main job's result (an object with ``to_dict()``, or the dict of ``ffsr-optimize --json``).
     series: its time series: a path to the ``--csv`` file, the CSV text, or a mapping of its columns;
         None: ``result.series`` (called when it is a method).
     run: the run the page opens on (baseline, optimized, global; default: the last the result holds).
     frames: at most this many samples per run go into the page (evenly spread; the first, the last
         and the phase boundary always).
+    height: the inline frame's height in Jupyter, in CSS pixels.
     Raises ViewInputError (a ValueError) naming the argument on bad input; nothing is written then.
     """
+    if isinstance(height, bool) or not isinstance(height, int) or height < 100:
+        raise ViewInputError(f"height: must be an integer >= 100 (pixels), got {height!r}")
     if series is None:
         series = getattr(result, "series", None)
         if callable(series):
             series = series()
-    html_text = page(page_data(result, series, run=run, frames=frames))
-    return _write_atomically(path, html_text)
+    view = CaptureView(page(page_data(result, series, run=run, frames=frames)), height=height)
+    if path is not None:
+        view.save(path)
+    return view
 
 
 # --- python -m ffsr.view ----------------------------------------------------------------------------------

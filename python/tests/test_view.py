@@ -9,9 +9,11 @@ variant with shapes and a clearance (the links' capsules, the target's box, the 
 from __future__ import annotations
 
 import csv
+import html as htmllib
 import io
 import json
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -105,7 +107,7 @@ def test_page_of_the_paper_3dof_run(paper_3dof, tmp_path):
 def test_page_with_shapes_at_a_chosen_time(shapes_3dof, tmp_path):
     result, series = shapes_3dof
     html = view.capture(json.loads(result.read_text()), tmp_path / "shapes.html", series, run="optimized")
-    page = open_page(html, tmp_path / "shapes.png", fragment="#t=60")
+    page = open_page(html.path, tmp_path / "shapes.png", fragment="#t=60")
     assert page.console == [], page.console
     s = page.summary()
     assert s["ready"] is True and s["errors"] == []
@@ -122,6 +124,77 @@ def test_page_with_shapes_at_a_chosen_time(shapes_3dof, tmp_path):
     assert s["time"] == pytest.approx(60.0)
     variance, colours = grey_statistics(page.png, (330, 200, 1000, 700))
     assert variance > 30 and colours > 50, (variance, colours)
+
+
+# The host page of the inline view, as a notebook shows a cell's HTML output: the view's iframe, and a
+# script that copies the summary the page inside the frame writes (same origin: srcdoc) into its own.
+NOTEBOOK = """<!doctype html><html><head><meta charset="utf-8"><title>notebook</title></head>
+<body style="margin: 0; padding: 20px 40px"><div class="output">@@FRAME@@</div>
+<pre id="ffsr-view-summary" hidden></pre>
+<script>
+const copy = () => {
+  const doc = document.querySelector('iframe').contentDocument;
+  const inner = doc && doc.getElementById('ffsr-view-summary');
+  const outer = document.getElementById('ffsr-view-summary');
+  if (inner && inner.textContent) outer.textContent = inner.textContent;
+  else setTimeout(copy, 50);
+};
+copy();
+</script></body></html>
+"""
+
+
+def test_inline_view_in_a_notebook(paper_3dof, tmp_path):
+    """capture() without a path writes nothing and returns the view; its _repr_html_ (a cell's HTML
+    output in Jupyter) is an iframe holding the whole page, the same text as the file written with a
+    path; in Chromium the page inside the frame builds its scene with no console error and no fetch."""
+    result, series = paper_3dof
+    j = json.loads(result.read_text())
+    shown = view.capture(j, series=series, frames=80, height=520)
+    assert shown.path is None and list(tmp_path.iterdir()) == []
+    with pytest.raises(TypeError, match="not written"):
+        os.fspath(shown)
+    assert "not written" in repr(shown)
+    written = view.capture(j, tmp_path / "capture.html", series, frames=80)
+    assert written.path == tmp_path / "capture.html" and os.fspath(written) == str(tmp_path / "capture.html")
+    assert written.path.read_text(encoding="utf-8") == written.html == shown.html
+    frame = shown._repr_html_()
+    m = re.fullmatch(r'<iframe srcdoc="([^"]*)"([^>]*)></iframe>', frame, re.S)
+    assert m, frame[:200]
+    assert htmllib.unescape(m.group(1)) == shown.html
+    assert "height: 520px" in m.group(2)
+    with pytest.raises(view.ViewInputError, match="height"):
+        view.capture(j, series=series, height=10)
+
+    notebook = tmp_path / "notebook.html"
+    notebook.write_text(NOTEBOOK.replace("@@FRAME@@", frame), encoding="utf-8")
+    page = open_page(notebook, tmp_path / "notebook.png")
+    assert page.console == [], page.console
+    s = page.summary()
+    assert s["ready"] is True and s["errors"] == [], s
+    assert s["runs"] == ["baseline", "optimized", "global"] and s["run"] == "global"
+    assert s["roles"]["bus"] == 1 and s["roles"]["link"] == 3 and s["roles"]["target"] == 1
+    # the frame (40 px from the left, 20 px from the top, 520 px high) is drawn, the page below it is blank
+    variance, colours = grey_statistics(page.png, (400, 150, 1000, 470))
+    assert variance > 30 and colours > 50, (variance, colours)
+    variance, _ = grey_statistics(page.png, (40, 600, 1240, 780))
+    assert variance < 1, variance
+
+
+def test_three_js_is_the_pinned_release_and_not_in_git():
+    """The package holds three.js at the version python/three.sha256 pins (its build fetched it; the
+    module's REVISION constant is the minor version); the repository holds none of its files."""
+    pinned = (ROOT / "python" / "three.sha256").read_text().split()[1]
+    version = re.fullmatch(r"three-(\d+)\.(\d+)\.(\d+)\.tgz", pinned)
+    assert version, pinned
+    module = (view.ASSETS / "three" / view.THREE_FILES[0]).read_text(encoding="utf-8")
+    assert module.startswith("/**\n * @license\n * Copyright 2010-") and "Three.js Authors" in module[:200]
+    assert f'const t="{version.group(2)}"' in module[:300]
+    assert "OrbitControls" in (view.ASSETS / "three" / view.THREE_FILES[1]).read_text(encoding="utf-8")
+    listed = subprocess.run(["git", "ls-files", "python/ffsr"], cwd=ROOT, capture_output=True, text=True)
+    if listed.returncode != 0:
+        pytest.skip("not a git checkout")
+    assert [f for f in listed.stdout.split() if "three" in f.lower()] == []
 
 
 # --- the series the command writes for the view: identities, not values pasted back ---------------------
@@ -208,7 +281,8 @@ def test_capture_from_a_result_object_with_its_series(paper_3dof, tmp_path):
             return series.read_text()
 
     out = view.capture(Result(), tmp_path / "object.html")
-    assert out.read_text(encoding="utf-8").startswith("<!doctype html>")
+    assert out.path == tmp_path / "object.html"
+    assert out.path.read_text(encoding="utf-8").startswith("<!doctype html>")
     columns = {}
     for row in csv.DictReader(io.StringIO(series.read_text())):
         for k, v in row.items():
