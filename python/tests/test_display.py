@@ -113,3 +113,28 @@ def test_results_of_the_algorithms_and_the_jobs():
     assert Cells(grid._repr_html_()).rows[0] == ["angles (deg)", "M_ie (kg)", "F_max (kN)"]
     i = int(np.argmin(grid.M_ie))
     assert f"M_ie {grid.M_ie[i]:.3f} kg" in repr(grid) and f"{grid.points} grid points" in repr(grid)
+
+
+def test_closed_loop_robust_and_pareto_tables():
+    sc = ffsr.Scenario.load(str(ROBOTS / "paper_3dof.toml"), **{"global": False})
+    loop = sc.closed_loop()
+    rows = Cells(loop._repr_html_()).rows
+    assert rows[1][:3] == ["closed loop", "[" + ", ".join(f"{np.degrees(x):.2f}" for x in loop.theta) + "]",
+                           f"{loop.M_ie:.3f}"]
+    assert rows[2][2] == f"{loop.open_loop.M_ie:.3f}" and f"plan '{loop.plan}'" in repr(loop)
+    uncertain = ffsr.Scenario.load(str(ROBOTS / "paper_7dof_position_uncertain.toml"), **{"global": False})
+    robust = uncertain.robust(force_model="closed", samples=8)
+    rows = Cells(robust._repr_html_()).rows
+    assert [r[0] for r in rows[1:]] == [c.name for c in robust.configurations]
+    assert all(r[-1] == f"{c.max / 1e3:.3f}" and r[3] == f"{c.p50 / 1e3:.3f}"
+               for r, c in zip(rows[1:], robust.configurations))
+    assert repr(robust).startswith(f"RobustResult(8 samples, seed {robust.seed},")
+
+
+def test_pareto_table():
+    result = ffsr.Scenario.load(str(ROBOTS / "paper_3dof.toml")).pareto(levels=4, starts=2)
+    rows = Cells(result._repr_html_()).rows
+    assert len(rows) == len(result.front) + 1
+    assert [r[1] for r in rows[1:]] == [f"{p.M_ie:.3f}" for p in result.front]
+    assert sum("(knee)" in r[0] for r in rows) == 1
+    assert f"knee ParetoPoint(M_ie {result.knee.M_ie:.3f} kg" in repr(result)
