@@ -127,8 +127,10 @@ def _failures(r):
 def _run_result(r):
     rows = run_rows(r)
     widths = [max(len(row[i]) for row in rows + [RUN_HEADER]) for i in range(len(RUN_HEADER))]
-    lines = ["  ".join(c.ljust(w) if i < 2 else c.rjust(w) for i, (c, w) in enumerate(zip(row, widths))).rstrip()
-             for row in [RUN_HEADER] + rows]
+    def line(row):  # labels and configurations left-aligned, numbers right-aligned, as the command
+        return "  ".join(c.ljust(w) if i < 2 else c.rjust(w) for i, (c, w) in enumerate(zip(row, widths)))
+
+    lines = [line(row).rstrip() for row in [RUN_HEADER] + rows]
     return "RunResult(\n" + "\n".join("  " + x for x in lines + _failures(r)) + ")"
 
 
@@ -138,10 +140,10 @@ def _run_result_html(r):
 
 
 def _capture_result(c):
-    return (f"CaptureResult(theta {_deg(c.theta)} deg, M_ie {c.M_ie:.3f} kg, F_max {c.f_max_closed_form / 1e3:.3f} "
-            f"kN (exact {c.f_max_exact / 1e3:.3f} kN),\n"
-            f"              tracking {c.tracking_error:.2e} m, approach velocity {_num(c.approach_velocity)} m/s, "
-            f"{c.steps} steps)")
+    return (f"CaptureResult(theta {_deg(c.theta)} deg, M_ie {c.M_ie:.3f} kg, "
+            f"F_max {c.f_max_closed_form / 1e3:.3f} kN (exact {c.f_max_exact / 1e3:.3f} kN),\n"
+            f"              tracking {c.tracking_error:.2e} m, "
+            f"approach velocity {_num(c.approach_velocity)} m/s, {c.steps} steps)")
 
 
 # --- the other jobs --------------------------------------------------------------------------------
@@ -202,7 +204,8 @@ def _robust_cells(c):
 
 
 def _robust_configuration(c):
-    return "RobustConfiguration(" + ", ".join(f"{h} {x}" for h, x in zip(ROBUST_HEADER, _robust_cells(c))) + ")"
+    cells = zip(ROBUST_HEADER, _robust_cells(c))
+    return "RobustConfiguration(" + ", ".join(f"{h} {x}" for h, x in cells) + ")"
 
 
 def _robust(r):
@@ -265,7 +268,8 @@ HTML = {
     "InspectResult": lambda r: _table(["", "value"], _inspect_rows(r)),
     "ContactResult": lambda r: _table(CONTACT_HEADER, [_contact_row_cells(w) for w in r.rows]),
     "ClosedLoopResult": lambda r: _table(CLOSED_LOOP_HEADER, _closed_loop_rows(r),
-                                         f"plan '{r.plan}', {r.ticks} ticks, max torque {_num(r.max_torque)} N m"),
+                                         f"plan '{r.plan}', {r.ticks} ticks, "
+                                         f"max torque {_num(r.max_torque)} N m"),
     "RobustResult": lambda r: _table(ROBUST_HEADER, [_robust_cells(c) for c in r.configurations],
                                      f"{r.samples} samples, seed {r.seed}"),
     "ParetoResult": lambda r: _table(PARETO_HEADER, _pareto_rows(r),

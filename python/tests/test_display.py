@@ -61,7 +61,8 @@ def test_run_result_html_shows_the_commands_rows(name):
     expected = command_table(scenario)
     result = ffsr.Scenario.load(str(scenario)).run()
     rows = Cells(result._repr_html_()).rows
-    assert rows[0] == ["", "Capture configuration (deg)", "M_ie (kg)", "F_max (kN)", "exact (kN)", "tracking (m)"]
+    header = ["", "Capture configuration (deg)", "M_ie (kg)", "F_max (kN)", "exact (kN)", "tracking (m)"]
+    assert rows[0] == header
     shown = [[c for c in r if c] for r in rows[1:]]  # the reductions leave the configuration cell empty
     assert len(expected) >= 4
     assert shown == expected
@@ -92,8 +93,8 @@ def test_model_data_target_base_pose_contact_law():
 def test_results_of_the_algorithms_and_the_jobs():
     sc = ffsr.Scenario.load(str(ROBOTS / "paper_3dof.toml"), **{"global": False})
     run = sc.run()
-    assert repr(run.plain).startswith(f"CaptureResult(theta [{', '.join(f'{np.degrees(x):.2f}' for x in run.plain.theta)}]"
-                                      f" deg, M_ie {run.plain.M_ie:.3f} kg")
+    degrees = ", ".join(f"{np.degrees(x):.2f}" for x in run.plain.theta)
+    assert repr(run.plain).startswith(f"CaptureResult(theta [{degrees}] deg, M_ie {run.plain.M_ie:.3f} kg")
     law = ffsr.make_contact_law("hunt-crossley", ffsr.ContactParams(), 0.2)
     peak = law.exact_peak(10.0)
     assert repr(peak).startswith(f"ForcePeak(force {peak.force:.6g} N")
