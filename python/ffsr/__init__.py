@@ -9,6 +9,9 @@ names as in C++. See docs/python.md.
 try:
     from ._ffsr import *  # noqa: F401,F403
     from ._ffsr import __doc__ as _ext_doc  # noqa: F401
+    from . import _display
+
+    _display.install()  # __repr__ and, for the jobs' results, _repr_html_ (the command's table)
 except ImportError as _error:  # no compiled extension: ffsr.view still reads and checks the command's files
     _missing_extension = _error
 

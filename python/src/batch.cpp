@@ -2,17 +2,20 @@
 // peak of Eq. 16) for an (N, n) array of joint configurations, on the library's thread pool
 // (detail::parallel_chunks: one Data per thread, fixed chunks, so the result does not depend on the
 // thread count), with the GIL released.
-#include "common.hpp"
+#include "arguments.hpp"
+#include "bindings.hpp"
+#include "outputs.hpp"
 
-#include <ffsr/contact/contact_law.hpp>
-#include <ffsr/detail/parallel.hpp>
+#include "ffsr/contact/contact_law.hpp"
+#include "ffsr/detail/parallel.hpp"
 
-#include <nanobind/stl/string.h>
 #include <nanobind/stl/pair.h>
+#include <nanobind/stl/string.h>
 
 #include <algorithm>
 #include <chrono>
 #include <memory>
+#include <optional>
 #include <thread>
 
 namespace ffsr::python {
@@ -25,48 +28,59 @@ unsigned threads_arg(int threads) {
   return threads == 0 ? std::max(1u, std::thread::hardware_concurrency()) : unsigned(threads);
 }
 
-nb::ndarray<nb::numpy, double> new_array(size_t n, double** data) {
-  auto* buf = new double[n];
-  nb::capsule owner(buf, [](void* p) noexcept { delete[] static_cast<double*>(p); });
-  *data = buf;
-  const size_t shape[1] = {n};
-  return nb::ndarray<nb::numpy, double>(buf, 1, shape, owner);
-}
+/// The arguments the batch calls share, read and checked with the GIL held.
+struct Batch {
+  Batch(const Model& model, nb::handle thetas, nb::handle frame_h, const Target* target_p,
+        const std::string& joints_name, nb::handle armature, int threads_n, const char* where)
+      : X(thetas, where, "thetas"),
+        frame(frame_arg(model, frame_h, where)),
+        target(target_or_default(target_p)),
+        threads(threads_arg(threads_n)) {
+    X.require(X.rows(), model.n());
+    const ContactJoints cj = joints_arg(model, joints_name, armature, where);
+    if (joints_name != "free" || !armature.is_none()) joints = cj;
+  }
+  MatIn X;
+  int frame;
+  const Target& target;
+  std::optional<ContactJoints> joints;  ///< none: the paper's free joints
+  unsigned threads;
+};
 
-/// M_ie of every row of `thetas` into M (N entries), on `threads` threads.
-void batch_mie(const Model& model, const BasePose& base, const MatIn& thetas, int frame, const Target& target,
-               const ContactJoints* joints, unsigned threads, double* M) {
-  const auto N = static_cast<std::uint64_t>(thetas.rows());
-  const Vector3 u = target.normal_world();
-  const double inv_t = target.inverse_mass_along_normal();
+/// M_ie of every row of the batch into M (N entries), by integrated_effective_mass's route (the O(n)
+/// recursion), with one Data per thread.
+void batch_mie(const Model& model, const BasePose& base, const Batch& b, double* M) {
+  const auto N = static_cast<std::uint64_t>(b.X.rows());
+  const Vector3 u = b.target.normal_world();
+  const double inv_t = b.target.inverse_mass_along_normal();
   std::vector<std::unique_ptr<Data>> datas;
-  for (unsigned t = 0; t < threads; ++t) datas.push_back(std::make_unique<Data>(model));
-  const auto X = thetas.map();
+  for (unsigned t = 0; t < b.threads; ++t) datas.push_back(std::make_unique<Data>(model));
+  const auto X = b.X.map();
   detail::ParallelOptions opt;
   opt.chunk = 256;
   detail::parallel_chunks(
-      N, threads,
+      N, b.threads,
       [&](unsigned worker, std::uint64_t lo, std::uint64_t hi) {
         Data& d = *datas[worker];
         Eigen::VectorXd theta(model.n());
         for (std::uint64_t i = lo; i < hi; ++i) {
           theta = X.row(Eigen::Index(i)).transpose();
-          if (joints) {
-            M[i] = integrated_effective_mass(model, d, base, theta, frame, target, *joints);
-          } else {
-            M[i] = integrated_effective_mass_fast(model, d, base, theta, frame, u, inv_t);
-          }
+          M[i] = b.joints
+                     ? integrated_effective_mass_fast(model, d, base, theta, b.frame, u, inv_t, *b.joints)
+                     : integrated_effective_mass_fast(model, d, base, theta, b.frame, u, inv_t);
         }
       },
       opt);
 }
 
-/// The median time per call of integrated_effective_mass from C++ over the rows of `thetas` (cycled),
+/// The median time per call of integrated_effective_mass's route from C++ over the rows of `thetas` (cycled),
 /// measured as bench/bench_main.cpp measures it: calls per batch calibrated to `batch_seconds`, the
 /// median of `batches` batch means. For python/bench: the same call without Python, in the same process.
 double time_cpp_mie(const Model& model, Data& data, const BasePose& base, const MatIn& thetas, int frame,
                     const Target& target, int batches, double batch_seconds) {
   using Clock = std::chrono::steady_clock;
+  const Vector3 u = target.normal_world();
+  const double inv_t = target.inverse_mass_along_normal();
   const auto X = thetas.map();
   std::vector<Eigen::VectorXd> rows;
   for (Eigen::Index i = 0; i < X.rows(); ++i) rows.emplace_back(X.row(i).transpose());
@@ -76,7 +90,7 @@ double time_cpp_mie(const Model& model, Data& data, const BasePose& base, const 
   auto run = [&](long n) {
     const auto t0 = Clock::now();
     for (long i = 0; i < n; ++i)
-      acc += integrated_effective_mass(model, data, base, rows[size_t(i) % m], frame, target);
+      acc += integrated_effective_mass_fast(model, data, base, rows[size_t(i) % m], frame, u, inv_t);
     return std::chrono::duration<double>(Clock::now() - t0).count();
   };
   long n = 1;
@@ -102,52 +116,35 @@ void bind_batch(nb::module_& m) {
       "integrated_effective_mass_batch",
       [](const Model& model, const BasePose& base, nb::handle thetas, nb::handle frame, const Target* target,
          const std::string& joints, nb::handle armature, int threads) {
-        const char* w = "integrated_effective_mass_batch";
-        const MatIn X(thetas, w, "thetas");
-        X.require(X.rows(), model.n());
-        detail::require_finite_all(X.map(), w, "thetas");
-        const int f = frame_arg(model, frame, w);
-        static const Target paper;
-        const Target& t = target ? *target : paper;
-        const bool free = joints == "free" && armature.is_none();
-        const ContactJoints cj = joints_arg(model, joints, armature);
-        const unsigned nt = threads_arg(threads);
+        const Batch b(model, thetas, frame, target, joints, armature, threads,
+                      "integrated_effective_mass_batch");
         double* M = nullptr;
-        auto result = new_array(size_t(X.rows()), &M);
+        auto result = new_array(size_t(b.X.rows()), &M);
         {
           nb::gil_scoped_release release;
-          batch_mie(model, base, X, f, t, free ? nullptr : &cj, nt, M);
+          batch_mie(model, base, b, M);
         }
         return result;
       },
-      "model"_a, "base"_a, "thetas"_a, "frame"_a.none() = nb::none(), "target"_a.none() = nb::none(), "joints"_a = "free",
-      "armature"_a.none() = nb::none(), "threads"_a = 0,
+      "model"_a, "base"_a, "thetas"_a, "frame"_a.none() = nb::none(), "target"_a.none() = nb::none(),
+      "joints"_a = "free", "armature"_a.none() = nb::none(), "threads"_a = 0,
       "M_ie (Eq. 14) of every row of thetas (N, n) at one base pose, (N,), on `threads` threads (0: one per\n"
-      "core), without the GIL. The same values as integrated_effective_mass row by row (to rounding: the\n"
-      "free joint model takes integrated_effective_mass_fast), whatever the thread count.");
+      "core), without the GIL. The same values as integrated_effective_mass row by row, whatever the thread\n"
+      "count; N = 0 gives an empty array.");
 
   m.def(
       "max_force_batch",
       [](const Model& model, const BasePose& base, nb::handle thetas, const ContactLaw& law, nb::handle frame,
          const Target* target, bool exact, const std::string& joints, nb::handle armature, int threads) {
-        const char* w = "max_force_batch";
-        const MatIn X(thetas, w, "thetas");
-        X.require(X.rows(), model.n());
-        detail::require_finite_all(X.map(), w, "thetas");
-        const int f = frame_arg(model, frame, w);
-        static const Target paper;
-        const Target& t = target ? *target : paper;
-        const bool free = joints == "free" && armature.is_none();
-        const ContactJoints cj = joints_arg(model, joints, armature);
-        const unsigned nt = threads_arg(threads);
-        const size_t N = size_t(X.rows());
+        const Batch b(model, thetas, frame, target, joints, armature, threads, "max_force_batch");
+        const size_t N = size_t(b.X.rows());
         double *M = nullptr, *F = nullptr;
         auto m_out = new_array(N, &M);
         auto f_out = new_array(N, &F);
         {
           nb::gil_scoped_release release;
-          batch_mie(model, base, X, f, t, free ? nullptr : &cj, nt, M);
-          detail::parallel_for(N, nt, [&](std::uint64_t i) {
+          batch_mie(model, base, b, M);
+          detail::parallel_for(N, b.threads, [&](std::uint64_t i) {
             F[i] = exact ? max_force_exact(law.law, M[i]) : max_force_closed_form(law.law, M[i]);
           });
         }
@@ -158,23 +155,26 @@ void bind_batch(nb::module_& m) {
       "(M_ie, F_max) of every row of thetas (N, n), two (N,) arrays: M_ie (Eq. 14) and the peak force of\n"
       "`law` (a ContactLaw): the closed form of Eq. 24, or with exact=True the exact peak of Eq. 16.\n"
       "Threads and GIL as integrated_effective_mass_batch.");
+}
 
+void bind_bench_timing(nb::module_& m) {
   m.def(
       "_time_cpp_integrated_effective_mass",
-      [](const Model& model, Data& data, const BasePose& base, nb::handle thetas, const Target* target, int batches,
-         double batch_seconds) {
+      [](const Model& model, Data& data, const BasePose& base, nb::handle thetas, const Target* target,
+         int batches, double batch_seconds) {
         const MatIn X(thetas, "_time_cpp_integrated_effective_mass", "thetas");
         X.require(X.rows(), model.n());
-        if (X.rows() < 1 || batches < 1) throw InputError("_time_cpp_integrated_effective_mass: nothing to time");
+        if (X.rows() < 1 || batches < 1)
+          throw InputError("_time_cpp_integrated_effective_mass: nothing to time");
         check_data(model, data, "_time_cpp_integrated_effective_mass");
-        static const Target paper;
-        return time_cpp_mie(model, data, base, X, model.end_effector(), target ? *target : paper, batches,
+        return time_cpp_mie(model, data, base, X, model.end_effector(), target_or_default(target), batches,
                             batch_seconds);
       },
       "model"_a, "data"_a, "base"_a, "thetas"_a, "target"_a.none() = nb::none(), "batches"_a = 31,
       "batch_seconds"_a = 5e-3,
-      "For the bench (python/bench): the median seconds per call of integrated_effective_mass from C++ over\n"
-      "the rows of thetas, timed as bench/bench_main.cpp times it, in this process.");
+      "For the bench (python/bench): the median seconds per call of integrated_effective_mass's route (the\n"
+      "O(n) recursion) from C++ over the rows of thetas, timed as bench/bench_main.cpp times it, in this "
+      "process.");
 }
 
 }  // namespace ffsr::python

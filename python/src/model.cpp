@@ -1,8 +1,10 @@
 // python/src/model.cpp -- the model side of ffsr._ffsr: Pose, BasePose, Inertia, Joint, Body, Frame,
-// Bus, UrdfReport, Model (Model.from_urdf, Model.from_urdf_string), ModelBuilder, Data and Target.
-#include "common.hpp"
+// Bus, UrdfReport, Model (Model.from_urdf, Model.from_urdf_string) and ModelBuilder.
+#include "arguments.hpp"
+#include "bindings.hpp"
+#include "outputs.hpp"
 
-#include <ffsr/parsers/urdf.hpp>
+#include "ffsr/parsers/urdf.hpp"
 
 #include <nanobind/stl/optional.h>
 #include <nanobind/stl/pair.h>
@@ -62,81 +64,22 @@ const char* const kFromUrdfDoc =
 
 }  // namespace
 
-void bind_model(nb::module_& m) {
+void bind_tree(nb::module_& m) {
   nb::enum_<JointType>(m, "JointType", "Joint type of a moving joint.")
       .value("Revolute", JointType::Revolute)
       .value("Prismatic", JointType::Prismatic);
 
-  nb::class_<Pose>(m, "Pose", "Pose of a frame b in a frame a: p the origin of b in a, R = aRb.")
-      .def(
-          "__init__",
-          [](Pose* self, nb::handle p, nb::handle R) {
-            new (self) Pose();
-            if (!p.is_none()) self->p = vec3(p, "Pose", "p");
-            if (!R.is_none()) self->R = mat3(R, "Pose", "R");
-            detail::require_finite_all(self->p, "Pose", "p");
-            detail::require_finite_all(self->R, "Pose", "R");
-          },
-          "p"_a.none() = nb::none(), "R"_a.none() = nb::none())
-      .def_static(
-          "from_xyz_rpy",
-          [](nb::handle xyz, nb::handle rpy) {
-            return Pose::from_xyz_rpy(vec3(xyz, "Pose.from_xyz_rpy", "xyz"), vec3(rpy, "Pose.from_xyz_rpy", "rpy"));
-          },
-          "xyz"_a, "rpy"_a, "The pose of a URDF <origin xyz rpy> (roll, pitch, yaw about fixed x, y, z; radians).")
-      .def_prop_rw(
-          "p", [](const Pose& s) { return out(s.p); },
-          [](Pose& s, nb::handle v) { s.p = vec3(v, "Pose", "p"); }, "Origin of b in a (3,).", nb::rv_policy::automatic)
-      .def_prop_rw(
-          "R", [](const Pose& s) { return out(s.R); },
-          [](Pose& s, nb::handle v) { s.R = mat3(v, "Pose", "R"); }, "Rotation aRb (3, 3).", nb::rv_policy::automatic)
-      .def("__mul__", &Pose::operator*, "Composition a_pose * b_pose.");
-
-  nb::class_<BasePose>(m, "BasePose",
-                       "The pose of the base in the inertial frame: position of the base link frame origin and\n"
-                       "attitude quaternion (x, y, z, w).")
-      .def(
-          "__init__",
-          [](BasePose* self, nb::handle position, nb::handle orientation) {
-            new (self) BasePose();
-            if (!position.is_none()) self->position = vec3(position, "BasePose", "position");
-            if (!orientation.is_none()) self->orientation = quat_xyzw(orientation, "BasePose", "orientation");
-          },
-          "position"_a.none() = nb::none(), "orientation"_a.none() = nb::none())
-      .def_prop_rw(
-          "position", [](const BasePose& s) { return out(s.position); },
-          [](BasePose& s, nb::handle v) { s.position = vec3(v, "BasePose", "position"); }, nb::rv_policy::automatic)
-      .def_prop_rw(
-          "orientation", [](const BasePose& s) { return out_quat(s.orientation); },
-          [](BasePose& s, nb::handle v) { s.orientation = quat_xyzw(v, "BasePose", "orientation"); },
-          "Attitude quaternion (x, y, z, w) of the base in the inertial frame.", nb::rv_policy::automatic);
-
-  nb::class_<Inertia>(m, "Inertia", "Mass (kg), centre of mass and inertia about it (kg m^2), in the link frame.")
-      .def(
-          "__init__",
-          [](Inertia* self, double mass, nb::handle com, nb::handle I) {
-            new (self) Inertia();
-            self->mass = mass;
-            if (!com.is_none()) self->com = vec3(com, "Inertia", "com");
-            if (!I.is_none()) self->I = mat3(I, "Inertia", "I");
-          },
-          "mass"_a, "com"_a.none() = nb::none(), "I"_a.none() = nb::none())
-      .def_rw("mass", &Inertia::mass)
-      .def_prop_rw(
-          "com", [](const Inertia& s) { return out(s.com); },
-          [](Inertia& s, nb::handle v) { s.com = vec3(v, "Inertia", "com"); }, nb::rv_policy::automatic)
-      .def_prop_rw(
-          "I", [](const Inertia& s) { return out(s.I); }, [](Inertia& s, nb::handle v) { s.I = mat3(v, "Inertia", "I"); }, nb::rv_policy::automatic);
-
   nb::class_<Joint>(m, "Joint", "A moving joint: name, type, unit axis (child frame), limits (rad or m).")
       .def_ro("name", &Joint::name)
       .def_ro("type", &Joint::type)
-      .def_prop_ro("axis", [](const Joint& j) { return out(j.axis); }, nb::rv_policy::automatic)
+      .def_prop_ro(
+          "axis", [](const Joint& j) { return out(j.axis); }, nb::rv_policy::automatic)
       .def_ro("lower", &Joint::lower)
       .def_ro("upper", &Joint::upper)
       .def("has_limits", &Joint::has_limits);
 
-  nb::class_<Body>(m, "Body", "One rigid body; body 0 is the free-floating base, body i > 0 hangs on a joint.")
+  nb::class_<Body>(m, "Body",
+                   "One rigid body; body 0 is the free-floating base, body i > 0 hangs on a joint.")
       .def_ro("name", &Body::name)
       .def_ro("parent", &Body::parent)
       .def_ro("joint", &Body::joint)
@@ -151,10 +94,88 @@ void bind_model(nb::module_& m) {
       .def_ro("name", &Frame::name)
       .def_ro("body", &Frame::body)
       .def_ro("pose", &Frame::pose);
+}
 
-  nb::class_<Bus>(m, "Bus",
-                  "A spacecraft bus to mount a URDF on (scenario keys bus-mass, bus-inertia, bus-com, mount-xyz,\n"
-                  "mount-rpy-deg). The bus frame is the free-floating base frame.")
+void bind_pose(nb::module_& m) {
+  nb::class_<Pose>(m, "Pose", "Pose of a frame b in a frame a: p the origin of b in a, R = aRb.")
+      .def(
+          "__init__",
+          [](Pose* self, nb::handle p, nb::handle R) {
+            new (self) Pose();
+            if (!p.is_none()) self->p = vec3(p, "Pose", "p");
+            if (!R.is_none()) self->R = mat3(R, "Pose", "R");
+            detail::require_finite_all(self->p, "Pose", "p");
+            detail::require_finite_all(self->R, "Pose", "R");
+          },
+          "p"_a.none() = nb::none(), "R"_a.none() = nb::none())
+      .def_static(
+          "from_xyz_rpy",
+          [](nb::handle xyz, nb::handle rpy) {
+            return Pose::from_xyz_rpy(vec3(xyz, "Pose.from_xyz_rpy", "xyz"),
+                                      vec3(rpy, "Pose.from_xyz_rpy", "rpy"));
+          },
+          "xyz"_a, "rpy"_a,
+          "The pose of a URDF <origin xyz rpy> (roll, pitch, yaw about fixed x, y, z; radians).")
+      .def_prop_rw(
+          "p", [](const Pose& s) { return out(s.p); },
+          [](Pose& s, nb::handle v) { s.p = vec3(v, "Pose", "p"); }, "Origin of b in a (3,).",
+          nb::rv_policy::automatic)
+      .def_prop_rw(
+          "R", [](const Pose& s) { return out(s.R); },
+          [](Pose& s, nb::handle v) { s.R = mat3(v, "Pose", "R"); }, "Rotation aRb (3, 3).",
+          nb::rv_policy::automatic)
+      .def("__mul__", &Pose::operator*, "Composition a_pose * b_pose.");
+}
+
+void bind_base_pose(nb::module_& m) {
+  nb::class_<BasePose>(
+      m, "BasePose",
+      "The pose of the base in the inertial frame: position of the base link frame origin and\n"
+      "attitude quaternion (x, y, z, w).")
+      .def(
+          "__init__",
+          [](BasePose* self, nb::handle position, nb::handle orientation) {
+            new (self) BasePose();
+            if (!position.is_none()) self->position = vec3(position, "BasePose", "position");
+            if (!orientation.is_none()) self->orientation = quat_xyzw(orientation, "BasePose", "orientation");
+          },
+          "position"_a.none() = nb::none(), "orientation"_a.none() = nb::none())
+      .def_prop_rw(
+          "position", [](const BasePose& s) { return out(s.position); },
+          [](BasePose& s, nb::handle v) { s.position = vec3(v, "BasePose", "position"); },
+          nb::rv_policy::automatic)
+      .def_prop_rw(
+          "orientation", [](const BasePose& s) { return out_quat(s.orientation); },
+          [](BasePose& s, nb::handle v) { s.orientation = quat_xyzw(v, "BasePose", "orientation"); },
+          "Attitude quaternion (x, y, z, w) of the base in the inertial frame.", nb::rv_policy::automatic);
+}
+
+void bind_inertia(nb::module_& m) {
+  nb::class_<Inertia>(m, "Inertia",
+                      "Mass (kg), centre of mass and inertia about it (kg m^2), in the link frame.")
+      .def(
+          "__init__",
+          [](Inertia* self, double mass, nb::handle com, nb::handle I) {
+            new (self) Inertia();
+            self->mass = mass;
+            if (!com.is_none()) self->com = vec3(com, "Inertia", "com");
+            if (!I.is_none()) self->I = mat3(I, "Inertia", "I");
+          },
+          "mass"_a, "com"_a.none() = nb::none(), "I"_a.none() = nb::none())
+      .def_rw("mass", &Inertia::mass)
+      .def_prop_rw(
+          "com", [](const Inertia& s) { return out(s.com); },
+          [](Inertia& s, nb::handle v) { s.com = vec3(v, "Inertia", "com"); }, nb::rv_policy::automatic)
+      .def_prop_rw(
+          "I", [](const Inertia& s) { return out(s.I); },
+          [](Inertia& s, nb::handle v) { s.I = mat3(v, "Inertia", "I"); }, nb::rv_policy::automatic);
+}
+
+void bind_bus(nb::module_& m) {
+  nb::class_<Bus>(
+      m, "Bus",
+      "A spacecraft bus to mount a URDF on (scenario keys bus-mass, bus-inertia, bus-com, mount-xyz,\n"
+      "mount-rpy-deg). The bus frame is the free-floating base frame.")
       .def(
           "__init__",
           [](Bus* self, double mass, nb::handle inertia, nb::handle com, const std::optional<Pose>& mount,
@@ -169,10 +190,14 @@ void bind_model(nb::module_& m) {
           "mass"_a, "inertia"_a, "com"_a.none() = nb::none(), "mount"_a.none() = nb::none(), "name"_a = "bus")
       .def_rw("name", &Bus::name)
       .def_rw("mass", &Bus::mass)
-      .def_prop_ro("inertia", [](const Bus& b) { return out(b.inertia); }, nb::rv_policy::automatic)
-      .def_prop_ro("com", [](const Bus& b) { return out(b.com); }, nb::rv_policy::automatic)
+      .def_prop_ro(
+          "inertia", [](const Bus& b) { return out(b.inertia); }, nb::rv_policy::automatic)
+      .def_prop_ro(
+          "com", [](const Bus& b) { return out(b.com); }, nb::rv_policy::automatic)
       .def_rw("mount", &Bus::mount);
+}
 
+void bind_urdf_report(nb::module_& m) {
   nb::class_<ModelRepair>(m, "ModelRepair", "One change the URDF loader made to a link's inertial values.")
       .def_ro("link", &ModelRepair::link)
       .def_ro("what", &ModelRepair::what)
@@ -183,32 +208,36 @@ void bind_model(nb::module_& m) {
       .def_ro("leader", &UrdfReport::Mimic::leader)
       .def_ro("multiplier", &UrdfReport::Mimic::multiplier)
       .def_ro("offset", &UrdfReport::Mimic::offset);
-  nb::class_<UrdfReport>(m, "UrdfReport",
-                         "What the URDF loader did to the file: links merged into the bus, mimic and locked joints,\n"
-                         "inertia repairs. Pass one as `report=` to Model.from_urdf.")
+  nb::class_<UrdfReport>(
+      m, "UrdfReport",
+      "What the URDF loader did to the file: links merged into the bus, mimic and locked joints,\n"
+      "inertia repairs. Pass one as `report=` to Model.from_urdf.")
       .def(nb::init<>())
       .def_ro("merged_links", &UrdfReport::merged_links)
       .def_ro("mimics", &UrdfReport::mimics)
       .def_ro("locked", &UrdfReport::locked)
       .def_ro("repairs", &UrdfReport::repairs);
+}
 
-  nb::class_<Model>(m, "Model",
-                    "A free-floating multibody tree, constant once built (Model.from_urdf or ModelBuilder).\n"
-                    "Coordinates: the base pose (BasePose) and the joint positions theta (n,), in model order;\n"
-                    "generalized velocity (6 + n,) [v0, w0, theta_dot], v0 of the base frame origin, both in the\n"
-                    "inertial frame.")
+void bind_model(nb::module_& m) {
+  nb::class_<Model>(
+      m, "Model",
+      "A free-floating multibody tree, constant once built (Model.from_urdf or ModelBuilder).\n"
+      "Coordinates: the base pose (BasePose) and the joint positions theta (n,), in model order;\n"
+      "generalized velocity (6 + n,) [v0, w0, theta_dot], v0 of the base frame origin, both in the\n"
+      "inertial frame.")
       .def_static(
           "from_urdf",
           [](const std::string& path, const std::string& end_effector, nb::handle end_effector_offset,
-             const std::optional<Bus>& bus, nb::handle locks, const std::string& inertia_repair, double min_mass,
-             double min_inertia, UrdfReport* report) {
+             const std::optional<Bus>& bus, nb::handle locks, const std::string& inertia_repair,
+             double min_mass, double min_inertia, UrdfReport* report) {
             const UrdfOptions o = urdf_options(end_effector, end_effector_offset, bus, locks, inertia_repair,
                                                min_mass, min_inertia);
             return model_from_urdf_file(path, o, report);
           },
-          "path"_a, "end_effector"_a = "", "end_effector_offset"_a.none() = nb::none(), "bus"_a.none() = nb::none(),
-          "locks"_a.none() = nb::none(), "inertia_repair"_a = "none", "min_mass"_a = 0.0, "min_inertia"_a = 0.0,
-          "report"_a.none() = nb::none(), kFromUrdfDoc)
+          "path"_a, "end_effector"_a = "", "end_effector_offset"_a.none() = nb::none(),
+          "bus"_a.none() = nb::none(), "locks"_a.none() = nb::none(), "inertia_repair"_a = "none",
+          "min_mass"_a = 0.0, "min_inertia"_a = 0.0, "report"_a.none() = nb::none(), kFromUrdfDoc)
       .def_static(
           "from_urdf_string",
           [](const std::string& xml, const std::string& source, const std::string& end_effector,
@@ -218,52 +247,67 @@ void bind_model(nb::module_& m) {
                                                min_mass, min_inertia);
             return model_from_urdf_string(xml, source, o, report);
           },
-          "xml"_a, "source"_a = "<string>", "end_effector"_a = "", "end_effector_offset"_a.none() = nb::none(),
-          "bus"_a.none() = nb::none(), "locks"_a.none() = nb::none(), "inertia_repair"_a = "none", "min_mass"_a = 0.0,
+          "xml"_a, "source"_a = "<string>", "end_effector"_a = "",
+          "end_effector_offset"_a.none() = nb::none(), "bus"_a.none() = nb::none(),
+          "locks"_a.none() = nb::none(), "inertia_repair"_a = "none", "min_mass"_a = 0.0,
           "min_inertia"_a = 0.0, "report"_a.none() = nb::none(),
           "Builds a Model from URDF text; `source` names it in error messages. Options as Model.from_urdf.")
       .def_prop_ro("n", &Model::n, "Number of coordinates (independent moving joints).")
       .def_prop_ro("nb", &Model::nb, "Number of bodies, the base included.")
       .def_prop_ro("nv", &Model::nv, "Dimension of the generalized velocity, 6 + n.")
       .def_prop_ro("end_effector", &Model::end_effector, "Index of the default end-effector frame.")
-      .def_prop_ro("joint_names", &Model::joint_names, "Names of the coordinates' joints, in coordinate order.")
+      .def_prop_ro("joint_names", &Model::joint_names,
+                   "Names of the coordinates' joints, in coordinate order.")
       .def_prop_ro("total_mass", &Model::total_mass)
-      .def_prop_ro("gravity", [](const Model& s) { return out(s.gravity); }, "Gravity in the inertial frame (zero by default).", nb::rv_policy::automatic)
+      .def_prop_ro(
+          "gravity", [](const Model& s) { return out(s.gravity); },
+          "Gravity in the inertial frame (zero by default).", nb::rv_policy::automatic)
       .def_ro("source", &Model::source, "A label for error messages (the URDF file).")
-      .def("joint", [](const Model& s, int k) {
-            if (k < 0 || k >= s.n()) throw InputError(str("Model.joint: index ", k, " out of range (n = ", s.n(), ")"));
+      .def(
+          "joint",
+          [](const Model& s, int k) {
+            if (k < 0 || k >= s.n())
+              throw InputError(str("Model.joint: index ", k, " out of range (n = ", s.n(), ")"));
             return s.joint(k);
-          }, "k"_a, "The joint of coordinate k.")
-      .def("coordinate_body", [](const Model& s, int k) {
-            if (k < 0 || k >= s.n()) throw InputError(str("Model.coordinate_body: index ", k, " out of range (n = ", s.n(), ")"));
+          },
+          "k"_a, "The joint of coordinate k.")
+      .def(
+          "coordinate_body",
+          [](const Model& s, int k) {
+            if (k < 0 || k >= s.n())
+              throw InputError(str("Model.coordinate_body: index ", k, " out of range (n = ", s.n(), ")"));
             return s.coordinate_body(k);
-          }, "k"_a)
+          },
+          "k"_a)
       .def_prop_ro("bodies", &Model::bodies)
       .def_prop_ro("frames", &Model::frames)
-      .def_prop_ro("frame_names", [](const Model& s) {
-            std::vector<std::string> names;
-            for (const auto& f : s.frames()) names.push_back(f.name);
-            return names;
-          })
-      .def("frame_index", &Model::frame_index, "name"_a, "Index of a named frame; InputError listing the frames.")
-      .def("__repr__", [](const Model& s) {
-        return str("<ffsr.Model '", s.source, "': ", s.n(), " joints, ", s.nb(), " bodies, ", s.total_mass(), " kg>");
-      });
+      .def_prop_ro("frame_names",
+                   [](const Model& s) {
+                     std::vector<std::string> names;
+                     for (const auto& f : s.frames()) names.push_back(f.name);
+                     return names;
+                   })
+      .def("frame_index", &Model::frame_index, "name"_a,
+           "Index of a named frame; InputError listing the frames.");
+}
 
-  nb::class_<ModelBuilder>(m, "ModelBuilder",
-                           "Builds a Model in code: ModelBuilder('base', Inertia(...)).add_joint(...)...build().")
+void bind_model_builder(nb::module_& m) {
+  nb::class_<ModelBuilder>(
+      m, "ModelBuilder",
+      "Builds a Model in code: ModelBuilder('base', Inertia(...)).add_joint(...)...build().")
       .def(nb::init<const std::string&, const Inertia&>(), "base_name"_a, "base_inertia"_a)
       .def(
           "add_joint",
-          [](ModelBuilder& b, const std::string& name, JointType type, const std::string& parent, const Pose& origin,
-             nb::handle axis, const std::string& child, const Inertia& inertia, double lower,
-             double upper) -> ModelBuilder& {
-            return b.add_joint(name, type, parent, origin, vec3(axis, "ModelBuilder.add_joint", "axis"), child,
-                               inertia, lower, upper);
+          [](ModelBuilder& b, const std::string& name, JointType type, const std::string& parent,
+             const Pose& origin, nb::handle axis, const std::string& child, const Inertia& inertia,
+             double lower, double upper) -> ModelBuilder& {
+            return b.add_joint(name, type, parent, origin, vec3(axis, "ModelBuilder.add_joint", "axis"),
+                               child, inertia, lower, upper);
           },
           "name"_a, "type"_a, "parent"_a, "origin"_a, "axis"_a, "child"_a, "inertia"_a, "lower"_a = -kInf,
           "upper"_a = kInf, nb::rv_policy::reference,
-          "Adds a moving joint from the frame `parent` to a new link `child` (origin: the joint frame in the\n"
+          "Adds a moving joint from the frame `parent` to a new link `child` (origin: the joint frame in "
+          "the\n"
           "parent's at zero position; axis in the joint frame). Returns the builder.")
       .def("add_fixed", &ModelBuilder::add_fixed, "name"_a, "parent"_a, "origin"_a, "child"_a, "inertia"_a,
            nb::rv_policy::reference, "Adds a fixed joint: `child` is merged into the body carrying `parent`.")
@@ -279,95 +323,12 @@ void bind_model(nb::module_& m) {
            nb::rv_policy::reference, "q_follower = multiplier * q_leader + offset (URDF <mimic>).")
       .def(
           "set_gravity",
-          [](ModelBuilder& b, nb::handle g) -> ModelBuilder& { return b.set_gravity(vec3(g, "set_gravity", "g")); },
+          [](ModelBuilder& b, nb::handle g) -> ModelBuilder& {
+            return b.set_gravity(vec3(g, "set_gravity", "g"));
+          },
           "g"_a, nb::rv_policy::reference)
       .def("set_source", &ModelBuilder::set_source, "source"_a, nb::rv_policy::reference)
       .def("build", &ModelBuilder::build, "Validates the tree and returns the Model.");
-
-  nb::class_<Data>(m, "Data",
-                   "The workspace every algorithm writes into, made once from a Model (one per thread).\n"
-                   "H, L, J, Jf and tau are read-only views into it: the next call on this Data overwrites them.")
-      .def(nb::init<const Model&>(), "model"_a)
-      .def_prop_ro("H", [](nb::handle s) { return view(nb::cast<Data&>(s).H, s); }, "H of the last crba, (6+n, 6+n).", nb::rv_policy::automatic)
-      .def_prop_ro("L", [](nb::handle s) { return view(nb::cast<Data&>(s).L, s); }, "Cholesky factor of H (lower).", nb::rv_policy::automatic)
-      .def_prop_ro("J", [](nb::handle s) { return view(nb::cast<Data&>(s).J, s); }, "J_bm of the last frame_jacobian, (6, 6+n).", nb::rv_policy::automatic)
-      .def_prop_ro("Jf", [](nb::handle s) { return view(nb::cast<Data&>(s).Jf, s); }, "J_f of the last generalized_jacobian, (6, n).", nb::rv_policy::automatic)
-      .def_prop_ro("tau", [](nb::handle s) { return view(nb::cast<Data&>(s).tau, s); }, "tau of the last rnea, (6+n,).", nb::rv_policy::automatic)
-      .def_prop_ro(
-          "positions",
-          [](const Data& d) {
-            Eigen::MatrixXd P(d.p.size(), 3);
-            for (size_t i = 0; i < d.p.size(); ++i) P.row(Eigen::Index(i)) = d.p[i].transpose();
-            return out(P);
-          },
-          "Body frame origins in the inertial frame, (nb, 3) (a copy).", nb::rv_policy::automatic)
-      .def_prop_ro(
-          "rotations",
-          [](const Data& d) {
-            std::vector<nb::ndarray<nb::numpy, double>> Rs;
-            for (const auto& R : d.R) Rs.push_back(out(R));
-            return Rs;
-          },
-          "Body frame rotations oR_i, a list of (3, 3) (copies).", nb::rv_policy::automatic);
-
-  nb::class_<Target>(m, "Target",
-                     "The tumbling target (Section 2.2). Defaults are the paper's: 200 kg, diag(100, 100, 100) kg m^2,\n"
-                     "r_tp = (-0.25, 0.15, 0), u_n = x. Vectors marked (target frame) rotate with it; attitude is the\n"
-                     "quaternion oR_t as (x, y, z, w). Validated when made (Target.validate).")
-      .def(
-          "__init__",
-          [](Target* self, double mass, nb::handle inertia, nb::handle position, nb::handle attitude,
-             nb::handle velocity, nb::handle angular_velocity, nb::handle contact_offset, nb::handle normal) {
-            Target t;
-            t.mass = mass;
-            if (!inertia.is_none()) t.inertia = mat3(inertia, "Target", "inertia");
-            if (!position.is_none()) t.position = vec3(position, "Target", "position");
-            if (!attitude.is_none()) t.attitude = quat_xyzw(attitude, "Target", "attitude");
-            if (!velocity.is_none()) t.velocity = vec3(velocity, "Target", "velocity");
-            if (!angular_velocity.is_none())
-              t.angular_velocity = vec3(angular_velocity, "Target", "angular_velocity");
-            if (!contact_offset.is_none()) t.contact_offset = vec3(contact_offset, "Target", "contact_offset");
-            if (!normal.is_none()) t.normal = vec3(normal, "Target", "normal");
-            t.validate();
-            new (self) Target(t);
-          },
-          "mass"_a = 200.0, "inertia"_a.none() = nb::none(), "position"_a.none() = nb::none(), "attitude"_a.none() = nb::none(),
-          "velocity"_a.none() = nb::none(), "angular_velocity"_a.none() = nb::none(), "contact_offset"_a.none() = nb::none(),
-          "normal"_a.none() = nb::none())
-      .def_rw("mass", &Target::mass, "m_t, kg.")
-      .def_prop_rw(
-          "inertia", [](const Target& s) { return out(s.inertia); },
-          [](Target& s, nb::handle v) { s.inertia = mat3(v, "Target", "inertia"); }, "I_t about the centre of mass (target frame).", nb::rv_policy::automatic)
-      .def_prop_rw(
-          "position", [](const Target& s) { return out(s.position); },
-          [](Target& s, nb::handle v) { s.position = vec3(v, "Target", "position"); }, "Centre of mass in o.", nb::rv_policy::automatic)
-      .def_prop_rw(
-          "attitude", [](const Target& s) { return out_quat(s.attitude); },
-          [](Target& s, nb::handle v) { s.attitude = quat_xyzw(v, "Target", "attitude"); }, "oR_t as (x, y, z, w).", nb::rv_policy::automatic)
-      .def_prop_rw(
-          "velocity", [](const Target& s) { return out(s.velocity); },
-          [](Target& s, nb::handle v) { s.velocity = vec3(v, "Target", "velocity"); }, "v_t, inertial frame.", nb::rv_policy::automatic)
-      .def_prop_rw(
-          "angular_velocity", [](const Target& s) { return out(s.angular_velocity); },
-          [](Target& s, nb::handle v) { s.angular_velocity = vec3(v, "Target", "angular_velocity"); },
-          "omega_t (target frame), rad/s.", nb::rv_policy::automatic)
-      .def_prop_rw(
-          "contact_offset", [](const Target& s) { return out(s.contact_offset); },
-          [](Target& s, nb::handle v) { s.contact_offset = vec3(v, "Target", "contact_offset"); }, "r_tp (target frame).", nb::rv_policy::automatic)
-      .def_prop_rw(
-          "normal", [](const Target& s) { return out(s.normal); },
-          [](Target& s, nb::handle v) { s.normal = vec3(v, "Target", "normal"); }, "u_n (target frame), unit.", nb::rv_policy::automatic)
-      .def("validate", [](const Target& t) { t.validate(); }, "Checks every field; InputError naming the field.")
-      .def("rotation", [](const Target& t) { return out(t.rotation()); }, "oR_t.")
-      .def("normal_world", [](const Target& t) { return out(t.normal_world()); }, "u = R_t u_n in o.")
-      .def("offset_world", [](const Target& t) { return out(t.offset_world()); }, "r = R_t r_tp in o.")
-      .def("contact_point", [](const Target& t) { return out(t.contact_point()); })
-      .def("contact_point_velocity", [](const Target& t) { return out(t.contact_point_velocity()); },
-           "v_tp = v_t + w_t x r (Eq. 12), in o.")
-      .def("inverse_mass_along_normal", &Target::inverse_mass_along_normal,
-           "1/m_t + (r x u)^T I^-1 (r x u): the target part of Eq. 14.");
-  m.def("propagate_target", &propagate_target, "target"_a, "t"_a,
-        "The target at time t: drift and torque-free Euler rotation.");
 }
 
 }  // namespace ffsr::python

@@ -2,20 +2,15 @@
 // **overrides) (the library's reader and validation, a keyword for each key the command takes as a flag)
 // and Scenario.run(), the main job of `ffsr-optimize` (plain, paper's-method and global runs), whose
 // result's to_dict() is the command's --json for the same scenario.
-#include "common.hpp"
+#include "bindings.hpp"
+#include "job_helpers.hpp"
 
-#include <ffsr/jobs/scenario_run.hpp>
+#include "ffsr/jobs/scenario_run.hpp"
 
 #include <nanobind/stl/optional.h>
-#include <nanobind/stl/string.h>
-#include <nanobind/stl/unique_ptr.h>
 #include <nanobind/stl/vector.h>
 
 #include <sstream>
-
-#ifndef FFSR_VERSION
-#error "FFSR_VERSION must be defined (python/CMakeLists.txt reads it from the project)"
-#endif
 
 namespace ffsr::python {
 namespace {
@@ -41,8 +36,8 @@ std::string flag_text(nb::handle v, const std::string& key) {
     throw InputError(str("--", key, ": expected a number, a string, a boolean or a list, got ",
                          nb::cast<std::string>(nb::str(x.type().attr("__name__")))));
   };
-  if (PyList_Check(v.ptr()) || PyTuple_Check(v.ptr()) || (nb::hasattr(v, "tolist") && nb::hasattr(v, "ndim") &&
-                                                          nb::cast<int>(v.attr("ndim")) == 1)) {
+  if (PyList_Check(v.ptr()) || PyTuple_Check(v.ptr()) ||
+      (nb::hasattr(v, "tolist") && nb::hasattr(v, "ndim") && nb::cast<int>(v.attr("ndim")) == 1)) {
     nb::object seq = (PyList_Check(v.ptr()) || PyTuple_Check(v.ptr())) ? nb::borrow(v) : v.attr("tolist")();
     std::string text;
     for (nb::handle x : seq) text += (text.empty() ? "" : ",") + number(x);
@@ -52,47 +47,67 @@ std::string flag_text(nb::handle v, const std::string& key) {
 }
 
 /// The main job's result and its JSON (the command's --json), made together.
-struct RunResult {
-  ScenarioResult result;
-  std::string json;
-};
+using RunResult = JobRun<ScenarioResult>;
 
+/// A run of the main job that holds a result, else None.
+std::optional<CaptureResult> run_or_none(bool ok, const CaptureResult& run) {
+  return ok ? std::optional<CaptureResult>(run) : std::nullopt;
+}
 
 }  // namespace
 
-void bind_scenario(nb::module_& m) {
-  nb::class_<CaptureResult>(m, "CaptureResult", "One capture run of the planner (plain, paper's method or global).")
-      .def_prop_ro("theta", [](const CaptureResult& r) { return out(r.theta); }, "Capture configuration, rad.",
-                   nb::rv_policy::automatic)
+void bind_capture_result(nb::module_& m) {
+  nb::class_<CaptureResult>(m, "CaptureResult",
+                            "One capture run of the planner (plain, paper's method or global).")
+      .def_prop_ro(
+          "theta", [](const CaptureResult& r) { return out(r.theta); }, "Capture configuration, rad.",
+          nb::rv_policy::automatic)
       .def_ro("base", &CaptureResult::base, "Base pose at T.")
-      .def_prop_ro("end_effector", [](const CaptureResult& r) { return out(r.end_effector); }, nb::rv_policy::automatic)
-      .def_prop_ro("capture_point", [](const CaptureResult& r) { return out(r.capture_point); }, nb::rv_policy::automatic)
+      .def_prop_ro(
+          "end_effector", [](const CaptureResult& r) { return out(r.end_effector); },
+          nb::rv_policy::automatic)
+      .def_prop_ro(
+          "capture_point", [](const CaptureResult& r) { return out(r.capture_point); },
+          nb::rv_policy::automatic)
       .def_ro("M_ie", &CaptureResult::M_ie, "Integrated effective mass at the capture (Eq. 14), kg.")
       .def_ro("approach_velocity", &CaptureResult::approach_velocity, "delta_dot^- at the capture, m/s.")
       .def_ro("f_max_closed_form", &CaptureResult::f_max_closed_form, "Peak force, closed form (Eq. 24), N.")
       .def_ro("f_max_exact", &CaptureResult::f_max_exact, "Peak force, exact single-body peak (Eq. 16), N.")
-      .def_ro("tracking_error", &CaptureResult::tracking_error, "|p_e(T) - capture point| on the task's axes, m.")
-      .def_ro("orientation_error", &CaptureResult::orientation_error, "Pose task: orientation error at T, rad.")
+      .def_ro("tracking_error", &CaptureResult::tracking_error,
+              "|p_e(T) - capture point| on the task's axes, m.")
+      .def_ro("orientation_error", &CaptureResult::orientation_error,
+              "Pose task: orientation error at T, rad.")
       .def_ro("max_joint_rate", &CaptureResult::max_joint_rate, "Largest |theta_dot_k| along the run, rad/s.")
       .def_ro("steps", &CaptureResult::steps);
+}
 
-  nb::class_<RunResult>(m, "RunResult",
-                        "The main job's result: the plain run, the paper's method (Eq. 29-31) and the global run.\n"
-                        "to_dict() is the command's --json for the same scenario.")
-      .def_prop_ro("plain", [](const RunResult& r) { return r.result.plain_ok() ? std::optional<CaptureResult>(r.result.plain) : std::nullopt; },
-                   "The plain run (rho = 0), or None when it failed (plain_failure).")
-      .def_prop_ro("optimized", [](const RunResult& r) { return r.result.optimized_ok() ? std::optional<CaptureResult>(r.result.optimized) : std::nullopt; },
-                   "The paper's method (the optimized run), or None when it failed (optimized_failure).")
-      .def_prop_ro("global_run", [](const RunResult& r) { return r.result.global ? std::optional<CaptureResult>(r.result.global->result.run) : std::nullopt; },
-                   "The global run, or None when the scenario has global = false.")
+void bind_run_result(nb::module_& m) {
+  job_result_class<RunResult>(
+      m, "RunResult",
+      "The main job's result: the plain run, the paper's method (Eq. 29-31) and the global run.\n"
+      "to_dict() is the command's --json for the same scenario.")
+      .def_prop_ro(
+          "plain", [](const RunResult& r) { return run_or_none(r.result.plain_ok(), r.result.plain); },
+          "The plain run (rho = 0), or None when it failed (plain_failure).")
+      .def_prop_ro(
+          "optimized",
+          [](const RunResult& r) { return run_or_none(r.result.optimized_ok(), r.result.optimized); },
+          "The paper's method (the optimized run), or None when it failed (optimized_failure).")
+      .def_prop_ro(
+          "global_run",
+          [](const RunResult& r) {
+            return r.result.global ? std::optional<CaptureResult>(r.result.global->result.run) : std::nullopt;
+          },
+          "The global run, or None when the scenario has global = false.")
       .def_prop_ro("plain_failure", [](const RunResult& r) { return r.result.plain_failure; })
-      .def_prop_ro("optimized_failure", [](const RunResult& r) { return r.result.optimized_failure; })
-      .def("to_dict", [](const RunResult& r) { return json_loads(r.json); }, "The command's --json, as a dict.")
-      .def("to_json", [](const RunResult& r) { return r.json; }, "The command's --json, as text.");
+      .def_prop_ro("optimized_failure", [](const RunResult& r) { return r.result.optimized_failure; });
+}
 
-  nb::class_<Scenario>(m, "Scenario",
-                       "A validated capture scenario (the command's --config file): the robot, the target, the\n"
-                       "contact, the tasks, the planner and the global run.")
+void bind_scenario(nb::module_& m) {
+  nb::class_<Scenario>(
+      m, "Scenario",
+      "A validated capture scenario (the command's --config file): the robot, the target, the\n"
+      "contact, the tasks, the planner and the global run.")
       .def_static(
           "load",
           [](const std::string& path, nb::kwargs overrides) {
@@ -107,30 +122,33 @@ void bind_scenario(nb::module_& m) {
             return std::make_unique<Scenario>(build_scenario(std::move(keys)));
           },
           "path"_a, "overrides"_a,
-          "Reads and validates a scenario file. A keyword overrides the key of the same name, as the command's\n"
+          "Reads and validates a scenario file. A keyword overrides the key of the same name, as the "
+          "command's\n"
           "flag does (an underscore for a dash: Scenario.load(path, gain=-0.02, joints_deg=[0, 90, -90])).\n"
           "InputError naming the file or the key; ModelError from the URDF loader.")
       .def_prop_ro("where", [](const Scenario& s) { return s.where; })
-      .def_prop_ro("model", [](const Scenario& s) -> const Model& { return *s.model; }, nb::rv_policy::reference_internal,
-                   "The robot as loaded.")
-      .def_prop_ro("target", [](const Scenario& s) { return s.problem.target; }, "The target at t = 0.")
-      .def_prop_ro("base", [](const Scenario& s) { return s.problem.base; }, "The base pose at t = 0.")
-      .def_prop_ro("theta", [](const Scenario& s) { return out(s.problem.theta); }, "The joint angles at t = 0, rad.",
-                   nb::rv_policy::automatic)
+      .def_prop_ro(
+          "model", [](const Scenario& s) -> const Model& { return *s.model; },
+          nb::rv_policy::reference_internal, "The robot as loaded.")
+      .def_prop_ro(
+          "target", [](const Scenario& s) { return s.problem.target; }, "The target at t = 0.")
+      .def_prop_ro(
+          "base", [](const Scenario& s) { return s.problem.base; }, "The base pose at t = 0.")
+      .def_prop_ro(
+          "theta", [](const Scenario& s) { return out(s.problem.theta); }, "The joint angles at t = 0, rad.",
+          nb::rv_policy::automatic)
       .def(
           "run",
           [](const Scenario& sc) {
-            auto r = std::make_unique<RunResult>();
-            {
-              nb::gil_scoped_release release;
+            return run_job<RunResult>([&sc](RunResult& r) {
               ScenarioRunOptions o;
               o.keep_going = true;  // as the command: a failed plain or paper's-method row is reported
-              r->result = run_scenario(sc, o);
-              r->json = scenario_json(sc, r->result, FFSR_VERSION).dump();
-            }
-            return r;
+              r.result = run_scenario(sc, o);
+              r.json = scenario_json(sc, r.result, FFSR_VERSION).dump();
+            });
           },
-          "The main job (ffsr-optimize --config FILE): the plain run, the paper's method (Eq. 29-31) and, unless\n"
+          "The main job (ffsr-optimize --config FILE): the plain run, the paper's method (Eq. 29-31) and, "
+          "unless\n"
           "global = false, the global run; M_ie (Eq. 14) and the peak force (Eq. 24, Eq. 16) of each.");
 }
 

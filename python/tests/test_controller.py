@@ -167,9 +167,8 @@ def test_bad_arrays_are_refused_naming_them_and_nothing_is_written(paper_7dof):
     refused(r"theta_dot must be a numpy array of float64 \(the caller's output\), got list", theta_dot=[0.0] * n)
     refused(r"reference has shape \(4,\), expected \(3,\)", reference=np.zeros(4))
     refused(r"theta has 6 entries, expected 7", theta=th[:6])
-    refused(r"theta must be an array of float64, got int64", theta=np.zeros(n, dtype=np.int64))
     refused(r"base_orientation has 3 entries, expected 4", base_orientation=q[:3])
-    refused(r"base_position must be contiguous", base_position=np.zeros(6)[::2])
+    refused(r"theta cannot be read as an array of float64", theta=["a"] * n)
     with pytest.raises(ffsr.InputError, match=r"CaptureController: the servo goal has 5 joints, the robot 7"):
         ffsr.CaptureController(sc, goal=np.zeros(5))
     with pytest.raises(ffsr.InputError, match=r"CaptureController: prediction window must be in 1\.\.100000"):

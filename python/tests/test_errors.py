@@ -1,7 +1,7 @@
 """Bad input raises the Python class of the library's exception, with the library's message: the C++
 hierarchy (ffsr::Error > InputError, ModelError, NumericalError > JointLimitError, IntegrationError)
-mirrored, a message that names the function or file and the argument, and no silent conversion of an
-array of the wrong dtype, layout or shape."""
+mirrored, a message that names the function or file and the argument; arrays converted as numpy
+converts them, but never one of the wrong shape or one holding NaN or infinity."""
 
 import numpy as np
 import pytest
@@ -61,36 +61,36 @@ def test_wrong_joint_count(robot):
 def test_nan(robot):
     model, data = robot
     theta = np.array([0.0, np.nan, 0.0])
-    with pytest.raises(ffsr.InputError, match=r"^forward_kinematics: theta must be finite, entry 1 is nan$"):
+    with pytest.raises(ffsr.InputError, match=r"^integrated_effective_mass: theta must be finite, entry 1 is nan$"):
         ffsr.integrated_effective_mass(model, data, ffsr.BasePose(), theta)
-    with pytest.raises(ffsr.InputError, match="^forward_kinematics: base position must be finite, entry 1 is inf$"):
-        ffsr.crba(model, data, ffsr.BasePose(position=[0, np.inf, 0]), np.zeros(3))
+    with pytest.raises(ffsr.InputError, match="^BasePose: position must be finite, entry 1 is inf$"):
+        ffsr.BasePose(position=[0, np.inf, 0])
+    with pytest.raises(ffsr.InputError, match="^crba: theta must be finite, entry 2 is inf$"):
+        ffsr.crba(model, data, ffsr.BasePose(), [0, 0, np.inf])
     with pytest.raises(ffsr.InputError, match="thetas must be finite"):
         ffsr.integrated_effective_mass_batch(model, ffsr.BasePose(), np.array([[0, 0, 0], [0, np.nan, 0.0]]))
 
 
-def test_non_contiguous(robot):
+def test_strided_and_transposed_arrays_are_read(robot):
     model, data = robot
-    strided = np.zeros(6)[::2]
-    assert strided.shape == (3,)
-    with pytest.raises(ffsr.InputError, match="^crba: theta must be contiguous"):
-        ffsr.crba(model, data, ffsr.BasePose(), strided)
-    thetas = np.zeros((3, 10))[:, :3]  # rows of 3 in a wider array
-    with pytest.raises(ffsr.InputError, match="thetas must be C-contiguous"):
-        ffsr.integrated_effective_mass_batch(model, ffsr.BasePose(), thetas)
-    with pytest.raises(ffsr.InputError, match="C-contiguous"):
-        ffsr.integrated_effective_mass_batch(model, ffsr.BasePose(), np.zeros((3, 5)).T)
+    theta = np.array([0.1, -0.4, 0.9])
+    strided = np.repeat(theta, 2)[::2]
+    assert not strided.flags.c_contiguous
+    ref = ffsr.crba(model, data, ffsr.BasePose(), theta).copy()
+    assert np.array_equal(ffsr.crba(model, data, ffsr.BasePose(), strided), ref)
+    thetas = np.tile(theta, (3, 1))
+    wide = np.zeros((3, 10))
+    wide[:, :3] = thetas  # rows of 3 in a wider array
+    single = ffsr.integrated_effective_mass_batch(model, ffsr.BasePose(), thetas)
+    assert np.array_equal(ffsr.integrated_effective_mass_batch(model, ffsr.BasePose(), wide[:, :3]), single)
+    assert np.array_equal(ffsr.integrated_effective_mass_batch(model, ffsr.BasePose(), thetas.T.copy().T), single)
 
 
-def test_wrong_dtype(robot):
+def test_wrong_type(robot):
     model, data = robot
-    with pytest.raises(ffsr.InputError, match="^crba: theta must be an array of float64, got float32$"):
-        ffsr.crba(model, data, ffsr.BasePose(), np.zeros(3, dtype=np.float32))
-    with pytest.raises(ffsr.InputError, match="got int64"):
-        ffsr.crba(model, data, ffsr.BasePose(), np.zeros(3, dtype=np.int64))
-    with pytest.raises(ffsr.InputError, match="must hold numbers, got str"):
+    with pytest.raises(ffsr.InputError, match=r"^crba: theta cannot be read as an array of float64 \(ValueError: "):
         ffsr.crba(model, data, ffsr.BasePose(), [0.0, "a", 0.0])
-    with pytest.raises(ffsr.InputError, match="must be a numpy array of float64 or a list of numbers, got dict"):
+    with pytest.raises(ffsr.InputError, match=r"crba: theta cannot be read as an array of float64 \(TypeError"):
         ffsr.crba(model, data, ffsr.BasePose(), {})
 
 

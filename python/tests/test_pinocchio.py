@@ -148,8 +148,8 @@ def check_case(case, seed, configs=4):
         M_ref = integrated_effective_mass_ref(effective_mass_ref(H_ref, J_ref, u_t), target, u_t)
         M = ffsr.integrated_effective_mass(case.fm, data, base, theta, None, target)
         assert abs(M - M_ref) < TOL * M_ref
-        M_fast = ffsr.integrated_effective_mass_fast(case.fm, data, base, theta, None, target)
-        assert abs(M_fast - M_ref) < TOL * M_ref
+        M_dense = ffsr.integrated_effective_mass_dense(case.fm, data, base, theta, None, target)
+        assert abs(M_dense - M_ref) < TOL * M_ref
 
 
 def test_paper_3dof():

@@ -1,0 +1,75 @@
+// python/src/job_helpers.hpp -- the pattern of every job of the command from Python: the job runs
+// without the GIL into a new result that keeps the command's --json beside it, the result's class has
+// to_dict() and to_json(), and the job is a method of ffsr.Scenario.
+#pragma once
+
+#include "outputs.hpp"
+
+#include "ffsr/jobs/subject.hpp"
+#include "ffsr/scenario/scenario.hpp"
+
+#include <nanobind/stl/string.h>
+#include <nanobind/stl/unique_ptr.h>
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#ifndef FFSR_VERSION
+#error "FFSR_VERSION must be defined (python/CMakeLists.txt reads it from the project)"
+#endif
+
+namespace ffsr::python {
+
+/// A job's result and the command's --json for the same job, made together.
+template <class Result>
+struct JobRun {
+  Result result;
+  std::string json;
+};
+
+/// Runs `job(run)` on a new Run without the GIL: the job fills the result and its JSON.
+template <class Run, class Job>
+std::unique_ptr<Run> run_job(Job&& job) {
+  auto run = std::make_unique<Run>();
+  {
+    nb::gil_scoped_release release;
+    job(*run);
+  }
+  return run;
+}
+
+/// The class of a job's result, with to_dict() and to_json() (the command's --json).
+template <class Run>
+nb::class_<Run> job_result_class(nb::module_& m, const char* name, const char* doc) {
+  nb::class_<Run> c(m, name, doc);
+  c.def(
+      "to_dict", [](const Run& r) { return json_loads(r.json); }, "The command's --json, as a dict.");
+  c.def(
+      "to_json", [](const Run& r) { return r.json; }, "The command's --json, as text.");
+  return c;
+}
+
+/// Adds `fn` as the method `name` of ffsr.Scenario (bound before the jobs, by bind_scenario).
+template <class Fn, class... Extra>
+void def_scenario_method(const char* name, Fn&& fn, const Extra&... extra) {
+  nb::handle scenario = nb::type<Scenario>();
+  scenario.attr(name) =
+      nb::cpp_function(std::forward<Fn>(fn), nb::is_method(), nb::name(name), nb::scope(scenario), extra...);
+}
+
+/// (key, value) given to a job as the command's flags; no value: the scenario's.
+using KeyOverrides = std::vector<std::pair<const char*, std::optional<std::string>>>;
+
+/// The subject of a scenario: its keys as resolved, built again by the job layer (as the command builds
+/// the subject of --config FILE), with `overrides` (values a scenario refuses, as 'all').
+inline Subject scenario_subject(const Scenario& sc, const KeyOverrides& overrides = {}) {
+  ScenarioKeys keys = sc.keys;
+  for (const auto& [key, value] : overrides)
+    if (value) override_scenario_key(keys, key, *value);
+  return load_subject(std::move(keys));
+}
+
+}  // namespace ffsr::python
