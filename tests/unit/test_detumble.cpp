@@ -9,6 +9,7 @@
 #include "ffsr/algorithm/aba.hpp"
 #include "ffsr/algorithm/forward_dynamics.hpp"
 #include "ffsr/algorithm/grasp.hpp"
+#include "ffsr/control/detumble_run.hpp"
 #include "ffsr/model/attach.hpp"
 
 #include <cmath>
@@ -159,6 +160,200 @@ TEST_CASE("grasp refuses bad input", "[detumble]") {
   v(7) = 0;
   t.mass = -1;
   CHECK_THROWS_AS(grasp(m, d, BasePose{}, theta, v, m.end_effector(), t), InputError);
+}
+
+namespace {
+
+/// The 7-DOF robot of robots/paper_7dof_position.toml at its initial configuration grasping the
+/// scenario's target (200 kg, 100 kg m^2, spin (1, -0.5, 2) deg/s) at the approach speed 0.2 m/s.
+struct Grasped {
+  Model robot;
+  GraspResult grasp;
+  Model stack;
+  int gripper;
+  DetumbleState start;
+};
+
+Grasped grasped_7dof() {
+  Model m = model_from_urdf_file(source_path("robots/paper_7dof.urdf"), "ee");
+  Eigen::VectorXd theta(7);
+  theta << 0, 90, 90, -90, 90, 90, 0;
+  theta *= M_PI / 180;
+  Target t;
+  t.angular_velocity = Vector3(1, -0.5, 2) * M_PI / 180;
+  t.contact_offset = Vector3(-0.25, 0.15, 0.1);
+  const int ee = m.end_effector();
+  GraspResult g = grasp_at_capture(m, ee, BasePose{}, theta, t, 0.2);
+  Model stack = attach_body(m, m.frame(ee).name, g.body);
+  DetumbleState s{BasePose{}, theta, g.v_after, Vector3::Zero()};
+  return {std::move(m), std::move(g), std::move(stack), ee, s};
+}
+
+/// The joint torque limits of robots/paper_7dof_detumble.toml: 60 N m at the shoulder (joints 1-3),
+/// 40 N m at the elbow (4), 20 N m at the wrist (5-7).
+Eigen::VectorXd limits_7dof() {
+  Eigen::VectorXd L(7);
+  L << 60, 60, 60, 40, 20, 20, 20;
+  return L;
+}
+
+void check_torques_within_limits(const DetumbleRunResult& r, const Eigen::VectorXd& L) {
+  for (const auto& s : r.series)
+    for (int k = 0; k < L.size(); ++k) REQUIRE(std::abs(s.tau(k)) <= L(k) * (1 + 1e-12));
+}
+
+}  // namespace
+
+TEST_CASE("detumble, free-floating: momentum kept, energy only through joint work, torques within limits, "
+          "at rest", "[detumble]") {
+  const Grasped g = grasped_7dof();
+  DetumbleLimits lim;
+  lim.joint_torque = limits_7dof();
+  DetumbleOptions opt;
+  DetumbleRunOptions run;
+  run.horizon = 60;
+  const DetumbleRunResult r = run_detumble(g.stack, g.gripper, g.grasp.body, g.start, lim, opt, run);
+  INFO("time to rest " << r.time_to_rest << " s, peak torque " << r.peak_joint_torque << " N m (joint "
+                       << r.peak_joint << "), gripper " << r.peak_gripper_force << " N "
+                       << r.peak_gripper_moment << " N m, attitude " << r.base_attitude_excursion
+                       << " rad, energy " << r.energy_start << " -> " << r.energy_end << " J, steps " << r.steps);
+  CHECK(r.at_rest);
+  CHECK(r.momentum_drift < 1e-8);
+  CHECK(r.max_energy_balance < 1e-6);  // T(k+1) - T(k) = tau . (theta(k+1) - theta(k)) each tick
+  CHECK(r.energy_end < r.energy_start);
+  CHECK(r.series.back().joint_rate < opt.rest_rate);
+  CHECK(r.series.back().relative_rate < opt.rest_rate);
+  CHECK(r.peak_joint_torque > 0);
+  check_torques_within_limits(r, lim.joint_torque);
+  // the stack keeps its momentum: the total momentum after the grasp equals the run's
+  CHECK((r.series.back().momentum - g.grasp.momentum_after).norm() < 1e-8 * g.grasp.momentum_after.norm());
+}
+
+TEST_CASE("detumble with reaction wheels: the stack's spin stopped, the wheels within their bounds",
+          "[detumble]") {
+  const Grasped g = grasped_7dof();
+  DetumbleLimits lim;
+  lim.joint_torque = limits_7dof();
+  lim.actuator = BaseActuator::ReactionWheels;
+  lim.wheel_torque = 0.2;
+  lim.wheel_momentum = 25;
+  DetumbleOptions opt;
+  opt.stop_stack_spin = true;
+  DetumbleRunOptions run;
+  run.horizon = 400;
+  run.record_every = 10;
+  const DetumbleRunResult r = run_detumble(g.stack, g.gripper, g.grasp.body, g.start, lim, opt, run);
+  INFO("time to rest " << r.time_to_rest << " s, wheels " << r.peak_wheel_momentum << " N m s");
+  CHECK(r.at_rest);
+  CHECK(r.series.back().stack_rate < opt.rest_rate);
+  CHECK(r.peak_wheel_momentum <= lim.wheel_momentum);
+  CHECK(r.peak_wheel_momentum > 0.1);  // the wheels took the stack's spin
+  CHECK(r.momentum_drift < 1e-8);      // stack + wheels
+  check_torques_within_limits(r, lim.joint_torque);
+  for (const auto& s : r.series)
+    REQUIRE((s.base_wrench.tail<3>().cwiseAbs().maxCoeff() <= std::sqrt(3.0) * lim.wheel_torque));
+}
+
+TEST_CASE("detumble with thrusters: the stack's spin stopped", "[detumble]") {
+  const Grasped g = grasped_7dof();
+  DetumbleLimits lim;
+  lim.joint_torque = limits_7dof();
+  lim.actuator = BaseActuator::Thrusters;
+  lim.thruster_force = 5;
+  lim.thruster_torque = 1;
+  DetumbleOptions opt;
+  opt.stop_stack_spin = true;
+  DetumbleRunOptions run;
+  run.horizon = 200;
+  run.record_every = 10;
+  const DetumbleRunResult r = run_detumble(g.stack, g.gripper, g.grasp.body, g.start, lim, opt, run);
+  INFO("time to rest " << r.time_to_rest << " s");
+  CHECK(r.at_rest);
+  CHECK(r.series.back().stack_rate < opt.rest_rate);
+  check_torques_within_limits(r, lim.joint_torque);
+}
+
+TEST_CASE("detumble: the gripper load is the rate of the target's momentum", "[detumble]") {
+  const Grasped g = grasped_7dof();
+  DetumbleLimits lim;
+  lim.joint_torque = limits_7dof();
+  DetumbleController ctrl(g.stack, g.gripper, lim);
+  DetumbleCommand cmd = ctrl.make_command();
+  ctrl.step(g.start, cmd);
+  REQUIRE(cmd.status == DetumbleStatus::Braking);
+  detail::DetumbleSystem sys(g.stack);
+  const Eigen::VectorXd y = sys.pack(g.start);
+  Vector3 f, n_p;
+  sys.gripper_load(y, cmd, g.gripper, g.grasp.body, f, n_p);
+  Eigen::VectorXd yd(sys.size());
+  sys.rhs(y, cmd, false, yd);
+  // the target's momentum about o from the stack's target frame (its centre of mass) and Jacobian
+  const int tf = g.stack.frame_index("target");
+  auto target_momentum = [&](const Eigen::VectorXd& yy) {
+    Data d(g.stack);
+    const DetumbleState s = sys.unpack(yy);
+    forward_kinematics(g.stack, d, s.base, s.theta);
+    frame_jacobian(g.stack, d, tf);
+    const Pose X = frame_pose(g.stack, d, tf);
+    const Vector6 tw = d.J * s.v;
+    Vector6 h;
+    h.head<3>() = g.grasp.body.mass * tw.head<3>();
+    h.tail<3>() = X.p.cross(h.head<3>()) + X.R * g.grasp.body.inertia * X.R.transpose() * tw.tail<3>();
+    return h;
+  };
+  const double eps = 1e-6;
+  const Vector6 dh = (target_momentum(y + eps * yd) - target_momentum(y - eps * yd)) / (2 * eps);
+  Data d(g.stack);
+  forward_kinematics(g.stack, d, g.start.base, g.start.theta);
+  const Vector3 p = frame_pose(g.stack, d, g.gripper).p;
+  INFO("force " << f.transpose() << " / " << dh.head<3>().transpose());
+  CHECK((f - dh.head<3>()).norm() < 1e-6 * std::max(1.0, dh.head<3>().norm()));
+  CHECK((n_p + p.cross(f) - dh.tail<3>()).norm() < 1e-6 * std::max(1.0, dh.tail<3>().norm()));
+  CHECK(f.norm() > 1e-2);
+}
+
+TEST_CASE("detumble refuses bad limits, a spin it cannot stop and an actuator too small", "[detumble]") {
+  const Grasped g = grasped_7dof();
+  DetumbleLimits lim;
+  lim.joint_torque = limits_7dof();
+  DetumbleOptions opt;
+  DetumbleRunOptions run;
+  auto refused = [&](const DetumbleLimits& l, const DetumbleOptions& o, const std::string& words) {
+    try {
+      run_detumble(g.stack, g.gripper, g.grasp.body, g.start, l, o, run);
+      FAIL("accepted: " << words);
+    } catch (const InputError& e) {
+      CHECK_THAT(e.what(), Catch::Contains(words));
+    }
+  };
+  DetumbleLimits l = lim;
+  l.joint_torque(3) = 0;
+  refused(l, opt, "torque limit of joint 'joint4' must be positive");
+  l.joint_torque(3) = std::numeric_limits<double>::infinity();
+  refused(l, opt, "torque limit of joint 'joint4' must be positive and finite");
+  l.joint_torque(3) = std::numeric_limits<double>::quiet_NaN();
+  refused(l, opt, "joint4");
+  DetumbleOptions o = opt;
+  o.stop_stack_spin = true;
+  refused(lim, o, "angular momentum is conserved");
+  l = lim;
+  l.actuator = BaseActuator::ReactionWheels;
+  l.wheel_torque = 0.2;
+  l.wheel_momentum = -1;
+  refused(l, o, "reaction wheels' momentum must be positive");
+  l.wheel_momentum = 0.05;
+  refused(l, o, "cannot store the stack's angular momentum");
+  l.wheel_momentum = 25;
+  l.wheel_torque = 1e-4;
+  refused(l, o, "needs at least");
+  l = lim;
+  l.actuator = BaseActuator::Thrusters;
+  l.thruster_force = 1;
+  l.thruster_torque = std::numeric_limits<double>::quiet_NaN();
+  refused(l, o, "thrusters' torque must be positive and finite");
+  DetumbleRunOptions bad = run;
+  bad.tick = 0;
+  CHECK_THROWS_AS(run_detumble(g.stack, g.gripper, g.grasp.body, g.start, lim, opt, bad), InputError);
 }
 
 }  // namespace test_detumble
