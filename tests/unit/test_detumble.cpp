@@ -198,8 +198,10 @@ Eigen::VectorXd limits_7dof() {
 }
 
 void check_torques_within_limits(const DetumbleRunResult& r, const Eigen::VectorXd& L) {
-  for (const auto& s : r.series)
+  for (const auto& s : r.series) {
     for (int k = 0; k < L.size(); ++k) REQUIRE(std::abs(s.tau(k)) <= L(k) * (1 + 1e-12));
+    REQUIRE(s.theta_dot.cwiseAbs().maxCoeff() == s.joint_rate);  // the series' rates are the controller's
+  }
 }
 
 }  // namespace
@@ -227,6 +229,41 @@ TEST_CASE("detumble, free-floating: momentum kept, energy only through joint wor
   check_torques_within_limits(r, lim.joint_torque);
   // the stack keeps its momentum: the total momentum after the grasp equals the run's
   CHECK((r.series.back().momentum - g.grasp.momentum_after).norm() < 1e-8 * g.grasp.momentum_after.norm());
+}
+
+TEST_CASE("detumble, free-floating, torque limits that bind: the brake scaled, still at rest", "[detumble]") {
+  const Grasped g = grasped_7dof();
+  DetumbleLimits lim;
+  lim.joint_torque = limits_7dof() / 30;  // 2 N m at the shoulder, below the unbounded law's peak of 8.8 N m
+  DetumbleRunOptions run;
+  run.horizon = 120;
+  const DetumbleRunResult r = run_detumble(g.stack, g.gripper, g.grasp.body, g.start, lim, {}, run);
+  INFO("time to rest " << r.time_to_rest << " s, peak torque " << r.peak_joint_torque);
+  CHECK(r.at_rest);
+  CHECK(r.momentum_drift < 1e-8);
+  CHECK(r.max_energy_balance < 1e-6);
+  check_torques_within_limits(r, lim.joint_torque);
+  long saturated = 0;
+  for (const auto& s : r.series) saturated += s.status == DetumbleStatus::Saturated;
+  CHECK(saturated > 10);
+}
+
+TEST_CASE("detumble, free-floating, the passive law: kinetic energy never increases", "[detumble]") {
+  const Grasped g = grasped_7dof();
+  DetumbleLimits lim;
+  lim.joint_torque = limits_7dof() / 30;
+  DetumbleOptions opt;
+  opt.hold = false;  // tau . qd <= 0 at every tick: no actuator puts work in
+  DetumbleRunOptions run;
+  run.horizon = 120;
+  const DetumbleRunResult r = run_detumble(g.stack, g.gripper, g.grasp.body, g.start, lim, opt, run);
+  INFO("time to rest " << r.time_to_rest << " s");
+  CHECK(r.at_rest);
+  CHECK(r.joint_work < 0);
+  CHECK(r.momentum_drift < 1e-8);
+  for (size_t k = 1; k < r.series.size(); ++k) REQUIRE(r.series[k].energy <= r.series[k - 1].energy * (1 + 1e-12));
+  for (const auto& s : r.series) REQUIRE(s.tau.dot(s.theta_dot) <= 0.0);
+  check_torques_within_limits(r, lim.joint_torque);
 }
 
 TEST_CASE("detumble with reaction wheels: the stack's spin stopped, the wheels within their bounds",

@@ -50,6 +50,9 @@ struct DetumbleOptions {
   double base_gain = 0.1;      ///< k (1/s): the actuator asks dL/dt = -k L (and dP/dt = -k P, thrusters)
   double rest_rate = 1e-3;     ///< rad/s (m/s prismatic): at rest below it
   bool stop_stack_spin = false;  ///< also stop the stack's spin (needs an actuator)
+  /// true: the exact law (qdd = -lambda qd, holding against the velocity terms) where the limits allow
+  /// it, else the passive one; false: the passive law always (tau . qd <= 0)
+  bool hold = true;
 };
 
 /// The measured state of the stack at a tick: base pose, joint angles, generalized velocity
@@ -105,7 +108,7 @@ inline const char* fault_name(DetumbleFault f) {
 struct DetumbleCommand {
   Eigen::VectorXd tau;                    ///< joint torques (zero on a fault)
   Vector6 base_wrench = Vector6::Zero();  ///< force and moment on the base about its origin, inertial
-  double brake_scale = 1;                 ///< share of the braking torque applied (1: none cut)
+  double brake_scale = 1;                 ///< the passive law's scale into the limits (1: none cut)
   double joint_rate = 0;                  ///< largest |qd_k|
   double relative_rate = 0;               ///< |angular velocity of the gripper relative to the base|
   double stack_rate = 0;                  ///< |angular velocity of the base|
@@ -164,8 +167,7 @@ class DetumbleController {
         opt_(options),
         data_(stack),
         qdd_(stack.n()),
-        hold_(stack.n()),
-        brake_(stack.n()) {
+        hold_(stack.n()) {
     detail::check_detumble(stack, limits, options, "DetumbleController");
     if (gripper < 0 || gripper >= static_cast<int>(stack.frames().size()))
       throw InputError(detail::str("DetumbleController: frame index ", gripper, " out of range"));
@@ -190,8 +192,8 @@ class DetumbleController {
     try {
       crba(*model_, data_, s.base, s.theta);
       base_wrench(s, out);
-      joint_torques(s, out);
-      rates(s, out);
+      const bool saturated = joint_torques(s, out);
+      rates(s, saturated, out);
     } catch (...) {
       return fault(out, DetumbleFault::Numerical);
     }
@@ -245,41 +247,50 @@ class DetumbleController {
     out.base_wrench.tail<3>() = R * tb;
   }
 
-  /// The joint torques that give qdd = -lambda qd on the floating stack with the base wrench w_b,
-  /// split into the part at qdd = 0 (hold) and the braking part; the braking part scaled by the largest
-  /// s in [0, 1] that keeps every joint within its limit, the sum clamped. With C = bias_forces:
-  ///   a_b = H_b^-1 (w_b - C_b - H_bm qdd),  tau = H_mb a_b + H_mm qdd + C_m.
-  /// Reads data_.H (crba). Writes data_.tau (bias_forces), qdd_, hold_, brake_, out.tau, out.brake_scale.
-  void joint_torques(const DetumbleState& s, DetumbleCommand& out) {
+  /// The joint torques. The exact law: the torques that give qdd = -lambda qd on the floating stack
+  /// with the base wrench w_b (C = bias_forces):
+  ///   a_b = H_b^-1 (w_b - C_b - H_bm qdd),  tau = H_mb a_b + H_mm qdd + C_m,
+  /// used when every joint stays within its limit. Otherwise (and always with hold = false) the passive
+  /// law tau_k = -s lambda H*_kk qd_k, H*_kk = H_kk - H_kb H_b^-1 H_bk the joint's inertia on the
+  /// floating stack, with the largest s <= 1 that keeps every joint within its limit: tau . qd <= 0, so
+  /// the joints only take energy out. Reads data_.H (crba). Writes data_.tau (bias_forces), qdd_,
+  /// hold_, out.tau, out.brake_scale; returns whether the passive law was used because of the limits.
+  bool joint_torques(const DetumbleState& s, DetumbleCommand& out) {
     const int n = model_->n();
     const Eigen::MatrixXd& H = data_.H;
     llt_.compute(H.topLeftCorner<6, 6>());
-    const Eigen::VectorXd& C = bias_forces(*model_, data_, s.base, s.theta, s.v);
-    qdd_ = -opt_.joint_gain * s.v.tail(n);
-    const Vector6 a0 = llt_.solve(Vector6(out.base_wrench - C.head<6>()));
-    Vector6 Hq;
-    for (int r = 0; r < 6; ++r) Hq(r) = H.row(r).tail(n).dot(qdd_);
-    const Vector6 a1 = llt_.solve(Vector6(-Hq));
-    double scale = 1.0;
-    for (int k = 0; k < n; ++k) {
-      hold_(k) = H.row(6 + k).head<6>().dot(a0) + C(6 + k);
-      brake_(k) = H.row(6 + k).head<6>().dot(a1) + H.row(6 + k).tail(n).dot(qdd_);
-      const double L = limits_.joint_torque(k), x = hold_(k), y = brake_(k);
-      if (std::abs(x) >= L) {
-        scale = 0;
-      } else if (std::abs(x + scale * y) > L) {
-        scale = std::min(scale, ((y > 0 ? L : -L) - x) / y);
+    const auto qd = s.v.tail(n);
+    out.brake_scale = 1.0;
+    if (opt_.hold) {
+      const Eigen::VectorXd& C = bias_forces(*model_, data_, s.base, s.theta, s.v);
+      qdd_ = -opt_.joint_gain * qd;
+      Vector6 rhs = out.base_wrench - C.head<6>();
+      for (int r = 0; r < 6; ++r) rhs(r) -= H.row(r).tail(n).dot(qdd_);
+      const Vector6 ab = llt_.solve(rhs);
+      bool within = true;
+      for (int k = 0; k < n; ++k) {
+        hold_(k) = H.row(6 + k).head<6>().dot(ab) + H.row(6 + k).tail(n).dot(qdd_) + C(6 + k);
+        within = within && std::abs(hold_(k)) <= limits_.joint_torque(k);
+      }
+      if (within) {
+        out.tau = hold_;
+        return false;
       }
     }
-    out.brake_scale = std::max(0.0, scale);
+    double scale = 1.0;
     for (int k = 0; k < n; ++k) {
-      const double L = limits_.joint_torque(k);
-      out.tau(k) = std::min(L, std::max(-L, hold_(k) + out.brake_scale * brake_(k)));
+      const Vector6 Hbk = H.col(6 + k).head<6>();
+      const double Hkk = H(6 + k, 6 + k) - Hbk.dot(llt_.solve(Hbk));
+      hold_(k) = -opt_.joint_gain * Hkk * qd(k);
+      if (std::abs(hold_(k)) > limits_.joint_torque(k)) scale = std::min(scale, limits_.joint_torque(k) / std::abs(hold_(k)));
     }
+    out.tau = scale * hold_;
+    out.brake_scale = scale;
+    return opt_.hold || scale < 1.0;
   }
 
   /// The rates that decide rest: joints, the gripper relative to the base, the base. Writes data_.J.
-  void rates(const DetumbleState& s, DetumbleCommand& out) {
+  void rates(const DetumbleState& s, bool saturated, DetumbleCommand& out) {
     const int n = model_->n();
     frame_jacobian(*model_, data_, gripper_);
     out.joint_rate = s.v.tail(n).cwiseAbs().maxCoeff();
@@ -292,7 +303,7 @@ class DetumbleController {
                       (!opt_.stop_stack_spin || out.stack_rate < thr);
     out.fault = DetumbleFault::None;
     out.status = rest                        ? DetumbleStatus::AtRest
-                 : out.brake_scale < 1.0     ? DetumbleStatus::Saturated
+                 : saturated                 ? DetumbleStatus::Saturated
                                              : DetumbleStatus::Braking;
   }
 
@@ -302,7 +313,7 @@ class DetumbleController {
   DetumbleOptions opt_;
   Data data_;
   Eigen::LLT<Matrix6> llt_;
-  Eigen::VectorXd qdd_, hold_, brake_;
+  Eigen::VectorXd qdd_, hold_;
 };
 
 }  // namespace ffsr

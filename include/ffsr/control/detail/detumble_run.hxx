@@ -37,7 +37,7 @@ inline DetumbleSample detumble_sample(DetumbleSystem& sys, const Eigen::VectorXd
   DetumbleSample s;
   const int n = sys.n;
   s.t = t;
-  s.theta_dot = y.segment(7 + n, n);
+  s.theta_dot = y.segment(13 + n, n);
   s.tau = cmd.tau;
   s.base_wrench = cmd.base_wrench;
   s.joint_rate = cmd.joint_rate;
