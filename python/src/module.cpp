@@ -219,6 +219,7 @@ namespace ffsr::python {
 void bind_scenario(nb::module_& m);    // scenario.cpp
 void bind_controller(nb::module_& m);  // controller.cpp
 void bind_jobs(nb::module_& m);        // jobs.cpp (after bind_scenario: methods of Scenario)
+void bind_detumble(nb::module_& m);    // detumble.cpp
 }  // namespace ffsr::python
 
 using namespace ffsr::python;
@@ -287,4 +288,5 @@ NB_MODULE(_ffsr, m) {
   bind_scenario(m);
   bind_jobs(m);
   bind_controller(m);
+  bind_detumble(m);
 }

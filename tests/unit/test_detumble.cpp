@@ -189,7 +189,7 @@ Grasped grasped_7dof() {
   return {std::move(m), std::move(g), std::move(stack), ee, s};
 }
 
-/// The joint torque limits of robots/paper_7dof_detumble.toml: 60 N m at the shoulder (joints 1-3),
+/// The joint torque limits of docs/detumble.md: 60 N m at the shoulder (joints 1-3),
 /// 40 N m at the elbow (4), 20 N m at the wrist (5-7).
 Eigen::VectorXd limits_7dof() {
   Eigen::VectorXd L(7);
