@@ -169,7 +169,8 @@ TEST_CASE("detumble controller: 1e5 ticks allocate nothing (7-DOF stack, wheels 
     long faults = 0, saturated = 0;
     const long n0 = g_news.load(), d0 = g_deletes.load();
     for (long k = 0; k < 100000; ++k) {
-      for (Eigen::Index j = 0; j < 7; ++j) st.theta(j) = 0.4 + 0.5 * std::sin(1e-3 * static_cast<double>(k + j));
+      for (Eigen::Index j = 0; j < 7; ++j)
+        st.theta(j) = 0.4 + 0.5 * std::sin(1e-3 * static_cast<double>(k + j));
       st.v(8) = (k % 1000 == 999) ? std::nan("") : 0.05;
       ctrl.step(st, cmd);
       faults += cmd.status == DetumbleStatus::Fault;

@@ -206,8 +206,10 @@ void check_torques_within_limits(const DetumbleRunResult& r, const Eigen::Vector
 
 }  // namespace
 
-TEST_CASE("detumble, free-floating: momentum kept, energy only through joint work, torques within limits, "
-          "at rest", "[detumble]") {
+TEST_CASE(
+    "detumble, free-floating: momentum kept, energy only through joint work, torques within limits, "
+    "at rest",
+    "[detumble]") {
   const Grasped g = grasped_7dof();
   DetumbleLimits lim;
   lim.joint_torque = limits_7dof();
@@ -218,7 +220,8 @@ TEST_CASE("detumble, free-floating: momentum kept, energy only through joint wor
   INFO("time to rest " << r.time_to_rest << " s, peak torque " << r.peak_joint_torque << " N m (joint "
                        << r.peak_joint << "), gripper " << r.peak_gripper_force << " N "
                        << r.peak_gripper_moment << " N m, attitude " << r.base_attitude_excursion
-                       << " rad, energy " << r.energy_start << " -> " << r.energy_end << " J, steps " << r.steps);
+                       << " rad, energy " << r.energy_start << " -> " << r.energy_end << " J, steps "
+                       << r.steps);
   CHECK(r.at_rest);
   CHECK(r.momentum_drift < 1e-8);
   CHECK(r.max_energy_balance < 1e-6);  // T(k+1) - T(k) = tau . (theta(k+1) - theta(k)) each tick
@@ -261,7 +264,8 @@ TEST_CASE("detumble, free-floating, the passive law: kinetic energy never increa
   CHECK(r.at_rest);
   CHECK(r.joint_work < 0);
   CHECK(r.momentum_drift < 1e-8);
-  for (size_t k = 1; k < r.series.size(); ++k) REQUIRE(r.series[k].energy <= r.series[k - 1].energy * (1 + 1e-12));
+  for (size_t k = 1; k < r.series.size(); ++k)
+    REQUIRE(r.series[k].energy <= r.series[k - 1].energy * (1 + 1e-12));
   for (const auto& s : r.series) REQUIRE(s.tau.dot(s.theta_dot) <= 0.0);
   check_torques_within_limits(r, lim.joint_torque);
 }

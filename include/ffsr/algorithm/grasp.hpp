@@ -13,14 +13,14 @@ namespace ffsr {
 /// The velocities just before and after the lock, and the impulse it took. Vectors in the inertial
 /// frame; twists and wrenches linear first.
 struct GraspResult {
-  Eigen::VectorXd v_before, v_after;            ///< robot generalized velocity (6+n); v_after is the stack's
-  Vector6 target_before = Vector6::Zero();      ///< target [v_c; w]: centre-of-mass velocity, angular velocity
-  Vector6 target_after = Vector6::Zero();       ///< the same after the lock
-  Vector6 impulse = Vector6::Zero();            ///< on the gripper from the target at the contact point: N s, N m s
+  Eigen::VectorXd v_before, v_after;        ///< robot generalized velocity (6+n); v_after is the stack's
+  Vector6 target_before = Vector6::Zero();  ///< target [v_c; w]: centre-of-mass velocity, angular velocity
+  Vector6 target_after = Vector6::Zero();   ///< the same after the lock
+  Vector6 impulse = Vector6::Zero();  ///< on the gripper from the target at the contact point: N s, N m s
   Vector6 base_velocity_jump = Vector6::Zero();  ///< [v_0; w_0] after minus before
   Vector6 momentum_before = Vector6::Zero();     ///< robot + target [P; L about o]
   Vector6 momentum_after = Vector6::Zero();
-  double energy_before = 0, energy_after = 0;   ///< kinetic energy of robot + target, J
+  double energy_before = 0, energy_after = 0;      ///< kinetic energy of robot + target, J
   Vector6 relative_twist_after = Vector6::Zero();  ///< gripper minus target at the contact point (zero)
   Vector3 contact_point = Vector3::Zero();         ///< the lock's point: the frame's origin
   AttachedBody body;  ///< the target as a body attached at the frame (attach_body gives the stack model)
@@ -59,8 +59,8 @@ inline Vector6 robot_momentum_about_origin(const Model& model, const Data& data,
 /// (O(n^3) for n joints), six solves with it. Reads base, theta, v. Writes the kinematics, data.H,
 /// data.L, data.J. Throws InputError for bad sizes, non-finite values, a bad frame or target.
 inline GraspResult grasp(const Model& model, Data& data, const BasePose& base,
-                         const Eigen::Ref<const Eigen::VectorXd>& theta, const Eigen::Ref<const Eigen::VectorXd>& v,
-                         int frame, const Target& target) {
+                         const Eigen::Ref<const Eigen::VectorXd>& theta,
+                         const Eigen::Ref<const Eigen::VectorXd>& v, int frame, const Target& target) {
   constexpr const char* w = "grasp";
   detail::require_size(v.size(), model.nv(), w, "v");
   detail::require_finite_all(v, w, "v");
@@ -98,8 +98,8 @@ inline GraspResult grasp(const Model& model, Data& data, const BasePose& base,
   r.target_after = r.target_before + MinvJt * r.impulse;
   r.relative_twist_after = data.J * r.v_after - Jt * r.target_after;
   r.base_velocity_jump = r.v_after.head<6>() - v.head<6>();
-  r.momentum_before = detail::robot_momentum_about_origin(model, data, v) +
-                      detail::target_momentum(target, r.target_before);
+  r.momentum_before =
+      detail::robot_momentum_about_origin(model, data, v) + detail::target_momentum(target, r.target_before);
   r.momentum_after = detail::robot_momentum_about_origin(model, data, r.v_after) +
                      detail::target_momentum(target, r.target_after);
   auto energy = [&](const Eigen::VectorXd& vr, const Vector6& tw) {

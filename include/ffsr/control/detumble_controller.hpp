@@ -46,9 +46,9 @@ struct DetumbleLimits {
 
 /// The law's settings.
 struct DetumbleOptions {
-  double joint_gain = 1.0;     ///< lambda (1/s): the joint rates asked to decay as qdd = -lambda qd
-  double base_gain = 0.1;      ///< k (1/s): the actuator asks dL/dt = -k L (and dP/dt = -k P, thrusters)
-  double rest_rate = 1e-3;     ///< rad/s (m/s prismatic): at rest below it
+  double joint_gain = 1.0;       ///< lambda (1/s): the joint rates asked to decay as qdd = -lambda qd
+  double base_gain = 0.1;        ///< k (1/s): the actuator asks dL/dt = -k L (and dP/dt = -k P, thrusters)
+  double rest_rate = 1e-3;       ///< rad/s (m/s prismatic): at rest below it
   bool stop_stack_spin = false;  ///< also stop the stack's spin (needs an actuator)
   /// true: the exact law (qdd = -lambda qd, holding against the velocity terms) where the limits allow
   /// it, else the passive one; false: the passive law always (tau . qd <= 0)
@@ -80,7 +80,16 @@ inline const char* status_name(DetumbleStatus s) {
 }
 
 /// The input field a fault names.
-enum class DetumbleFault { None, Size, BasePosition, BaseOrientation, JointAngle, Velocity, WheelMomentum, Numerical };
+enum class DetumbleFault {
+  None,
+  Size,
+  BasePosition,
+  BaseOrientation,
+  JointAngle,
+  Velocity,
+  WheelMomentum,
+  Numerical
+};
 
 inline const char* fault_name(DetumbleFault f) {
   switch (f) {
@@ -141,8 +150,9 @@ inline void check_detumble(const Model& stack, const DetumbleLimits& l, const De
   positive(o.base_gain, "the base gain");
   positive(o.rest_rate, "the rest rate");
   if (o.stop_stack_spin && l.actuator == BaseActuator::None)
-    throw InputError(str(where, ": the stack's spin cannot be stopped without a base actuator: its total "
-                                "angular momentum is conserved (name reaction wheels or thrusters)"));
+    throw InputError(str(where,
+                         ": the stack's spin cannot be stopped without a base actuator: its total "
+                         "angular momentum is conserved (name reaction wheels or thrusters)"));
 }
 
 /// x clamped to [-L, L] per base axis: the components of x in the base frame (R) clamped, rotated back.
@@ -282,7 +292,8 @@ class DetumbleController {
       const Vector6 Hbk = H.col(6 + k).head<6>();
       const double Hkk = H(6 + k, 6 + k) - Hbk.dot(llt_.solve(Hbk));
       hold_(k) = -opt_.joint_gain * Hkk * qd(k);
-      if (std::abs(hold_(k)) > limits_.joint_torque(k)) scale = std::min(scale, limits_.joint_torque(k) / std::abs(hold_(k)));
+      if (std::abs(hold_(k)) > limits_.joint_torque(k))
+        scale = std::min(scale, limits_.joint_torque(k) / std::abs(hold_(k)));
     }
     out.tau = scale * hold_;
     out.brake_scale = scale;
@@ -299,12 +310,12 @@ class DetumbleController {
     out.relative_rate = wrel.norm();
     out.stack_rate = s.v.segment<3>(3).norm();
     const double thr = opt_.rest_rate;
-    const bool rest = out.joint_rate < thr && out.relative_rate < thr &&
-                      (!opt_.stop_stack_spin || out.stack_rate < thr);
+    const bool rest =
+        out.joint_rate < thr && out.relative_rate < thr && (!opt_.stop_stack_spin || out.stack_rate < thr);
     out.fault = DetumbleFault::None;
-    out.status = rest                        ? DetumbleStatus::AtRest
-                 : saturated                 ? DetumbleStatus::Saturated
-                                             : DetumbleStatus::Braking;
+    out.status = rest        ? DetumbleStatus::AtRest
+                 : saturated ? DetumbleStatus::Saturated
+                             : DetumbleStatus::Braking;
   }
 
   const Model* model_;

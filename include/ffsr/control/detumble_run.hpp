@@ -16,11 +16,11 @@ namespace ffsr {
 
 /// The run's settings.
 struct DetumbleRunOptions {
-  double tick = 0.01;       ///< control period, s
-  double horizon = 120;     ///< longest run, s
-  int record_every = 1;     ///< keep every k-th tick in the series (0: none)
-  double rtol = 1e-12;      ///< CVODE
-  double atol = 1e-15;      ///< CVODE, on positions, angles, rates and wheel momentum
+  double tick = 0.01;    ///< control period, s
+  double horizon = 120;  ///< longest run, s
+  int record_every = 1;  ///< keep every k-th tick in the series (0: none)
+  double rtol = 1e-12;   ///< CVODE
+  double atol = 1e-15;   ///< CVODE, on positions, angles, rates and wheel momentum
 };
 
 /// One recorded tick (inertial frame unless said).
@@ -33,25 +33,26 @@ struct DetumbleSample {
   double base_attitude = 0;                  ///< rotation of the base since the grasp, rad
   Vector3 wheel_momentum = Vector3::Zero();  ///< stored in the wheels, base frame, N m s
   double joint_rate = 0, relative_rate = 0, stack_rate = 0;
-  double energy = 0;                          ///< the stack's kinetic energy, J
-  Vector6 momentum = Vector6::Zero();         ///< stack + wheels [P; L about o]
+  double energy = 0;                   ///< the stack's kinetic energy, J
+  Vector6 momentum = Vector6::Zero();  ///< stack + wheels [P; L about o]
   DetumbleStatus status = DetumbleStatus::Braking;
 };
 
 struct DetumbleRunResult {
   bool at_rest = false;
-  double time_to_rest = 0;        ///< first tick at rest (the horizon if never)
-  double peak_joint_torque = 0;   ///< N m
-  int peak_joint = -1;            ///< its joint (coordinate)
-  double peak_gripper_force = 0;  ///< N
-  double peak_gripper_moment = 0;  ///< N m
-  double base_attitude_excursion = 0;  ///< largest rotation of the base since the grasp, rad
-  double peak_wheel_momentum = 0;      ///< largest stored component, N m s
+  double time_to_rest = 0;                       ///< first tick at rest (the horizon if never)
+  double peak_joint_torque = 0;                  ///< N m
+  int peak_joint = -1;                           ///< its joint (coordinate)
+  double peak_gripper_force = 0;                 ///< N
+  double peak_gripper_moment = 0;                ///< N m
+  double base_attitude_excursion = 0;            ///< largest rotation of the base since the grasp, rad
+  double peak_wheel_momentum = 0;                ///< largest stored component, N m s
   Vector3 wheel_momentum_end = Vector3::Zero();  ///< base frame
-  double momentum_drift = 0;   ///< largest |h(t) - h(0)| / |h(0)| (stack + wheels; not with thrusters)
+  double momentum_drift = 0;  ///< largest |h(t) - h(0)| / |h(0)| (stack + wheels; not with thrusters)
   double energy_start = 0, energy_end = 0;
-  double joint_work = 0;        ///< sum over ticks of tau . (theta(t+) - theta(t)): exact for held torques
-  double max_energy_balance = 0;  ///< largest |T_k+1 - T_k - W_k| / T(0) over the ticks (without wheels/thrusters)
+  double joint_work = 0;  ///< sum over ticks of tau . (theta(t+) - theta(t)): exact for held torques
+  double max_energy_balance =
+      0;  ///< largest |T_k+1 - T_k - W_k| / T(0) over the ticks (without wheels/thrusters)
   long ticks = 0, steps = 0, faults = 0;
   std::vector<DetumbleSample> series;
 };
@@ -81,7 +82,8 @@ struct DetumbleSystem {
   Data data;
   int n;
   Eigen::VectorXd tau, a, theta, v;
-  DetumbleSystem(const Model& m) : model(m), data(m), n(m.n()), tau(m.nv()), a(m.nv()), theta(m.n()), v(m.nv()) {}
+  DetumbleSystem(const Model& m)
+      : model(m), data(m), n(m.n()), tau(m.nv()), a(m.nv()), theta(m.n()), v(m.nv()) {}
   Eigen::Index size() const { return 16 + 2 * n; }
   BasePose base(const Eigen::Ref<const Eigen::VectorXd>& y) const {
     BasePose b;
@@ -166,9 +168,9 @@ inline void check_detumble_feasible(const Model& stack, const DetumbleState& s, 
                                  L, " N m s about its centre of mass, at most ", axes * l.wheel_momentum,
                                  " N m s (", l.wheel_momentum, " per axis)"));
   if (L / (axes * tmax) > horizon)
-    throw InputError(detail::str("detumble: the base actuator's torque (", tmax, " N m per axis) needs at least ",
-                                 L / (axes * tmax), " s to remove the stack's angular momentum ", L,
-                                 " N m s; the horizon is ", horizon, " s"));
+    throw InputError(detail::str(
+        "detumble: the base actuator's torque (", tmax, " N m per axis) needs at least ", L / (axes * tmax),
+        " s to remove the stack's angular momentum ", L, " N m s; the horizon is ", horizon, " s"));
 }
 
 /// The post-capture run from `start` (the grasp's state on the stack model; see the top of the file).
@@ -176,8 +178,8 @@ inline void check_detumble_feasible(const Model& stack, const DetumbleState& s, 
 /// at each tick and held until the next; the run stops at the first tick at rest or at the horizon.
 /// InputError for bad options; IntegrationError from CVODE.
 inline DetumbleRunResult run_detumble(const Model& stack, int gripper, const AttachedBody& body,
-                               const DetumbleState& start, const DetumbleLimits& limits,
-                               const DetumbleOptions& options, const DetumbleRunOptions& run);
+                                      const DetumbleState& start, const DetumbleLimits& limits,
+                                      const DetumbleOptions& options, const DetumbleRunOptions& run);
 
 }  // namespace ffsr
 

@@ -7,8 +7,8 @@ namespace ffsr {
 
 namespace detail {
 
-inline void check_detumble_run(const Model& stack, int gripper, const AttachedBody& body, const DetumbleState& s,
-                               const DetumbleRunOptions& r) {
+inline void check_detumble_run(const Model& stack, int gripper, const AttachedBody& body,
+                               const DetumbleState& s, const DetumbleRunOptions& r) {
   constexpr const char* w = "run_detumble";
   if (!std::isfinite(r.tick) || !(r.tick > 0))
     throw InputError(str(w, ": the tick must be positive and finite, got ", r.tick));
@@ -93,8 +93,8 @@ inline DetumbleRunResult run_detumble(const Model& stack, int gripper, const Att
     const double t = static_cast<double>(k) * run.tick;
     ctrl.step(sys.unpack(y), cmd);
     if (cmd.status == DetumbleStatus::Fault)
-      throw NumericalError(detail::str("run_detumble: the controller faulted (", fault_name(cmd.fault),
-                                       ") at t = ", t, " s"));
+      throw NumericalError(
+          detail::str("run_detumble: the controller faulted (", fault_name(cmd.fault), ") at t = ", t, " s"));
     DetumbleSample s = detail::detumble_sample(probe, y, t, cmd, gripper, body, R_start, res);
     res.momentum_drift = std::max(res.momentum_drift, (s.momentum - h0).norm() / std::max(h0.norm(), 1e-300));
     res.energy_end = s.energy;
