@@ -8,6 +8,9 @@
 #include <nanobind/stl/string.h>
 
 namespace ffsr::python {
+
+using namespace nb::literals;
+
 namespace {
 
 BaseActuator actuator_arg(const std::string& name) {
@@ -70,33 +73,52 @@ nb::dict grasp_dict(const GraspResult& g) {
 }
 
 void bind_results(nb::module_& m) {
-  nb::class_<AttachedBody>(m, "AttachedBody",
-                           "A rigid body attached at a frame: mass (kg), inertia about its centre of mass (its\n"
-                           "axes, kg m^2), pose of its centre-of-mass frame in the frame, the name of that frame.")
+  nb::class_<AttachedBody>(
+      m, "AttachedBody",
+      "A rigid body attached at a frame: mass (kg), inertia about its centre of mass (its\n"
+      "axes, kg m^2), pose of its centre-of-mass frame in the frame, the name of that frame.")
       .def_ro("mass", &AttachedBody::mass)
-      .def_prop_ro("inertia", [](const AttachedBody& b) { return out(b.inertia); })
+      .def_prop_ro(
+          "inertia", [](const AttachedBody& b) { return out(b.inertia); }, nb::rv_policy::automatic)
       .def_ro("pose", &AttachedBody::pose)
       .def_ro("name", &AttachedBody::name);
   nb::class_<GraspResult>(m, "GraspResult",
                           "The plastic lock of gripper and target: velocities before and after (inertial,\n"
                           "linear first), the impulse on the gripper at the contact point (N s, N m s).")
-      .def_prop_ro("v_before", [](const GraspResult& g) { return out(g.v_before); })
-      .def_prop_ro("v_after", [](const GraspResult& g) { return out(g.v_after); })
-      .def_prop_ro("target_before", [](const GraspResult& g) { return out(g.target_before); })
-      .def_prop_ro("target_after", [](const GraspResult& g) { return out(g.target_after); })
-      .def_prop_ro("impulse", [](const GraspResult& g) { return out(g.impulse); })
-      .def_prop_ro("base_velocity_jump", [](const GraspResult& g) { return out(g.base_velocity_jump); })
-      .def_prop_ro("momentum_before", [](const GraspResult& g) { return out(g.momentum_before); })
-      .def_prop_ro("momentum_after", [](const GraspResult& g) { return out(g.momentum_after); })
+      .def_prop_ro(
+          "v_before", [](const GraspResult& g) { return out(g.v_before); }, nb::rv_policy::automatic)
+      .def_prop_ro(
+          "v_after", [](const GraspResult& g) { return out(g.v_after); }, nb::rv_policy::automatic)
+      .def_prop_ro(
+          "target_before", [](const GraspResult& g) { return out(g.target_before); },
+          nb::rv_policy::automatic)
+      .def_prop_ro(
+          "target_after", [](const GraspResult& g) { return out(g.target_after); }, nb::rv_policy::automatic)
+      .def_prop_ro(
+          "impulse", [](const GraspResult& g) { return out(g.impulse); }, nb::rv_policy::automatic)
+      .def_prop_ro(
+          "base_velocity_jump", [](const GraspResult& g) { return out(g.base_velocity_jump); },
+          nb::rv_policy::automatic)
+      .def_prop_ro(
+          "momentum_before", [](const GraspResult& g) { return out(g.momentum_before); },
+          nb::rv_policy::automatic)
+      .def_prop_ro(
+          "momentum_after", [](const GraspResult& g) { return out(g.momentum_after); },
+          nb::rv_policy::automatic)
       .def_ro("energy_before", &GraspResult::energy_before)
       .def_ro("energy_after", &GraspResult::energy_after)
-      .def_prop_ro("relative_twist_after", [](const GraspResult& g) { return out(g.relative_twist_after); })
-      .def_prop_ro("contact_point", [](const GraspResult& g) { return out(g.contact_point); })
+      .def_prop_ro(
+          "relative_twist_after", [](const GraspResult& g) { return out(g.relative_twist_after); },
+          nb::rv_policy::automatic)
+      .def_prop_ro(
+          "contact_point", [](const GraspResult& g) { return out(g.contact_point); },
+          nb::rv_policy::automatic)
       .def_ro("body", &GraspResult::body)
       .def("to_dict", &grasp_dict)
       .def("__repr__", [](const GraspResult& g) {
-        return detail::str("GraspResult(impulse ", g.impulse.head<3>().norm(), " N s, ", g.impulse.tail<3>().norm(),
-                           " N m s, energy ", g.energy_before, " -> ", g.energy_after, " J)");
+        return detail::str("GraspResult(impulse ", g.impulse.head<3>().norm(), " N s, ",
+                           g.impulse.tail<3>().norm(), " N m s, energy ", g.energy_before, " -> ",
+                           g.energy_after, " J)");
       });
   nb::class_<DetumbleRunResult>(m, "DetumbleResult", "The post-capture run's summary and series (SI units).")
       .def_ro("at_rest", &DetumbleRunResult::at_rest)
@@ -112,19 +134,27 @@ void bind_results(nb::module_& m) {
       .def_ro("energy_end", &DetumbleRunResult::energy_end)
       .def_ro("joint_work", &DetumbleRunResult::joint_work)
       .def_ro("ticks", &DetumbleRunResult::ticks)
-      .def_prop_ro("series_t", [](const DetumbleRunResult& r) {
-        Eigen::VectorXd t(static_cast<Eigen::Index>(r.series.size()));
-        for (size_t i = 0; i < r.series.size(); ++i) t(static_cast<Eigen::Index>(i)) = r.series[i].t;
-        return out(t);
-      })
-      .def_prop_ro("series_tau", [](const DetumbleRunResult& r) {
-        Eigen::MatrixXd x(static_cast<Eigen::Index>(r.series.size()), r.series.empty() ? 0 : r.series[0].tau.size());
-        for (size_t i = 0; i < r.series.size(); ++i) x.row(static_cast<Eigen::Index>(i)) = r.series[i].tau.transpose();
-        return out(x);
-      })
+      .def_prop_ro(
+          "series_t",
+          [](const DetumbleRunResult& r) {
+            Eigen::VectorXd t(static_cast<Eigen::Index>(r.series.size()));
+            for (size_t i = 0; i < r.series.size(); ++i) t(static_cast<Eigen::Index>(i)) = r.series[i].t;
+            return out(t);
+          },
+          nb::rv_policy::automatic)
+      .def_prop_ro(
+          "series_tau",
+          [](const DetumbleRunResult& r) {
+            Eigen::MatrixXd x(static_cast<Eigen::Index>(r.series.size()),
+                              r.series.empty() ? 0 : r.series[0].tau.size());
+            for (size_t i = 0; i < r.series.size(); ++i)
+              x.row(static_cast<Eigen::Index>(i)) = r.series[i].tau.transpose();
+            return out(x);
+          },
+          nb::rv_policy::automatic)
       .def("__repr__", [](const DetumbleRunResult& r) {
-        return detail::str("DetumbleResult(", r.at_rest ? "at rest in " : "not at rest after ", r.time_to_rest,
-                           " s, peak joint torque ", r.peak_joint_torque, " N m)");
+        return detail::str("DetumbleResult(", r.at_rest ? "at rest in " : "not at rest after ",
+                           r.time_to_rest, " s, peak joint torque ", r.peak_joint_torque, " N m)");
       });
 }
 
@@ -132,19 +162,20 @@ void bind_results(nb::module_& m) {
 
 void bind_detumble(nb::module_& m) {
   bind_results(m);
-  nb::class_<DetumbleController>(m, "DetumbleController",
-                                 "The detumbling controller on the stack model: one step per tick, no allocation.")
+  nb::class_<DetumbleController>(
+      m, "DetumbleController",
+      "The detumbling controller on the stack model: one step per tick, no allocation.")
       .def(
           "__init__",
           [](DetumbleController* self, const Model& stack, nb::handle gripper, nb::handle joint_torque,
              const std::string& actuator, double wheel_torque, double wheel_momentum, double thruster_force,
-             double thruster_torque, double joint_gain, double base_gain, double rest_rate, bool stop_stack_spin,
-             bool hold) {
-            new (self) DetumbleController(
-                stack, frame_arg(stack, gripper, "DetumbleController"),
-                limits_arg(stack, joint_torque, actuator, wheel_torque, wheel_momentum, thruster_force,
-                           thruster_torque),
-                options_arg(joint_gain, base_gain, rest_rate, stop_stack_spin, hold));
+             double thruster_torque, double joint_gain, double base_gain, double rest_rate,
+             bool stop_stack_spin, bool hold) {
+            new (self)
+                DetumbleController(stack, frame_arg(stack, gripper, "DetumbleController"),
+                                   limits_arg(stack, joint_torque, actuator, wheel_torque, wheel_momentum,
+                                              thruster_force, thruster_torque),
+                                   options_arg(joint_gain, base_gain, rest_rate, stop_stack_spin, hold));
           },
           "stack"_a, "gripper"_a, "joint_torque"_a, "actuator"_a = "none", "wheel_torque"_a = 0.0,
           "wheel_momentum"_a = 0.0, "thruster_force"_a = 0.0, "thruster_torque"_a = 0.0, "joint_gain"_a = 1.0,
@@ -181,8 +212,8 @@ void bind_detumble(nb::module_& m) {
       "body, a frame `name` at its centre of mass. InputError for a non-physical body or unknown frame.");
   m.def(
       "grasp",
-      [](const Model& model, Data& data, const BasePose& base, nb::handle theta, nb::handle v, nb::handle frame,
-         const Target& target) {
+      [](const Model& model, Data& data, const BasePose& base, nb::handle theta, nb::handle v,
+         nb::handle frame, const Target& target) {
         check_data(model, data, "grasp");
         const VecIn th(theta, "grasp", "theta"), vv(v, "grasp", "v");
         return grasp(model, data, base, th.map(), vv.map(), frame_arg(model, frame, "grasp"), target);
@@ -204,10 +235,11 @@ void bind_detumble(nb::module_& m) {
       "under zero momentum, the target's contact point on the frame's origin).");
   m.def(
       "run_detumble",
-      [](const Model& stack, nb::handle gripper, const AttachedBody& body, const BasePose& base, nb::handle theta,
-         nb::handle v, nb::handle joint_torque, const std::string& actuator, double wheel_torque,
-         double wheel_momentum, double thruster_force, double thruster_torque, double joint_gain,
-         double base_gain, double rest_rate, bool stop_stack_spin, bool hold, double tick, double horizon) {
+      [](const Model& stack, nb::handle gripper, const AttachedBody& body, const BasePose& base,
+         nb::handle theta, nb::handle v, nb::handle joint_torque, const std::string& actuator,
+         double wheel_torque, double wheel_momentum, double thruster_force, double thruster_torque,
+         double joint_gain, double base_gain, double rest_rate, bool stop_stack_spin, bool hold, double tick,
+         double horizon) {
         const DetumbleLimits l = limits_arg(stack, joint_torque, actuator, wheel_torque, wheel_momentum,
                                             thruster_force, thruster_torque);
         DetumbleRunOptions r;
