@@ -34,10 +34,12 @@ def random_target(rng, point):
 
 
 def pinocchio_grasp(path, fm, base, theta, v, target, ee_name):
-    """v+ of robot and target (ffsr's coordinates: robot [v0, w0, theta_dot], target [v_c, w]) by Pinocchio."""
+    """v+ of robot and target (ffsr's coordinates: robot [v0, w0, theta_dot], target [v_c, w]) and the
+    impulse on the gripper, by Pinocchio."""
     pm = pin.buildModelFromUrdf(str(path), pin.JointModelFreeFlyer())
     tj = pm.addJoint(0, pin.JointModelFreeFlyer(), pin.SE3.Identity(), "target_free_flyer")
-    pm.appendBodyToJoint(tj, pin.Inertia(target.mass, np.zeros(3), np.asarray(target.inertia)), pin.SE3.Identity())
+    inertia = pin.Inertia(target.mass, np.zeros(3), np.asarray(target.inertia))
+    pm.appendBodyToJoint(tj, inertia, pin.SE3.Identity())
     pd = pm.createData()
     R0 = quat_to_rot(base.orientation)
     Rt = quat_to_rot(target.attitude)
