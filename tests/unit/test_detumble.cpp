@@ -376,7 +376,8 @@ TEST_CASE("detumble refuses bad limits, a spin it cannot stop and an actuator to
   refused(l, opt, "joint4");
   DetumbleOptions o = opt;
   o.stop_stack_spin = true;
-  refused(lim, o, "angular momentum is conserved");
+  refused(lim, o, "its angular momentum about its centre of mass, ");
+  refused(lim, o, "N m s, is conserved");
   l = lim;
   l.actuator = BaseActuator::ReactionWheels;
   l.wheel_torque = 0.2;

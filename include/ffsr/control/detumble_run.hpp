@@ -149,18 +149,24 @@ struct DetumbleSystem {
 
 }  // namespace detail
 
-/// Refuses a run the actuator cannot finish: InputError when the stack's angular momentum about its
-/// centre of mass, L_c, exceeds what the wheels can store (|L_c| above sqrt(3) times the bound per axis)
-/// or needs longer than the horizon at the actuator's largest torque (|L_c| / (sqrt(3) t_max)).
+/// Refuses a run that cannot stop the stack's spin, with InputError naming L_c, the stack's angular
+/// momentum about its centre of mass: without an actuator (L_c is conserved), with wheels that cannot
+/// store it (|L_c| above sqrt(3) times the bound per axis), or when removing it needs longer than the
+/// horizon at the actuator's largest torque (|L_c| / (sqrt(3) t_max)).
 inline void check_detumble_feasible(const Model& stack, const DetumbleState& s, const DetumbleLimits& l,
                                     const DetumbleOptions& o, double horizon) {
-  if (!o.stop_stack_spin || l.actuator == BaseActuator::None) return;
+  if (!o.stop_stack_spin) return;
   Data d(stack);
   crba(stack, d, s.base, s.theta);
   const Vector6 h = d.H.topRows<6>() * s.v;
   const double M = d.H(0, 0);
   const Vector3 rc(d.H(5, 1) / M, d.H(3, 2) / M, d.H(4, 0) / M);
   const double L = (h.tail<3>() - rc.cross(h.head<3>())).norm();
+  if (l.actuator == BaseActuator::None)
+    throw InputError(
+        detail::str("detumble: the stack's spin cannot be stopped without a base actuator: its "
+                    "angular momentum about its centre of mass, ",
+                    L, " N m s, is conserved (name reaction wheels or thrusters)"));
   const double tmax = l.actuator == BaseActuator::ReactionWheels ? l.wheel_torque : l.thruster_torque;
   const double axes = std::sqrt(3.0);
   if (l.actuator == BaseActuator::ReactionWheels && L > axes * l.wheel_momentum)

@@ -67,6 +67,8 @@ inline DetumbleRunResult run_detumble(const Model& stack, int gripper, const Att
                                       const DetumbleState& start, const DetumbleLimits& limits,
                                       const DetumbleOptions& options, const DetumbleRunOptions& run) {
   detail::check_detumble_run(stack, gripper, body, start, run);
+  if (limits.actuator == BaseActuator::None)
+    check_detumble_feasible(stack, start, limits, options, run.horizon);
   detail::check_detumble(stack, limits, options, "run_detumble");
   check_detumble_feasible(stack, start, limits, options, run.horizon);
   DetumbleController ctrl(stack, gripper, limits, options);
