@@ -11,6 +11,7 @@
 #include "ffsr/algorithm/grasp.hpp"
 #include "ffsr/control/detumble_run.hpp"
 #include "ffsr/model/attach.hpp"
+#include "ffsr/scenario/scenario.hpp"
 
 #include <cmath>
 #include <limits>
@@ -232,6 +233,32 @@ TEST_CASE(
   check_torques_within_limits(r, lim.joint_torque);
   // the stack keeps its momentum: the total momentum after the grasp equals the run's
   CHECK((r.series.back().momentum - g.grasp.momentum_after).norm() < 1e-8 * g.grasp.momentum_after.norm());
+}
+
+TEST_CASE("detumble after the paper's approach on robots/paper_7dof_position.toml: at rest within the limits",
+          "[detumble]") {
+  const Scenario sc = load_scenario(source_path("robots/paper_7dof_position.toml"));
+  const CaptureProblem& pb = sc.problem;
+  const CaptureResult plan = plan_capture(pb, sc.task, sc.capture);
+  const CaptureSetup setup = prepare_capture(pb, sc.task, sc.capture);
+  const GraspResult g =
+      grasp_at_capture(*pb.model, pb.frame, plan.base, plan.theta, setup.capture_target, pb.approach_speed);
+  CHECK(g.relative_twist_after.cwiseAbs().maxCoeff() < 1e-12);
+  CHECK(rel(g.momentum_after, g.momentum_before) < 1e-10);
+  const Model stack = attach_body(*pb.model, pb.model->frame(pb.frame).name, g.body);
+  DetumbleLimits lim;
+  lim.joint_torque = limits_7dof();
+  DetumbleRunOptions run;
+  run.horizon = 60;
+  const DetumbleRunResult r =
+      run_detumble(stack, pb.frame, g.body, {plan.base, plan.theta, g.v_after, {}}, lim, {}, run);
+  INFO("time to rest " << r.time_to_rest << " s, peak torque " << r.peak_joint_torque << " N m (joint "
+                       << r.peak_joint << "), gripper " << r.peak_gripper_force << " N "
+                       << r.peak_gripper_moment << " N m, attitude " << r.base_attitude_excursion << " rad");
+  CHECK(r.at_rest);
+  CHECK(r.momentum_drift < 1e-8);
+  CHECK(r.max_energy_balance < 1e-6);
+  check_torques_within_limits(r, lim.joint_torque);
 }
 
 TEST_CASE("detumble, free-floating, torque limits that bind: the brake scaled, still at rest", "[detumble]") {
