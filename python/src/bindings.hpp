@@ -60,4 +60,7 @@ void bind_pareto(nanobind::module_& m);
 void bind_target_estimate(nanobind::module_& m);
 void bind_controller(nanobind::module_& m);
 
+// detumble.cpp: the post-capture phase (the stack model, the grasp, the detumbling controller, its run)
+void bind_detumble(nanobind::module_& m);
+
 }  // namespace ffsr::python

@@ -76,6 +76,9 @@ void operator delete[](void* p, std::size_t) noexcept { operator delete(p); }
 #include <catch2/catch.hpp>
 
 #include "ffsr/control/capture_controller.hpp"
+#include "ffsr/control/detumble_controller.hpp"
+#include "ffsr/model/attach.hpp"
+#include "ffsr/parsers/urdf.hpp"
 #include "ffsr/scenario/scenario.hpp"
 
 #include <cmath>
@@ -142,6 +145,42 @@ TEST_CASE("controller: 1e5 ticks allocate nothing (3-DOF and 7-DOF, gradient and
     CHECK(s.news == 0);
     CHECK(s.deletes == 0);
     CHECK(faults == 100);
+  }
+}
+
+TEST_CASE("detumble controller: 1e5 ticks allocate nothing (7-DOF stack, wheels and free-floating)") {
+  const Model robot = model_from_urdf_file(kRobots + "paper_7dof.urdf");
+  AttachedBody body;
+  body.mass = 200;
+  body.inertia = Vector3(100, 80, 120).asDiagonal();
+  body.pose.p = Vector3(0.3, -0.1, 0.2);
+  const Model stack = attach_body(robot, "ee", body);
+  for (const BaseActuator a : {BaseActuator::None, BaseActuator::ReactionWheels}) {
+    DetumbleLimits lim;
+    lim.joint_torque = Eigen::VectorXd::Constant(7, 5.0);
+    lim.actuator = a;
+    lim.wheel_torque = 0.2;
+    lim.wheel_momentum = 1;
+    DetumbleOptions opt;
+    opt.stop_stack_spin = a != BaseActuator::None;
+    DetumbleController ctrl(stack, stack.frame_index("ee"), lim, opt);
+    DetumbleCommand cmd = ctrl.make_command();
+    DetumbleState st{BasePose{}, Eigen::VectorXd::Constant(7, 0.4), Eigen::VectorXd::Constant(13, 0.05),
+                     Vector3(0.5, -2.0, 0.1)};
+    long faults = 0, saturated = 0;
+    const long n0 = g_news.load(), d0 = g_deletes.load();
+    for (long k = 0; k < 100000; ++k) {
+      for (Eigen::Index j = 0; j < 7; ++j)
+        st.theta(j) = 0.4 + 0.5 * std::sin(1e-3 * static_cast<double>(k + j));
+      st.v(8) = (k % 1000 == 999) ? std::nan("") : 0.05;
+      ctrl.step(st, cmd);
+      faults += cmd.status == DetumbleStatus::Fault;
+      saturated += cmd.status == DetumbleStatus::Saturated;
+    }
+    CHECK(g_news.load() - n0 == 0);
+    CHECK(g_deletes.load() - d0 == 0);
+    CHECK(faults == 100);
+    CHECK(saturated > 0);
   }
 }
 

@@ -168,6 +168,10 @@ inline JointKinematics joint_kinematics(const Body& b) {
 }  // namespace detail
 
 class ModelBuilder;
+class Model;
+struct AttachedBody;
+/// The model with a rigid body attached at a frame (model/attach.hpp).
+inline Model attach_body(const Model& model, const std::string& frame, const AttachedBody& body);
 
 /// A free-floating multibody tree. Constant after it is built (see ModelBuilder).
 class Model {
@@ -222,6 +226,7 @@ class Model {
 
  private:
   friend class ModelBuilder;
+  friend Model attach_body(const Model& model, const std::string& frame, const AttachedBody& body);
   std::vector<Body> bodies_;
   std::vector<Frame> frames_;
   std::vector<int> coord_body_;

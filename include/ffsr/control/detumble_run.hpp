@@ -1,0 +1,192 @@
+// ffsr/control/detumble_run.hpp -- the post-capture run: the grasp at the end of the approach, then the
+// stack's full dynamics (ABA on the stack model) integrated with CVODE, the detumbling controller in the
+// loop at a fixed tick (its command held over the tick), the series and its summary.
+#pragma once
+
+#include "ffsr/algorithm/aba.hpp"
+#include "ffsr/algorithm/grasp.hpp"
+#include "ffsr/control/detumble_controller.hpp"
+#include "ffsr/simulate/cvode.hpp"
+#include "ffsr/simulate/multibody.hpp"
+
+#include <string>
+#include <vector>
+
+namespace ffsr {
+
+/// The run's settings.
+struct DetumbleRunOptions {
+  double tick = 0.01;    ///< control period, s
+  double horizon = 120;  ///< longest run, s
+  int record_every = 1;  ///< keep every k-th tick in the series (0: none)
+  double rtol = 1e-12;   ///< CVODE
+  double atol = 1e-15;   ///< CVODE, on positions, angles, rates and wheel momentum
+};
+
+/// One recorded tick (inertial frame unless said).
+struct DetumbleSample {
+  double t = 0;
+  Eigen::VectorXd theta_dot, tau;
+  Vector3 gripper_force = Vector3::Zero();   ///< on the target by the gripper, N
+  Vector3 gripper_moment = Vector3::Zero();  ///< the same, moment about the contact point, N m
+  Vector6 base_wrench = Vector6::Zero();     ///< the actuator's, about the base origin
+  double base_attitude = 0;                  ///< rotation of the base since the grasp, rad
+  Vector3 wheel_momentum = Vector3::Zero();  ///< stored in the wheels, base frame, N m s
+  double joint_rate = 0, relative_rate = 0, stack_rate = 0;
+  double energy = 0;                   ///< the stack's kinetic energy, J
+  Vector6 momentum = Vector6::Zero();  ///< stack + wheels [P; L about o]
+  DetumbleStatus status = DetumbleStatus::Braking;
+};
+
+struct DetumbleRunResult {
+  bool at_rest = false;
+  double time_to_rest = 0;                       ///< first tick at rest (the horizon if never)
+  double peak_joint_torque = 0;                  ///< N m
+  int peak_joint = -1;                           ///< its joint (coordinate)
+  double peak_gripper_force = 0;                 ///< N
+  double peak_gripper_moment = 0;                ///< N m
+  double base_attitude_excursion = 0;            ///< largest rotation of the base since the grasp, rad
+  double peak_wheel_momentum = 0;                ///< largest stored component, N m s
+  Vector3 wheel_momentum_end = Vector3::Zero();  ///< base frame
+  double momentum_drift = 0;  ///< largest |h(t) - h(0)| / |h(0)| (stack + wheels; not with thrusters)
+  double energy_start = 0, energy_end = 0;
+  double joint_work = 0;  ///< sum over ticks of tau . (theta(t+) - theta(t)): exact for held torques
+  double max_energy_balance =
+      0;  ///< largest |T_k+1 - T_k - W_k| / T(0) over the ticks (without wheels/thrusters)
+  long ticks = 0, steps = 0, faults = 0;
+  std::vector<DetumbleSample> series;
+};
+
+/// The grasp at the end of the approach: the robot at (base, theta) with its contact point moving at
+/// `approach_speed` along the target's normal under zero total momentum (approach_joint_rates, as the
+/// multibody contact run starts), the target (its state at the capture) placed with its contact point
+/// on the frame's origin. Returns grasp() of that state.
+inline GraspResult grasp_at_capture(const Model& model, int frame, const BasePose& base,
+                                    const Eigen::VectorXd& theta, Target target, double approach_speed) {
+  Data d(model);
+  forward_kinematics(model, d, base, theta);
+  const Eigen::VectorXd qd =
+      approach_joint_rates(model, d, base, theta, frame, target.normal_world(), approach_speed);
+  Eigen::VectorXd v(model.nv());
+  v << base_velocity_from_momentum(model, d, qd), qd;
+  target.position = frame_pose(model, d, frame).p - target.offset_world();
+  return grasp(model, d, base, theta, v, frame, target);
+}
+
+namespace detail {
+
+/// The stack's ODE: y = [p_0 (3), base quaternion (x, y, z, w), theta (n), v (6+n), wheel momentum (3,
+/// inertial)] with the command held; ABA on the stack. Also the gripper load of a state.
+struct DetumbleSystem {
+  const Model& model;
+  Data data;
+  int n;
+  Eigen::VectorXd tau, a, theta, v;
+  DetumbleSystem(const Model& m)
+      : model(m), data(m), n(m.n()), tau(m.nv()), a(m.nv()), theta(m.n()), v(m.nv()) {}
+  Eigen::Index size() const { return 16 + 2 * n; }
+  BasePose base(const Eigen::Ref<const Eigen::VectorXd>& y) const {
+    BasePose b;
+    b.position = y.head<3>();
+    b.orientation = Quaternion(y(6), y(3), y(4), y(5)).normalized();
+    return b;
+  }
+  Eigen::VectorXd pack(const DetumbleState& s) const {
+    Eigen::VectorXd y(size());
+    const Quaternion q = s.base.orientation.normalized();
+    y << s.base.position, q.x(), q.y(), q.z(), q.w(), s.theta, s.v, s.wheel_momentum;
+    return y;
+  }
+  DetumbleState unpack(const Eigen::Ref<const Eigen::VectorXd>& y) const {
+    return {base(y), y.segment(7, n), y.segment(7 + n, 6 + n), y.tail<3>()};
+  }
+  /// ydot at y for the command c (wheel torque: the base's moment when the actuator is wheels).
+  void rhs(const Eigen::Ref<const Eigen::VectorXd>& y, const DetumbleCommand& c, bool wheels,
+           Eigen::Ref<Eigen::VectorXd> ydot) {
+    const BasePose b = base(y);
+    theta = y.segment(7, n);
+    v = y.segment(7 + n, 6 + n);
+    tau << c.base_wrench, c.tau;
+    aba(model, data, b, theta, v, tau, a);
+    const Vector3 w = v.segment<3>(3);
+    const Quaternion qd = Quaternion(0, w.x(), w.y(), w.z()) * Quaternion(y(6), y(3), y(4), y(5));
+    ydot.head<3>() = v.head<3>();
+    ydot.segment<4>(3) = 0.5 * qd.coeffs();
+    ydot.segment(7, n) = v.tail(n);
+    ydot.segment(7 + n, 6 + n) = a;
+    ydot.tail<3>() = wheels ? Vector3(-c.base_wrench.tail<3>()) : Vector3::Zero();
+  }
+  /// The wrench the gripper applies on the target (its rate of momentum, the Newton-Euler equation of
+  /// the attached body from the stack's accelerations): f = I_t A_e + V_e x* (I_t V_e) - I_t a_g about
+  /// p_0, moved to the contact point. Runs aba (rhs) first. Writes force and moment.
+  void gripper_load(const Eigen::Ref<const Eigen::VectorXd>& y, const DetumbleCommand& c, int gripper,
+                    const AttachedBody& body, Vector3& force, Vector3& moment) {
+    Eigen::VectorXd ydot(size());
+    rhs(y, c, false, ydot);
+    const int e = model.frame(gripper).body;
+    const Pose pg = frame_pose(model, data, gripper);
+    const Pose pt = pg * body.pose;
+    const Vector3& p0 = data.p[0];
+    const SpatialInertia It =
+        SpatialInertia::from_com(body.mass, pt.p - p0, pt.R * body.inertia * pt.R.transpose());
+    Vector6 f = It * data.A[static_cast<size_t>(e)], bias;
+    rigid_bias_force(It, data.V[static_cast<size_t>(e)], model.gravity, bias);
+    f += bias;
+    force = f.head<3>();
+    moment = f.tail<3>() - (pg.p - p0).cross(force);
+  }
+  /// The stack's kinetic energy and [P; L about o] plus the wheels' momentum.
+  void energy_momentum(const Eigen::Ref<const Eigen::VectorXd>& y, double& T, Vector6& h) {
+    const BasePose b = base(y);
+    theta = y.segment(7, n);
+    v = y.segment(7 + n, 6 + n);
+    forward_kinematics(model, data, b, theta);
+    T = kinetic_energy(model, data, v);
+    h = robot_momentum_about_origin(model, data, v);
+    h.tail<3>() += y.tail<3>();
+  }
+};
+
+}  // namespace detail
+
+/// Refuses a run that cannot stop the stack's spin, with InputError naming L_c, the stack's angular
+/// momentum about its centre of mass: without an actuator (L_c is conserved), with wheels that cannot
+/// store it (|L_c| above sqrt(3) times the bound per axis), or when removing it needs longer than the
+/// horizon at the actuator's largest torque (|L_c| / (sqrt(3) t_max)).
+inline void check_detumble_feasible(const Model& stack, const DetumbleState& s, const DetumbleLimits& l,
+                                    const DetumbleOptions& o, double horizon) {
+  if (!o.stop_stack_spin) return;
+  Data d(stack);
+  crba(stack, d, s.base, s.theta);
+  const Vector6 h = d.H.topRows<6>() * s.v;
+  const double M = d.H(0, 0);
+  const Vector3 rc(d.H(5, 1) / M, d.H(3, 2) / M, d.H(4, 0) / M);
+  const double L = (h.tail<3>() - rc.cross(h.head<3>())).norm();
+  if (l.actuator == BaseActuator::None)
+    throw InputError(
+        detail::str("detumble: the stack's spin cannot be stopped without a base actuator: its "
+                    "angular momentum about its centre of mass, ",
+                    L, " N m s, is conserved (name reaction wheels or thrusters)"));
+  const double tmax = l.actuator == BaseActuator::ReactionWheels ? l.wheel_torque : l.thruster_torque;
+  const double axes = std::sqrt(3.0);
+  if (l.actuator == BaseActuator::ReactionWheels && L > axes * l.wheel_momentum)
+    throw InputError(detail::str("detumble: the reaction wheels cannot store the stack's angular momentum: ",
+                                 L, " N m s about its centre of mass, at most ", axes * l.wheel_momentum,
+                                 " N m s (", l.wheel_momentum, " per axis)"));
+  if (L / (axes * tmax) > horizon)
+    throw InputError(detail::str(
+        "detumble: the base actuator's torque (", tmax, " N m per axis) needs at least ", L / (axes * tmax),
+        " s to remove the stack's angular momentum ", L, " N m s; the horizon is ", horizon, " s"));
+}
+
+/// The post-capture run from `start` (the grasp's state on the stack model; see the top of the file).
+/// `gripper` is the frame carrying `body` (the grasped target). The controller's command is computed
+/// at each tick and held until the next; the run stops at the first tick at rest or at the horizon.
+/// InputError for bad options; IntegrationError from CVODE.
+inline DetumbleRunResult run_detumble(const Model& stack, int gripper, const AttachedBody& body,
+                                      const DetumbleState& start, const DetumbleLimits& limits,
+                                      const DetumbleOptions& options, const DetumbleRunOptions& run);
+
+}  // namespace ffsr
+
+#include "ffsr/control/detail/detumble_run.hxx"

@@ -1,0 +1,261 @@
+// python/src/detumble.cpp -- the post-capture phase: attach_body (the stack model), grasp and
+// grasp_at_capture (the plastic lock), the DetumbleController (one step per tick) and run_detumble
+// (the stack's dynamics with the controller in the loop). Names and fields mirror C++.
+#include "arguments.hpp"
+#include "bindings.hpp"
+#include "outputs.hpp"
+
+#include "ffsr/control/detumble_run.hpp"
+
+#include <nanobind/stl/string.h>
+
+namespace ffsr::python {
+
+using namespace nb::literals;
+
+namespace {
+
+BaseActuator actuator_arg(const std::string& name) {
+  for (BaseActuator a : {BaseActuator::None, BaseActuator::ReactionWheels, BaseActuator::Thrusters})
+    if (name == actuator_name(a)) return a;
+  throw InputError(detail::str("detumble: unknown actuator '", name, "' (none, reaction-wheels, thrusters)"));
+}
+
+DetumbleLimits limits_arg(const Model& stack, nb::handle joint_torque, const std::string& actuator,
+                          double wheel_torque, double wheel_momentum, double thruster_force,
+                          double thruster_torque) {
+  DetumbleLimits l;
+  const VecIn t(joint_torque, "detumble", "joint_torque");
+  t.require(stack.n());
+  l.joint_torque = t.map();
+  l.actuator = actuator_arg(actuator);
+  l.wheel_torque = wheel_torque;
+  l.wheel_momentum = wheel_momentum;
+  l.thruster_force = thruster_force;
+  l.thruster_torque = thruster_torque;
+  return l;
+}
+
+DetumbleOptions options_arg(double joint_gain, double base_gain, double rest_rate, bool stop_stack_spin,
+                            bool hold) {
+  DetumbleOptions o;
+  o.joint_gain = joint_gain;
+  o.base_gain = base_gain;
+  o.rest_rate = rest_rate;
+  o.stop_stack_spin = stop_stack_spin;
+  o.hold = hold;
+  return o;
+}
+
+DetumbleState state_arg(const Model& stack, const BasePose& base, nb::handle theta, nb::handle v,
+                        nb::handle wheel_momentum) {
+  const VecIn th(theta, "detumble", "theta"), vv(v, "detumble", "v");
+  th.require(stack.n());
+  vv.require(stack.nv());
+  DetumbleState s{base, th.map(), vv.map(), Vector3::Zero()};
+  if (!wheel_momentum.is_none()) s.wheel_momentum = vec3(wheel_momentum, "detumble", "wheel_momentum");
+  return s;
+}
+
+nb::dict grasp_dict(const GraspResult& g) {
+  nb::dict d;
+  d["v_before"] = out(g.v_before);
+  d["v_after"] = out(g.v_after);
+  d["target_before"] = out(g.target_before);
+  d["target_after"] = out(g.target_after);
+  d["impulse"] = out(g.impulse);
+  d["base_velocity_jump"] = out(g.base_velocity_jump);
+  d["momentum_before"] = out(g.momentum_before);
+  d["momentum_after"] = out(g.momentum_after);
+  d["energy_before"] = g.energy_before;
+  d["energy_after"] = g.energy_after;
+  d["relative_twist_after"] = out(g.relative_twist_after);
+  d["contact_point"] = out(g.contact_point);
+  return d;
+}
+
+void bind_results(nb::module_& m) {
+  nb::class_<AttachedBody>(
+      m, "AttachedBody",
+      "A rigid body attached at a frame: mass (kg), inertia about its centre of mass (its\n"
+      "axes, kg m^2), pose of its centre-of-mass frame in the frame, the name of that frame.")
+      .def_ro("mass", &AttachedBody::mass)
+      .def_prop_ro(
+          "inertia", [](const AttachedBody& b) { return out(b.inertia); }, nb::rv_policy::automatic)
+      .def_ro("pose", &AttachedBody::pose)
+      .def_ro("name", &AttachedBody::name);
+  nb::class_<GraspResult>(m, "GraspResult",
+                          "The plastic lock of gripper and target: velocities before and after (inertial,\n"
+                          "linear first), the impulse on the gripper at the contact point (N s, N m s).")
+      .def_prop_ro(
+          "v_before", [](const GraspResult& g) { return out(g.v_before); }, nb::rv_policy::automatic)
+      .def_prop_ro(
+          "v_after", [](const GraspResult& g) { return out(g.v_after); }, nb::rv_policy::automatic)
+      .def_prop_ro(
+          "target_before", [](const GraspResult& g) { return out(g.target_before); },
+          nb::rv_policy::automatic)
+      .def_prop_ro(
+          "target_after", [](const GraspResult& g) { return out(g.target_after); }, nb::rv_policy::automatic)
+      .def_prop_ro(
+          "impulse", [](const GraspResult& g) { return out(g.impulse); }, nb::rv_policy::automatic)
+      .def_prop_ro(
+          "base_velocity_jump", [](const GraspResult& g) { return out(g.base_velocity_jump); },
+          nb::rv_policy::automatic)
+      .def_prop_ro(
+          "momentum_before", [](const GraspResult& g) { return out(g.momentum_before); },
+          nb::rv_policy::automatic)
+      .def_prop_ro(
+          "momentum_after", [](const GraspResult& g) { return out(g.momentum_after); },
+          nb::rv_policy::automatic)
+      .def_ro("energy_before", &GraspResult::energy_before)
+      .def_ro("energy_after", &GraspResult::energy_after)
+      .def_prop_ro(
+          "relative_twist_after", [](const GraspResult& g) { return out(g.relative_twist_after); },
+          nb::rv_policy::automatic)
+      .def_prop_ro(
+          "contact_point", [](const GraspResult& g) { return out(g.contact_point); },
+          nb::rv_policy::automatic)
+      .def_ro("body", &GraspResult::body)
+      .def("to_dict", &grasp_dict)
+      .def("__repr__", [](const GraspResult& g) {
+        return detail::str("GraspResult(impulse ", g.impulse.head<3>().norm(), " N s, ",
+                           g.impulse.tail<3>().norm(), " N m s, energy ", g.energy_before, " -> ",
+                           g.energy_after, " J)");
+      });
+  nb::class_<DetumbleRunResult>(m, "DetumbleResult", "The post-capture run's summary and series (SI units).")
+      .def_ro("at_rest", &DetumbleRunResult::at_rest)
+      .def_ro("time_to_rest", &DetumbleRunResult::time_to_rest)
+      .def_ro("peak_joint_torque", &DetumbleRunResult::peak_joint_torque)
+      .def_ro("peak_joint", &DetumbleRunResult::peak_joint)
+      .def_ro("peak_gripper_force", &DetumbleRunResult::peak_gripper_force)
+      .def_ro("peak_gripper_moment", &DetumbleRunResult::peak_gripper_moment)
+      .def_ro("base_attitude_excursion", &DetumbleRunResult::base_attitude_excursion)
+      .def_ro("peak_wheel_momentum", &DetumbleRunResult::peak_wheel_momentum)
+      .def_ro("momentum_drift", &DetumbleRunResult::momentum_drift)
+      .def_ro("energy_start", &DetumbleRunResult::energy_start)
+      .def_ro("energy_end", &DetumbleRunResult::energy_end)
+      .def_ro("joint_work", &DetumbleRunResult::joint_work)
+      .def_ro("ticks", &DetumbleRunResult::ticks)
+      .def_prop_ro(
+          "series_t",
+          [](const DetumbleRunResult& r) {
+            Eigen::VectorXd t(static_cast<Eigen::Index>(r.series.size()));
+            for (size_t i = 0; i < r.series.size(); ++i) t(static_cast<Eigen::Index>(i)) = r.series[i].t;
+            return out(t);
+          },
+          nb::rv_policy::automatic)
+      .def_prop_ro(
+          "series_tau",
+          [](const DetumbleRunResult& r) {
+            Eigen::MatrixXd x(static_cast<Eigen::Index>(r.series.size()),
+                              r.series.empty() ? 0 : r.series[0].tau.size());
+            for (size_t i = 0; i < r.series.size(); ++i)
+              x.row(static_cast<Eigen::Index>(i)) = r.series[i].tau.transpose();
+            return out(x);
+          },
+          nb::rv_policy::automatic)
+      .def("__repr__", [](const DetumbleRunResult& r) {
+        return detail::str("DetumbleResult(", r.at_rest ? "at rest in " : "not at rest after ",
+                           r.time_to_rest, " s, peak joint torque ", r.peak_joint_torque, " N m)");
+      });
+}
+
+}  // namespace
+
+void bind_detumble(nb::module_& m) {
+  bind_results(m);
+  nb::class_<DetumbleController>(
+      m, "DetumbleController",
+      "The detumbling controller on the stack model: one step per tick, no allocation.")
+      .def(
+          "__init__",
+          [](DetumbleController* self, const Model& stack, nb::handle gripper, nb::handle joint_torque,
+             const std::string& actuator, double wheel_torque, double wheel_momentum, double thruster_force,
+             double thruster_torque, double joint_gain, double base_gain, double rest_rate,
+             bool stop_stack_spin, bool hold) {
+            new (self)
+                DetumbleController(stack, frame_arg(stack, gripper, "DetumbleController"),
+                                   limits_arg(stack, joint_torque, actuator, wheel_torque, wheel_momentum,
+                                              thruster_force, thruster_torque),
+                                   options_arg(joint_gain, base_gain, rest_rate, stop_stack_spin, hold));
+          },
+          "stack"_a, "gripper"_a, "joint_torque"_a, "actuator"_a = "none", "wheel_torque"_a = 0.0,
+          "wheel_momentum"_a = 0.0, "thruster_force"_a = 0.0, "thruster_torque"_a = 0.0, "joint_gain"_a = 1.0,
+          "base_gain"_a = 0.1, "rest_rate"_a = 1e-3, "stop_stack_spin"_a = false, "hold"_a = true,
+          nb::keep_alive<1, 2>())
+      .def(
+          "step",
+          [](DetumbleController& c, const Model& stack, const BasePose& base, nb::handle theta, nb::handle v,
+             nb::handle wheel_momentum) {
+            DetumbleCommand cmd = c.make_command();
+            c.step(state_arg(stack, base, theta, v, wheel_momentum), cmd);
+            nb::dict d;
+            d["tau"] = out(cmd.tau);
+            d["base_wrench"] = out(cmd.base_wrench);
+            d["status"] = status_name(cmd.status);
+            d["fault"] = fault_name(cmd.fault);
+            d["joint_rate"] = cmd.joint_rate;
+            d["relative_rate"] = cmd.relative_rate;
+            d["stack_rate"] = cmd.stack_rate;
+            d["brake_scale"] = cmd.brake_scale;
+            return d;
+          },
+          "stack"_a, "base"_a, "theta"_a, "v"_a, "wheel_momentum"_a = nb::none(),
+          "One tick: the command (tau, base_wrench, status...) as a dict.");
+  m.def(
+      "attach_body",
+      [](const Model& model, const std::string& frame, double mass, nb::handle inertia, const Pose& pose,
+         const std::string& name) {
+        AttachedBody b{mass, mat3(inertia, "attach_body", "inertia"), pose, name};
+        return attach_body(model, frame, b);
+      },
+      "model"_a, "frame"_a, "mass"_a, "inertia"_a, "pose"_a = Pose{}, "name"_a = "target",
+      "The model with a rigid body attached at `frame` (the stack): its inertia merged into the frame's\n"
+      "body, a frame `name` at its centre of mass. InputError for a non-physical body or unknown frame.");
+  m.def(
+      "grasp",
+      [](const Model& model, Data& data, const BasePose& base, nb::handle theta, nb::handle v,
+         nb::handle frame, const Target& target) {
+        check_data(model, data, "grasp");
+        const VecIn th(theta, "grasp", "theta"), vv(v, "grasp", "v");
+        return grasp(model, data, base, th.map(), vv.map(), frame_arg(model, frame, "grasp"), target);
+      },
+      "model"_a, "data"_a, "base"_a, "theta"_a, "v"_a, "frame"_a = nb::none(), "target"_a,
+      "The plastic 6-D lock of the gripper (the frame's origin) on the target: the KKT system\n"
+      "[M J^T; J 0][v+; -p] = [M v-; 0] with the target as a second free body.");
+  m.def(
+      "grasp_at_capture",
+      [](const Model& model, nb::handle frame, const BasePose& base, nb::handle theta, const Target& target,
+         double approach_speed) {
+        const VecIn th(theta, "grasp_at_capture", "theta");
+        th.require(model.n());
+        return grasp_at_capture(model, frame_arg(model, frame, "grasp_at_capture"), base, th.map(), target,
+                                approach_speed);
+      },
+      "model"_a, "frame"_a = nb::none(), "base"_a, "theta"_a, "target"_a, "approach_speed"_a,
+      "The grasp at the end of the approach (contact point moving at approach_speed along the normal\n"
+      "under zero momentum, the target's contact point on the frame's origin).");
+  m.def(
+      "run_detumble",
+      [](const Model& stack, nb::handle gripper, const AttachedBody& body, const BasePose& base,
+         nb::handle theta, nb::handle v, nb::handle joint_torque, const std::string& actuator,
+         double wheel_torque, double wheel_momentum, double thruster_force, double thruster_torque,
+         double joint_gain, double base_gain, double rest_rate, bool stop_stack_spin, bool hold, double tick,
+         double horizon) {
+        const DetumbleLimits l = limits_arg(stack, joint_torque, actuator, wheel_torque, wheel_momentum,
+                                            thruster_force, thruster_torque);
+        DetumbleRunOptions r;
+        r.tick = tick;
+        r.horizon = horizon;
+        return run_detumble(stack, frame_arg(stack, gripper, "run_detumble"), body,
+                            state_arg(stack, base, theta, v, nb::none()), l,
+                            options_arg(joint_gain, base_gain, rest_rate, stop_stack_spin, hold), r);
+      },
+      "stack"_a, "gripper"_a, "body"_a, "base"_a, "theta"_a, "v"_a, "joint_torque"_a, "actuator"_a = "none",
+      "wheel_torque"_a = 0.0, "wheel_momentum"_a = 0.0, "thruster_force"_a = 0.0, "thruster_torque"_a = 0.0,
+      "joint_gain"_a = 1.0, "base_gain"_a = 0.1, "rest_rate"_a = 1e-3, "stop_stack_spin"_a = false,
+      "hold"_a = true, "tick"_a = 0.01, "horizon"_a = 120.0,
+      "The post-capture run on the stack (ABA, CVODE) with the DetumbleController in the loop.");
+}
+
+}  // namespace ffsr::python

@@ -1,0 +1,131 @@
+"""The grasp of ffsr against an independent computation with Pinocchio (`pin`): the robot's URDF with a
+free-flyer base plus the target as a second free-flyer, the 6-D lock's Jacobian from Pinocchio's frame
+Jacobians (the gripper frame minus a frame of the target at the same point), and the plastic impulse
+from the KKT system [M J^T; J 0][v+; -p] = [M v-; 0] solved with numpy. The velocities after the lock
+agree to 1e-9 on both paper robots. Also the post-capture run and the controller through Python."""
+
+import numpy as np
+import pytest
+
+import ffsr
+
+pin = pytest.importorskip("pinocchio", reason="Pinocchio's Python package `pin` is a test requirement")
+
+from conftest import ROBOTS  # noqa: E402
+
+
+def quat_to_rot(q):  # (x, y, z, w)
+    x, y, z, w = q / np.linalg.norm(q)
+    return np.array([
+        [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+        [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+        [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+    ])
+
+
+def random_target(rng, point):
+    a = rng.uniform(5, 60, 3)
+    Q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+    inertia = Q @ np.diag([a[1] + a[2], a[0] + a[2], a[0] + a[1]]) @ Q.T
+    quat = rng.normal(size=4)
+    return ffsr.Target(mass=180.0, inertia=inertia, position=point + rng.uniform(-0.4, 0.4, 3),
+                       attitude=quat / np.linalg.norm(quat), velocity=rng.uniform(-0.05, 0.05, 3),
+                       angular_velocity=rng.uniform(-0.1, 0.1, 3))
+
+
+def pinocchio_grasp(path, fm, base, theta, v, target, ee_name):
+    """v+ of robot and target (ffsr's coordinates: robot [v0, w0, theta_dot], target [v_c, w]) and the
+    impulse on the gripper, by Pinocchio."""
+    pm = pin.buildModelFromUrdf(str(path), pin.JointModelFreeFlyer())
+    tj = pm.addJoint(0, pin.JointModelFreeFlyer(), pin.SE3.Identity(), "target_free_flyer")
+    inertia = pin.Inertia(target.mass, np.zeros(3), np.asarray(target.inertia))
+    pm.appendBodyToJoint(tj, inertia, pin.SE3.Identity())
+    pd = pm.createData()
+    R0 = quat_to_rot(base.orientation)
+    Rt = quat_to_rot(target.attitude)
+    q = np.zeros(pm.nq)
+    q[:3] = base.position
+    q[3:7] = base.orientation
+    n = fm.n
+    T = np.zeros((pm.nv, fm.nv + 6))  # Pinocchio's v = T [ffsr v; target twist]
+    T[0:3, 0:3] = R0.T
+    T[3:6, 3:6] = R0.T
+    for b in fm.bodies[1:]:
+        j = pm.joints[pm.getJointId(b.joint.name)]
+        if j.nq == 2:
+            q[j.idx_q:j.idx_q + 2] = [np.cos(theta[b.coord]), np.sin(theta[b.coord])]
+        else:
+            q[j.idx_q] = theta[b.coord]
+        T[j.idx_v, 6 + b.coord] = 1.0
+    jt = pm.joints[tj]
+    q[jt.idx_q:jt.idx_q + 3] = target.position
+    q[jt.idx_q + 3:jt.idx_q + 7] = target.attitude
+    T[jt.idx_v:jt.idx_v + 3, fm.nv:fm.nv + 3] = Rt.T
+    T[jt.idx_v + 3:jt.idx_v + 6, fm.nv + 3:fm.nv + 6] = Rt.T
+    pin.forwardKinematics(pm, pd, q)
+    pin.updateFramePlacements(pm, pd)
+    ee = pm.getFrameId(ee_name)
+    p = pd.oMf[ee].translation
+    # a frame of the target at the contact point (its placement in the target's centre-of-mass frame)
+    grip = pm.addFrame(pin.Frame("target_grip", tj, 0, pin.SE3(np.eye(3), Rt.T @ (p - target.position)),
+                                 pin.FrameType.OP_FRAME))
+    pd = pm.createData()
+    pin.crba(pm, pd, q)
+    M = np.triu(pd.M) + np.triu(pd.M, 1).T
+    pin.computeJointJacobians(pm, pd, q)
+    pin.updateFramePlacements(pm, pd)
+    assert np.allclose(pd.oMf[grip].translation, p, atol=1e-12)
+    Jg = pin.getFrameJacobian(pm, pd, ee, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
+    Jt = pin.getFrameJacobian(pm, pd, grip, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
+    J = Jg - Jt
+    vminus = T @ np.concatenate([v, target.velocity, Rt @ target.angular_velocity])
+    K = np.block([[M, J.T], [J, np.zeros((6, 6))]])
+    sol = np.linalg.solve(K, np.concatenate([M @ vminus, np.zeros(6)]))
+    vplus = sol[:pm.nv]
+    back = np.linalg.lstsq(T, vplus, rcond=None)[0]  # T has full column rank (square, invertible blocks)
+    return back[:fm.nv], back[fm.nv:], -sol[pm.nv:]
+
+
+@pytest.mark.parametrize("urdf", ["paper_3dof.urdf", "paper_7dof.urdf"])
+def test_grasp_against_pinocchio(urdf):
+    path = ROBOTS / urdf
+    fm = ffsr.Model.from_urdf(str(path), end_effector="ee")
+    data = ffsr.Data(fm)
+    rng = np.random.default_rng(48)
+    for _ in range(4):
+        quat = rng.normal(size=4)
+        base = ffsr.BasePose(rng.uniform(-1, 1, 3), quat / np.linalg.norm(quat))
+        theta = rng.uniform(-1.5, 1.5, fm.n)
+        v = rng.uniform(-0.3, 0.3, fm.nv)
+        ffsr.forward_kinematics(fm, data, base, theta)
+        point = ffsr.frame_pose(fm, data, fm.end_effector).p
+        target = random_target(rng, point)
+        g = ffsr.grasp(fm, data, base, theta, v, None, target)
+        v_ref, tw_ref, p_ref = pinocchio_grasp(path, fm, base, theta, v, target, "ee")
+        scale = max(1.0, np.max(np.abs(v_ref)))
+        assert np.max(np.abs(g.v_after - v_ref)) / scale < 1e-9
+        assert np.max(np.abs(g.target_after - tw_ref)) / max(1.0, np.max(np.abs(tw_ref))) < 1e-9
+        assert np.max(np.abs(g.impulse - p_ref)) / max(1.0, np.max(np.abs(p_ref))) < 1e-9
+        assert np.linalg.norm(g.impulse) > 1e-3
+        d = g.to_dict()
+        assert np.array_equal(d["v_after"], g.v_after)
+
+
+def test_detumble_run_and_controller():
+    fm = ffsr.Model.from_urdf(str(ROBOTS / "paper_7dof.urdf"), end_effector="ee")
+    theta = np.radians([0, 90, 90, -90, 90, 90, 0])
+    target = ffsr.Target(angular_velocity=np.radians([1, -0.5, 2]), contact_offset=[-0.25, 0.15, 0.1])
+    base = ffsr.BasePose()
+    g = ffsr.grasp_at_capture(fm, None, base, theta, target, 0.2)
+    stack = ffsr.attach_body(fm, "ee", g.body.mass, g.body.inertia, g.body.pose)
+    limits = [60, 60, 60, 40, 20, 20, 20]
+    r = ffsr.run_detumble(stack, "ee", g.body, base, theta, g.v_after, limits, horizon=60.0)
+    assert r.at_rest and r.momentum_drift < 1e-8
+    assert np.all(np.abs(r.series_tau) <= np.asarray(limits) * (1 + 1e-12))
+    c = ffsr.DetumbleController(stack, "ee", limits)
+    cmd = c.step(stack, base, theta, g.v_after)
+    assert cmd["status"] == "braking" and np.all(np.abs(cmd["tau"]) <= limits)
+    with pytest.raises(ffsr.InputError, match="angular momentum is conserved"):
+        ffsr.DetumbleController(stack, "ee", limits, stop_stack_spin=True)
+    with pytest.raises(ffsr.InputError, match="mass must be positive"):
+        ffsr.attach_body(fm, "ee", 0.0, np.eye(3), g.body.pose)

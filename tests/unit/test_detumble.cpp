@@ -1,0 +1,428 @@
+// The post-capture phase: the stack model (a body attached at a frame) against sums over bodies from
+// finite differences of forward kinematics; the grasp's plastic impulse (momentum conserved, relative
+// twist zero, the stack's momentum equal to the two bodies'); the detumbling controller and its run.
+
+#include <catch2/catch.hpp>
+
+#include "support/dynamics_helpers.hpp"
+
+#include "ffsr/algorithm/aba.hpp"
+#include "ffsr/algorithm/forward_dynamics.hpp"
+#include "ffsr/algorithm/grasp.hpp"
+#include "ffsr/control/detumble_run.hpp"
+#include "ffsr/model/attach.hpp"
+#include "ffsr/scenario/scenario.hpp"
+
+#include <cmath>
+#include <limits>
+#include <string>
+
+namespace test_detumble {
+
+using namespace ffsr;
+using namespace ffsr_test;
+
+namespace {
+
+/// A target of the paper's kind with a full inertia, placed so that the frame's origin is a point of it.
+Target random_target(Rng& rng, const Vector3& contact) {
+  Target t;
+  t.mass = 200;
+  t.inertia = rng.inertia(60.0);
+  t.attitude = rng.quaternion();
+  t.position = contact + rng.vec3(0.4);
+  t.velocity = rng.vec3(0.05);
+  t.angular_velocity = rng.vec3(0.1);
+  return t;
+}
+
+double rel(const Vector6& a, const Vector6& b) { return (a - b).norm() / std::max(b.norm(), 1e-300); }
+
+}  // namespace
+
+TEST_CASE("attach_body: the stack's momentum, energy and H equal sums over its bodies", "[detumble]") {
+  for (const std::string file : {"paper_3dof.urdf", "paper_7dof.urdf"}) {
+    const TestRobot robot = paper_robot(file);
+    Rng rng(7);
+    AttachedBody body;
+    body.mass = 150;
+    body.inertia = rng.inertia(40.0);
+    body.pose = Pose{rng.vec3(0.5), rng.rotation()};
+    TestRobot stack{file + " + target", attach_body(robot.model, robot.model.frame(robot.ee).name, body),
+                    robot.links, robot.ee};
+    stack.links.push_back({"target", Inertia{body.mass, Vector3::Zero(), body.inertia}});
+    REQUIRE(stack.model.n() == robot.model.n());
+    REQUIRE(std::abs(stack.model.total_mass() - robot.model.total_mass() - body.mass) < 1e-12);
+    for (int trial = 0; trial < 3; ++trial) {
+      const Config q = random_config(stack.model, rng);
+      const VectorXd v = rng.vec(stack.model.nv(), 0.5);
+      Data d(stack.model);
+      crba(stack.model, d, q.base, q.theta);
+      const auto lv = fd_link_velocities(stack, q, v, advance_library);
+      // momentum about the base origin: the sum over the listed masses (finite differences)
+      const Vector6 h_fd = fd_momentum(stack, lv, d.p[0]);
+      CHECK(rel(momentum(stack.model, d, v), h_fd) < 1e-7);
+      CHECK(rel(Vector6(d.H.topRows<6>() * v), h_fd) < 1e-7);
+      const double T_fd = fd_kinetic_energy(stack, lv);
+      CHECK(std::abs(kinetic_energy(stack.model, d, v) - T_fd) < 1e-7 * T_fd);
+      CHECK(std::abs(0.5 * v.dot(d.H * v) - T_fd) < 1e-7 * T_fd);
+      // ABA on the stack equals the CRBA/RNEA forward dynamics of the stack
+      const VectorXd tau = rng.vec(stack.model.nv(), 5.0);
+      VectorXd a1, a2;
+      aba(stack.model, d, q.base, q.theta, v, tau, a1);
+      forward_dynamics(stack.model, d, q.base, q.theta, v, tau, a2);
+      CHECK((a1 - a2).norm() < 1e-9 * std::max(1.0, a2.norm()));
+    }
+  }
+}
+
+TEST_CASE("attach_body refuses a non-physical body and an unknown frame", "[detumble]") {
+  const Model m = model_from_urdf_file(source_path("robots/paper_7dof.urdf"));
+  AttachedBody b;
+  b.mass = 100;
+  b.inertia = Vector3(10, 20, 25).asDiagonal();
+  CHECK_NOTHROW(attach_body(m, "ee", b));
+  auto refused = [&](AttachedBody x, const std::string& frame, const std::string& words) {
+    try {
+      attach_body(m, frame, x);
+      FAIL("accepted: " << words);
+    } catch (const InputError& e) {
+      CHECK_THAT(e.what(), Catch::Contains(words));
+    }
+  };
+  AttachedBody x = b;
+  x.mass = 0;
+  refused(x, "ee", "mass must be positive");
+  x.mass = -1;
+  refused(x, "ee", "mass must be positive");
+  x.mass = std::numeric_limits<double>::quiet_NaN();
+  refused(x, "ee", "mass must be positive");
+  x = b;
+  x.inertia = Vector3(10, 20, -1).asDiagonal();
+  refused(x, "ee", "positive definite");
+  x.inertia = Vector3(1, 1, 5).asDiagonal();
+  refused(x, "ee", "triangle inequality");
+  x.inertia(0, 1) = 0.5;
+  refused(x, "ee", "symmetric");
+  x = b;
+  x.inertia(2, 2) = std::numeric_limits<double>::infinity();
+  refused(x, "ee", "inertia");
+  refused(b, "gripper", "unknown frame 'gripper'");
+  x = b;
+  x.name = "link3";
+  refused(x, "ee", "already has a frame 'link3'");
+}
+
+TEST_CASE("grasp: momentum conserved, relative twist zero, the stack's momentum the two bodies'",
+          "[detumble]") {
+  for (const std::string file : {"paper_3dof.urdf", "paper_7dof.urdf"}) {
+    const Model m = model_from_urdf_file(source_path("robots/" + file));
+    Data d(m);
+    Rng rng(11);
+    for (int trial = 0; trial < 4; ++trial) {
+      const Config q = random_config(m, rng, 2.0);
+      const VectorXd v = rng.vec(m.nv(), 0.3);
+      forward_kinematics(m, d, q.base, q.theta);
+      const Target t = random_target(rng, frame_pose(m, d, m.end_effector()).p);
+      const GraspResult g = grasp(m, d, q.base, q.theta, v, m.end_effector(), t);
+      // the KKT system's second row: the relative twist after the lock is zero
+      CHECK(g.relative_twist_after.cwiseAbs().maxCoeff() < 1e-12);
+      CHECK(rel(g.momentum_after, g.momentum_before) < 1e-10);
+      CHECK(g.energy_after <= g.energy_before);  // plastic: energy is lost, never gained
+      CHECK(g.impulse.norm() > 1e-3);            // the relative twist was not zero before
+      // the stack model's momentum at v+ is the two bodies' momentum after the lock
+      const Model stack = attach_body(m, m.frame(m.end_effector()).name, g.body);
+      Data ds(stack);
+      forward_kinematics(stack, ds, q.base, q.theta);
+      Vector6 hs = momentum(stack, ds, g.v_after);
+      hs.tail<3>() += ds.p[0].cross(hs.head<3>());
+      CHECK(rel(hs, g.momentum_after) < 1e-10);
+      CHECK(std::abs(kinetic_energy(stack, ds, g.v_after) - g.energy_after) < 1e-10 * g.energy_after);
+      // the target frame of the stack sits where the target is
+      const Pose tp = frame_pose(stack, ds, stack.frame_index("target"));
+      CHECK((tp.p - t.position).norm() < 1e-12);
+      CHECK((tp.R - t.rotation()).norm() < 1e-12);
+      CHECK((g.base_velocity_jump - (g.v_after - v).head<6>()).norm() == 0.0);
+    }
+  }
+}
+
+TEST_CASE("grasp refuses bad input", "[detumble]") {
+  const Model m = model_from_urdf_file(source_path("robots/paper_3dof.urdf"));
+  Data d(m);
+  const Eigen::VectorXd theta = Eigen::VectorXd::Zero(m.n());
+  Eigen::VectorXd v = Eigen::VectorXd::Zero(m.nv());
+  Target t;
+  CHECK_THROWS_AS(grasp(m, d, BasePose{}, theta, Eigen::VectorXd::Zero(m.nv() + 1), m.end_effector(), t),
+                  InputError);
+  CHECK_THROWS_AS(grasp(m, d, BasePose{}, theta, v, 99, t), InputError);
+  v(7) = std::numeric_limits<double>::quiet_NaN();
+  CHECK_THROWS_AS(grasp(m, d, BasePose{}, theta, v, m.end_effector(), t), InputError);
+  v(7) = 0;
+  t.mass = -1;
+  CHECK_THROWS_AS(grasp(m, d, BasePose{}, theta, v, m.end_effector(), t), InputError);
+}
+
+namespace {
+
+/// The 7-DOF robot of robots/paper_7dof_position.toml at its initial configuration grasping the
+/// scenario's target (200 kg, 100 kg m^2, spin (1, -0.5, 2) deg/s) at the approach speed 0.2 m/s.
+struct Grasped {
+  Model robot;
+  GraspResult grasp;
+  Model stack;
+  int gripper;
+  DetumbleState start;
+};
+
+Grasped grasped_7dof() {
+  Model m = model_from_urdf_file(source_path("robots/paper_7dof.urdf"), "ee");
+  Eigen::VectorXd theta(7);
+  theta << 0, 90, 90, -90, 90, 90, 0;
+  theta *= M_PI / 180;
+  Target t;
+  t.angular_velocity = Vector3(1, -0.5, 2) * M_PI / 180;
+  t.contact_offset = Vector3(-0.25, 0.15, 0.1);
+  const int ee = m.end_effector();
+  GraspResult g = grasp_at_capture(m, ee, BasePose{}, theta, t, 0.2);
+  Model stack = attach_body(m, m.frame(ee).name, g.body);
+  DetumbleState s{BasePose{}, theta, g.v_after, Vector3::Zero()};
+  return {std::move(m), std::move(g), std::move(stack), ee, s};
+}
+
+/// The joint torque limits of docs/detumble.md: 60 N m at the shoulder (joints 1-3),
+/// 40 N m at the elbow (4), 20 N m at the wrist (5-7).
+Eigen::VectorXd limits_7dof() {
+  Eigen::VectorXd L(7);
+  L << 60, 60, 60, 40, 20, 20, 20;
+  return L;
+}
+
+void check_torques_within_limits(const DetumbleRunResult& r, const Eigen::VectorXd& L) {
+  for (const auto& s : r.series) {
+    for (int k = 0; k < L.size(); ++k) REQUIRE(std::abs(s.tau(k)) <= L(k) * (1 + 1e-12));
+    REQUIRE(s.theta_dot.cwiseAbs().maxCoeff() == s.joint_rate);  // the series' rates are the controller's
+  }
+}
+
+}  // namespace
+
+TEST_CASE(
+    "detumble, free-floating: momentum kept, energy only through joint work, torques within limits, "
+    "at rest",
+    "[detumble]") {
+  const Grasped g = grasped_7dof();
+  DetumbleLimits lim;
+  lim.joint_torque = limits_7dof();
+  DetumbleOptions opt;
+  DetumbleRunOptions run;
+  run.horizon = 60;
+  const DetumbleRunResult r = run_detumble(g.stack, g.gripper, g.grasp.body, g.start, lim, opt, run);
+  INFO("time to rest " << r.time_to_rest << " s, peak torque " << r.peak_joint_torque << " N m (joint "
+                       << r.peak_joint << "), gripper " << r.peak_gripper_force << " N "
+                       << r.peak_gripper_moment << " N m, attitude " << r.base_attitude_excursion
+                       << " rad, energy " << r.energy_start << " -> " << r.energy_end << " J, steps "
+                       << r.steps);
+  CHECK(r.at_rest);
+  CHECK(r.momentum_drift < 1e-8);
+  CHECK(r.max_energy_balance < 1e-6);  // T(k+1) - T(k) = tau . (theta(k+1) - theta(k)) each tick
+  CHECK(r.energy_end < r.energy_start);
+  CHECK(r.series.back().joint_rate < opt.rest_rate);
+  CHECK(r.series.back().relative_rate < opt.rest_rate);
+  CHECK(r.peak_joint_torque > 0);
+  check_torques_within_limits(r, lim.joint_torque);
+  // the stack keeps its momentum: the total momentum after the grasp equals the run's
+  CHECK((r.series.back().momentum - g.grasp.momentum_after).norm() < 1e-8 * g.grasp.momentum_after.norm());
+}
+
+TEST_CASE("detumble after the paper's approach on robots/paper_7dof_position.toml: at rest within the limits",
+          "[detumble]") {
+  const Scenario sc = load_scenario(source_path("robots/paper_7dof_position.toml"));
+  const CaptureProblem& pb = sc.problem;
+  const CaptureResult plan = plan_capture(pb, sc.task, sc.capture);
+  const CaptureSetup setup = prepare_capture(pb, sc.task, sc.capture);
+  const GraspResult g =
+      grasp_at_capture(*pb.model, pb.frame, plan.base, plan.theta, setup.capture_target, pb.approach_speed);
+  CHECK(g.relative_twist_after.cwiseAbs().maxCoeff() < 1e-12);
+  CHECK(rel(g.momentum_after, g.momentum_before) < 1e-10);
+  const Model stack = attach_body(*pb.model, pb.model->frame(pb.frame).name, g.body);
+  DetumbleLimits lim;
+  lim.joint_torque = limits_7dof();
+  DetumbleRunOptions run;
+  run.horizon = 60;
+  const DetumbleRunResult r =
+      run_detumble(stack, pb.frame, g.body, {plan.base, plan.theta, g.v_after, {}}, lim, {}, run);
+  INFO("time to rest " << r.time_to_rest << " s, peak torque " << r.peak_joint_torque << " N m (joint "
+                       << r.peak_joint << "), gripper " << r.peak_gripper_force << " N "
+                       << r.peak_gripper_moment << " N m, attitude " << r.base_attitude_excursion << " rad");
+  CHECK(r.at_rest);
+  CHECK(r.momentum_drift < 1e-8);
+  CHECK(r.max_energy_balance < 1e-6);
+  check_torques_within_limits(r, lim.joint_torque);
+}
+
+TEST_CASE("detumble, free-floating, torque limits that bind: the brake scaled, still at rest", "[detumble]") {
+  const Grasped g = grasped_7dof();
+  DetumbleLimits lim;
+  lim.joint_torque = limits_7dof() / 30;  // 2 N m at the shoulder, below the unbounded law's peak of 8.8 N m
+  DetumbleRunOptions run;
+  run.horizon = 120;
+  const DetumbleRunResult r = run_detumble(g.stack, g.gripper, g.grasp.body, g.start, lim, {}, run);
+  INFO("time to rest " << r.time_to_rest << " s, peak torque " << r.peak_joint_torque);
+  CHECK(r.at_rest);
+  CHECK(r.momentum_drift < 1e-8);
+  CHECK(r.max_energy_balance < 1e-6);
+  check_torques_within_limits(r, lim.joint_torque);
+  long saturated = 0;
+  for (const auto& s : r.series) saturated += s.status == DetumbleStatus::Saturated;
+  CHECK(saturated > 10);
+}
+
+TEST_CASE("detumble, free-floating, the passive law: kinetic energy never increases", "[detumble]") {
+  const Grasped g = grasped_7dof();
+  DetumbleLimits lim;
+  lim.joint_torque = limits_7dof() / 30;
+  DetumbleOptions opt;
+  opt.hold = false;  // tau . qd <= 0 at every tick: no actuator puts work in
+  DetumbleRunOptions run;
+  run.horizon = 120;
+  const DetumbleRunResult r = run_detumble(g.stack, g.gripper, g.grasp.body, g.start, lim, opt, run);
+  INFO("time to rest " << r.time_to_rest << " s");
+  CHECK(r.at_rest);
+  CHECK(r.joint_work < 0);
+  CHECK(r.momentum_drift < 1e-8);
+  for (size_t k = 1; k < r.series.size(); ++k)
+    REQUIRE(r.series[k].energy <= r.series[k - 1].energy * (1 + 1e-12));
+  for (const auto& s : r.series) REQUIRE(s.tau.dot(s.theta_dot) <= 0.0);
+  check_torques_within_limits(r, lim.joint_torque);
+}
+
+TEST_CASE("detumble with reaction wheels: the stack's spin stopped, the wheels within their bounds",
+          "[detumble]") {
+  const Grasped g = grasped_7dof();
+  DetumbleLimits lim;
+  lim.joint_torque = limits_7dof();
+  lim.actuator = BaseActuator::ReactionWheels;
+  lim.wheel_torque = 0.2;
+  lim.wheel_momentum = 25;
+  DetumbleOptions opt;
+  opt.stop_stack_spin = true;
+  DetumbleRunOptions run;
+  run.horizon = 400;
+  run.record_every = 10;
+  const DetumbleRunResult r = run_detumble(g.stack, g.gripper, g.grasp.body, g.start, lim, opt, run);
+  INFO("time to rest " << r.time_to_rest << " s, wheels " << r.peak_wheel_momentum << " N m s");
+  CHECK(r.at_rest);
+  CHECK(r.series.back().stack_rate < opt.rest_rate);
+  CHECK(r.peak_wheel_momentum <= lim.wheel_momentum);
+  CHECK(r.peak_wheel_momentum > 0.1);  // the wheels took the stack's spin
+  CHECK(r.momentum_drift < 1e-8);      // stack + wheels
+  check_torques_within_limits(r, lim.joint_torque);
+  for (const auto& s : r.series)
+    REQUIRE((s.base_wrench.tail<3>().cwiseAbs().maxCoeff() <= std::sqrt(3.0) * lim.wheel_torque));
+}
+
+TEST_CASE("detumble with thrusters: the stack's spin stopped", "[detumble]") {
+  const Grasped g = grasped_7dof();
+  DetumbleLimits lim;
+  lim.joint_torque = limits_7dof();
+  lim.actuator = BaseActuator::Thrusters;
+  lim.thruster_force = 5;
+  lim.thruster_torque = 1;
+  DetumbleOptions opt;
+  opt.stop_stack_spin = true;
+  DetumbleRunOptions run;
+  run.horizon = 200;
+  run.record_every = 10;
+  const DetumbleRunResult r = run_detumble(g.stack, g.gripper, g.grasp.body, g.start, lim, opt, run);
+  INFO("time to rest " << r.time_to_rest << " s");
+  CHECK(r.at_rest);
+  CHECK(r.series.back().stack_rate < opt.rest_rate);
+  check_torques_within_limits(r, lim.joint_torque);
+}
+
+TEST_CASE("detumble: the gripper load is the rate of the target's momentum", "[detumble]") {
+  const Grasped g = grasped_7dof();
+  DetumbleLimits lim;
+  lim.joint_torque = limits_7dof();
+  DetumbleController ctrl(g.stack, g.gripper, lim);
+  DetumbleCommand cmd = ctrl.make_command();
+  ctrl.step(g.start, cmd);
+  REQUIRE(cmd.status == DetumbleStatus::Braking);
+  detail::DetumbleSystem sys(g.stack);
+  const Eigen::VectorXd y = sys.pack(g.start);
+  Vector3 f, n_p;
+  sys.gripper_load(y, cmd, g.gripper, g.grasp.body, f, n_p);
+  Eigen::VectorXd yd(sys.size());
+  sys.rhs(y, cmd, false, yd);
+  // the target's momentum about o from the stack's target frame (its centre of mass) and Jacobian
+  const int tf = g.stack.frame_index("target");
+  auto target_momentum = [&](const Eigen::VectorXd& yy) {
+    Data d(g.stack);
+    const DetumbleState s = sys.unpack(yy);
+    forward_kinematics(g.stack, d, s.base, s.theta);
+    frame_jacobian(g.stack, d, tf);
+    const Pose X = frame_pose(g.stack, d, tf);
+    const Vector6 tw = d.J * s.v;
+    Vector6 h;
+    h.head<3>() = g.grasp.body.mass * tw.head<3>();
+    h.tail<3>() = X.p.cross(h.head<3>()) + X.R * g.grasp.body.inertia * X.R.transpose() * tw.tail<3>();
+    return h;
+  };
+  const double eps = 1e-6;
+  const Vector6 dh = (target_momentum(y + eps * yd) - target_momentum(y - eps * yd)) / (2 * eps);
+  Data d(g.stack);
+  forward_kinematics(g.stack, d, g.start.base, g.start.theta);
+  const Vector3 p = frame_pose(g.stack, d, g.gripper).p;
+  INFO("force " << f.transpose() << " / " << dh.head<3>().transpose());
+  CHECK((f - dh.head<3>()).norm() < 1e-6 * std::max(1.0, dh.head<3>().norm()));
+  CHECK((n_p + p.cross(f) - dh.tail<3>()).norm() < 1e-6 * std::max(1.0, dh.tail<3>().norm()));
+  CHECK(f.norm() > 1e-2);
+}
+
+TEST_CASE("detumble refuses bad limits, a spin it cannot stop and an actuator too small", "[detumble]") {
+  const Grasped g = grasped_7dof();
+  DetumbleLimits lim;
+  lim.joint_torque = limits_7dof();
+  DetumbleOptions opt;
+  DetumbleRunOptions run;
+  auto refused = [&](const DetumbleLimits& l, const DetumbleOptions& o, const std::string& words) {
+    try {
+      run_detumble(g.stack, g.gripper, g.grasp.body, g.start, l, o, run);
+      FAIL("accepted: " << words);
+    } catch (const InputError& e) {
+      CHECK_THAT(e.what(), Catch::Contains(words));
+    }
+  };
+  DetumbleLimits l = lim;
+  l.joint_torque(3) = 0;
+  refused(l, opt, "torque limit of joint 'joint4' must be positive");
+  l.joint_torque(3) = std::numeric_limits<double>::infinity();
+  refused(l, opt, "torque limit of joint 'joint4' must be positive and finite");
+  l.joint_torque(3) = std::numeric_limits<double>::quiet_NaN();
+  refused(l, opt, "joint4");
+  DetumbleOptions o = opt;
+  o.stop_stack_spin = true;
+  refused(lim, o, "its angular momentum about its centre of mass, ");
+  refused(lim, o, "N m s, is conserved");
+  l = lim;
+  l.actuator = BaseActuator::ReactionWheels;
+  l.wheel_torque = 0.2;
+  l.wheel_momentum = -1;
+  refused(l, o, "reaction wheels' momentum must be positive");
+  l.wheel_momentum = 0.05;
+  refused(l, o, "cannot store the stack's angular momentum");
+  l.wheel_momentum = 25;
+  l.wheel_torque = 1e-4;
+  refused(l, o, "needs at least");
+  l = lim;
+  l.actuator = BaseActuator::Thrusters;
+  l.thruster_force = 1;
+  l.thruster_torque = std::numeric_limits<double>::quiet_NaN();
+  refused(l, o, "thrusters' torque must be positive and finite");
+  DetumbleRunOptions bad = run;
+  bad.tick = 0;
+  CHECK_THROWS_AS(run_detumble(g.stack, g.gripper, g.grasp.body, g.start, lim, opt, bad), InputError);
+}
+
+}  // namespace test_detumble
