@@ -73,10 +73,15 @@ inline double effective_mass(const Model& model, Data& data, const BasePose& bas
 
 /// Integrated effective mass (Eq. 14) from the robot's effective mass along u = R_t u_n:
 /// M_ie = 1 / (1/m_e + 1/m_t + (r x u)^T I^-1 (r x u)), r = R_t r_tp, I = R_t I_t R_t^T.
+/// NumericalError when the sum of the inverses overflows (a denormal m_e: M_ie would read 0).
 inline double integrated_effective_mass(double m_e, const Target& target) {
   if (!(m_e > 0) || !std::isfinite(m_e))
     throw InputError(detail::str("integrated_effective_mass: m_e must be positive and finite, got ", m_e));
-  return 1.0 / (1.0 / m_e + target.inverse_mass_along_normal());
+  const double inverse = 1.0 / m_e + target.inverse_mass_along_normal();
+  if (!std::isfinite(inverse))
+    throw NumericalError(
+        detail::str("integrated_effective_mass: 1/m_e + 1/m_t overflows double precision, m_e = ", m_e));
+  return 1.0 / inverse;
 }
 
 /// Integrated effective mass (Eq. 14) of the robot at (base, theta) with the end-effector `frame`
