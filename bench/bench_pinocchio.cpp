@@ -21,7 +21,7 @@
 // "pinL+s": LOCAL followed by the copy of its upper triangle into the lower, the same output as
 // ffsr's (shown beside, with its own ratio "ffsr/s"; the headline ratio ffsr/p is against the faster
 // of crba's two conventions alone); M_ie --
-// ffsr::integrated_effective_mass_fast (the O(n) articulated-body route), the frozen dispatching
+// ffsr::integrated_effective_mass (the O(n) articulated-body route), the frozen dispatching
 // function, and Pinocchio's crba + computeJointJacobians + getFrameJacobian + LLT solve. Each time is
 // the median over 51 passes of the mean time per call over 200 of the poses, in CPU time of the
 // thread (CLOCK_THREAD_CPUTIME_ID: time while descheduled does not count); every pass times the eight
@@ -133,11 +133,11 @@ void compare(const std::string& name, const std::string& urdf) {
   auto crba_before = [&](int k) { return before::crba(fm, bd, P.base[size_t(k)], P.theta[size_t(k)])(6, 6); };
   auto mie_now = [&](int k) {
     const auto uk = static_cast<size_t>(k);
-    return 1.0 / ffsr::integrated_effective_mass_fast(fm, fd, P.base[uk], P.theta[uk], fee, P.u[uk], 0.0);
+    return 1.0 / ffsr::integrated_effective_mass(fm, fd, P.base[uk], P.theta[uk], fee, P.u[uk], 0.0);
   };
   auto mie_before = [&](int k) {
     const auto uk = static_cast<size_t>(k);
-    return 1.0 / before::integrated_effective_mass_fast(fm, bd, P.base[uk], P.theta[uk], fee, P.u[uk], 0.0);
+    return 1.0 / before::integrated_effective_mass(fm, bd, P.base[uk], P.theta[uk], fee, P.u[uk], 0.0);
   };
   double dH = 0, dHpin = 0, dM = 0, dMpin = 0;
   for (int k = 0; k < kPoses; ++k) {

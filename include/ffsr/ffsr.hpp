@@ -10,11 +10,12 @@
 //   algorithm/rnea.hpp              C (recursive Newton-Euler)
 //   algorithm/jacobian.hpp          J_bm, J_f
 //   algorithm/momentum.hpp          linear and angular momentum
-//   algorithm/effective_mass.hpp    m_e (Eq. 4), M_ie (Eq. 14)
+//   algorithm/effective_mass.hpp    m_e (Eq. 4), M_ie (Eq. 14) under every joint model
 //   algorithm/effective_mass_gradient.hpp
 //                                   the inverse inertia at a frame, the gradients of m_e and M_ie
-//   algorithm/articulated_effective_mass.hpp, algorithm/joint_models.hpp
-//                                   M_ie under the contact-joint models (free, locked, armature)
+//   algorithm/joint_models.hpp      the contact-joint models (free, locked, armature)
+//   algorithm/articulated_effective_mass.hpp
+//                                   1/m_e in O(n), the recursion behind integrated_effective_mass
 // Include the rest where it is needed, each with its CMake target (docs/library.md):
 //   ffsr/contact/contact_law.hpp    contact laws, closed-form and exact maxima   (ffsr::ffsr)
 //   ffsr/parsers/urdf.hpp                the URDF loader                              (ffsr::urdf)

@@ -21,7 +21,7 @@
 // (SingleBodyResult::restitution); a test compares them.
 #pragma once
 
-#include "ffsr/algorithm/joint_models.hpp"
+#include "ffsr/algorithm/effective_mass.hpp"
 #include "ffsr/algorithm/jacobian.hpp"
 #include "ffsr/contact/contact_law.hpp"
 

@@ -22,9 +22,8 @@
 // force peak (dF/dt = 0) are located by CVODE's root finding.
 #pragma once
 
-#include "ffsr/algorithm/effective_mass.hpp"
+#include "ffsr/algorithm/effective_mass_gradient.hpp"
 #include "ffsr/algorithm/forward_dynamics.hpp"
-#include "ffsr/algorithm/joint_models.hpp"
 #include "ffsr/algorithm/jacobian.hpp"
 #include "ffsr/algorithm/momentum.hpp"
 #include "ffsr/contact/contact_law.hpp"
