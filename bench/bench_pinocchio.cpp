@@ -30,7 +30,7 @@
 // (the faster of its two CRBA conventions for CRBA). The last columns check the numbers: H against
 // the frozen code (largest entry difference over the largest entry), H's joint block against
 // Pinocchio's, and the inverse effective mass against both (relative).
-#include <ffsr/algorithm/articulated_effective_mass.hpp>
+#include <ffsr/algorithm/effective_mass.hpp>
 #include <ffsr/parsers/urdf.hpp>
 
 #include "bench_before.hpp"
