@@ -505,10 +505,12 @@ inline double approach_velocity(const Eigen::Vector3d& u, const Eigen::Vector3d&
   const Eigen::Vector3d v_tp = v_t + omega_t.cross(r);  // Eq. 12
   const double v = u.dot(v_e - v_tp);
   // finite inputs whose products pass 1e308 (omega_t x r) give inf, or NaN from 0 * inf in the dot
-  if (!std::isfinite(v))
-    throw NumericalError(detail::str(where, ": the relative velocity overflows double precision (|v_e| = ",
-                                     v_e.norm(), ", |v_t| = ", v_t.norm(), ", |omega_t| = ", omega_t.norm(),
-                                     ", |r| = ", r.norm(), ")"));
+  if (!std::isfinite(v)) {
+    auto largest = [](const Eigen::Vector3d& x) { return x.cwiseAbs().maxCoeff(); };
+    throw NumericalError(detail::str(where, ": the relative velocity overflows double precision (largest ",
+                                     "entries: v_e ", largest(v_e), ", v_t ", largest(v_t), ", omega_t ",
+                                     largest(omega_t), ", r ", largest(r), ")"));
+  }
   return v;
 }
 
