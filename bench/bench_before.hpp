@@ -317,10 +317,10 @@ inline double inverse_effective_mass_articulated(const Model& model, BeforeData&
   return f.dot(data.A[static_cast<size_t>(ee)]);
 }
 
-/// integrated_effective_mass_fast: dense below 8 joints (and with mimics), the recursion from there.
-inline double integrated_effective_mass_fast(const Model& model, BeforeData& data, const BasePose& base,
-                                             const Eigen::Ref<const Eigen::VectorXd>& theta, int frame,
-                                             const Vector3& u, double target_inverse_mass) {
+/// integrated_effective_mass, frozen: dense below 8 joints (and with mimics), the recursion from there.
+inline double integrated_effective_mass(const Model& model, BeforeData& data, const BasePose& base,
+                                        const Eigen::Ref<const Eigen::VectorXd>& theta, int frame,
+                                        const Vector3& u, double target_inverse_mass) {
   if (model.n() < 8 || model.nb() - 1 != model.n()) {
     crba(model, data, base, theta);
     return 1.0 / (inverse_effective_mass(model, data, frame, u) + target_inverse_mass);

@@ -6,7 +6,7 @@
 // Times (steady_clock, wall, one thread) crba + the inverse effective mass, and the gradient of M_ie
 // (crba included), per call, over random configurations. DIR holds paper_7dof.urdf (default
 // FFSR_SOURCE_DIR/robots).
-#include "ffsr/algorithm/joint_models.hpp"
+#include "ffsr/algorithm/effective_mass_gradient.hpp"
 #include "ffsr/parsers/urdf.hpp"
 
 #include <chrono>

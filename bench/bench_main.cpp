@@ -6,11 +6,11 @@
 // default FFSR_SOURCE_DIR/robots. For each robot it reports the median and the minimum over 31
 // batches of the mean time per call (std::chrono::steady_clock; a batch lasts about 5 ms), and the
 // heap allocations per call after set-up, of: forward_kinematics, crba, J_f (frame_jacobian +
-// generalized_jacobian), crba + J_f, M_ie (integrated_effective_mass: H, J, the solve), its
-// analytic gradient, rnea, and momentum + kinetic_energy; one point of `ffsr-optimize map` (M_ie,
-// F_max and its CSV row) in points per second. Then the contact benchmarks (bench_contact.hpp), one
-// multibody CVODE contact run per robot, and the paper's capture scenarios (plan_capture, plain and
-// optimized). The time targets are printed beside the figures.
+// generalized_jacobian), crba + J_f, M_ie (integrated_effective_mass, the O(n) recursion; and
+// integrated_effective_mass_dense: H, J, the solve), its analytic gradient, rnea, and momentum +
+// kinetic_energy; one point of `ffsr-optimize map` (M_ie, F_max and its CSV row) in points per
+// second. Then the contact benchmarks (bench_contact.hpp), one multibody CVODE contact run per robot,
+// and the paper's capture scenarios (plan_capture, plain and optimized). The time targets are printed beside the figures.
 //
 // Allocations are counted by replacing the global operator new/delete and, on glibc, by
 // interposing malloc/calloc/realloc/free (Eigen allocates with malloc, not with operator new).
@@ -388,9 +388,14 @@ void bench_hot_paths(const Settings& s, const Robot& r, AllocCheck& check) {
   const Timing mie = measure(s, [&](long i) {
     return integrated_effective_mass(model, data, bases[pick(i)], thetas[pick(i)], r.ee, target);
   });
-  print_row(r.name, "M_ie: integrated_effective_mass (H, J, solve)", mie,
-            n == 7 ? "< 2 us, 0 allocs" : "0 allocs", n == 7 ? 2e-6 : 0);
+  print_row(r.name, "M_ie: integrated_effective_mass (O(n))", mie, n == 7 ? "< 2 us, 0 allocs" : "0 allocs",
+            n == 7 ? 2e-6 : 0);
   check.require_zero(r.name, "integrated_effective_mass", mie);
+  const Timing mie_dense = measure(s, [&](long i) {
+    return integrated_effective_mass_dense(model, data, bases[pick(i)], thetas[pick(i)], r.ee, target);
+  });
+  print_row(r.name, "M_ie: integrated_effective_mass_dense (H, J, solve)", mie_dense, "0 allocs");
+  check.require_zero(r.name, "integrated_effective_mass_dense", mie_dense);
 
   const Timing dmie = measure(s, [&](long i) {
     const double M = integrated_effective_mass_gradient(model, data, bases[pick(i)], thetas[pick(i)], r.ee, u,
@@ -509,11 +514,11 @@ void bench_crossover(const Settings& s, AllocCheck& check) {
     check.require_zero(name, "inverse_effective_mass_articulated", aba);
     const ContactJoints armature{JointModel::Armature, Eigen::VectorXd::Constant(n, 0.1)};
     const Timing arm = measure(s, [&](long i) {
-      return integrated_effective_mass_fast(model, data, base, thetas[static_cast<size_t>(i % K)], ee, u, 0.005,
-                                            armature);
+      return integrated_effective_mass(model, data, base, thetas[static_cast<size_t>(i % K)], ee, u, 0.005,
+                                       armature);
     });
     print_row(name, "M_ie, armature joints, O(n)", arm, "");
-    check.require_zero(name, "integrated_effective_mass_fast (armature)", arm);
+    check.require_zero(name, "integrated_effective_mass (armature)", arm);
     Eigen::VectorXd grad(n);
     const Timing g = measure(s, [&](long i) {
       return integrated_effective_mass_gradient_fast(model, data, base, thetas[static_cast<size_t>(i % K)], ee, u,

@@ -19,7 +19,7 @@
 // Routes: CRBA -- ffsr::crba (the full symmetric H), the frozen code before the rewrite
 // (bench_before.hpp), pinocchio::crba in its LOCAL and WORLD conventions (upper triangle; the ratio is
 // against the faster of the two) and LOCAL followed by the copy of its upper triangle into the lower
-// (the same output as ffsr's); M_ie -- ffsr::integrated_effective_mass_fast (the O(n)
+// (the same output as ffsr's); M_ie -- ffsr::integrated_effective_mass (the O(n)
 // articulated-body route), the frozen function, Pinocchio's crba + computeJointJacobians +
 // getFrameJacobian + LLT solve ("dense") and its computeDelassusMatrix of a 3-D contact at the frame
 // ("Delassus", O(n)); the ratio is against the faster of the two. Each time is the minimum over 51
@@ -29,7 +29,7 @@
 // code (largest entry difference over the largest entry), H's joint block against Pinocchio's, and
 // the inverse effective mass against the frozen code and both Pinocchio routes (relative).
 // The output is the two Markdown tables of docs/performance.md.
-#include "ffsr/algorithm/articulated_effective_mass.hpp"
+#include "ffsr/algorithm/effective_mass.hpp"
 #include "ffsr/parsers/urdf.hpp"
 
 #include "bench_before.hpp"
@@ -134,11 +134,11 @@ Row compare(const std::string& name, const std::string& urdf) {
   auto crba_before = [&](int k) { return before::crba(fm, bd, P.base[size_t(k)], P.theta[size_t(k)])(6, 6); };
   auto mie_now = [&](int k) {
     const auto uk = static_cast<size_t>(k);
-    return 1.0 / ffsr::integrated_effective_mass_fast(fm, fd, P.base[uk], P.theta[uk], fee, P.u[uk], 0.0);
+    return 1.0 / ffsr::integrated_effective_mass(fm, fd, P.base[uk], P.theta[uk], fee, P.u[uk], 0.0);
   };
   auto mie_before = [&](int k) {
     const auto uk = static_cast<size_t>(k);
-    return 1.0 / before::integrated_effective_mass_fast(fm, bd, P.base[uk], P.theta[uk], fee, P.u[uk], 0.0);
+    return 1.0 / before::integrated_effective_mass(fm, bd, P.base[uk], P.theta[uk], fee, P.u[uk], 0.0);
   };
   Row row{name, n, {}, {}};
   double* d = row.agree;  // H-before, H-pin, M-before, M-dense, M-Delassus, Delassus-dense

@@ -111,6 +111,11 @@ inline void check_effective_mass(Input& in, const ffsr::Model& model) {
     require_finite(M_ie, "M_ie");
     if (!(M_ie > 0)) fail("M_ie is not positive: " + std::to_string(M_ie));
   });
+  returns_or_ffsr_error("integrated_effective_mass_dense", [&] {
+    const double M_ie = ffsr::integrated_effective_mass_dense(model, data, base, theta, f, target);
+    require_finite(M_ie, "M_ie (dense)");
+    if (!(M_ie > 0)) fail("M_ie (dense) is not positive: " + std::to_string(M_ie));
+  });
   returns_or_ffsr_error("integrated_effective_mass(m_e, target)", [&] {
     const double M_ie = ffsr::integrated_effective_mass(in.real(5.8), target);
     require_finite(M_ie, "M_ie(m_e)");

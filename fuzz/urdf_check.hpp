@@ -22,6 +22,11 @@ inline void check_configuration(const ffsr::Model& model, ffsr::Data& data, cons
     require_finite(M_ie, "M_ie");
     if (!(M_ie > 0)) fail("M_ie is not positive: " + std::to_string(M_ie));
   });
+  returns_or_ffsr_error("integrated_effective_mass_dense", [&] {
+    const double M_ie = ffsr::integrated_effective_mass_dense(model, data, base, theta, frame, target);
+    require_finite(M_ie, "M_ie (dense)");
+    if (!(M_ie > 0)) fail("M_ie (dense) is not positive: " + std::to_string(M_ie));
+  });
   returns_or_ffsr_error("effective_mass", [&] {
     const double m_e = ffsr::effective_mass(model, data, base, theta, frame, target.normal_world());
     require_finite(m_e, "m_e");

@@ -14,12 +14,12 @@
 #include "ffsr/algorithm/rnea.hpp"            // C (recursive Newton-Euler)
 #include "ffsr/algorithm/jacobian.hpp"        // J_bm, J_f
 #include "ffsr/algorithm/momentum.hpp"        // linear and angular momentum
-#include "ffsr/algorithm/effective_mass.hpp"  // m_e (Eq. 4), M_ie (Eq. 14)
+#include "ffsr/algorithm/effective_mass.hpp"  // m_e (Eq. 4), M_ie (Eq. 14) under every joint model
 // the inverse inertia at a frame, the gradients of m_e and M_ie
 #include "ffsr/algorithm/effective_mass_gradient.hpp"
-// M_ie under the contact-joint models (free, locked, armature)
+#include "ffsr/algorithm/joint_models.hpp"  // the contact-joint models (free, locked, armature)
+// 1/m_e in O(n), the recursion behind integrated_effective_mass
 #include "ffsr/algorithm/articulated_effective_mass.hpp"
-#include "ffsr/algorithm/joint_models.hpp"
 
 // The rest, with its CMake target:
 //   ffsr/contact/contact_law.hpp         contact laws, closed-form and exact maxima   (ffsr::ffsr)

@@ -227,9 +227,9 @@ void bind_integrated_effective_mass(nb::module_& m) {
         const int f = frame_arg(model, frame, "integrated_effective_mass");
         const Vector3 u = t.normal_world();
         if (joints == "free" && armature.is_none())  // the paper's joints, without the joint model's vectors
-          return integrated_effective_mass_fast(model, data, base, c.theta.map(), f, u,
+          return integrated_effective_mass(model, data, base, c.theta.map(), f, u,
                                                 t.inverse_mass_along_normal());
-        return integrated_effective_mass_fast(
+        return integrated_effective_mass(
             model, data, base, c.theta.map(), f, u, t.inverse_mass_along_normal(),
             joints_arg(model, joints, armature, "integrated_effective_mass"));
       },
@@ -259,8 +259,8 @@ void bind_integrated_effective_mass(nb::module_& m) {
         const int f = frame_arg(model, frame, "integrated_effective_mass_dense");
         const Target& t = target_or_default(target);
         if (joints == "free" && armature.is_none())
-          return integrated_effective_mass(model, data, base, c.theta.map(), f, t);
-        return integrated_effective_mass(
+          return integrated_effective_mass_dense(model, data, base, c.theta.map(), f, t);
+        return integrated_effective_mass_dense(
             model, data, base, c.theta.map(), f, t,
             joints_arg(model, joints, armature, "integrated_effective_mass_dense"));
       },

@@ -66,8 +66,8 @@ void batch_mie(const Model& model, const BasePose& base, const Batch& b, double*
         for (std::uint64_t i = lo; i < hi; ++i) {
           theta = X.row(Eigen::Index(i)).transpose();
           M[i] = b.joints
-                     ? integrated_effective_mass_fast(model, d, base, theta, b.frame, u, inv_t, *b.joints)
-                     : integrated_effective_mass_fast(model, d, base, theta, b.frame, u, inv_t);
+                     ? integrated_effective_mass(model, d, base, theta, b.frame, u, inv_t, *b.joints)
+                     : integrated_effective_mass(model, d, base, theta, b.frame, u, inv_t);
         }
       },
       opt);
@@ -90,7 +90,7 @@ double time_cpp_mie(const Model& model, Data& data, const BasePose& base, const 
   auto run = [&](long n) {
     const auto t0 = Clock::now();
     for (long i = 0; i < n; ++i)
-      acc += integrated_effective_mass_fast(model, data, base, rows[size_t(i) % m], frame, u, inv_t);
+      acc += integrated_effective_mass(model, data, base, rows[size_t(i) % m], frame, u, inv_t);
     return std::chrono::duration<double>(Clock::now() - t0).count();
   };
   long n = 1;

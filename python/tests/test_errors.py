@@ -140,3 +140,18 @@ def test_bad_physical_values(robot):
     with pytest.raises(ffsr.ModelError, match="mass must be positive"):
         ffsr.ModelBuilder("base", ffsr.Inertia(10.0, I=np.eye(3))).add_joint(
             "j1", ffsr.JointType.Revolute, "base", ffsr.Pose(), [0, 0, 1], "l1", ffsr.Inertia(0.0)).build()
+
+
+def test_overflow_from_finite_values_is_a_numerical_error():
+    # omega_t x r = (0, 1e400, 0) overflows; u . (...) then multiplies inf by u_y = 0 (NaN before)
+    with pytest.raises(ffsr.NumericalError, match="approach_velocity: the relative velocity overflows"):
+        ffsr.approach_velocity([1, 0, 0], [0.2, 0, 0], [0, 0, 0], [0, 0, 1e200], [1e200, 0, 0])
+    # the fuzz_numeric finding (tests/data/fuzz_regressions/fuzz_numeric/approach_velocity_nan)
+    with pytest.raises(ffsr.NumericalError):
+        ffsr.approach_velocity([6.663691e-317, 0.0, 1.0], [0.0, 0.0, 0.0],
+                               [200.0, 100.0, 3.893880265755862e-308],
+                               [-9.255963143549733e61, -4.783214422640232e300, 4.228978974595545e159],
+                               [-3.197300970554343e168, 1.27855629e-314, 8.1387e-320])
+    # finite values still answer: u . (v_e - omega_t x r) with (omega_t x r)_x = -omega_z r_y
+    assert ffsr.approach_velocity([1, 0, 0], [0.2, 0, 0], [0, 0, 0], [0, 0, 0.03], [-0.25, 0.15, 0]) == \
+        pytest.approx(0.2 + 0.03 * 0.15, rel=1e-15)

@@ -555,4 +555,31 @@ TEST_CASE("the force peak next to first touch (tiny exponent) is found, and ξ i
   }
 }
 
+TEST_CASE("finite inputs whose arithmetic overflows are NumericalErrors, not NaN or inf", "[contact][fuzz]") {
+  // the values of the fuzz_numeric finding tests/data/fuzz_regressions/fuzz_numeric/approach_velocity_nan:
+  // omega_t x r passes 1e308 in y and z, and u . (...) multiplies the infinite y by u_y = 0 (NaN)
+  const Eigen::Vector3d u(6.663691e-317, 0.0, 1.0), v_e(0.0, 0.0, 0.0),
+      v_t(200.0, 100.0, 3.893880265755862e-308), omega_t(-9.255963143549733e+61, -4.783214422640232e+300,
+                                                         4.228978974595545e+159),
+      r(-3.197300970554343e+168, 1.27855629e-314, 8.1387e-320);
+  CHECK_THROWS_AS(approach_velocity(u, v_e, v_t, omega_t, r), NumericalError);
+  CHECK_THROWS_WITH(approach_velocity(u, v_e, v_t, omega_t, r),
+                    Contains("approach_velocity") && Contains("overflows"));
+  // the same failure from the README's values (Python: ffsr.approach_velocity([1,0,0], ...))
+  const Eigen::Vector3d x = Eigen::Vector3d::UnitX(), zero = Eigen::Vector3d::Zero();
+  const Eigen::Vector3d spin(0, 0, 1e200);
+  CHECK_THROWS_AS(approach_velocity(x, 0.2 * x, zero, spin, 1e200 * x), NumericalError);
+  CHECK_THROWS_AS(approach_velocity(x, 1e308 * x, -1e308 * x, zero, zero), NumericalError);  // v_e - v_t
+  CHECK(approach_velocity(x, 1e300 * x, zero, Eigen::Vector3d(0, 0, 1e150), 1e150 * x) ==
+        1e300);  // large but representable: omega_t x r = 1e300 along y is finite, u_y = 0 drops it
+  // the law's constants and its force
+  CHECK_THROWS_AS(make_contact_law("hunt-crossley", {1e9, 1.5, 0.9}, 1e200), NumericalError);  // zeta
+  CHECK_THROWS_AS(make_contact_law("flores", {1e9, 1.5, 1e-320}, 0.2), NumericalError);         // f(c_r)
+  const AnyContactLaw law = make_contact_law("hunt-crossley", kPaper, 0.2);
+  CHECK_THROWS_AS(force(law, 1e300, 0.0), NumericalError);    // K delta^alpha
+  CHECK_THROWS_AS(force(law, 1e-3, 1e305), NumericalError);   // K + lambda delta_dot
+  CHECK(std::isnan(force(law, 1e-3, std::nan(""))));          // NaN still propagates
+  CHECK(force(law, 1e-3, 0.1) > 0.0);
+}
+
 }  // namespace test_contact

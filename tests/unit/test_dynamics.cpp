@@ -449,9 +449,9 @@ TEST_CASE("inverse effective mass: the articulated-body recursion equals the den
       }
       Target t;
       t.attitude = rng.quaternion();
-      const double M = integrated_effective_mass(model, d, q.base, q.theta, model.end_effector(), t);
-      const double fast = integrated_effective_mass_fast(model, e, q.base, q.theta, model.end_effector(),
-                                                         t.normal_world(), t.inverse_mass_along_normal());
+      const double M = integrated_effective_mass_dense(model, d, q.base, q.theta, model.end_effector(), t);
+      const double fast = integrated_effective_mass(model, e, q.base, q.theta, model.end_effector(),
+                                                    t.normal_world(), t.inverse_mass_along_normal());
       CHECK(std::abs(fast - M) < 1e-10 * M);
     }
   }

@@ -312,4 +312,42 @@ TEST_CASE("Edge: CVODE asked for impossible tolerances", "[edge]") {
                   InputError);
 }
 
+TEST_CASE("Edge: finite inputs past double precision are NumericalErrors, never NaN or inf", "[edge][fuzz]") {
+  const Model m = model_from_urdf_file(kRobots + "paper_3dof.urdf");
+  Data d(m);
+  const Eigen::VectorXd q = deg({0, 150, -100});
+  const int nv = m.nv();
+  // huge but finite velocities: the products overflow in the dynamics
+  Eigen::VectorXd v = Eigen::VectorXd::Zero(nv), a = Eigen::VectorXd::Zero(nv), acc;
+  v(6) = 1e160;
+  CHECK_THROWS_AS(rnea(m, d, BasePose{}, q, v, a), NumericalError);
+  CHECK_THROWS_AS(forward_dynamics(m, d, BasePose{}, q, v, a, acc), NumericalError);
+  CHECK_THROWS_AS(aba(m, d, BasePose{}, q, v, a, acc), NumericalError);
+  forward_kinematics(m, d, BasePose{}, q);
+  CHECK_THROWS_AS(kinetic_energy(m, d, v), NumericalError);
+  v(6) = 1e308;
+  v(7) = 1e308;
+  CHECK_THROWS_AS(momentum(m, d, v), NumericalError);
+  v(6) = std::nan("");
+  CHECK(std::isnan(kinetic_energy(m, d, v)));  // NaN in, NaN out: not an overflow
+  // the target: its contact point's velocity and its motion
+  Target t;
+  t.angular_velocity = Vector3(0, 0, 1e200);
+  t.contact_offset = Vector3(1e200, 0, 0);
+  CHECK_THROWS_AS(t.contact_point_velocity(), NumericalError);
+  t = Target{};
+  t.velocity = Vector3(1e300, 0, 0);
+  CHECK_THROWS_AS(propagate_target(t, 1e10), NumericalError);
+  CHECK_THROWS_AS(propagate_target(Target{}, std::numeric_limits<double>::infinity()), InputError);
+  t = Target{};
+  t.inertia = Vector3(100, 200, 250).asDiagonal();  // not isotropic: the Euler equations are integrated
+  t.angular_velocity = Vector3(0, 0, 0.01);
+  CHECK_THROWS_AS(propagate_target(t, 1e300), InputError);  // too long a span, not a cast past long
+  t.angular_velocity = Vector3(1e200, 1e200, 1e200);
+  CHECK_THROWS_AS(propagate_target(t, 1.0), NumericalError);
+  // M_ie from an effective mass whose inverse overflows
+  CHECK_THROWS_AS(integrated_effective_mass(1e-310, Target{}), NumericalError);
+  CHECK(integrated_effective_mass(5.0, Target{}) > 0.0);
+}
+
 }  // namespace test_edge_cases

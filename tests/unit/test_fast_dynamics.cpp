@@ -163,11 +163,19 @@ TEST_CASE("the O(n) integrated effective mass equals the dense path under every 
       for (const ContactJoints& joints : joint_models(model)) {
         INFO(name << " config " << k << " joints " << joint_model_name(joints.model));
         // dense: crba, H (+ armature) factorized, forward substitution; or H_bb for locked
-        const double M = integrated_effective_mass(model, dense, q.base, q.theta, model.end_effector(), t, joints);
+        const double M =
+            integrated_effective_mass_dense(model, dense, q.base, q.theta, model.end_effector(), t, joints);
         const double M_fast =
-            integrated_effective_mass_fast(model, fast, q.base, q.theta, model.end_effector(), u, tim, joints);
+            integrated_effective_mass(model, fast, q.base, q.theta, model.end_effector(), u, tim, joints);
         // two factorizations of the same SPD system: rounding, 1e-12 relative
         CHECK(std::abs(M_fast - M) <= 1e-12 * M);
+        // one name, one route: the target's overload is the (u, 1/m_t) one, free joints the default
+        const int ee = model.end_effector();
+        CHECK(integrated_effective_mass(model, fast, q.base, q.theta, ee, t, joints) == M_fast);
+        if (joints.model == JointModel::Free) {
+          CHECK(integrated_effective_mass(model, fast, q.base, q.theta, ee, t) == M_fast);
+          CHECK(integrated_effective_mass_dense(model, dense, q.base, q.theta, ee, t) == M);
+        }
         // the inverse effective mass alone at another frame (the base's) and the first link's
         for (int frame : {0, 1}) {
           crba(model, dense, q.base, q.theta);
@@ -207,8 +215,9 @@ TEST_CASE("the O(n) gradient of M_ie equals the dense gradient and finite differ
           VectorXd tp = q.theta, tm = q.theta;
           tp(j) += h;
           tm(j) -= h;
-          const double fd = (integrated_effective_mass_fast(model, fast, q.base, tp, model.end_effector(), u, tim, joints) -
-                             integrated_effective_mass_fast(model, fast, q.base, tm, model.end_effector(), u, tim, joints)) /
+          const int ee = model.end_effector();
+          const double fd = (integrated_effective_mass(model, fast, q.base, tp, ee, u, tim, joints) -
+                             integrated_effective_mass(model, fast, q.base, tm, ee, u, tim, joints)) /
                             (2 * h);
           INFO("joint " << j << " analytic " << g_fast(j) << " finite differences " << fd);
           CHECK(std::abs(g_fast(j) - fd) < 1e-6 * gs + 1e-8 * M);
@@ -371,11 +380,12 @@ TEST_CASE("the O(n) paths refuse what they cannot do and fall back for mimic joi
   forward_kinematics(m, d, q.base, q.theta);
   CHECK_THROWS_WITH(inverse_effective_mass_articulated(m, d, m.end_effector(), u),
                     Catch::Contains("mimic joints; use inverse_effective_mass"));
-  // integrated_effective_mass_fast and its gradient take the dense route: the same numbers
+  // integrated_effective_mass and its O(n) gradient take the dense route: the same numbers
   for (const ContactJoints& joints : joint_models(m)) {
     crba(m, e, q.base, q.theta);
     const double M = 1.0 / (inverse_effective_mass(m, e, m.end_effector(), u, joints) + 0.01);
-    CHECK(integrated_effective_mass_fast(m, d, q.base, q.theta, m.end_effector(), u, 0.01, joints) == M);
+    CHECK(integrated_effective_mass(m, d, q.base, q.theta, m.end_effector(), u, 0.01, joints) == M);
+    CHECK(integrated_effective_mass_dense(m, e, q.base, q.theta, m.end_effector(), u, 0.01, joints) == M);
     VectorXd g(m.n()), g_dense(m.n());
     CHECK(integrated_effective_mass_gradient_fast(m, d, q.base, q.theta, m.end_effector(), u, 0.01, joints, g) ==
           integrated_effective_mass_gradient(m, e, q.base, q.theta, m.end_effector(), u, 0.01, joints, g_dense));
@@ -388,16 +398,19 @@ TEST_CASE("the O(n) paths refuse what they cannot do and fall back for mimic joi
   VectorXd g(c.n());
   const ContactJoints bad{JointModel::Armature, VectorXd::Zero(2)};
   CHECK_THROWS_WITH(
-      integrated_effective_mass_fast(c, dc, qc.base, qc.theta, c.end_effector(), u, 0.0, bad),
+      integrated_effective_mass(c, dc, qc.base, qc.theta, c.end_effector(), u, 0.0, bad),
       Catch::Contains("armature"));
-  CHECK_THROWS_WITH(integrated_effective_mass_fast(c, dc, qc.base, qc.theta, c.end_effector(), Vector3(1, 1, 0), 0.0,
-                                                   ContactJoints{}),
+  CHECK_THROWS_WITH(integrated_effective_mass(c, dc, qc.base, qc.theta, c.end_effector(), Vector3(1, 1, 0),
+                                              0.0, ContactJoints{}),
                     Catch::Contains("unit vector"));
+  CHECK_THROWS_WITH(integrated_effective_mass(c, dc, qc.base, qc.theta, c.end_effector(), u, -1.0),
+                    Catch::Contains("inverse mass"));
   VectorXd short_grad(2);
   CHECK_THROWS_WITH(integrated_effective_mass_gradient_fast(c, dc, qc.base, qc.theta, c.end_effector(), u, 0.0,
                                                             ContactJoints{}, short_grad),
                     Catch::Contains("grad"));
-  CHECK_THROWS_AS(integrated_effective_mass_fast(c, dc, qc.base, qc.theta, 99, u, 0.0, ContactJoints{}), InputError);
+  CHECK_THROWS_AS(integrated_effective_mass(c, dc, qc.base, qc.theta, 99, u, 0.0, ContactJoints{}),
+                  InputError);
 }
 
 }  // namespace test_fast_dynamics

@@ -14,7 +14,7 @@
 
 #include <catch2/catch.hpp>
 
-#include "ffsr/algorithm/joint_models.hpp"
+#include "ffsr/algorithm/effective_mass_gradient.hpp"
 #include "ffsr/scenario/scenario.hpp"
 #include "ffsr/jobs/scenario_run.hpp"
 #include "ffsr/simulate/multibody.hpp"

@@ -166,7 +166,7 @@ inline void aba_acceleration_pass(const Model& model, Data& data, const Eigen::R
 /// Reads base, theta, v, tau. Writes the kinematics, data.Ic (bodies alone), data.V, data.F,
 /// data.IA, data.U, data.D, data.pA, data.A, data.u and a (resized to 6+n). Throws InputError for
 /// bad sizes, non-finite values or a model with mimic joints (use forward_dynamics), NumericalError
-/// when the articulated inertias are not positive definite.
+/// when the articulated inertias are not positive definite or the accelerations overflow.
 inline void aba(const Model& model, Data& data, const BasePose& base, const Eigen::Ref<const Eigen::VectorXd>& theta,
                 const Eigen::Ref<const Eigen::VectorXd>& v, const Eigen::Ref<const Eigen::VectorXd>& tau,
                 Eigen::VectorXd& a) {
@@ -179,6 +179,7 @@ inline void aba(const Model& model, Data& data, const BasePose& base, const Eige
   a.resize(model.nv());
   detail::aba_velocity_pass(model, data, base, theta, v);
   detail::aba_acceleration_pass(model, data, v, tau, a);
+  if (!a.allFinite()) throw NumericalError("aba: the accelerations overflow double precision");
 }
 
 }  // namespace ffsr

@@ -1,5 +1,6 @@
-// ffsr/algorithm/articulated_effective_mass.hpp -- the effective mass (Eq. 4), the integrated
-// effective mass (Eq. 14) and its gradient in O(n), by articulated-body inertias, without forming H.
+// ffsr/algorithm/articulated_effective_mass.hpp -- the inverse effective mass (Eq. 4) in O(n) by
+// articulated-body inertias, without forming H: the recursion behind integrated_effective_mass
+// (effective_mass.hpp) and its gradient (effective_mass_gradient.hpp).
 #pragma once
 
 #include "ffsr/algorithm/joint_models.hpp"
@@ -291,77 +292,6 @@ inline double inverse_effective_mass_articulated(const Model& model, Data& data,
   }
   detail::articulated_inertias(model, data, detail::armature_of(model, joints));
   return detail::articulated_solve(model, data, model.frame(frame).body, f, false);
-}
-
-/// Kept for callers that chose the path by size: the articulated-body recursion is now the faster
-/// path at every size (ffsr-bench-pinocchio), so integrated_effective_mass_fast uses it from one joint on.
-inline constexpr int kArticulatedMinJoints = 1;
-
-/// Integrated effective mass (Eq. 14) as integrated_effective_mass, in O(n) by the articulated-body
-/// recursion (inverse_effective_mass_articulated); a model with mimic joints takes crba and the dense
-/// Cholesky solve. The two agree to rounding (tested to 1e-12 relative). Writes the kinematics and
-/// the recursion's fields (or data.H, data.L, data.w, data.y for mimics): do not rely on data.H afterwards.
-inline double integrated_effective_mass_fast(const Model& model, Data& data, const BasePose& base,
-                                             const Eigen::Ref<const Eigen::VectorXd>& theta, int frame,
-                                             const Vector3& u, double target_inverse_mass) {
-  if (model.n() < kArticulatedMinJoints || model.nb() - 1 != model.n()) {  // mimic joints: dense
-    crba(model, data, base, theta);
-    return 1.0 / (inverse_effective_mass(model, data, frame, u) + target_inverse_mass);
-  }
-  forward_kinematics(model, data, base, theta);
-  return 1.0 / (inverse_effective_mass_articulated(model, data, frame, u) + target_inverse_mass);
-}
-
-/// Integrated effective mass (Eq. 14) under the joint model `joints`, in O(n)
-/// (inverse_effective_mass_articulated with `joints`); mimic joints: crba and the dense path of
-/// joint_models.hpp. Writes the kinematics and the recursion's fields: do not rely on data.H afterwards.
-inline double integrated_effective_mass_fast(const Model& model, Data& data, const BasePose& base,
-                                             const Eigen::Ref<const Eigen::VectorXd>& theta, int frame,
-                                             const Vector3& u, double target_inverse_mass,
-                                             const ContactJoints& joints) {
-  if (model.nb() - 1 != model.n()) {
-    crba(model, data, base, theta);
-    return 1.0 / (inverse_effective_mass(model, data, frame, u, joints) + target_inverse_mass);
-  }
-  forward_kinematics(model, data, base, theta);
-  return 1.0 / (inverse_effective_mass_articulated(model, data, frame, u, joints) + target_inverse_mass);
-}
-
-/// Analytic gradient of the integrated effective mass in the joint angles under the joint model, at a
-/// fixed base pose, in O(n): the same formula as integrated_effective_mass_gradient
-/// (inverse_inertia_form_gradient: dq = 2 s . d(J y) - y^T dH y with q = 1/m_e, y = (H + diag(0, a))^-1 w,
-/// w = J_v^T u), with y the generalized acceleration of the articulated-body algorithm under the test
-/// force (detail::articulated_solve with every body) instead of a dense Cholesky solve; Locked: the
-/// composite inertias and detail::locked_inverse_form_gradient. dM_ie = -M_ie^2 d(1/m_e). Mimic joints:
-/// integrated_effective_mass_gradient. Runs forward_kinematics. Writes the recursion's fields,
-/// data.Ic (composite), data.y, data.V, data.F and grad (size n); not data.H. Returns M_ie.
-inline double integrated_effective_mass_gradient_fast(const Model& model, Data& data, const BasePose& base,
-                                                      const Eigen::Ref<const Eigen::VectorXd>& theta,
-                                                      int frame, const Vector3& u, double target_inverse_mass,
-                                                      const ContactJoints& joints,
-                                                      Eigen::Ref<Eigen::VectorXd> grad) {
-  if (model.nb() - 1 != model.n())
-    return integrated_effective_mass_gradient(model, data, base, theta, frame, u, target_inverse_mass, joints,
-                                              grad);
-  detail::require_size(grad.size(), model.n(), "integrated_effective_mass_gradient", "grad");
-  forward_kinematics(model, data, base, theta);
-  const Vector6 f = detail::unit_point_force(model, data, frame, u);
-  double inv_me;
-  if (joints.model == JointModel::Locked) {
-    detail::body_inertias(model, data);
-    for (int i = model.nb() - 1; i > 0; --i)
-      data.Ic[static_cast<size_t>(model.body(i).parent)] += data.Ic[static_cast<size_t>(i)];
-    Vector6 yb;
-    inv_me = detail::locked_inverse_form_composite(data, f, yb);
-    detail::locked_inverse_form_gradient(model, data, frame, u, yb, grad);
-  } else {
-    detail::articulated_inertias(model, data, detail::armature_of(model, joints));
-    inv_me = detail::articulated_solve(model, data, model.frame(frame).body, f, true);
-    detail::inverse_inertia_form_gradient_from_y(model, data, frame, f.head<3>(), Vector3::Zero(), grad);
-  }
-  const double M = 1.0 / (inv_me + target_inverse_mass);
-  grad *= -M * M;
-  return M;
 }
 
 }  // namespace ffsr

@@ -2,7 +2,7 @@
 // of a capture (the impact disturbance of the spacecraft's bus).
 #pragma once
 
-#include "ffsr/algorithm/joint_models.hpp"
+#include "ffsr/algorithm/effective_mass.hpp"
 #include "ffsr/algorithm/jacobian.hpp"
 #include "ffsr/contact/contact_law.hpp"
 

@@ -10,7 +10,7 @@ namespace ffsr {
 /// tau holds the generalized forces (base wrench at the base origin in o, then joint torques), for
 /// instance J_bm^T F_e for an external wrench F_e at a frame.
 /// Reads base, theta, v, tau. Writes what crba and rnea write, data.L, and a. Throws NumericalError
-/// if H is not positive definite.
+/// if H is not positive definite or the accelerations overflow double precision.
 inline void forward_dynamics(const Model& model, Data& data, const BasePose& base,
                              const Eigen::Ref<const Eigen::VectorXd>& theta,
                              const Eigen::Ref<const Eigen::VectorXd>& v,
@@ -21,6 +21,7 @@ inline void forward_dynamics(const Model& model, Data& data, const BasePose& bas
   a = tau - bias_forces(model, data, base, theta, v);
   detail::cholesky(data.H, data.L, "forward_dynamics");
   detail::cholesky_solve(data.L, a);
+  if (!a.allFinite()) throw NumericalError("forward_dynamics: the accelerations overflow double precision");
 }
 
 }  // namespace ffsr

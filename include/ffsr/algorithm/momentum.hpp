@@ -41,7 +41,7 @@ void for_each_body_velocity(const Model& model, const Data& data, const Eigen::R
 
 /// Total momentum [P; L] of the system: linear momentum and angular momentum about the base frame
 /// origin, inertial frame, summed body by body. Equals the first six rows of H v.
-/// Reads the kinematics (forward_kinematics) and v.
+/// Reads the kinematics (forward_kinematics) and v. NumericalError when a finite v overflows it.
 inline Vector6 momentum(const Model& model, const Data& data, const Eigen::Ref<const Eigen::VectorXd>& v) {
   Vector6 h = Vector6::Zero();
   for_each_body_velocity(model, data, v, [&](int i, const Vector3& w, const Vector3& vc, const Vector3& c) {
@@ -50,6 +50,8 @@ inline Vector6 momentum(const Model& model, const Data& data, const Eigen::Ref<c
     h.head<3>() += in.mass * vc;
     h.tail<3>() += (c - data.p[0]).cross(in.mass * vc) + R * in.I * R.transpose() * w;
   });
+  if (!h.allFinite() && v.allFinite())  // NaN in v propagates; finite v whose products overflow do not
+    throw NumericalError("momentum: the momentum overflows double precision");
   return h;
 }
 
@@ -68,7 +70,7 @@ inline Vector6 momentum_from_velocity_pass(const Model& model, const Data& data)
 }  // namespace detail
 
 /// Kinetic energy, summed body by body: sum of 1/2 m |v_c|^2 + 1/2 w^T I w.
-/// Reads the kinematics (forward_kinematics) and v.
+/// Reads the kinematics (forward_kinematics) and v. NumericalError when a finite v overflows it.
 inline double kinetic_energy(const Model& model, const Data& data,
                              const Eigen::Ref<const Eigen::VectorXd>& v) {
   double T = 0;
@@ -77,12 +79,14 @@ inline double kinetic_energy(const Model& model, const Data& data,
     const Matrix3& R = data.R[static_cast<size_t>(i)];
     T += 0.5 * in.mass * vc.squaredNorm() + 0.5 * w.dot(R * in.I * R.transpose() * w);
   });
+  if (!std::isfinite(T) && v.allFinite())
+    throw NumericalError("kinetic_energy: the energy overflows double precision");
   return T;
 }
 
 /// Base velocity [v0; w0] from momentum conservation: H_b x_b_dot + H_bm theta_dot = h, with h the
 /// total momentum [P; L about the base frame origin] (zero by default).
-/// Reads data.H (crba) and theta_dot.
+/// Reads data.H (crba) and theta_dot. NumericalError when the finite inputs overflow it.
 inline Vector6 base_velocity_from_momentum(const Model& model, const Data& data,
                                            const Eigen::Ref<const Eigen::VectorXd>& theta_dot,
                                            const Vector6& h = Vector6::Zero()) {
@@ -91,7 +95,10 @@ inline Vector6 base_velocity_from_momentum(const Model& model, const Data& data,
   detail::require_finite_all(h, "base_velocity_from_momentum", "momentum");
   const Eigen::LLT<Matrix6> Hb(data.H.topLeftCorner<6, 6>());
   if (Hb.info() != Eigen::Success) throw NumericalError("base_velocity_from_momentum: H_b is singular");
-  return Hb.solve(h - data.H.topRightCorner(6, model.n()) * theta_dot);
+  const Vector6 xb = Hb.solve(h - data.H.topRightCorner(6, model.n()) * theta_dot);
+  if (!xb.allFinite())
+    throw NumericalError("base_velocity_from_momentum: the base velocity overflows double precision");
+  return xb;
 }
 
 }  // namespace ffsr

@@ -11,6 +11,7 @@ namespace ffsr {
 /// The first six entries of tau are the force and the moment about the base frame origin on the
 /// base, in the inertial frame. Computed independently of crba (body coordinates, no composites).
 /// Reads base, theta, v, a. Writes data.Xup, data.V, data.A, data.F, data.tau. Returns data.tau.
+/// NumericalError when finite v and a give forces past double precision.
 inline const Eigen::VectorXd& rnea(const Model& model, Data& data, const BasePose& base,
                                    const Eigen::Ref<const Eigen::VectorXd>& theta,
                                    const Eigen::Ref<const Eigen::VectorXd>& v,
@@ -79,6 +80,8 @@ inline const Eigen::VectorXd& rnea(const Model& model, Data& data, const BasePos
   }
   data.tau.head<3>() = R0 * data.F[0].head<3>();
   data.tau.segment<3>(3) = R0 * data.F[0].tail<3>();
+  if (!data.tau.allFinite())  // finite velocities whose products pass double precision
+    throw NumericalError("rnea: the generalized forces overflow double precision");
   return data.tau;
 }
 

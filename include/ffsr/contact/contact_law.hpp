@@ -68,7 +68,8 @@ class HertzDamped {
   using damping_type = Damping;
   static constexpr std::string_view name = Damping::name;
 
-  /// Validates p (see validate) and the approach velocity δ̇⁻ (> 0 and finite: the bodies approach).
+  /// Validates p (see validate) and the approach velocity δ̇⁻ (> 0 and finite: the bodies approach);
+  /// NumericalError when finite values overflow the law's constants λ or ζ.
   HertzDamped(const ContactParams& p, double approach_velocity);
 
   const ContactParams& params() const { return p_; }
@@ -76,7 +77,8 @@ class HertzDamped {
   double f() const { return f_; }                   ///< f(c_r) of Table 1 (Eq. 22)
   double lambda() const { return lambda_; }         ///< λ = f K / δ̇⁻ (Eq. 22)
 
-  /// F(δ, δ̇) of Eq. 15 [N]; 0 for δ <= 0 and clamped at 0 (never pulls). NaN propagates.
+  /// F(δ, δ̇) of Eq. 15 [N]; 0 for δ <= 0 and clamped at 0 (never pulls). NaN propagates;
+  /// NumericalError when finite δ, δ̇ give a force past double precision.
   double force(double delta, double delta_dot) const;
 
   /// δ as a function of δ̇ along the single-body contact (Eq. 19) [m]. Requires M_ie > 0 and a rate
@@ -145,7 +147,8 @@ inline double relative_error(const AnyContactLaw& law);
 /// point, positive when the end-effector and the target approach. u is the contact normal (unit,
 /// pointing from the end-effector into the target), v_e the end-effector velocity, v_t and ω_t the
 /// target's linear and angular velocity, r = r_tp from the target's mass centre to the contact
-/// point; all in the inertial frame. InputError for non-finite entries or |u| not 1 (to 1e-9).
+/// point; all in the inertial frame. InputError for non-finite entries or |u| not 1 (to 1e-9);
+/// NumericalError when the products of finite entries overflow double precision.
 inline double approach_velocity(const Eigen::Vector3d& u, const Eigen::Vector3d& v_e,
                                 const Eigen::Vector3d& v_t, const Eigen::Vector3d& omega_t,
                                 const Eigen::Vector3d& r);
@@ -331,8 +334,8 @@ HertzDamped<Damping>::HertzDamped(const ContactParams& p, double approach_veloci
             approach_velocity < 0.0 ? ": the bodies are receding" : ": the bodies do not approach"));
   v0_ = approach_velocity;
   f_ = Damping::factor(p.c_r);
-  if (!(f_ >= 0.0) || !std::isfinite(f_))
-    throw InputError(str(where, ": damping factor f(c_r) = ", f_, " for c_r = ", p.c_r));
+  if (!(f_ >= 0.0) || !std::isfinite(f_))  // a tiny c_r (1e-320) overflows f = 8 (1 - c_r) / (5 c_r)
+    throw NumericalError(str(where, ": damping factor f(c_r) = ", f_, " for c_r = ", p.c_r));
   lambda_ = f_ * p.K / v0_;
   G0_ = detail::contact_G(f_, 0.0);
   // Eq. 25 written with G(0) = h(f)/f²: ζ = K^(1/(α+1)) ((α+1) δ̇⁻² G(0))^(α/(α+1)).
@@ -341,7 +344,7 @@ HertzDamped<Damping>::HertzDamped(const ContactParams& p, double approach_veloci
   // Finite inputs can still overflow the law's constants (an approach velocity of 1e200 m/s, or
   // K = 1e300 with a tiny approach velocity): an error, not a law that answers inf or NaN.
   if (!std::isfinite(lambda_) || !std::isfinite(zeta_))
-    throw InputError(
+    throw NumericalError(
         str(where, ": the parameters overflow double precision (lambda = f K / approach velocity = ", lambda_,
             ", zeta = ", zeta_, " for K = ", p.K, ", alpha = ", p.alpha, ", approach velocity ",
             approach_velocity, ")"));
@@ -353,7 +356,11 @@ double HertzDamped<Damping>::force(double delta, double delta_dot) const {
   const double g = p_.K + lambda_ * delta_dot;  // the force is pushing while K + λ δ̇ > 0
   if (!(g > 0.0)) return g <= 0.0 ? 0.0 : g;    // never pulls; NaN propagates
   const double P = std::pow(delta, p_.alpha);
-  return P == 0.0 ? 0.0 : P * g;  // δ^α underflowing to 0 times a huge g is 0, not NaN
+  const double F = P == 0.0 ? 0.0 : P * g;  // δ^α underflowing to 0 times a huge g is 0, not NaN
+  if (std::isinf(F) && std::isfinite(delta) && std::isfinite(delta_dot))
+    throw NumericalError(detail::str(name, ": the force overflows double precision at delta = ", delta,
+                                     " m, delta_dot = ", delta_dot, " m/s"));
+  return F;
 }
 
 template <class Damping>
@@ -496,7 +503,15 @@ inline double approach_velocity(const Eigen::Vector3d& u, const Eigen::Vector3d&
   if (std::abs(u.norm() - 1.0) > 1e-9)
     throw InputError(detail::str(where, ": normal u must be a unit vector, |u| = ", u.norm()));
   const Eigen::Vector3d v_tp = v_t + omega_t.cross(r);  // Eq. 12
-  return u.dot(v_e - v_tp);
+  const double v = u.dot(v_e - v_tp);
+  // finite inputs whose products pass 1e308 (omega_t x r) give inf, or NaN from 0 * inf in the dot
+  if (!std::isfinite(v)) {
+    auto largest = [](const Eigen::Vector3d& x) { return x.cwiseAbs().maxCoeff(); };
+    throw NumericalError(detail::str(where, ": the relative velocity overflows double precision (largest ",
+                                     "entries: v_e ", largest(v_e), ", v_t ", largest(v_t), ", omega_t ",
+                                     largest(omega_t), ", r ", largest(r), ")"));
+  }
+  return v;
 }
 
 inline double model_accuracy(double F_model, double F_exact) {

@@ -10,6 +10,16 @@
 
 namespace ffsr {
 
+namespace detail {
+/// Returns v; NumericalError naming `where` unless v is finite (finite inputs whose arithmetic
+/// passed double precision, or inputs that were not finite).
+inline Vector3 finite_result(const Vector3& v, const char* where) {
+  if (!v.allFinite())
+    throw NumericalError(str(where, ": the result is not finite (", v.transpose(), ")"));
+  return v;
+}
+}  // namespace detail
+
 /// The target of the capture (Section 2.2). Vectors marked (target frame) rotate with it.
 struct Target {
   double mass = 200.0;                                 ///< m_t, kg
@@ -60,12 +70,18 @@ struct Target {
   Vector3 normal_world() const { return rotation() * normal.normalized(); }
   /// Contact point offset r = R_t r_tp in o.
   Vector3 offset_world() const { return rotation() * contact_offset; }
-  /// Contact point position in o.
-  Vector3 contact_point() const { return position + offset_world(); }
+  /// Contact point position in o. NumericalError when the sum overflows double precision.
+  Vector3 contact_point() const {
+    return detail::finite_result(Vector3(position + offset_world()), "Target::contact_point");
+  }
   /// Angular velocity in o.
   Vector3 angular_velocity_world() const { return rotation() * angular_velocity; }
   /// Velocity of the target's material contact point, v_tp = v_t + w_t x r (Eq. 12), in o.
-  Vector3 contact_point_velocity() const { return velocity + angular_velocity_world().cross(offset_world()); }
+  /// NumericalError when w_t x r overflows double precision.
+  Vector3 contact_point_velocity() const {
+    return detail::finite_result(Vector3(velocity + angular_velocity_world().cross(offset_world())),
+                                         "Target::contact_point_velocity");
+  }
   /// The target's inverse mass perceived along the normal at the contact point,
   /// 1/m_t + (r x u)^T I^-1 (r x u) (the target part of Eq. 14). It does not depend on the attitude.
   double inverse_mass_along_normal() const {
@@ -114,9 +130,12 @@ inline void euler_rate(const Matrix3& I, const Matrix3& Iinv, const double* w, d
 
 /// The target at time t: centre of mass drifting with its velocity, attitude and spin from the
 /// torque-free Euler equations (RK4 with a fine step; exact rotation when the inertia is isotropic).
+/// InputError for a t that is not finite or too long a span; NumericalError when the motion of
+/// finite values passes double precision.
 inline Target propagate_target(const Target& t0, double t) {
+  if (!std::isfinite(t)) throw InputError(detail::str("propagate_target: time must be finite, got ", t));
   Target t1 = t0;
-  t1.position = t0.position + t0.velocity * t;
+  t1.position = detail::finite_result(Vector3(t0.position + t0.velocity * t), "propagate_target: position");
   const Matrix3 I = t0.inertia;
   bool isotropic = true;
   const double tol = 1e-12 * I(0, 0);
@@ -128,8 +147,9 @@ inline Target propagate_target(const Target& t0, double t) {
     return t1;
   }
   const Matrix3 Iinv = detail::inverse3(I);
-  const long nsteps = std::max<long>(1, static_cast<long>(std::ceil(std::abs(t) / 1e-3)));
-  if (nsteps > 100000000) throw InputError("propagate_target: time span too long");
+  const double steps = std::ceil(std::abs(t) / 1e-3);
+  if (steps > 1e8) throw InputError("propagate_target: time span too long");
+  const long nsteps = std::max<long>(1, static_cast<long>(steps));
   const double h = t / static_cast<double>(nsteps), hh = 0.5 * h, h6 = h / 6;
   Matrix3 R = t0.rotation();
   double w[3] = {t0.angular_velocity(0), t0.angular_velocity(1), t0.angular_velocity(2)};  // body frame
@@ -147,6 +167,9 @@ inline Target propagate_target(const Target& t0, double t) {
     R = R * rotation_from_vector(half);  // midpoint rotation, body frame
     for (int i = 0; i < 3; ++i) w[i] = wn[i];
   }
+  if (!R.allFinite() || !Vector3(w[0], w[1], w[2]).allFinite())  // a spin whose products overflow
+    throw NumericalError(detail::str("propagate_target: the rotation is not finite after ", t,
+                                     " s (angular velocity ", t0.angular_velocity.transpose(), " rad/s)"));
   t1.attitude = detail::quaternion_from_rotation(R);
   t1.angular_velocity = Vector3(w[0], w[1], w[2]);
   return t1;

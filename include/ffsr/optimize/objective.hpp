@@ -5,7 +5,7 @@
 // contact and the objective kind reach all of them.
 #pragma once
 
-#include "ffsr/algorithm/articulated_effective_mass.hpp"
+#include "ffsr/algorithm/effective_mass_gradient.hpp"
 #include "ffsr/algorithm/base_disturbance.hpp"
 #include "ffsr/optimize/capture_problem.hpp"
 #include "ffsr/uncertainty/robust_objective.hpp"
@@ -128,10 +128,10 @@ class CaptureEvaluator {
   }
 
   /// M_ie at (base, theta) by the faster path for many evaluations (maps): the articulated-body
-  /// recursion of the joint model (integrated_effective_mass_fast; the same M_ie to rounding). Writes
-  /// the kinematics and the recursion's fields.
+  /// recursion of the joint model (integrated_effective_mass; the same M_ie as mass to rounding).
+  /// Writes the kinematics and the recursion's fields.
   double mass_fast(Data& data, const BasePose& base, const Eigen::Ref<const Eigen::VectorXd>& theta) const {
-    return integrated_effective_mass_fast(*model_, data, base, theta, frame_, u_, b_, *joints_);
+    return integrated_effective_mass(*model_, data, base, theta, frame_, u_, b_, *joints_);
   }
 
   /// M_ie and its analytic gradient in theta (size n) at a fixed base pose

@@ -28,7 +28,7 @@
 //     counted as equal (the arm can turn the impulse's line through the point that leaves the base's
 //     rotation alone: the least rate is then zero to rounding, reached on a whole set of
 //     configurations, and the rate end is the one of least M_ie among them).
-// The gradient of M_ie is analytic (effective_mass.hpp); that of |Delta w_0|^2 a central difference
+// The gradient of M_ie is analytic (effective_mass_gradient.hpp); that of |Delta w_0|^2 a central difference
 // (step 1e-6 rad), 2n evaluations of crba and one back substitution each.
 //
 // Reported beside the front: the hypervolume dominated by it up to the nadir of the two ends

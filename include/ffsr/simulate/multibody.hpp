@@ -2,9 +2,8 @@
 // "classical numerical integration method" that the paper uses as its reference (Tables 3 and 6).
 #pragma once
 
-#include "ffsr/algorithm/effective_mass.hpp"
+#include "ffsr/algorithm/effective_mass_gradient.hpp"
 #include "ffsr/algorithm/forward_dynamics.hpp"
-#include "ffsr/algorithm/joint_models.hpp"
 #include "ffsr/algorithm/jacobian.hpp"
 #include "ffsr/algorithm/momentum.hpp"
 #include "ffsr/contact/contact_law.hpp"

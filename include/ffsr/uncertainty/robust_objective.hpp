@@ -3,7 +3,7 @@
 // the global capture search (optimize/global.hpp). Eigen only.
 #pragma once
 
-#include "ffsr/algorithm/joint_models.hpp"
+#include "ffsr/algorithm/effective_mass_gradient.hpp"
 #include "ffsr/uncertainty/sampling.hpp"
 
 #include <algorithm>
@@ -33,7 +33,7 @@
 // The gradient. dF_i = p_i F_i / M_i dM_i and dM_i = -M_i^2 d(s_i^T Lambda^-1 s_i), so the gradient
 // of CVaR_95 is d tr(Lambda^-1 W) with W = sum over the tail of w_i s_i s_i^T, w_i = -p_i F_i M_i / k.
 // W is a symmetric 6x6 matrix: with its eigen-decomposition W = sum_j l_j e_j e_j^T the gradient is
-// sum_j l_j d(e_j^T Lambda^-1 e_j), six analytic form gradients (effective_mass.hpp,
+// sum_j l_j d(e_j^T Lambda^-1 e_j), six analytic form gradients (effective_mass_gradient.hpp,
 // inverse_inertia_form_gradient) whatever the number of samples.
 
 namespace ffsr {
@@ -92,7 +92,7 @@ class RobustForceObjective {
   }
 
   /// The same under the joint model of the contact: Lambda^-1 and its form gradients of that model
-  /// (inverse_inertia_matrix and inverse_inertia_form_gradient of joint_models.hpp).
+  /// (inverse_inertia_matrix and inverse_inertia_form_gradient of effective_mass_gradient.hpp).
   double value_and_gradient(const Model& model, Data& data, const BasePose& base,
                             const Eigen::Ref<const Eigen::VectorXd>& theta, int frame,
                             const ContactJoints& joints, Eigen::Ref<Eigen::VectorXd> grad) {

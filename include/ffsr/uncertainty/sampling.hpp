@@ -205,7 +205,7 @@ inline Matrix3 robot_inverse_mass_matrix(const Model& model, Data& data, const B
                                          const Eigen::Ref<const Eigen::VectorXd>& theta, int frame);
 
 /// The robot's 6x6 inverse inertia Lambda^-1 = J H^-1 J^T at the origin of `frame`
-/// (effective_mass.hpp, inverse_inertia_matrix): a sample's robot-side inverse effective mass is
+/// (effective_mass_gradient.hpp, inverse_inertia_matrix): a sample's robot-side inverse effective mass is
 /// s^T Lambda^-1 s with s = UncertainSample::wrench (its top-left block is G). Runs crba. Writes data.
 inline Matrix6 robot_inverse_inertia(const Model& model, Data& data, const BasePose& base,
                                      const Eigen::Ref<const Eigen::VectorXd>& theta, int frame);
