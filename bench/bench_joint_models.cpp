@@ -51,7 +51,7 @@ int main(int argc, char** argv) {
         std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - t0).count();
     t0 = std::chrono::steady_clock::now();
     for (int r = 0; r < reps; ++r)
-      sink += integrated_effective_mass_gradient(model, data, base, thetas[size_t(r) % thetas.size()],
+      sink += integrated_effective_mass_gradient_dense(model, data, base, thetas[size_t(r) % thetas.size()],
                                                  model.end_effector(), u, 0.01, joints, grad);
     const double t_grad =
         std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - t0).count();

@@ -122,7 +122,7 @@ inline void check_effective_mass(Input& in, const ffsr::Model& model) {
   });
   returns_or_ffsr_error("integrated_effective_mass_gradient", [&] {
     Eigen::VectorXd grad(model.n());
-    const double M_ie = ffsr::integrated_effective_mass_gradient(
+    const double M_ie = ffsr::integrated_effective_mass_gradient_dense(
         model, data, base, theta, f, target.normal_world(), target.inverse_mass_along_normal(), grad);
     require_finite(M_ie, "M_ie (gradient)");
     require_finite(grad, "grad M_ie");

@@ -212,7 +212,8 @@ void bind_effective_mass(nb::module_& m) {
       (std::string(
            "(M_ie, dM_ie/dtheta): the integrated effective mass (Eq. 14) and its analytic O(n) gradient in\n"
            "the joint angles at a fixed base pose, for the contact direction u = R_t u_n (the objective of\n"
-           "the null-space planner, Eq. 30-31). Runs crba.\n") +
+           "the null-space planner, Eq. 30-31), by the articulated-body recursion (mimic joints: the dense\n"
+           "route inside it).\n") +
        kJointsDoc)
           .c_str());
 }

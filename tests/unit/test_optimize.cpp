@@ -65,7 +65,7 @@ TEST_CASE("The analytic M_ie gradient equals central differences", "[optimize]")
       const Vector3 u = t.normal_world();
       const double c = t.inverse_mass_along_normal();
       Eigen::VectorXd g(m.n());
-      const double M = integrated_effective_mass_gradient(m, d, b, q, m.end_effector(), u, c, g);
+      const double M = integrated_effective_mass_gradient_dense(m, d, b, q, m.end_effector(), u, c, g);
       CHECK(M == Approx(integrated_effective_mass(m, d, b, q, m.end_effector(), t)).epsilon(1e-12));
       for (int k = 0; k < m.n(); ++k) {
         const double h = 1e-5;

@@ -206,7 +206,7 @@ inline double inverse_inertia_form_gradient(const Model& model, Data& data, int 
   return detail::inverse_inertia_form_gradient_prepared(model, data, frame, s, joints, grad);
 }
 
-/// integrated_effective_mass_gradient (below) at the configuration of the last crba (data.H and the
+/// integrated_effective_mass_gradient_dense (below) at the configuration of the last crba (data.H and the
 /// kinematics as crba left them), for a caller that has just run it at (base, theta): the same
 /// numbers, without a second crba. Free: inverse_inertia_form_gradient for s = [u; 0]. Armature: the
 /// same formula with H + diag(0, a) factorized (the armature is constant, so dH/dtheta is unchanged).
@@ -254,7 +254,7 @@ inline double integrated_effective_mass_gradient_at(const Model& model, Data& da
 /// integrated_effective_mass_gradient_at): with 1/m_e = q(u) of inverse_inertia_form_gradient for
 /// s = [u; 0], dM_ie = -M_ie^2 d(1/m_e). Writes data.H, data.L, data.w, data.y, data.V, data.F and
 /// grad (size n). Returns M_ie.
-inline double integrated_effective_mass_gradient(const Model& model, Data& data, const BasePose& base,
+inline double integrated_effective_mass_gradient_dense(const Model& model, Data& data, const BasePose& base,
                                                  const Eigen::Ref<const Eigen::VectorXd>& theta, int frame,
                                                  const Vector3& u, double target_inverse_mass,
                                                  const ContactJoints& joints,
@@ -266,30 +266,30 @@ inline double integrated_effective_mass_gradient(const Model& model, Data& data,
   return integrated_effective_mass_gradient_at(model, data, frame, u, target_inverse_mass, joints, grad);
 }
 
-/// integrated_effective_mass_gradient for the free joints (the paper's).
-inline double integrated_effective_mass_gradient(const Model& model, Data& data, const BasePose& base,
+/// integrated_effective_mass_gradient_dense for the free joints (the paper's).
+inline double integrated_effective_mass_gradient_dense(const Model& model, Data& data, const BasePose& base,
                                                  const Eigen::Ref<const Eigen::VectorXd>& theta, int frame,
                                                  const Vector3& u, double target_inverse_mass,
                                                  Eigen::Ref<Eigen::VectorXd> grad) {
-  return integrated_effective_mass_gradient(model, data, base, theta, frame, u, target_inverse_mass,
+  return integrated_effective_mass_gradient_dense(model, data, base, theta, frame, u, target_inverse_mass,
                                             ContactJoints{}, grad);
 }
 
 /// Analytic gradient of the integrated effective mass in the joint angles under the joint model, at a
-/// fixed base pose, in O(n): the same formula as integrated_effective_mass_gradient
+/// fixed base pose, in O(n): the same formula as integrated_effective_mass_gradient_dense
 /// (inverse_inertia_form_gradient: dq = 2 s . d(J y) - y^T dH y with q = 1/m_e, y = (H + diag(0, a))^-1 w,
 /// w = J_v^T u), with y the generalized acceleration of the articulated-body algorithm under the test
 /// force (detail::articulated_solve with every body) instead of a dense Cholesky solve; Locked: the
 /// composite inertias and detail::locked_inverse_form_gradient. dM_ie = -M_ie^2 d(1/m_e). Mimic joints:
-/// integrated_effective_mass_gradient. Runs forward_kinematics. Writes the recursion's fields,
+/// integrated_effective_mass_gradient_dense. Runs forward_kinematics. Writes the recursion's fields,
 /// data.Ic (composite), data.y, data.V, data.F and grad (size n); not data.H. Returns M_ie.
-inline double integrated_effective_mass_gradient_fast(const Model& model, Data& data, const BasePose& base,
+inline double integrated_effective_mass_gradient(const Model& model, Data& data, const BasePose& base,
                                                       const Eigen::Ref<const Eigen::VectorXd>& theta,
                                                       int frame, const Vector3& u, double target_inverse_mass,
                                                       const ContactJoints& joints,
                                                       Eigen::Ref<Eigen::VectorXd> grad) {
   if (model.nb() - 1 != model.n())
-    return integrated_effective_mass_gradient(model, data, base, theta, frame, u, target_inverse_mass, joints,
+    return integrated_effective_mass_gradient_dense(model, data, base, theta, frame, u, target_inverse_mass, joints,
                                               grad);
   detail::require_size(grad.size(), model.n(), "integrated_effective_mass_gradient", "grad");
   forward_kinematics(model, data, base, theta);
