@@ -10,9 +10,6 @@ from __future__ import annotations
 import dataclasses
 import json
 import os
-import shutil
-import subprocess
-import tempfile
 from typing import Any, Dict, Iterable, List, Mapping, Optional, Union
 
 import numpy as np
@@ -116,25 +113,18 @@ def robust_shard(scenario: Union[str, os.PathLike], shard_k: int, shard_n: int, 
     return _scenario(scenario, overrides).robust(shard_k=shard_k, shard_n=shard_n, **options).to_json()
 
 
-def _command(command: Optional[Union[str, os.PathLike]]) -> str:
-    found = command or os.environ.get("FFSR_OPTIMIZE") or shutil.which("ffsr-optimize")
-    if not found:
-        raise FileNotFoundError("merge_robust: the command ffsr-optimize is needed (its robust --merge): "
-                                "pass command=PATH, set FFSR_OPTIMIZE, or put it on the PATH")
-    return os.fspath(found)
+def merge_robust(parts: Iterable[Any]) -> Dict[str, Any]:
+    """The summary of the shards together (any order), as ``ffsr-optimize robust --merge`` makes it (the
+    library's merge_shards, through ffsr.merge_robust_shards): the samples concatenated by index and the
+    percentiles, mean and tail computed again, those of the unsharded run to the bit. Returns the
+    merged --json as a dict.
 
-
-def merge_robust(parts: Iterable[Any], *,
-                 command: Optional[Union[str, os.PathLike]] = None) -> Dict[str, Any]:
-    """The summary of the shards together (any order), as ``ffsr-optimize robust --merge`` makes it: the
-    samples concatenated by index and the percentiles, mean and tail computed again, those of the
-    unsharded run to the bit. Returns the command's --json as a dict.
-
-    parts: each shard's --json as text (robust_shard), as a dict, or a RobustResult. The merge is the
-    command's (the extension has no binding of the library's merge): command, else $FFSR_OPTIMIZE, else
-    ffsr-optimize on the PATH. ValueError with the command's message when the shards are not of one run
-    (seed, samples, laws, scenario) or leave gaps or overlaps.
+    parts: each shard's --json as text (robust_shard), as a dict, or a RobustResult. ffsr.InputError (a
+    ValueError) when the shards are not of one run (seed, samples, laws, scenario) or leave gaps or
+    overlaps.
     """
+    import ffsr
+
     texts = []
     for p in parts:
         if hasattr(p, "to_json"):
@@ -142,19 +132,7 @@ def merge_robust(parts: Iterable[Any], *,
         texts.append(p if isinstance(p, str) else json.dumps(p))
     if not texts:
         raise ValueError("merge_robust: no shard to merge")
-    exe = _command(command)
-    with tempfile.TemporaryDirectory(prefix="ffsr-merge-") as tmp:
-        files = []
-        for i, text in enumerate(texts):
-            files.append(os.path.join(tmp, f"shard{i}.json"))
-            with open(files[-1], "w", encoding="utf-8") as f:
-                f.write(text)
-        out = os.path.join(tmp, "merged.json")
-        done = subprocess.run([exe, "robust", "--merge", *files, "--json", out, "--quiet"],
-                              capture_output=True, text=True)
-        if done.returncode != 0:
-            err = done.stderr.strip()
-            message = err.splitlines()[-1] if err else f"exit status {done.returncode}"
-            raise (ValueError if done.returncode == 2 else RuntimeError)(f"merge_robust: {message}")
-        with open(out, encoding="utf-8") as f:
-            return json.loads(f.read())
+    try:
+        return ffsr.merge_robust_shards(texts).to_dict()
+    except ffsr.InputError as e:
+        raise ffsr.InputError(f"merge_robust: {e}") from None

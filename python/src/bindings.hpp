@@ -54,6 +54,7 @@ void bind_closed_loop(nanobind::module_& m);
 // studies.cpp: the jobs over many configurations or samples, as methods of Scenario
 void bind_map(nanobind::module_& m);
 void bind_robust(nanobind::module_& m);
+void bind_robust_merge(nanobind::module_& m);
 void bind_pareto(nanobind::module_& m);
 
 // controller.cpp: the capture controller

@@ -46,6 +46,7 @@ NB_MODULE(_ffsr, m) {
   bind_closed_loop(m);
   bind_map(m);
   bind_robust(m);
+  bind_robust_merge(m);
   bind_pareto(m);
 
   bind_target_estimate(m);

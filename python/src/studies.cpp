@@ -207,6 +207,33 @@ void bind_robust(nb::module_& m) {
       "(results do not depend on them). The keywords are the command's flags (an underscore for a dash).");
 }
 
+void bind_robust_merge(nb::module_& m) {
+  m.def(
+      "merge_robust_shards",
+      [](const std::vector<std::string>& parts) {
+        return run_job<RobustRunResult>([&](RobustRunResult& r) {
+          std::vector<RobustSummary> summaries;
+          for (std::size_t i = 0; i < parts.size(); ++i) {
+            const std::string where = detail::str("merge_robust_shards: part ", i);
+            nlohmann::json j;
+            try {
+              j = nlohmann::json::parse(parts[i]);
+            } catch (const std::exception& e) {
+              throw InputError(detail::str(where, " is not JSON: ", e.what()));
+            }
+            summaries.push_back(RobustSummary::from_json(j, where));
+          }
+          r.result = merge_shards(std::move(summaries));
+          r.json = r.result.to_json().dump();
+        });
+      },
+      "parts"_a,
+      "The shards of one robust run merged (any order), as `ffsr-optimize robust --merge` merges them:\n"
+      "parts are the shards' --json texts (RobustResult.to_json()); the samples are concatenated by index\n"
+      "and the percentiles, mean and tail computed again, those of the unsharded run to the bit.\n"
+      "InputError when the parts are not shards of one run or leave gaps or overlaps.");
+}
+
 void bind_pareto(nb::module_& m) {
   nb::class_<ParetoPoint>(m, "ParetoPoint", "A capture configuration on the axes of the front.")
       .def_ro("M_ie", &ParetoPoint::M_ie, "Integrated effective mass (Eq. 14), kg.")

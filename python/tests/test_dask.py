@@ -4,7 +4,9 @@ the command merges its shards, equal to one run in this process to the bit (byte
 the JSON). A Slurm or Kubernetes cluster changes only the cluster object (docs/python.md).
 """
 
+import json
 import logging
+import subprocess
 
 import numpy as np
 import pytest
@@ -102,23 +104,31 @@ def test_robust_shards_hold_the_samples_of_one_run(robust_runs):
         assert same_bits(f, np.asarray(config.f_max)), config.name
 
 
-def test_robust_shards_merged_equal_one_run(robust_runs):
-    """The shards merged as ffsr-optimize robust --merge merges them: the JSON of one run, but for the
-    record of the shard (merged_from)."""
+def test_robust_shards_merged_equal_one_run(robust_runs, tmp_path):
+    """The shards merged in this process (the library's merge): the JSON of one run, but for the record
+    of the shard (merged_from); and the same JSON as ffsr-optimize robust --merge makes of them."""
     parts, one = robust_runs
-    merged = studies.merge_robust(list(reversed(parts)), command=command())
+    merged = studies.merge_robust(list(reversed(parts)))
+    files = []
+    for i, text in enumerate(parts):
+        files.append(tmp_path / f"shard{i}.json")
+        files[-1].write_text(text)
+    out = tmp_path / "merged.json"
+    subprocess.run([command(), "robust", "--merge", *map(str, files), "--json", str(out), "--quiet"],
+                   check=True)
+    assert json.loads(out.read_text()) == merged  # the command's merge, to the bit
     whole = one.to_dict()
     assert merged.pop("shard") == {"k": 0, "n": 1, "first": 0, "end": 61, "merged_from": 3}
     assert whole.pop("shard") == {"k": 0, "n": 1, "first": 0, "end": 61}
     assert merged == whole  # every double bit for bit: the percentiles, the mean, the tails
-    with pytest.raises(ValueError, match="merge_robust: .*samples 20 to 40 are missing"):
-        studies.merge_robust([parts[0], parts[2]], command=command())
+    with pytest.raises(ffsr.InputError, match="merge_robust: .*samples 20 to 40 are missing"):
+        studies.merge_robust([parts[0], parts[2]])
 
 
-def test_merge_robust_names_what_it_lacks(monkeypatch, tmp_path):
+def test_merge_robust_names_what_it_lacks():
     with pytest.raises(ValueError, match="merge_robust: no shard to merge"):
         studies.merge_robust([])
-    monkeypatch.delenv("FFSR_OPTIMIZE", raising=False)
-    monkeypatch.setenv("PATH", str(tmp_path))  # no ffsr-optimize there
-    with pytest.raises(FileNotFoundError, match="merge_robust: the command ffsr-optimize is needed"):
+    with pytest.raises(ffsr.InputError, match="merge_robust: .*part 0 is not JSON"):
+        studies.merge_robust(["{not json"])
+    with pytest.raises(ffsr.InputError, match="merge_robust: "):
         studies.merge_robust(['{"kind": "ffsr-robust"}'])

@@ -68,6 +68,9 @@ TEST_CASE("jobs: robust shards merged by the library equal one run, bit for bit"
   CHECK(c.summary.n == 41);
   CHECK(c.tail.size() == ffsr::kRobustTail);
   CHECK(c.tail.front().force.f_max == *std::max_element(c.f_max.begin(), c.f_max.end()));
+  // the redraws of every shard add up (this scenario redraws none: counts set by hand)
+  for (std::size_t i = 0; i < shards.size(); ++i) shards[i].redraws = 2 * i + 1;
+  CHECK(ffsr::merge_shards(shards).redraws == 1 + 3 + 5);
 }
 
 TEST_CASE("jobs: merge_shards refuses a gap and shards of another run", "[jobs][robust]") {

@@ -451,6 +451,7 @@ inline RobustSummary merge_shards(std::vector<RobustSummary> parts) {
     if (p.configurations.size() != first.configurations.size())
       throw InputError("--merge: the summaries have different configurations");
     if (i == 0) continue;
+    m.redraws += p.redraws;  // the samples each shard redrew, counted once
     m.stiffness.insert(m.stiffness.end(), p.stiffness.begin(), p.stiffness.end());  // by index
     m.exponent.insert(m.exponent.end(), p.exponent.begin(), p.exponent.end());
     for (std::size_t c = 0; c < p.configurations.size(); ++c) {
