@@ -74,7 +74,7 @@ nb::dict grasp_dict(const GraspResult& g) {
   return d;
 }
 
-void bind_results(nb::module_& m) {
+void bind_grasp_result(nb::module_& m) {
   nb::class_<AttachedBody>(
       m, "AttachedBody",
       "A rigid body attached at a frame: mass (kg), inertia about its centre of mass (its\n"
@@ -122,6 +122,9 @@ void bind_results(nb::module_& m) {
                            g.impulse.tail<3>().norm(), " N m s, energy ", g.energy_before, " -> ",
                            g.energy_after, " J)");
       });
+}
+
+void bind_detumble_result(nb::module_& m) {
   nb::class_<DetumbleRunResult>(m, "DetumbleResult", "The post-capture run's summary and series (SI units).")
       .def_ro("at_rest", &DetumbleRunResult::at_rest)
       .def_ro("time_to_rest", &DetumbleRunResult::time_to_rest)
@@ -160,10 +163,7 @@ void bind_results(nb::module_& m) {
       });
 }
 
-}  // namespace
-
-void bind_detumble(nb::module_& m) {
-  bind_results(m);
+void bind_detumble_controller(nb::module_& m) {
   nb::class_<DetumbleController>(
       m, "DetumbleController",
       "The detumbling controller on the stack model: one step per tick, no allocation.")
@@ -202,6 +202,14 @@ void bind_detumble(nb::module_& m) {
           },
           "stack"_a, "base"_a, "theta"_a, "v"_a, "wheel_momentum"_a = nb::none(),
           "One tick: the command (tau, base_wrench, status...) as a dict.");
+}
+
+}  // namespace
+
+void bind_detumble(nb::module_& m) {
+  bind_grasp_result(m);
+  bind_detumble_result(m);
+  bind_detumble_controller(m);
   m.def(
       "attach_body",
       [](const Model& model, const std::string& frame, double mass, nb::handle inertia, const Pose& pose,

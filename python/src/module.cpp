@@ -52,5 +52,4 @@ NB_MODULE(_ffsr, m) {
   bind_target_estimate(m);
   bind_controller(m);
   bind_detumble(m);
-  bind_detumble(m);
 }
