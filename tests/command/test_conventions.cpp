@@ -448,7 +448,8 @@ TEST_CASE("conventions: --quiet, --json FILE and --json - on every subcommand", 
   }
 }
 
-TEST_CASE("conventions: --json - alone is the only thing on standard output of every subcommand", "[cli][conventions]") {
+TEST_CASE("conventions: --json - alone is the only thing on standard output of every subcommand",
+          "[cli][conventions]") {
   // no other output (the map's --csv dropped) and no --quiet: the table and the progress go elsewhere
   std::vector<Sub> subs = subcommands();
   subs.push_back({"robust", {"--merge", "shard.json"}});  // a summary written by the robust run above
@@ -492,7 +493,8 @@ TEST_CASE("conventions: map without --csv evaluates the grid for its summary", "
   without.insert(without.end(), {"--json", "b.json"});
   REQUIRE(cli(with_csv, tmp.str()).exit_code == 0);
   REQUIRE(cli(without, tmp.str()).exit_code == 0);
-  json a = ffsr::test::read_json_file(tmp.str() + "/a.json"), b = ffsr::test::read_json_file(tmp.str() + "/b.json");
+  json a = ffsr::test::read_json_file(tmp.str() + "/a.json"),
+       b = ffsr::test::read_json_file(tmp.str() + "/b.json");
   a.erase("seconds");
   b.erase("seconds");
   CHECK(a == b);  // the same summary, with and without the map's file
@@ -627,9 +629,10 @@ TEST_CASE("conventions: a row of the main job says which keys of the scenario it
     CHECK(not_applied(*j, "global").empty());
   }
   // what a row says is what its run does: a row that does not take a key is the same without it
+  // (the global search also starts from the optimized run's configuration, which the held run does
+  // not give here: its search has one start fewer, and ends on the same run)
   auto without_notes = [](json row) {
-    row.erase("keys_not_applied");
-    if (row.contains("search")) row["search"].erase("seconds");
+    for (const char* key : {"keys_not_applied", "search", "branches"}) row.erase(key);
     return row;
   };
   CHECK(without_notes(held.at("baseline")) == without_notes(free.at("baseline")));

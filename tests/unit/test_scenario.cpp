@@ -250,8 +250,9 @@ TEST_CASE("scenario: bad keys and values name the file or the key", "[scenario]"
   // several keys, one of them a flag's: the file's named as written, the flag's as a flag
   keys = ffsr::read_scenario_file(with(""));
   ffsr::override_scenario_key(keys, "restitution", "0");
-  CHECK(error_of([&] { ffsr::build_scenario(keys); })
-            .rfind("scenario " + tmp.path.string() + "/s.toml:22: stiffness/exponent/--restitution: ", 0) == 0);
+  CHECK(error_of([&] {
+          ffsr::build_scenario(keys);
+        }).rfind("scenario " + tmp.path.string() + "/s.toml:22: stiffness/exponent/--restitution: ", 0) == 0);
 }
 
 TEST_CASE("scenario: the keys a row of the main job does not take", "[scenario]") {
@@ -271,7 +272,8 @@ TEST_CASE("scenario: the keys a row of the main job does not take", "[scenario]"
   // the keys of a task act on the rows of that task
   ffsr::override_scenario_key(k, "task-axes", "xy");
   ffsr::override_scenario_key(k, "orientation-tolerance-deg", "1");
-  CHECK(ffsr::keys_not_applied(k, ScenarioRow::Plain) == V{"task-axes", "base-attitude", "max-joint-rate-deg"});
+  CHECK(ffsr::keys_not_applied(k, ScenarioRow::Plain) ==
+        V{"task-axes", "base-attitude", "max-joint-rate-deg"});
   CHECK(ffsr::keys_not_applied(k, ScenarioRow::Global) == V{"orientation-tolerance-deg", "base-attitude"});
   // multibody-force: the global run's objective; the paper's method descends M_ie
   ffsr::override_scenario_key(k, "objective", "multibody-force");

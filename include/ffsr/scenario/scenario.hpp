@@ -122,8 +122,8 @@ struct ScenarioRows {
 /// "--" + name), kind, help text, group, whether a file must give it, how it is set, its own check
 /// and its echo in the result's resolved scenario. The setters and the check throw InputError naming
 /// the key: from_toml as written in the file ("name: ..."), from_text and the check as a flag
-/// ("--name: ...", located_key_message renames a key the file gave). Checks that involve several keys or the robot are made where the problem
-/// is built (build_scenario).
+/// ("--name: ...", located_key_message renames a key the file gave). Checks that involve several
+/// keys or the robot are made where the problem is built (build_scenario).
 struct ScenarioKey {
   std::string name;
   KeyKind kind;

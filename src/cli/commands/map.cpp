@@ -213,7 +213,8 @@ int run_map(const MapOptions& o) {
   MapSink sink;
   sink.evaluated = [&](unsigned t, const MapBlock& b) {
     if (out) rows[t].format(b, k);
-    if (plotting) std::copy(b.M_ie, b.M_ie + b.count, values.begin() + static_cast<std::ptrdiff_t>(b.first - plan.first));
+    if (plotting)
+      std::copy(b.M_ie, b.M_ie + b.count, values.begin() + static_cast<std::ptrdiff_t>(b.first - plan.first));
   };
   sink.commit = [&](unsigned t, const MapBlock&) {
     if (out) out->write(rows[t].text.data(), rows[t].bytes);

@@ -224,7 +224,8 @@ void print_rows(std::ostream& out, const Scenario& sc, const ScenarioResult& r) 
       << std::setw(11) << "M_ie (kg)" << std::setw(14) << "F_max (kN)" << std::setw(14) << "exact (kN)"
       << std::setw(15) << "tracking (m)"
       << "\n";
-  auto row = [&](const char* label, ScenarioRow which, const CaptureResult& x, const std::string& failure = {}) {
+  auto row = [&](const char* label, ScenarioRow which, const CaptureResult& x,
+                 const std::string& failure = {}) {
     if (!failure.empty()) {  // the message follows the table
       out << std::left << std::setw(24) << label << "failed (below)";
     } else {

@@ -199,10 +199,9 @@ inline void add_subject_keys(std::vector<ScenarioKey>& keys) {
 inline void add_planner_keys(std::vector<ScenarioKey>& keys) {
   using K = ScenarioKeys;
   keys.push_back(FFSR_KEY("task", task, "Optimized run's task: position or pose").needed());
-  keys.push_back(
-      FFSR_KEY("task-axes", task_axes, "Position task: constrained inertial axes, e.g. xy", "xyz")
-          .acting(on_the_task("position"))
-          .skipping(skips_other_task("position")));
+  keys.push_back(FFSR_KEY("task-axes", task_axes, "Position task: constrained inertial axes, e.g. xy", "xyz")
+                     .acting(on_the_task("position"))
+                     .skipping(skips_other_task("position")));
   keys.push_back(FFSR_KEY("baseline-task", baseline_task, "Plain run's task (default: the optimized run's)")
                      .echoed([](const Scenario& sc, nlohmann::json& j) {
                        j["baseline-task"] =
@@ -222,12 +221,13 @@ inline void add_planner_keys(std::vector<ScenarioKey>& keys) {
                           "Pose task: required orientation accuracy, deg", "0.5")
                      .acting(on_the_task("pose"))
                      .skipping(skips_other_task("pose")));
-  keys.push_back(FFSR_KEY(
-      "objective", objective,
-      "mass (M_ie, the paper's), exact-force, or multibody-force (CVODE peak; global search only, the "
-      "paper's method then descends M_ie)",
-      "mass")
-                     .skipping(skips_of_objective));
+  keys.push_back(
+      FFSR_KEY(
+          "objective", objective,
+          "mass (M_ie, the paper's), exact-force, or multibody-force (CVODE peak; global search only, the "
+          "paper's method then descends M_ie)",
+          "mass")
+          .skipping(skips_of_objective));
   // the spacecraft's side: the reaction-null-space approach
   keys.push_back(
       FFSR_KEY("base-attitude", base_attitude,
