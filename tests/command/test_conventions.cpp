@@ -456,7 +456,7 @@ TEST_CASE("conventions: --json - alone is the only thing on standard output of e
   for (const Sub& sub : subs) {
     INFO((sub.name.empty() ? "main job" : sub.name));
     ffsr::test::TempDir tmp;
-    if (sub.base.front() == "--merge") {  // the shard to merge
+    if (!sub.base.empty() && sub.base.front() == "--merge") {  // the shard to merge
       const Sub& run = subs[5];
       REQUIRE(run.name == "robust");
       Args a{"robust"};

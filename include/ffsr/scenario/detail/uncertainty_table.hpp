@@ -138,7 +138,16 @@ inline UncertaintySpec uncertainty_spec(const ScenarioKeys& keys, std::optional<
   }
   if (samples) spec.samples = *samples;
   if (seed) spec.seed = *seed;
-  validate(spec);
+  try {
+    validate(spec);
+  } catch (const InputError& e) {  // "uncertainty.<entry>...: ": located at the entry's line
+    const std::string m = e.what(), prefix = "uncertainty.";
+    const toml::node* entry =
+        m.rfind(prefix, 0) == 0 ? u->get(m.substr(prefix.size(), m.find_first_of(".:", prefix.size()) - prefix.size()))
+                                : nullptr;
+    if (!entry) throw;
+    throw InputError(detail::located(keys.where, *entry, m));
+  }
   return spec;
 }
 
