@@ -657,4 +657,13 @@ TEST_CASE("conventions: a row of the main job says which keys of the scenario it
   CHECK(ends_with(rows["Without optimization"], "  not applied: base-attitude, max-joint-rate-deg"));
   CHECK(ends_with(rows["With optimization"], "  not applied: max-joint-rate-deg"));
   CHECK(ends_with(rows["Global"], "  not applied: base-attitude"));
+  // pareto places the same three runs on its front, with the same notes
+  const CommandResult p = cli({"pareto", "--config", kPosition7, "--levels", "2", "--starts", "2",
+                               "--global-starts", "2", "--json", "-", "--quiet"});
+  INFO(p.err);
+  REQUIRE(p.exit_code == 0);
+  const json front = json::parse(p.out);
+  CHECK(front.at("runs").at("baseline").at("keys_not_applied").get<V>() == V{"max-joint-rate-deg"});
+  CHECK(front.at("runs").at("optimized").at("keys_not_applied").get<V>() == V{"max-joint-rate-deg"});
+  CHECK(front.at("runs").at("global").at("keys_not_applied").get<V>().empty());
 }
