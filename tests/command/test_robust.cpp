@@ -284,9 +284,9 @@ TEST_CASE("robust: bad inputs give one error line naming the key, exit 2, no out
     const std::string path = write(dir, "bad.toml", text);
     // an entry of the table is named as written, after the file and the entry's line; a flag by itself
     const std::string expected =
-        c.flags.empty()
-            ? "scenario " + path + ":" + std::to_string(std::count(text.begin(), text.end(), '\n')) + ": " + c.expected
-            : c.expected;
+        c.flags.empty() ? "scenario " + path + ":" +
+                              std::to_string(std::count(text.begin(), text.end(), '\n')) + ": " + c.expected
+                        : c.expected;
     Args a{"--config", path, "--json", dir / "out.json"};
     a.insert(a.end(), kGiven.begin(), kGiven.end());
     a.insert(a.end(), c.flags.begin(), c.flags.end());

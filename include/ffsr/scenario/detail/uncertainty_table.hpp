@@ -143,8 +143,9 @@ inline UncertaintySpec uncertainty_spec(const ScenarioKeys& keys, std::optional<
   } catch (const InputError& e) {  // "uncertainty.<entry>...: ": located at the entry's line
     const std::string m = e.what(), prefix = "uncertainty.";
     const toml::node* entry =
-        m.rfind(prefix, 0) == 0 ? u->get(m.substr(prefix.size(), m.find_first_of(".:", prefix.size()) - prefix.size()))
-                                : nullptr;
+        m.rfind(prefix, 0) == 0
+            ? u->get(m.substr(prefix.size(), m.find_first_of(".:", prefix.size()) - prefix.size()))
+            : nullptr;
     if (!entry) throw;
     throw InputError(detail::located(keys.where, *entry, m));
   }
