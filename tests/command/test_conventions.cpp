@@ -18,6 +18,7 @@
 #include <map>
 #include <regex>
 #include <set>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -448,6 +449,81 @@ TEST_CASE("conventions: --quiet, --json FILE and --json - on every subcommand", 
   }
 }
 
+TEST_CASE("conventions: --json - alone is the only thing on standard output of every subcommand",
+          "[cli][conventions]") {
+  // no other output (the map's --csv dropped) and no --quiet: the table and the progress go elsewhere
+  std::vector<Sub> subs = subcommands();
+  subs.push_back({"robust", {"--merge", "shard.json"}});  // a summary written by the robust run above
+  for (const Sub& sub : subs) {
+    INFO((sub.name.empty() ? "main job" : sub.name));
+    ffsr::test::TempDir tmp;
+    if (!sub.base.empty() && sub.base.front() == "--merge") {  // the shard to merge
+      const Sub& run = subs[5];
+      REQUIRE(run.name == "robust");
+      Args a{"robust"};
+      a.insert(a.end(), run.base.begin(), run.base.end());
+      a.insert(a.end(), {"--quiet", "--json", "shard.json"});
+      REQUIRE(cli(a, tmp.str()).exit_code == 0);
+    }
+    Args a;
+    if (!sub.name.empty()) a.push_back(sub.name);
+    for (size_t i = 0; i < sub.base.size(); ++i) {
+      if (sub.base[i] == "--csv") {
+        ++i;
+        continue;
+      }
+      a.push_back(sub.base[i]);
+    }
+    a.insert(a.end(), {"--json", "-"});
+    const CommandResult r = cli(a, tmp.str());
+    INFO(r.err);
+    REQUIRE(r.exit_code == 0);
+    json j;
+    REQUIRE_NOTHROW(j = json::parse(r.out));  // one JSON document and nothing else
+    CHECK(j.is_object());
+    CHECK(j.contains("version"));
+    CHECK_FALSE(r.err.empty());  // the table went to standard error
+  }
+}
+
+TEST_CASE("conventions: map without --csv evaluates the grid for its summary", "[cli][conventions]") {
+  ffsr::test::TempDir tmp;
+  const Args grid{"map", "--vary", "1,2", "--step-deg", "30", "--quiet"};
+  Args with_csv = grid, without = grid;
+  with_csv.insert(with_csv.end(), {"--json", "a.json", "--csv", "map.csv"});
+  without.insert(without.end(), {"--json", "b.json"});
+  REQUIRE(cli(with_csv, tmp.str()).exit_code == 0);
+  REQUIRE(cli(without, tmp.str()).exit_code == 0);
+  json a = ffsr::test::read_json_file(tmp.str() + "/a.json"),
+       b = ffsr::test::read_json_file(tmp.str() + "/b.json");
+  a.erase("seconds");
+  b.erase("seconds");
+  CHECK(a == b);  // the same summary, with and without the map's file
+  // the extremes against the CSV's rows: the summary is of the points evaluated, not of a file
+  std::ifstream csv(tmp.str() + "/map.csv");
+  std::string line;
+  std::getline(csv, line);  // header
+  double max_M = -1, min_M = 1e300;
+  size_t rows = 0;
+  while (std::getline(csv, line)) {
+    const size_t c2 = line.find(',', line.find(',') + 1);
+    const double M = std::stod(line.substr(c2 + 1, line.find(',', c2 + 1) - c2 - 1));
+    max_M = std::max(max_M, M);
+    min_M = std::min(min_M, M);
+    ++rows;
+  }
+  CHECK(rows == 144);  // 12 x 12 points
+  CHECK(b.at("max").at("integrated_effective_mass").get<double>() == max_M);
+  CHECK(b.at("min").at("integrated_effective_mass").get<double>() == min_M);
+  // no output at all: the summary is the table on standard output
+  Args plain = grid;
+  plain.pop_back();  // --quiet
+  const CommandResult t = cli(plain, tmp.str());
+  REQUIRE(t.exit_code == 0);
+  CHECK(t.out.find("max M_ie") != std::string::npos);
+  CHECK(t.out.find("wrote") == std::string::npos);
+}
+
 TEST_CASE("conventions: --csv - is the only thing on standard output, where a subcommand has series", "[cli][conventions]") {
   for (const Sub& sub : subcommands()) {
     if (sub.name == "inspect") continue;  // one configuration: no series
@@ -481,14 +557,14 @@ TEST_CASE("a bad value in a scenario file names the file, the key and its line",
     std::ofstream(file) << std::regex_replace(toml, std::regex("duration = 180"), "duration = \"long\"");
     const CommandResult r = cli({"--config", file, "--global", "false", "--quiet"});
     CHECK(r.exit_code == 2);
-    CHECK(r.err.find("scenario " + file + ":27: --duration: 'long' is not a number") != std::string::npos);
+    CHECK(r.err.find("scenario " + file + ":27: duration: 'long' is not a number") != std::string::npos);
   }
   SECTION("a value out of range, found when the scenario is built") {
     std::ofstream(file) << std::regex_replace(toml, std::regex("duration = 180"), "duration = -5");
     for (const Args& a : {Args{"--config", file, "--global", "false", "--quiet"}, Args{"pareto", "--config", file}}) {
       const CommandResult r = cli(a);
       CHECK(r.exit_code == 2);
-      CHECK(r.err.find("scenario " + file + ":27: --duration: must be positive") != std::string::npos);
+      CHECK(r.err.find("scenario " + file + ":27: duration: must be positive") != std::string::npos);
     }
   }
   SECTION("a flag's bad value names the flag only") {
@@ -524,4 +600,72 @@ TEST_CASE("conventions: --config with --urdf keeps the file's end-effector and j
   const json m = ffsr::test::parse_json(
       cli({"--config", scenario, "--urdf", copy, "--global", "false", "--quiet", "--json", "-"}));
   CHECK(m.at("scenario").at("end_effector") == a.at("end_effector"));
+}
+
+TEST_CASE("conventions: a row of the main job says which keys of the scenario it does not take",
+          "[cli][conventions]") {
+  // base-attitude = hold is the optimized run's mode: the plain and the global row run as without it
+  // (the global row turns the base by degrees), and say so; max-joint-rate-deg acts on the global row
+  ffsr::test::TempDir tmp;
+  auto run = [&](const Args& extra, const std::string& name) {
+    Args a{"--config", kPosition7, "--json", name};
+    a.insert(a.end(), extra.begin(), extra.end());
+    const CommandResult r = cli(a, tmp.str());
+    INFO(r.err);
+    REQUIRE(r.exit_code == 0);
+    return std::make_pair(r.out, ffsr::test::read_json_file(tmp.str() + "/" + name));
+  };
+  const auto [table, held] = run({"--base-attitude", "hold"}, "held.json");
+  const json free = run({}, "free.json").second;
+  const json explicitly_free = run({"--base-attitude", "free"}, "free2.json").second;
+  const json faster = run({"--max-joint-rate-deg", "5"}, "faster.json").second;
+  using V = std::vector<std::string>;
+  auto not_applied = [](const json& j, const char* row) { return j.at(row).at("keys_not_applied").get<V>(); };
+  CHECK(not_applied(held, "baseline") == V{"base-attitude", "max-joint-rate-deg"});
+  CHECK(not_applied(held, "optimized") == V{"max-joint-rate-deg"});
+  CHECK(not_applied(held, "global") == V{"base-attitude"});
+  for (const json* j : {&free, &explicitly_free}) {  // free is how every run is: it skips no row
+    CHECK(not_applied(*j, "baseline") == V{"max-joint-rate-deg"});
+    CHECK(not_applied(*j, "optimized") == V{"max-joint-rate-deg"});
+    CHECK(not_applied(*j, "global").empty());
+  }
+  // what a row says is what its run does: a row that does not take a key is the same without it
+  // (the global search also starts from the optimized run's configuration, which the held run does
+  // not give here: its search has one start fewer, and ends on the same run)
+  auto without_notes = [](json row) {
+    for (const char* key : {"keys_not_applied", "search", "branches"}) row.erase(key);
+    return row;
+  };
+  CHECK(without_notes(held.at("baseline")) == without_notes(free.at("baseline")));
+  CHECK(without_notes(held.at("global")) == without_notes(free.at("global")));
+  CHECK(held.at("global").at("base_attitude_drift_deg").get<double>() > 1.0);  // the base turns
+  CHECK(held.at("optimized").contains("error"));  // the held run meets a singularity here (docs)
+  CHECK(without_notes(faster.at("baseline")) == without_notes(free.at("baseline")));
+  CHECK(without_notes(faster.at("optimized")) == without_notes(free.at("optimized")));
+  // the global row takes it: limited to 3 deg/s by the file, it moves faster under 5
+  CHECK(faster.at("global").at("max_joint_rate_deg").get<double>() >
+        free.at("global").at("max_joint_rate_deg").get<double>() + 0.1);
+  // the table says it on the rows
+  std::istringstream lines(table);
+  std::map<std::string, std::string> rows;
+  for (std::string line; std::getline(lines, line);)
+    for (const char* label : {"Without optimization", "With optimization", "Global"})
+      if (line.rfind(label, 0) == 0) rows[label] = line;
+  REQUIRE(rows.size() == 3);
+  auto ends_with = [](const std::string& s, const std::string& end) {
+    return s.size() >= end.size() && s.compare(s.size() - end.size(), end.size(), end) == 0;
+  };
+  CHECK(ends_with(rows["Without optimization"], "  not applied: base-attitude, max-joint-rate-deg"));
+  CHECK(ends_with(rows["With optimization"], "  not applied: max-joint-rate-deg"));
+  CHECK(ends_with(rows["Global"], "  not applied: base-attitude"));
+  // pareto places the same three runs on its front, with the same notes
+  const CommandResult p = cli({"pareto", "--config", kPosition7, "--levels", "2", "--starts", "2",
+                               "--global-starts", "2", "--json", "-", "--quiet"});
+  INFO(p.err);
+  REQUIRE(p.exit_code == 0);
+  const json front = json::parse(p.out);
+  const V global_keys{"max-joint-rate-deg", "global-starts"};  // the file's, and the flag's
+  CHECK(front.at("runs").at("baseline").at("keys_not_applied").get<V>() == global_keys);
+  CHECK(front.at("runs").at("optimized").at("keys_not_applied").get<V>() == global_keys);
+  CHECK(front.at("runs").at("global").at("keys_not_applied").get<V>().empty());
 }

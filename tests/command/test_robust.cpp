@@ -280,14 +280,20 @@ TEST_CASE("robust: bad inputs give one error line naming the key, exit 2, no out
       {"samples = 10", {"--force-model", "fem"}, "--force-model: unknown model 'fem'"},
   };
   for (const auto& c : cases) {
-    const std::string path = write(dir, "bad.toml", scenario_with(c.uncertainty));
+    const std::string text = scenario_with(c.uncertainty);
+    const std::string path = write(dir, "bad.toml", text);
+    // an entry of the table is named as written, after the file and the entry's line; a flag by itself
+    const std::string expected =
+        c.flags.empty() ? "scenario " + path + ":" +
+                              std::to_string(std::count(text.begin(), text.end(), '\n')) + ": " + c.expected
+                        : c.expected;
     Args a{"--config", path, "--json", dir / "out.json"};
     a.insert(a.end(), kGiven.begin(), kGiven.end());
     a.insert(a.end(), c.flags.begin(), c.flags.end());
     const CommandResult r = robust(a, dir.str());
     INFO(c.uncertainty << " " << (c.flags.empty() ? "" : c.flags[0]) << "\nstderr: " << r.err);
     CHECK(r.exit_code == 2);
-    CHECK(r.err.find("ffsr-optimize: error: " + c.expected) == 0);
+    CHECK(r.err.find("ffsr-optimize: error: " + expected) == 0);
     CHECK(std::count(r.err.begin(), r.err.end(), '\n') == 1);
     CHECK(r.out.empty());
     CHECK_FALSE(std::ifstream(dir / "out.json").good());

@@ -223,10 +223,10 @@ TEST_CASE("scenario: bad keys and values name the file or the key", "[scenario]"
         std::string::npos);
   CHECK(error_of([&] {
           ffsr::read_scenario_file(with("orientation-tolerance-deg = \"fast\""));
-        }).find("--orientation-tolerance-deg: 'fast' is not a number") != std::string::npos);
+        }).find(":2: orientation-tolerance-deg: 'fast' is not a number") != std::string::npos);
   CHECK(error_of([&] {
           ffsr::read_scenario_file(with("global-starts = \"many\""));
-        }).find("--global-starts") != std::string::npos);
+        }).find(":2: global-starts: 'many' is not an integer") != std::string::npos);
 
   ffsr::ScenarioKeys keys = ffsr::read_scenario_file(with(""));
   ffsr::override_scenario_key(keys, "duration", "-1");
@@ -243,6 +243,44 @@ TEST_CASE("scenario: bad keys and values name the file or the key", "[scenario]"
   CHECK(error_of([&] {
           ffsr::read_scenario_text("duration = [", "scenario x.toml");
         }).rfind("scenario x.toml:1: ", 0) == 0);
+  // a value of the file found bad when the scenario is built: the key as the file writes it
+  const std::string lock = with("base-attitude = \"lock\"");
+  CHECK(error_of([&] { ffsr::load_scenario(lock); }) ==
+        "scenario " + lock + ":2: base-attitude: unknown mode 'lock'; expected 'free' or 'hold'");
+  // several keys, one of them a flag's: the file's named as written, the flag's as a flag
+  keys = ffsr::read_scenario_file(with(""));
+  ffsr::override_scenario_key(keys, "restitution", "0");
+  CHECK(error_of([&] {
+          ffsr::build_scenario(keys);
+        }).rfind("scenario " + tmp.path.string() + "/s.toml:22: stiffness/exponent/--restitution: ", 0) == 0);
+}
+
+TEST_CASE("scenario: the keys a row of the main job does not take", "[scenario]") {
+  using ffsr::ScenarioRow;
+  using V = std::vector<std::string>;
+  // paper_7dof_position: the plain run tracks the pose, the optimized and the global run the position
+  ffsr::ScenarioKeys k = ffsr::read_scenario_file(kSource + "/robots/paper_7dof_position.toml");
+  CHECK(ffsr::keys_not_applied(k, ScenarioRow::Plain) == V{"max-joint-rate-deg"});
+  CHECK(ffsr::keys_not_applied(k, ScenarioRow::Optimized) == V{"max-joint-rate-deg"});
+  CHECK(ffsr::keys_not_applied(k, ScenarioRow::Global).empty());
+  ffsr::override_scenario_key(k, "base-attitude", "free");  // the base of every run is free
+  CHECK(ffsr::keys_not_applied(k, ScenarioRow::Global).empty());
+  ffsr::override_scenario_key(k, "base-attitude", "hold");  // the optimized run's mode
+  CHECK(ffsr::keys_not_applied(k, ScenarioRow::Plain) == V{"base-attitude", "max-joint-rate-deg"});
+  CHECK(ffsr::keys_not_applied(k, ScenarioRow::Optimized) == V{"max-joint-rate-deg"});
+  CHECK(ffsr::keys_not_applied(k, ScenarioRow::Global) == V{"base-attitude"});
+  // the keys of a task act on the rows of that task
+  ffsr::override_scenario_key(k, "task-axes", "xy");
+  ffsr::override_scenario_key(k, "orientation-tolerance-deg", "1");
+  CHECK(ffsr::keys_not_applied(k, ScenarioRow::Plain) ==
+        V{"task-axes", "base-attitude", "max-joint-rate-deg"});
+  CHECK(ffsr::keys_not_applied(k, ScenarioRow::Global) == V{"orientation-tolerance-deg", "base-attitude"});
+  // multibody-force: the global run's objective; the paper's method descends M_ie
+  ffsr::override_scenario_key(k, "objective", "multibody-force");
+  ffsr::override_scenario_key(k, "joint-stiffness", "10");
+  CHECK(ffsr::keys_not_applied(k, ScenarioRow::Optimized) ==
+        V{"orientation-tolerance-deg", "objective", "max-joint-rate-deg", "joint-stiffness"});
+  CHECK(ffsr::keys_not_applied(k, ScenarioRow::Global) == V{"orientation-tolerance-deg", "base-attitude"});
 }
 
 }  // namespace test_scenario

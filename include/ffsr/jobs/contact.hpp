@@ -128,7 +128,7 @@ inline std::vector<std::string> contact_laws(const Subject& s) {
   try {
     make_contact_law(s.law, s.params, 1.0);  // unknown name: lists the laws
   } catch (const InputError& e) {
-    throw InputError(std::string("--model: ") + e.what());
+    throw InputError(located_key_message(s.keys, std::string("--model: ") + e.what()));
   }
   names.push_back(s.law);
   return names;
@@ -140,9 +140,13 @@ inline ContactRow contact_row(const Subject& s, const std::string& law_name, con
   const ContactParams& p = s.params;
   MultibodyContactOptions mo;
   mo.record_series = o.record_series;
-  mo.joint_stiffness = per_joint_values(s.keys.joint_stiffness, r.model, "--joint-stiffness");
-  mo.joint_damping = per_joint_values(s.keys.joint_damping, r.model, "--joint-damping");
-  mo.armature = per_joint_values(s.keys.armature, r.model, "--armature");
+  try {  // located in the file when the file gave the key
+    mo.joint_stiffness = per_joint_values(s.keys.joint_stiffness, r.model, "--joint-stiffness");
+    mo.joint_damping = per_joint_values(s.keys.joint_damping, r.model, "--joint-damping");
+    mo.armature = per_joint_values(s.keys.armature, r.model, "--armature");
+  } catch (const InputError& e) {
+    throw InputError(located_key_message(s.keys, e.what()));
+  }
   MultibodyContactResult mb =
       simulate_contact(r.model, r.base, r.theta, r.end_effector, target, s.approach_speed, p, law_name, mo);
   const AnyContactLaw law = make_contact_law(law_name, p, mb.approach_velocity);

@@ -87,8 +87,12 @@ inline nlohmann::json pareto_json(const Scenario& sc, const ParetoJobResult& r, 
   for (const ParetoPoint& p : f.points) pts.push_back(pareto_point_json(p));
   const Eigen::Vector4d q = r.base.orientation.coeffs();
   const char* names[] = {"baseline", "optimized", "global"};
+  const ScenarioRow rows[] = {ScenarioRow::Plain, ScenarioRow::Optimized, ScenarioRow::Global};
   nlohmann::json rj;
-  for (size_t i = 0; i < r.runs.size(); ++i) rj[names[i]] = pareto_point_json(r.runs[i]);
+  for (size_t i = 0; i < r.runs.size(); ++i) {
+    rj[names[i]] = pareto_point_json(r.runs[i]);
+    rj[names[i]]["keys_not_applied"] = keys_not_applied(sc.keys, rows[i]);  // as the main job's rows
+  }
   return {{"version", version},
           {"scenario", sc.where},
           {"base_position", detail::vector_json(Eigen::VectorXd(r.base.position))},

@@ -38,9 +38,13 @@ struct Subject {
   /// The joint models of the contact (contact-joints, armature; algorithm/joint_models.hpp); 'all'
   /// (contact: each model in turn) gives free. InputError naming the key.
   ContactJoints contact_joints() const {
-    const JointModel m =
-        all_joint_models() ? JointModel::Free : parse_joint_model(keys.contact_joints, "--contact-joints");
-    return {m, per_joint_values(keys.armature, robot.model, "--armature")};
+    try {  // located in the file when the file gave the key
+      const JointModel m =
+          all_joint_models() ? JointModel::Free : parse_joint_model(keys.contact_joints, "--contact-joints");
+      return {m, per_joint_values(keys.armature, robot.model, "--armature")};
+    } catch (const InputError& e) {
+      throw InputError(located_key_message(keys, e.what()));
+    }
   }
   bool all_joint_models() const { return keys.contact_joints == "all"; }
 };

@@ -23,8 +23,8 @@
 
 // A scenario file is a flat TOML table: every key of `scenario_keys()` (robot, start state, target,
 // contact, tasks, planner, global run) and an optional [uncertainty] table. Messages name the file
-// ("scenario FILE: missing key 'duration'") or the key ("--duration: must be positive, got -1"): the
-// keys are spelled as the command's flags, so a message reads the same for a file and a flag.
+// ("scenario FILE: missing key 'duration'") and the key as the file writes it ("scenario FILE:27:
+// duration: ...") or as the flag that set it ("--duration: must be positive, got -1").
 //
 //   ffsr::Scenario sc = ffsr::load_scenario("robots/paper_7dof_position.toml");
 //   ffsr::ScenarioResult r = ffsr::run_scenario(sc);          // scenario_run.hpp
@@ -107,11 +107,23 @@ enum class KeyGroup {
 
 struct Scenario;
 
+/// The rows of the main job (jobs/scenario_run.hpp): the plain run (rho = 0, baseline-task), the
+/// paper's method (the optimized run) and the global run.
+enum class ScenarioRow { Plain, Optimized, Global };
+/// A set of rows: the rows a key does not act on (ScenarioKey::skips).
+struct ScenarioRows {
+  bool plain = false, optimized = false, global = false;
+  bool has(ScenarioRow r) const {
+    return r == ScenarioRow::Plain ? plain : r == ScenarioRow::Optimized ? optimized : global;
+  }
+};
+
 /// One key of a scenario, everything about it in one entry: its name (as in the file; the flag is
 /// "--" + name), kind, help text, group, whether a file must give it, how it is set, its own check
 /// and its echo in the result's resolved scenario. The setters and the check throw InputError naming
-/// the key ("--name: ..."). Checks that involve several keys or the robot are made where the problem
-/// is built (build_scenario).
+/// the key: from_toml as written in the file ("name: ..."), from_text and the check as a flag
+/// ("--name: ...", located_key_message renames a key the file gave). Checks that involve several
+/// keys or the robot are made where the problem is built (build_scenario).
 struct ScenarioKey {
   std::string name;
   KeyKind kind;
@@ -131,6 +143,11 @@ struct ScenarioKey {
   /// as an override (a flag, a keyword) where it does not act is refused (check_scenario_keys); a
   /// scenario file may hold it, since a file serves several jobs.
   std::function<std::string(const ScenarioKeys&)> acts;
+  /// The rows of the main job whose run does not take the key as set (given the other keys: a mode
+  /// of the optimized run, a key of the other task, a key of the global run); null: every row takes
+  /// it. The plain row is the run without optimization: the keys that make the optimization (task,
+  /// baseline-task, gain, objective) are not counted as skipping a row. keys_not_applied lists them.
+  std::function<ScenarioRows(const ScenarioKeys&)> skips;
 
   // building the table: key(...).in(KeyGroup::Robot).needed().checked(f).echoed(f).acting(f)
   ScenarioKey& in(KeyGroup g) {
@@ -153,12 +170,20 @@ struct ScenarioKey {
     acts = std::move(f);
     return *this;
   }
+  ScenarioKey& skipping(std::function<ScenarioRows(const ScenarioKeys&)> f) {
+    skips = std::move(f);
+    return *this;
+  }
 };
 
 /// Every key, in the order a command lists them.
 const std::vector<ScenarioKey>& scenario_keys();
 /// The key named `name`, or null.
 const ScenarioKey* find_scenario_key(const std::string& name);
+
+/// The keys the scenario sets (ScenarioKeys::given) that the run of `row` does not take
+/// (ScenarioKey::skips), in the table's order: what a row's note says does not apply to it.
+std::vector<std::string> keys_not_applied(const ScenarioKeys& keys, ScenarioRow row);
 
 /// Keys a scenario file must name (the others have defaults): the table's required keys.
 const std::vector<std::string>& required_scenario_keys();
@@ -183,7 +208,8 @@ void check_scenario_keys(const ScenarioKeys& keys);
 /// The line of key `name` in the scenario file (0: not in the file, or overridden by a flag).
 long scenario_key_line(const ScenarioKeys& keys, const std::string& name);
 /// A message that starts with a key's flag ("--duration: ..."), located in the file when the file
-/// gave that key: "scenario FILE:LINE: --duration: ...". Unchanged otherwise.
+/// gave that key, which it then names as written there: "scenario FILE:LINE: duration: ...".
+/// Unchanged otherwise.
 std::string located_key_message(const ScenarioKeys& keys, const std::string& message);
 
 struct SceneGeometry;  // scenario/geometry.hpp

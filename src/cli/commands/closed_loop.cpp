@@ -87,6 +87,7 @@ int run_closed_loop(ClosedLoopCliOptions o, const CLI::App& app) {
   for_each_file_key(keys, app,
                     [&](const std::string& name, const std::string& text, const std::string& flag) {
                       o.set_from_file(name, text, flag);
+                      if (name == "plot-format") plot::parse_format(text, flag);  // checked here: located
                     });
   set_quiet(o.quiet);  // the flag, or the file's quiet key
   // the controller follows one plan, of the scenario's task: the pose task's keys act on it only

@@ -17,6 +17,7 @@
 #include <iostream>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <thread>
 
@@ -47,7 +48,7 @@ struct MapOptions {
   std::string slice_deg;
   unsigned threads = 0;
   std::uint64_t max_points = 1000000000ULL;
-  OutputKeys out;  ///< --csv (required: the map), --json (its summary), --plot, --quiet
+  OutputKeys out;  ///< --csv (the map), --json (its summary), --plot, --quiet
 };
 
 /// The job's options from the flags' text: the lists parsed, the joints checked to be whole numbers.
@@ -183,7 +184,7 @@ void print_map_summary(std::ostream& os, const MapOptions& o, const MapRun& r) {
     os << "max M_ie = " << e.max_M << " kg at " << point_deg(p.grid, e.argmax) << " deg; min M_ie = " << e.min_M
        << " kg at " << point_deg(p.grid, e.argmin) << " deg\n";
   }
-  if (!is_stdout_name(o.out.csv)) os << "wrote " << o.out.csv << "\n";
+  if (!o.out.csv.empty() && !is_stdout_name(o.out.csv)) os << "wrote " << o.out.csv << "\n";
 }
 
 int run_map(const MapOptions& o) {
@@ -199,21 +200,25 @@ int run_map(const MapOptions& o) {
   const std::vector<double> slice_deg = check_map_plot(o, plan);
   std::vector<double> values(plotting ? plan.count() : 0);
 
-  StreamingOutput out("--csv", o.out.csv);  // checked before any point is evaluated
-  if (plan.shard_k == 0) {
+  std::optional<StreamingOutput> out;  // the map; without --csv, the summary (--json, the table) only
+  if (!o.out.csv.empty()) out.emplace("--csv", o.out.csv);  // checked before any point is evaluated
+  if (out && plan.shard_k == 0) {
     const std::string header = map_csv_header(subject, plan);
-    out.write(header.data(), header.size());
+    out->write(header.data(), header.size());
   }
   const size_t k = plan.grid.axes.size();
-  std::vector<RowText> rows(plan.threads);
+  std::vector<RowText> rows(out ? plan.threads : 0);
   for (RowText& t : rows) t.text.resize((k + 2) * 32 * static_cast<size_t>(plan.block) + 1);
   Progress progress("map", o.out.quiet);
   MapSink sink;
   sink.evaluated = [&](unsigned t, const MapBlock& b) {
-    rows[t].format(b, k);
-    if (plotting) std::copy(b.M_ie, b.M_ie + b.count, values.begin() + static_cast<std::ptrdiff_t>(b.first - plan.first));
+    if (out) rows[t].format(b, k);
+    if (plotting)
+      std::copy(b.M_ie, b.M_ie + b.count, values.begin() + static_cast<std::ptrdiff_t>(b.first - plan.first));
   };
-  sink.commit = [&](unsigned t, const MapBlock&) { out.write(rows[t].text.data(), rows[t].bytes); };
+  sink.commit = [&](unsigned t, const MapBlock&) {
+    if (out) out->write(rows[t].text.data(), rows[t].bytes);
+  };
   sink.progress = [&](std::uint64_t done, std::uint64_t total) { progress(done, total); };
   MapRun run = evaluate_map(subject, plan, sink);
   // the pictures before the CSV is committed: a failed drawing leaves no CSV behind
@@ -225,7 +230,7 @@ int run_map(const MapOptions& o) {
   run.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   outputs.set("--json", map_json(subject, run, FFSR_VERSION).dump(2) + "\n");
   outputs.write();  // the summary first: a failed JSON leaves no CSV behind
-  out.commit();
+  if (out) out->commit();
   std::ostream& os = outputs.table();  // standard error when the CSV or the JSON goes to standard output
   print_map_summary(os, o, run);
   for (const std::string& f : drawn) os << "wrote " << f << "\n";
@@ -266,7 +271,6 @@ void register_map(CLI::App& app, Action& action) {
        "Write the map (one row per point: varied angles deg, M_ie kg, F_max N) as CSV to FILE",
        "Draw the map: M_ie against one joint, a heat map for two (Figure 9), slices and a 3-D view for "
        "three (Figures 8, 9)"});
-  sub->get_option("--csv")->required();
   sub->add_option("--slice-deg", o->slice_deg,
                   "Three varied joints: the point the slices go through, one angle per varied joint, deg "
                   "(default 0,0,0)");

@@ -31,10 +31,16 @@ const char* const kRunNames[] = {"plain run", "paper's method", "global run"};
 
 void print_front(std::ostream& out, const Scenario& sc, const ParetoFront& f,
                  const std::vector<ParetoPoint>& runs) {
-  auto row = [&](const char* label, const ParetoPoint& p) {
+  auto row = [&](const char* label, const ParetoPoint& p, std::vector<std::string> not_applied = {}) {
     out << std::left << std::setw(26) << label << std::right << std::fixed << std::setprecision(4)
         << std::setw(11) << p.M_ie << std::scientific << std::setprecision(4) << std::setw(16)
-        << p.base_rate * kDeg << std::defaultfloat << "\n";
+        << p.base_rate * kDeg << std::defaultfloat;
+    const char* sep = "  not applied: ";  // the keys of the scenario this run does not take
+    for (const std::string& key : not_applied) {
+      out << sep << key;
+      sep = ", ";
+    }
+    out << "\n";
   };
   out << "ffsr-optimize pareto: " << sc.where << ": " << f.points.size()
       << " non-dominated capture configurations at the global run's base pose\n\n"
@@ -44,7 +50,8 @@ void print_front(std::ostream& out, const Scenario& sc, const ParetoFront& f,
   row("least M_ie (end)", f.min_mass);
   row("knee", f.points[f.knee]);
   row("least base rate (end)", f.min_rate);
-  for (size_t i = 0; i < runs.size(); ++i) row(kRunNames[i], runs[i]);
+  const ScenarioRow rows[] = {ScenarioRow::Plain, ScenarioRow::Optimized, ScenarioRow::Global};
+  for (size_t i = 0; i < runs.size(); ++i) row(kRunNames[i], runs[i], keys_not_applied(sc.keys, rows[i]));
   out << "\nhypervolume " << f.hypervolume * kDeg << " kg deg/s up to the nadir of the ends (normalized "
       << f.hypervolume_normalized << "); " << f.evaluations << " evaluations, " << f.seconds << " s\n"
       << "|dw_0|: jump of the base's angular velocity from the contact impulse (single-body model)\n";

@@ -255,10 +255,14 @@ RobustOptions with_file_keys(const RobustOptions& flags, const ScenarioKeys& key
   RobustOptions o = flags;
   for_each_file_key(keys, app,
                     [&](const std::string& name, const std::string& text, const std::string& flag) {
-                      if (o.set_from_file(name, text, flag)) return;
-                      if (name == "force-model") o.force_model = text;
-                      if (name == "samples") o.samples = text;
-                      if (name == "shard") o.shard = text;
+                      // checked here, where an error is located in the file
+                      if (o.set_from_file(name, text, flag)) {
+                        if (name == "plot-format") plot::parse_format(text, flag);
+                        return;
+                      }
+                      if (name == "force-model") robust_force_model(o.force_model = text);
+                      if (name == "samples") parse_count(o.samples = text, flag);
+                      if (name == "shard") parse_shard(o.shard = text);
                       if (name == "threads")
                         o.threads = static_cast<int>(detail::integer_from_text(text, flag));
                     });

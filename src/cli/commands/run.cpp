@@ -49,7 +49,10 @@ RunSettings settings_of(const RunSettings& flags, const ScenarioKeys& keys, cons
   RunSettings s = flags;
   for_each_file_key(keys, app,
                     [&](const std::string& name, const std::string& text, const std::string& flag) {
-                      if (s.set_from_file(name, text, flag)) return;
+                      if (s.set_from_file(name, text, flag)) {
+                        if (name == "plot-format") plot::parse_format(text, flag);  // checked here: located
+                        return;
+                      }
                       if (name == "rtol") s.rtol = detail::number_from_text(text, flag);
                       if (name == "atol") s.atol = detail::number_from_text(text, flag);
                       if (name == "expect") {  // relative to the scenario file
@@ -221,15 +224,22 @@ void print_rows(std::ostream& out, const Scenario& sc, const ScenarioResult& r) 
       << std::setw(11) << "M_ie (kg)" << std::setw(14) << "F_max (kN)" << std::setw(14) << "exact (kN)"
       << std::setw(15) << "tracking (m)"
       << "\n";
-  auto row = [&](const char* label, const CaptureResult& x, const std::string& failure = {}) {
+  auto row = [&](const char* label, ScenarioRow which, const CaptureResult& x,
+                 const std::string& failure = {}) {
     if (!failure.empty()) {  // the message follows the table
-      out << std::left << std::setw(24) << label << "failed (below)\n";
-      return;
+      out << std::left << std::setw(24) << label << "failed (below)";
+    } else {
+      out << std::left << std::setw(24) << label << std::setw(w) << deg_list(x.theta) << std::right
+          << std::fixed << std::setprecision(3) << std::setw(11) << x.M_ie << std::setw(14)
+          << x.f_max_closed_form / 1e3 << std::setw(14) << x.f_max_exact / 1e3 << std::setw(15)
+          << std::scientific << std::setprecision(2) << x.tracking_error << std::fixed;
     }
-    out << std::left << std::setw(24) << label << std::setw(w) << deg_list(x.theta) << std::right
-        << std::fixed << std::setprecision(3) << std::setw(11) << x.M_ie << std::setw(14)
-        << x.f_max_closed_form / 1e3 << std::setw(14) << x.f_max_exact / 1e3 << std::setw(15)
-        << std::scientific << std::setprecision(2) << x.tracking_error << std::fixed << "\n";
+    const char* sep = "  not applied: ";  // the keys of the scenario this row's run does not take
+    for (const std::string& key : keys_not_applied(sc.keys, which)) {
+      out << sep << key;
+      sep = ", ";
+    }
+    out << "\n";
   };
   auto reduction = [&](const char* label, const CaptureResult& x) {
     out << std::left << std::setw(24 + w) << label << std::right << std::fixed << std::setprecision(2)
@@ -237,9 +247,9 @@ void print_rows(std::ostream& out, const Scenario& sc, const ScenarioResult& r) 
         << reduction_percent(r.plain.f_max_closed_form, x.f_max_closed_form) << "%" << std::setw(13)
         << reduction_percent(r.plain.f_max_exact, x.f_max_exact) << "%\n";
   };
-  row("Without optimization", r.plain, r.plain_failure);
-  row("With optimization", r.optimized, r.optimized_failure);
-  if (r.global) row("Global", r.global->result.run);
+  row("Without optimization", ScenarioRow::Plain, r.plain, r.plain_failure);
+  row("With optimization", ScenarioRow::Optimized, r.optimized, r.optimized_failure);
+  if (r.global) row("Global", ScenarioRow::Global, r.global->result.run);
   if (r.plain_ok() && r.optimized_ok()) reduction("Reduction (optimization)", r.optimized);
   if (r.global && r.plain_ok()) reduction("Reduction (global)", r.global->result.run);
   for (const std::string* f : {&r.plain_failure, &r.optimized_failure})

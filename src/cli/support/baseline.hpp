@@ -34,7 +34,8 @@ struct Tolerance {
 /// in their shortest round-trip form). A key present on one side only, an array of another length,
 /// a changed string or boolean and a change of type are differences too. Top-level keys listed in
 /// `skip` (inputs such as the resolved scenario and the version, not results) are not compared, nor
-/// are the keys of kUncomparedKeys at any depth (wall-clock times and the optimizers' work counters).
+/// are the keys of kUncomparedKeys at any depth (wall-clock times, the optimizers' work counters,
+/// the keys not applied to a row).
 std::vector<std::string> compare_results(const nlohmann::json& stored, const nlohmann::json& now,
                                          Tolerance tol, const std::vector<std::string>& skip);
 
@@ -46,9 +47,10 @@ using nlohmann::json;
 
 /// Keys of these names (at any depth) are never compared: wall-clock times (global.search.seconds)
 /// and the optimizers' work counters (SLSQP and damped-step evaluations), which move with the last
-/// bit of a gradient -- another compiler, Eigen version or libm -- while the results agree.
-inline constexpr std::array<std::string_view, 4> kUncomparedKeys{
-    "seconds", "evaluations", "damped_evaluations", "multibody_evaluations"};
+/// bit of a gradient -- another compiler, Eigen version or libm -- while the results agree; each
+/// row's keys_not_applied, which the scenario's keys decide (inputs, as the top-level `scenario`).
+inline constexpr std::array<std::string_view, 5> kUncomparedKeys{
+    "seconds", "evaluations", "damped_evaluations", "multibody_evaluations", "keys_not_applied"};
 inline bool uncompared(const std::string& key) {
   return std::find(kUncomparedKeys.begin(), kUncomparedKeys.end(), key) != kUncomparedKeys.end();
 }

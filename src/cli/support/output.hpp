@@ -137,12 +137,18 @@ void add_output_flags(CLI::App& app, OutputKeys& keys, const OutputHelp& help);
 
 /// Calls set(name, text, flag) for every command key the scenario file holds (ScenarioKeys::extra:
 /// json, csv, plot, ...) whose flag was not given on the command line: a flag overrides the file.
+/// `set` parses and checks the text (InputError "--key: ..."); the error is located in the file and
+/// names the key as written there ("scenario FILE:LINE: key: ...", located_key_message).
 template <class Set>
 void for_each_file_key(const ScenarioKeys& keys, const CLI::App& app, Set&& set) {
   for (const auto& [name, text] : keys.extra) {
     const std::string flag = "--" + name;
     if (app.get_option(flag)->count() > 0) continue;
-    set(name, text, flag);
+    try {
+      set(name, text, flag);
+    } catch (const InputError& e) {
+      throw InputError(located_key_message(keys, e.what()));
+    }
   }
 }
 

@@ -206,6 +206,11 @@ inline nlohmann::json scenario_json(const Scenario& sc, const ScenarioResult& r,
   const CaptureResult* plain = r.plain_ok() ? &r.plain : nullptr;
   detail::add_reductions_json(j, "", plain, r.optimized_ok() ? &r.optimized : nullptr);
   if (r.global) detail::add_global_json(j, sc, *r.global, plain);
+  // each row's keys that its run does not take (ScenarioKey::skips)
+  for (const auto& [name, row] : {std::pair{"baseline", ScenarioRow::Plain},
+                                  {"optimized", ScenarioRow::Optimized},
+                                  {"global", ScenarioRow::Global}})
+    if (j.contains(name)) j[name]["keys_not_applied"] = keys_not_applied(sc.keys, row);
   detail::add_base_disturbance_json(j, sc, r);
   if (sc.geometry) detail::add_clearance_json(j, r);
   j["scene"] = detail::scene_json(sc);

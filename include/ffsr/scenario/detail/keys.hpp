@@ -40,8 +40,9 @@ ScenarioKey make_key(const char* name, T& (*get)(ScenarioKeys&), const char* hel
   key.kind = kind_of<T>();
   key.help = help;
   key.default_text = shown;
-  key.from_toml = [get, flag, mark](ScenarioKeys& k, const toml::node& node) {
-    get(k) = value_from_toml<T>(node, flag);
+  // a value of the file names the key as written there, a flag's value the flag
+  key.from_toml = [get, n, mark](ScenarioKeys& k, const toml::node& node) {
+    get(k) = value_from_toml<T>(node, n);
     mark(k);
   };
   key.from_text = [get, flag, mark](ScenarioKeys& k, const std::string& text) {
@@ -119,6 +120,37 @@ inline std::string on_the_multibody_reference(const ScenarioKeys& k) {
              ? ""
              : "acts on the multibody reference only: the global run's objective multibody-force (or the "
                "contact subcommand)";
+}
+
+// --- the rows of the main job a key does not act on (ScenarioKey::skips) ------------------------------
+
+/// A key of one kind of task ("pose", "position"): the rows whose task is the other.
+inline std::function<ScenarioRows(const ScenarioKeys&)> skips_other_task(const char* kind) {
+  return [kind](const ScenarioKeys& k) {
+    ScenarioRows r;
+    r.plain = plain_run_task(k) != kind;
+    r.optimized = r.global = k.task != kind;
+    return r;
+  };
+}
+
+/// A key of the global run: the plain and the optimized rows.
+inline ScenarioRows skips_but_global(const ScenarioKeys&) { return {true, true, false}; }
+
+/// base-attitude = hold: the optimized run holds the base's attitude, the plain and the global run
+/// do not (free acts on no row: the base of every run is free).
+inline ScenarioRows skips_of_base_attitude(const ScenarioKeys& k) {
+  return k.base_attitude == "hold" ? ScenarioRows{true, false, true} : ScenarioRows{};
+}
+
+/// multibody-force and robust-force: the global run's objective; the paper's method descends M_ie.
+inline ScenarioRows skips_of_objective(const ScenarioKeys& k) {
+  return {false, k.objective == "multibody-force" || k.objective == "robust-force", false};
+}
+
+/// The multibody reference's servo: the global run's objective multibody-force only.
+inline ScenarioRows skips_but_multibody_reference(const ScenarioKeys& k) {
+  return {true, true, k.objective != "multibody-force"};
 }
 
 // --- the keys ------------------------------------------------------------------------------------
@@ -226,9 +258,9 @@ inline void add_subject_keys(std::vector<ScenarioKey>& keys) {
 inline void add_planner_keys(std::vector<ScenarioKey>& keys) {
   using K = ScenarioKeys;
   keys.push_back(FFSR_KEY("task", task, "Optimized run's task: position or pose").needed());
-  keys.push_back(
-      FFSR_KEY("task-axes", task_axes, "Position task: constrained inertial axes, e.g. xy", "xyz")
-          .acting(on_the_task("position")));
+  keys.push_back(FFSR_KEY("task-axes", task_axes, "Position task: constrained inertial axes, e.g. xy", "xyz")
+                     .acting(on_the_task("position"))
+                     .skipping(skips_other_task("position")));
   keys.push_back(FFSR_KEY("baseline-task", baseline_task, "Plain run's task (default: the optimized run's)")
                      .echoed([](const Scenario& sc, nlohmann::json& j) {
                        j["baseline-task"] =
@@ -237,7 +269,8 @@ inline void add_planner_keys(std::vector<ScenarioKey>& keys) {
   keys.push_back(FFSR_KEY("final-rpy-deg", final_rpy_deg,
                           "Pose task: final end-effector orientation (default: hold the initial)")
                      .echoed(echo_given("final-rpy-deg", &K::final_rpy_deg))
-                     .acting(on_the_task("pose")));
+                     .acting(on_the_task("pose"))
+                     .skipping(skips_other_task("pose")));
   keys.push_back(FFSR_KEY("duration", duration, "Task time T, s").needed());
   keys.push_back(FFSR_KEY("step", step, "RK4 step, s").needed());
   keys.push_back(FFSR_KEY("gain", gain, "rho of Eq. 30 (< 0 lowers the objective)").needed());
@@ -245,18 +278,22 @@ inline void add_planner_keys(std::vector<ScenarioKey>& keys) {
   keys.push_back(FFSR_KEY("tolerance", tolerance, "Required capture-point accuracy, m").needed());
   keys.push_back(FFSR_KEY("orientation-tolerance-deg", orientation_tolerance_deg,
                           "Pose task: required orientation accuracy, deg", "0.5")
-                     .acting(on_the_task("pose")));
-  keys.push_back(FFSR_KEY(
-      "objective", objective,
-      "mass (M_ie, the paper's), exact-force, or multibody-force (CVODE peak; global search only, the "
-      "paper's method then descends M_ie)",
-      "mass"));
+                     .acting(on_the_task("pose"))
+                     .skipping(skips_other_task("pose")));
+  keys.push_back(
+      FFSR_KEY(
+          "objective", objective,
+          "mass (M_ie, the paper's), exact-force, or multibody-force (CVODE peak; global search only, the "
+          "paper's method then descends M_ie)",
+          "mass")
+          .skipping(skips_of_objective));
   // the spacecraft's side: the reaction-null-space approach
   keys.push_back(
       FFSR_KEY("base-attitude", base_attitude,
                "Optimized run: free, or hold (the base's angular velocity stays zero; the objective "
                "uses the freedom left)",
-               "free"));
+               "free")
+          .skipping(skips_of_base_attitude));
 }
 
 /// The global capture optimization and the reconfiguration before its approach (optimize/reconfigure.hpp).
@@ -346,7 +383,8 @@ inline void add_joint_and_shape_keys(std::vector<ScenarioKey>& keys) {
             if (sc.keys.given.count("joint-stiffness"))
               j["joint-stiffness"] = joint_values_json(sc.joint_stiffness);
           })
-          .acting(on_the_multibody_reference));
+          .acting(on_the_multibody_reference)
+          .skipping(skips_but_multibody_reference));
   keys.push_back(FFSR_KEY("joint-damping", joint_damping,
                           "Multibody reference: joint PD damping, N m s/rad (one or per joint)", "0")
                      .in(G::JointModels)
@@ -354,7 +392,8 @@ inline void add_joint_and_shape_keys(std::vector<ScenarioKey>& keys) {
                        if (sc.keys.given.count("joint-damping"))
                          j["joint-damping"] = joint_values_json(sc.joint_damping);
                      })
-                     .acting(on_the_multibody_reference));
+                     .acting(on_the_multibody_reference)
+                     .skipping(skips_but_multibody_reference));
   keys.push_back(FFSR_KEY("target-shape", target_shape,
                           "Target's collision shape: box, sphere or cylinder (default: none)")
                      .in(G::Shapes)
@@ -404,7 +443,8 @@ inline std::vector<ScenarioKey> build_scenario_keys() {
   add_joint_and_shape_keys(keys);
   // every key of the global run but the switch acts on that run only
   for (ScenarioKey& key : keys)
-    if (key.group == KeyGroup::Global && key.name != "global") key.acting(on_the_global_run);
+    if (key.group == KeyGroup::Global && key.name != "global")
+      key.acting(on_the_global_run).skipping(skips_but_global);
   return keys;
 }
 
@@ -451,6 +491,13 @@ inline const ScenarioKey* find_scenario_key(const std::string& name) {
   return nullptr;
 }
 
+inline std::vector<std::string> keys_not_applied(const ScenarioKeys& keys, ScenarioRow row) {
+  std::vector<std::string> out;
+  for (const ScenarioKey& k : scenario_keys())
+    if (k.skips && keys.given.count(k.name) && k.skips(keys).has(row)) out.push_back(k.name);
+  return out;
+}
+
 inline const std::vector<std::string>& required_scenario_keys() {
   static const std::vector<std::string> names = [] {
     std::vector<std::string> out;
@@ -484,13 +531,13 @@ inline std::string extra_text(const toml::node& v, const std::string& key) {
     std::string joined;
     for (const toml::node& e : *a) {
       const auto t = text_of(e);
-      if (!t) throw InputError(str("--", key, ": expected a list of single values"));
+      if (!t) throw InputError(str(key, ": expected a list of single values"));
       joined += (joined.empty() ? "" : ",") + *t;
     }
     return joined;
   }
   const auto t = text_of(v);
-  if (!t) throw InputError(str("--", key, ": expected a single value"));
+  if (!t) throw InputError(str(key, ": expected a single value"));
   return *t;
 }
 
@@ -524,14 +571,27 @@ inline long scenario_key_line(const ScenarioKeys& k, const std::string& name) {
   return n ? static_cast<long>(n->source().begin.line) : 0;
 }
 
-/// A message about the keys ("--key: ...", the flag of the key it names first) located in the file
-/// that gave the key: "scenario FILE:LINE: --key: ...". Unchanged when the key came from a flag or
-/// the built-in scenario.
+/// A message about the keys ("--key: ..." or "--a/--b: ...", the flags of the keys it is about)
+/// located in the file that gave the first key, the keys the file gave named as written there:
+/// "scenario FILE:LINE: key: ...". Unchanged when the first key came from a flag or the built-in
+/// scenario.
 inline std::string located_key_message(const ScenarioKeys& k, const std::string& message) {
   if (k.file.empty() || message.rfind("--", 0) != 0) return message;
-  const size_t end = message.find_first_of(":/ ", 2);
-  const long line = scenario_key_line(k, message.substr(2, end == std::string::npos ? end : end - 2));
-  return line > 0 ? detail::str(k.where, ":", line, ": ", message) : message;
+  const size_t end = std::min(message.find_first_of(": "), message.size());
+  std::vector<std::string> names;  // the keys before the first ':' or ' ', "--a/--b"
+  for (size_t at = 0; at < end;) {
+    const size_t slash = std::min(message.find('/', at), end);
+    names.push_back(message.substr(at, slash - at));
+    at = slash + 1;
+  }
+  for (const std::string& n : names)
+    if (n.rfind("--", 0) != 0) return message;  // not a list of flags ("--a/b" is a path)
+  const long line = scenario_key_line(k, names.front().substr(2));
+  if (line <= 0) return message;
+  std::string keys;
+  for (const std::string& n : names)
+    keys += (keys.empty() ? "" : "/") + (scenario_key_line(k, n.substr(2)) > 0 ? n.substr(2) : n);
+  return detail::str(k.where, ":", line, ": ", keys, message.substr(end));
 }
 
 inline ScenarioKeys read_scenario_text(const std::string& text, const std::string& where,

@@ -139,6 +139,25 @@ inline std::uint64_t count_of(const toml::node& v, const std::string& name, cons
   return static_cast<std::uint64_t>(*i);
 }
 
+/// One entry `name` = `v` of the [uncertainty] table into `spec`: samples, seed or a quantity's law.
+inline void read_uncertainty_entry(UncertaintySpec& spec, const std::string& name, const toml::node& v) {
+  const std::string key = "uncertainty." + name;
+  if (name == "samples" || name == "seed") {
+    (name == "samples" ? spec.samples : spec.seed) = count_of(v, name, key);
+    return;
+  }
+  const auto it = std::find(kQuantityNames.begin(), kQuantityNames.end(), name);
+  if (it == kQuantityNames.end()) {
+    std::string names;
+    for (auto n : kQuantityNames) names += (names.empty() ? "" : ", ") + std::string(n);
+    throw InputError(str(key, ": unknown uncertain quantity; expected one of ", names, ", samples, seed"));
+  }
+  const toml::table* t = v.as_table();
+  if (!t) throw InputError(str(key, ": expected a table such as { law = \"normal\", std = 0.01 }"));
+  const Quantity q = static_cast<Quantity>(it - kQuantityNames.begin());
+  spec[q] = spread_of(q, *t, key);
+}
+
 }  // namespace detail
 
 inline UncertaintySpec uncertainty_spec(const ScenarioKeys& keys, std::optional<std::uint64_t> samples,
@@ -151,25 +170,25 @@ inline UncertaintySpec uncertainty_spec(const ScenarioKeys& keys, std::optional<
   UncertaintySpec spec;
   for (const auto& [k, v] : *u) {
     const std::string name(k.str());
-    const std::string key = "uncertainty." + name;
-    if (name == "samples" || name == "seed") {
-      (name == "samples" ? spec.samples : spec.seed) = detail::count_of(v, name, key);
-      continue;
+    try {  // an entry's error is located at its line
+      detail::read_uncertainty_entry(spec, name, v);
+    } catch (const InputError& e) {
+      throw InputError(detail::located(keys.where, v, e.what()));
     }
-    const auto it = std::find(kQuantityNames.begin(), kQuantityNames.end(), name);
-    if (it == kQuantityNames.end()) {
-      std::string names;
-      for (auto n : kQuantityNames) names += (names.empty() ? "" : ", ") + std::string(n);
-      throw InputError(str(key, ": unknown uncertain quantity; expected one of ", names, ", samples, seed"));
-    }
-    const toml::table* t = v.as_table();
-    if (!t) throw InputError(str(key, ": expected a table such as { law = \"normal\", std = 0.01 }"));
-    const Quantity q = static_cast<Quantity>(it - kQuantityNames.begin());
-    spec[q] = detail::spread_of(q, *t, key);
   }
   if (samples) spec.samples = *samples;
   if (seed) spec.seed = *seed;
-  validate(spec);
+  try {
+    validate(spec);
+  } catch (const InputError& e) {  // "uncertainty.<entry>...: ": located at the entry's line
+    const std::string m = e.what(), prefix = "uncertainty.";
+    const toml::node* entry =
+        m.rfind(prefix, 0) == 0
+            ? u->get(m.substr(prefix.size(), m.find_first_of(".:", prefix.size()) - prefix.size()))
+            : nullptr;
+    if (!entry) throw;
+    throw InputError(detail::located(keys.where, *entry, m));
+  }
   return spec;
 }
 

@@ -119,8 +119,20 @@ T value_from_text(const std::string& text, const std::string& key) {
   }
 }
 
+/// What a key of member type T takes, for messages.
+template <class T>
+const char* value_kind_text() {
+  if constexpr (std::is_same_v<T, std::string>) return "a text value";
+  if constexpr (std::is_same_v<T, std::vector<std::string>>) return "a list of text values";
+  if constexpr (std::is_same_v<T, double>) return "a number";
+  if constexpr (std::is_same_v<T, std::vector<double>>) return "a list of numbers";
+  if constexpr (std::is_same_v<T, int>) return "an integer";
+  return "true or false";
+}
+
 template <class T>
 T value_from_toml(const toml::node& n, const std::string& key) {
+  if (n.is_table()) throw InputError(str(key, ": expected ", value_kind_text<T>(), ", got a table"));
   if constexpr (std::is_same_v<T, std::vector<double>> || std::is_same_v<T, std::vector<std::string>>) {
     if (const toml::array* a = n.as_array()) {
       T out;
