@@ -2,16 +2,15 @@
 # Checks the wheel of scripts/build-wheel.sh on a machine without compilers: in a minimal Debian 12 root
 # (debootstrap --variant=minbase, python3 and python3-venv only), offline (a network namespace without
 # interfaces, pip --no-index), a venv gets the wheel and numpy from a folder, imports ffsr and runs the
-# README's Python example. Needs root (chroot). The root is cached as build-wheel/bookworm-minbase.tar.
+# README's Python example. Needs root (chroot). The root is cached as build-wheel/bookworm-minbase.tar;
+# `check-wheel.sh --root-only` only makes that cache (CI makes it in the background while it compiles).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 out=build-wheel
 [ "$(id -u)" -eq 0 ] || { echo "check-wheel.sh: needs root (debootstrap, chroot)" >&2; exit 1; }
-wheels=("$out"/wheelhouse/ffsr-*.whl)
-[ ${#wheels[@]} -eq 1 ] && [ -f "${wheels[0]}" ] ||
-  { echo "check-wheel.sh: not one wheel in $out/wheelhouse: run scripts/build-wheel.sh first" >&2; exit 1; }
-wheel=${wheels[0]}
-py="$out/venv/bin/python"   # build-wheel.sh's venv (the host side: pip download)
+root_only=0
+[ "${1:-}" = "--root-only" ] && root_only=1
+mkdir -p "$out"
 command -v debootstrap >/dev/null || {
   apt-get update -qq &&
     DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends debootstrap; }
@@ -49,6 +48,12 @@ if [ ! -f "$cache" ] || [ "$(cat "$cache.key" 2>/dev/null)" != "$key" ]; then
   echo "$key" > "$cache.key"
   rm -rf "$out/debootstrap"
 fi
+[ "$root_only" -eq 0 ] || exit 0
+wheels=("$out"/wheelhouse/ffsr-*.whl)
+[ ${#wheels[@]} -eq 1 ] && [ -f "${wheels[0]}" ] ||
+  { echo "check-wheel.sh: not one wheel in $out/wheelhouse: run scripts/build-wheel.sh first" >&2; exit 1; }
+wheel=${wheels[0]}
+py="$out/venv/bin/python"   # build-wheel.sh's venv (the host side: pip download)
 root=$out/root
 cleanup() {
   mountpoint -q "$root/proc" && umount "$root/proc"

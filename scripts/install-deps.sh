@@ -8,6 +8,7 @@ packages=(cmake ninja-build g++ pkg-config libeigen3-dev liburdfdom-dev libtinyx
 packages+=(libnlopt-cxx-dev)  # NLopt: the global capture search (optimize/global.hpp)
 packages+=(libfcl-dev)  # FCL: distances between the robot, the bus and the target (geometry/distance.hpp; optional)
 packages+=(chromium)  # the 3-D view's tests (python/tests/test_view.py): headless, WebGL through SwiftShader
+packages+=(debootstrap)  # the wheel's check in a minimal Debian 12 root (scripts/check-wheel.sh)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
