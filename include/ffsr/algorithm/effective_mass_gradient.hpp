@@ -259,10 +259,7 @@ inline double integrated_effective_mass_gradient_dense(const Model& model, Data&
                                                  const Vector3& u, double target_inverse_mass,
                                                  const ContactJoints& joints,
                                                  Eigen::Ref<Eigen::VectorXd> grad) {
-  detail::require_size(grad.size(), model.n(), "integrated_effective_mass_gradient", "grad");
-  detail::check_unit_direction(u, "effective_mass");
-  detail::check_frame(model, frame, "effective_mass");
-  crba(model, data, base, theta);
+  crba(model, data, base, theta);  // integrated_effective_mass_gradient_at checks grad, u and frame
   return integrated_effective_mass_gradient_at(model, data, frame, u, target_inverse_mass, joints, grad);
 }
 
