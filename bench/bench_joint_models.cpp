@@ -52,7 +52,7 @@ int main(int argc, char** argv) {
     t0 = std::chrono::steady_clock::now();
     for (int r = 0; r < reps; ++r)
       sink += integrated_effective_mass_gradient_dense(model, data, base, thetas[size_t(r) % thetas.size()],
-                                                 model.end_effector(), u, 0.01, joints, grad);
+                                                       model.end_effector(), u, 0.01, joints, grad);
     const double t_grad =
         std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - t0).count();
     std::printf("%-10s %14.0f %18.0f   (checksum %.6g)\n", joint_model_name(m), t_value / reps, t_grad / reps,

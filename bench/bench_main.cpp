@@ -398,8 +398,8 @@ void bench_hot_paths(const Settings& s, const Robot& r, AllocCheck& check) {
   check.require_zero(r.name, "integrated_effective_mass_dense", mie_dense);
 
   const Timing dmie = measure(s, [&](long i) {
-    const double M = integrated_effective_mass_gradient_dense(model, data, bases[pick(i)], thetas[pick(i)], r.ee, u,
-                                                        target_inv_mass, grad);
+    const double M = integrated_effective_mass_gradient_dense(model, data, bases[pick(i)], thetas[pick(i)],
+                                                              r.ee, u, target_inv_mass, grad);
     return M + grad(0);
   });
   print_row(r.name, "dM_ie/dtheta: integrated_effective_mass_gradient_dense", dmie, "0 allocs");
@@ -522,7 +522,7 @@ void bench_crossover(const Settings& s, AllocCheck& check) {
     Eigen::VectorXd grad(n);
     const Timing g = measure(s, [&](long i) {
       return integrated_effective_mass_gradient(model, data, base, thetas[static_cast<size_t>(i % K)], ee, u,
-                                                     0.005, ContactJoints{}, grad);
+                                                0.005, ContactJoints{}, grad);
     });
     print_row(name, "gradient of M_ie, O(n)", g, "");
     check.require_zero(name, "integrated_effective_mass_gradient", g);

@@ -267,7 +267,7 @@ TEST_CASE("mimic reduction: H, C, J_bm, M_ie gradient against the full model", "
     };
     VectorXd grad(8);
     const double M = integrated_effective_mass_gradient_dense(red.model, dr, q.base, q.theta, red.ee, u,
-                                                        target.inverse_mass_along_normal(), grad);
+                                                              target.inverse_mass_along_normal(), grad);
     CHECK(M == Approx(M_from_full(q.theta)).epsilon(1e-12));
     // its gradient against central differences of that (h = 1e-5: truncation ~1e-10 relative)
     const double h = 1e-5;
@@ -440,10 +440,10 @@ TEST_CASE("end-effector offset: the contact point where the fingers close", "[ur
     const BasePose base = rng.base_pose();
     const VectorXd th = rng.vec(8, 1.0);
     VectorXd g1(8), g2(8);
-    const double M1 = integrated_effective_mass_gradient_dense(mo, d1, base, th, mo.end_effector(),
-                                                         t.normal_world(), t.inverse_mass_along_normal(), g1);
-    const double M2 = integrated_effective_mass_gradient_dense(mt, d2, base, th, mt.end_effector(),
-                                                         t.normal_world(), t.inverse_mass_along_normal(), g2);
+    const double M1 = integrated_effective_mass_gradient_dense(
+        mo, d1, base, th, mo.end_effector(), t.normal_world(), t.inverse_mass_along_normal(), g1);
+    const double M2 = integrated_effective_mass_gradient_dense(
+        mt, d2, base, th, mt.end_effector(), t.normal_world(), t.inverse_mass_along_normal(), g2);
     CHECK(M1 == Approx(M2).epsilon(1e-12));
     CHECK((g1 - g2).cwiseAbs().maxCoeff() < 1e-12 * std::max(1.0, g2.cwiseAbs().maxCoeff()));
     const MatrixXd J1 = generalized_jacobian(mo, d1, base, th, mo.end_effector());

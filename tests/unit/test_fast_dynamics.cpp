@@ -200,10 +200,10 @@ TEST_CASE("the O(n) gradient of M_ie equals the dense gradient and finite differ
       for (const ContactJoints& joints : joint_models(model)) {
         INFO(name << " config " << k << " joints " << joint_model_name(joints.model));
         VectorXd g_dense(model.n()), g_fast(model.n());
-        const double M_dense = integrated_effective_mass_gradient_dense(model, dense, q.base, q.theta, model.end_effector(),
-                                                                  u, tim, joints, g_dense);
-        const double M = integrated_effective_mass_gradient(model, fast, q.base, q.theta, model.end_effector(),
-                                                                 u, tim, joints, g_fast);
+        const double M_dense = integrated_effective_mass_gradient_dense(
+            model, dense, q.base, q.theta, model.end_effector(), u, tim, joints, g_dense);
+        const double M = integrated_effective_mass_gradient(model, fast, q.base, q.theta,
+                                                            model.end_effector(), u, tim, joints, g_fast);
         CHECK(std::abs(M - M_dense) <= 1e-12 * M_dense);
         // the same formula fed by two solves: rounding, 1e-10 of the gradient's largest entry
         const double gs = std::max(g_dense.cwiseAbs().maxCoeff(), 1e-12);
@@ -388,7 +388,8 @@ TEST_CASE("the O(n) paths refuse what they cannot do and fall back for mimic joi
     CHECK(integrated_effective_mass_dense(m, e, q.base, q.theta, m.end_effector(), u, 0.01, joints) == M);
     VectorXd g(m.n()), g_dense(m.n());
     CHECK(integrated_effective_mass_gradient(m, d, q.base, q.theta, m.end_effector(), u, 0.01, joints, g) ==
-          integrated_effective_mass_gradient_dense(m, e, q.base, q.theta, m.end_effector(), u, 0.01, joints, g_dense));
+          integrated_effective_mass_gradient_dense(m, e, q.base, q.theta, m.end_effector(), u, 0.01, joints,
+                                                   g_dense));
     CHECK(g == g_dense);
   }
   // bad input names the argument
@@ -407,7 +408,7 @@ TEST_CASE("the O(n) paths refuse what they cannot do and fall back for mimic joi
                     Catch::Contains("inverse mass"));
   VectorXd short_grad(2);
   CHECK_THROWS_WITH(integrated_effective_mass_gradient(c, dc, qc.base, qc.theta, c.end_effector(), u, 0.0,
-                                                            ContactJoints{}, short_grad),
+                                                       ContactJoints{}, short_grad),
                     Catch::Contains("grad"));
   CHECK_THROWS_AS(integrated_effective_mass(c, dc, qc.base, qc.theta, 99, u, 0.0, ContactJoints{}),
                   InputError);

@@ -232,7 +232,8 @@ TEST_CASE("joint models: the gradient of M_ie against central differences", "[jo
       const Eigen::VectorXd th = perturbed(Eigen::VectorXd::Constant(n, 0.4), rng, 0.8);
       const Vector3 u = random_unit(rng);
       Eigen::VectorXd g(n), gd(n);
-      const double M = integrated_effective_mass_gradient_dense(model, data, base, th, frame, u, tinv, joints, g);
+      const double M =
+          integrated_effective_mass_gradient_dense(model, data, base, th, frame, u, tinv, joints, g);
       const double h = 1e-6;
       for (int k = 0; k < n; ++k) {
         Eigen::VectorXd tp = th, tm = th;
@@ -268,7 +269,7 @@ TEST_CASE("joint models: no allocation per call, H left as it was", "[joints]") 
     sum += inverse_effective_mass(model, data, sc.problem.frame, u, *j);
     sum += inverse_effective_mass(model, data, sc.problem.frame, u, locked());
     sum += integrated_effective_mass_gradient_dense(model, data, sc.problem.base, sc.problem.theta,
-                                              sc.problem.frame, u, 0.01, *j, g);
+                                                    sc.problem.frame, u, 0.01, *j, g);
   }
   Eigen::internal::set_is_malloc_allowed(true);
   CHECK(std::isfinite(sum));

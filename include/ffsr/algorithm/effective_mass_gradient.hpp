@@ -255,21 +255,23 @@ inline double integrated_effective_mass_gradient_at(const Model& model, Data& da
 /// s = [u; 0], dM_ie = -M_ie^2 d(1/m_e). Writes data.H, data.L, data.w, data.y, data.V, data.F and
 /// grad (size n). Returns M_ie.
 inline double integrated_effective_mass_gradient_dense(const Model& model, Data& data, const BasePose& base,
-                                                 const Eigen::Ref<const Eigen::VectorXd>& theta, int frame,
-                                                 const Vector3& u, double target_inverse_mass,
-                                                 const ContactJoints& joints,
-                                                 Eigen::Ref<Eigen::VectorXd> grad) {
+                                                       const Eigen::Ref<const Eigen::VectorXd>& theta,
+                                                       int frame, const Vector3& u,
+                                                       double target_inverse_mass,
+                                                       const ContactJoints& joints,
+                                                       Eigen::Ref<Eigen::VectorXd> grad) {
   crba(model, data, base, theta);  // integrated_effective_mass_gradient_at checks grad, u and frame
   return integrated_effective_mass_gradient_at(model, data, frame, u, target_inverse_mass, joints, grad);
 }
 
 /// integrated_effective_mass_gradient_dense for the free joints (the paper's).
 inline double integrated_effective_mass_gradient_dense(const Model& model, Data& data, const BasePose& base,
-                                                 const Eigen::Ref<const Eigen::VectorXd>& theta, int frame,
-                                                 const Vector3& u, double target_inverse_mass,
-                                                 Eigen::Ref<Eigen::VectorXd> grad) {
+                                                       const Eigen::Ref<const Eigen::VectorXd>& theta,
+                                                       int frame, const Vector3& u,
+                                                       double target_inverse_mass,
+                                                       Eigen::Ref<Eigen::VectorXd> grad) {
   return integrated_effective_mass_gradient_dense(model, data, base, theta, frame, u, target_inverse_mass,
-                                            ContactJoints{}, grad);
+                                                  ContactJoints{}, grad);
 }
 
 /// Analytic gradient of the integrated effective mass in the joint angles under the joint model, at a
@@ -281,13 +283,13 @@ inline double integrated_effective_mass_gradient_dense(const Model& model, Data&
 /// integrated_effective_mass_gradient_dense. Runs forward_kinematics. Writes the recursion's fields,
 /// data.Ic (composite), data.y, data.V, data.F and grad (size n); not data.H. Returns M_ie.
 inline double integrated_effective_mass_gradient(const Model& model, Data& data, const BasePose& base,
-                                                      const Eigen::Ref<const Eigen::VectorXd>& theta,
-                                                      int frame, const Vector3& u, double target_inverse_mass,
-                                                      const ContactJoints& joints,
-                                                      Eigen::Ref<Eigen::VectorXd> grad) {
+                                                 const Eigen::Ref<const Eigen::VectorXd>& theta, int frame,
+                                                 const Vector3& u, double target_inverse_mass,
+                                                 const ContactJoints& joints,
+                                                 Eigen::Ref<Eigen::VectorXd> grad) {
   if (model.nb() - 1 != model.n())
-    return integrated_effective_mass_gradient_dense(model, data, base, theta, frame, u, target_inverse_mass, joints,
-                                              grad);
+    return integrated_effective_mass_gradient_dense(model, data, base, theta, frame, u, target_inverse_mass,
+                                                    joints, grad);
   detail::require_size(grad.size(), model.n(), "integrated_effective_mass_gradient", "grad");
   forward_kinematics(model, data, base, theta);
   const Vector6 f = detail::unit_point_force(model, data, frame, u);

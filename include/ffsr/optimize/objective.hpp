@@ -138,7 +138,8 @@ class CaptureEvaluator {
   /// (integrated_effective_mass_gradient_dense of the joint model). Runs crba. Writes data and grad.
   double mass_gradient(Data& data, const BasePose& base, const Eigen::Ref<const Eigen::VectorXd>& theta,
                        Eigen::Ref<Eigen::VectorXd> grad) const {
-    return integrated_effective_mass_gradient_dense(*model_, data, base, theta, frame_, u_, b_, *joints_, grad);
+    return integrated_effective_mass_gradient_dense(*model_, data, base, theta, frame_, u_, b_, *joints_,
+                                                    grad);
   }
 
   /// The same at the configuration of the last crba (integrated_effective_mass_gradient_at): for a
