@@ -8,6 +8,7 @@
 #include "ffsr/algorithm/joint_models.hpp"
 #include "ffsr/control/detumble_run.hpp"
 #include "ffsr/jobs/detail/json_values.hpp"
+#include "ffsr/jobs/scenario_run.hpp"
 #include "ffsr/jobs/subject.hpp"
 #include "ffsr/model/attach.hpp"
 
@@ -20,8 +21,11 @@ namespace ffsr {
 
 /// The job's result: the grasp, the run's summary and series, the limits it ran under.
 struct DetumbleJobResult {
+  std::string
+      run;  ///< the main job's run it starts from (baseline, optimized, global); empty: a configuration
+  Eigen::VectorXd theta;  ///< the capture configuration, rad
   GraspResult grasp;
-  DetumbleRunResult run;
+  DetumbleRunResult result;
   DetumbleLimits limits;
   DetumbleOptions options;
   std::string peak_joint_name;  ///< the joint of the peak torque
@@ -73,9 +77,11 @@ inline void detumble_settings(const ScenarioKeys& k, const Model& model, Detumbl
 /// The job: grasp_at_capture at the subject's configuration (the contact point moving at the approach
 /// speed along the target's normal), the stack, run_detumble. InputError for bad keys, an actuator too
 /// small for the horizon (check_detumble_feasible), or a stack not at rest at the horizon.
-inline DetumbleJobResult detumble(const Subject& s) {
+inline DetumbleJobResult detumble(const Subject& s, const BasePose& base, const Eigen::VectorXd& theta,
+                                  const Target& target) {
   using detail::str;
   DetumbleJobResult out;
+  out.theta = theta;
   const Robot& r = s.robot;
   try {  // an error of a key the file gave names the file and the key's line
     detumble_settings(s.keys, r.model, out.limits, out.options);
@@ -83,9 +89,9 @@ inline DetumbleJobResult detumble(const Subject& s) {
     throw InputError(located_key_message(s.keys, e.what()));
   }
   const int ee = r.end_effector;
-  out.grasp = grasp_at_capture(r.model, ee, r.base, r.theta, s.target, s.approach_speed);
+  out.grasp = grasp_at_capture(r.model, ee, base, theta, target, s.approach_speed);
   const Model stack = attach_body(r.model, r.model.frame(ee).name, out.grasp.body);
-  const DetumbleState start{r.base, r.theta, out.grasp.v_after, Vector3::Zero()};
+  const DetumbleState start{base, theta, out.grasp.v_after, Vector3::Zero()};
   DetumbleRunOptions run;
   run.tick = s.keys.detumble_tick;
   run.horizon = s.keys.detumble_horizon;
@@ -100,9 +106,9 @@ inline DetumbleJobResult detumble(const Subject& s) {
                                                                       : "wheel-torque";
     throw InputError(located_key_message(s.keys, str("--", key, ": ", why)));
   }
-  out.run = run_detumble(stack, ee, out.grasp.body, start, out.limits, out.options, run);
-  if (!out.run.at_rest) {
-    const DetumbleSample& e = out.run.series.back();
+  out.result = run_detumble(stack, ee, out.grasp.body, start, out.limits, out.options, run);
+  if (!out.result.at_rest) {
+    const DetumbleSample& e = out.result.series.back();
     constexpr double deg = 180 / M_PI;
     throw InputError(str("--detumble-horizon: the stack is not at rest after ", run.horizon,
                          " s under these limits (largest joint rate ", e.joint_rate * deg,
@@ -111,7 +117,43 @@ inline DetumbleJobResult detumble(const Subject& s) {
                          s.keys.rest_rate_deg,
                          " deg/s): raise the limits, the wheels' momentum or the horizon"));
   }
-  out.peak_joint_name = out.run.peak_joint >= 0 ? r.model.joint(out.run.peak_joint).name : "";
+  out.peak_joint_name = out.result.peak_joint >= 0 ? r.model.joint(out.result.peak_joint).name : "";
+  return out;
+}
+
+/// At the subject's configuration (its start state, the target at t = 0).
+inline DetumbleJobResult detumble(const Subject& s) {
+  return detumble(s, s.robot.base, s.robot.theta, s.target);
+}
+
+/// From the capture of the main job's runs (jobs/scenario_run.hpp) of the scenario `sc` (built from
+/// the subject's keys): `which` is plain, optimized, global or all (every run the scenario has); each
+/// run's capture configuration and base pose at T, the target at T. InputError naming --run.
+inline std::vector<DetumbleJobResult> detumble_runs(const Subject& s, const Scenario& sc,
+                                                    const std::string& which) {
+  using detail::str;
+  if (which != "plain" && which != "optimized" && which != "global" && which != "all")
+    throw InputError(str("--run: expected plain, optimized, global or all, got '", which, "'"));
+  if (which == "global" && !sc.keys.global)
+    throw InputError("--run: global asks for the global run, and this scenario has none (global = false)");
+  const Target target = prepare_capture(sc.problem, sc.task, sc.capture).capture_target;
+  std::vector<std::pair<std::string, CaptureResult>> runs;
+  if (which == "plain" || which == "optimized") {
+    auto [plain, optimized] = plan_plain_and_optimized(sc);
+    runs.emplace_back(which == "plain" ? "baseline" : "optimized", which == "plain" ? plain : optimized);
+  } else {
+    const ScenarioResult r = run_scenario(sc);
+    if (which == "all") {
+      runs.emplace_back("baseline", r.plain);
+      runs.emplace_back("optimized", r.optimized);
+    }
+    if (r.global) runs.emplace_back("global", r.global->result.run);
+  }
+  std::vector<DetumbleJobResult> out;
+  for (const auto& [name, run] : runs) {
+    out.push_back(detumble(s, run.base, run.theta, target));
+    out.back().run = name;
+  }
   return out;
 }
 
@@ -120,11 +162,12 @@ inline nlohmann::json detumble_json(const Subject& s, const DetumbleJobResult& d
                                     const std::string& version) {
   const GraspResult& g = d.grasp;
   using detail::vector_json;
-  const DetumbleRunResult& r = d.run;
+  const DetumbleRunResult& r = d.result;
   const DetumbleSample& e = r.series.back();
   nlohmann::json j;
   j["version"] = version;
-  j["joints_deg"] = vector_json(Eigen::VectorXd(s.robot.theta * 180.0 / M_PI));
+  if (!d.run.empty()) j["run"] = d.run;
+  j["joints_deg"] = vector_json(Eigen::VectorXd(d.theta * 180.0 / M_PI));
   j["grasp"] = {{"impulse_force", vector_json(Eigen::VectorXd(g.impulse.head<3>()))},
                 {"impulse_moment", vector_json(Eigen::VectorXd(g.impulse.tail<3>()))},
                 {"base_velocity_jump", vector_json(Eigen::VectorXd(g.base_velocity_jump.head<3>()))},
@@ -157,25 +200,42 @@ inline nlohmann::json detumble_json(const Subject& s, const DetumbleJobResult& d
   return j;
 }
 
-/// The series as the CSV of `ffsr-optimize detumble --csv`: time, the rates, the gripper load, the
-/// base's rotation, the wheels' momentum, the energy, then each joint's rate and torque.
-inline std::string detumble_series_csv(const DetumbleJobResult& d) {
+/// The results of detumble_runs as JSON: {"version", "runs": [each run's detumble_json]}.
+inline nlohmann::json detumble_runs_json(const Subject& s, const std::vector<DetumbleJobResult>& d,
+                                         const std::string& version) {
+  nlohmann::json j{{"version", version}, {"runs", nlohmann::json::array()}};
+  for (const DetumbleJobResult& x : d) {
+    nlohmann::json r = detumble_json(s, x, version);
+    r.erase("version");
+    j["runs"].push_back(std::move(r));
+  }
+  return j;
+}
+
+/// The series as the CSV of `ffsr-optimize detumble --csv`: (with runs: the run's name first) time,
+/// the rates, the gripper load, the base's rotation, the wheels' momentum, the energy, then each
+/// joint's rate and torque.
+inline std::string detumble_series_csv(const std::vector<DetumbleJobResult>& results) {
   std::ostringstream o;
   o << std::setprecision(10);
-  const int n = int(d.limits.joint_torque.size());
-  o << "t,joint_rate,relative_rate,stack_rate,gripper_force,gripper_moment,base_attitude,wheel_momentum,"
+  const bool runs = !results.empty() && !results.front().run.empty();
+  const int n = results.empty() ? 0 : int(results.front().limits.joint_torque.size());
+  o << (runs ? "run," : "")
+    << "t,joint_rate,relative_rate,stack_rate,gripper_force,gripper_moment,base_attitude,wheel_momentum,"
        "energy";
   for (int k = 0; k < n; ++k) o << ",theta_dot_" << k + 1;
   for (int k = 0; k < n; ++k) o << ",tau_" << k + 1;
   o << "\n";
-  for (const DetumbleSample& x : d.run.series) {
-    o << x.t << ',' << x.joint_rate << ',' << x.relative_rate << ',' << x.stack_rate << ','
-      << x.gripper_force.norm() << ',' << x.gripper_moment.norm() << ',' << x.base_attitude << ','
-      << x.wheel_momentum.norm() << ',' << x.energy;
-    for (int k = 0; k < n; ++k) o << ',' << x.theta_dot(k);
-    for (int k = 0; k < n; ++k) o << ',' << x.tau(k);
-    o << "\n";
-  }
+  for (const DetumbleJobResult& d : results)
+    for (const DetumbleSample& x : d.result.series) {
+      if (runs) o << d.run << ',';
+      o << x.t << ',' << x.joint_rate << ',' << x.relative_rate << ',' << x.stack_rate << ','
+        << x.gripper_force.norm() << ',' << x.gripper_moment.norm() << ',' << x.base_attitude << ','
+        << x.wheel_momentum.norm() << ',' << x.energy;
+      for (int k = 0; k < n; ++k) o << ',' << x.theta_dot(k);
+      for (int k = 0; k < n; ++k) o << ',' << x.tau(k);
+      o << "\n";
+    }
   return o.str();
 }
 

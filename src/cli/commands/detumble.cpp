@@ -17,13 +17,15 @@ namespace {
 
 struct DetumbleCommandOptions {
   SubjectOptions subject;
-  OutputKeys out;  ///< --json, --csv, --quiet
+  OutputKeys out;   ///< --json, --csv, --quiet
+  std::string run;  ///< --run: plain, optimized, global or all; empty: the scenario's configuration
 };
 
 void print_detumble_table(std::ostream& out, const DetumbleJobResult& d) {
   const GraspResult& g = d.grasp;
-  const DetumbleRunResult& r = d.run;
+  const DetumbleRunResult& r = d.result;
   constexpr double deg = 180.0 / M_PI;
+  if (!d.run.empty()) out << "-- " << d.run << " run's capture\n";
   out << std::setprecision(4) << "grasp impulse            " << g.impulse.head<3>().norm() << " N s, "
       << g.impulse.tail<3>().norm() << " N m s\n"
       << "base velocity jump       " << g.base_velocity_jump.head<3>().norm() * 1e3 << " mm/s, "
@@ -44,11 +46,21 @@ int run_detumble_command(const DetumbleCommandOptions& o) {
   set_quiet(o.out.quiet);
   Outputs outputs = o.out.outputs();  // an output on standard output: the table goes to standard error
   const Subject subject = load_subject(o.subject);
-  const DetumbleJobResult d = detumble(subject);
-  outputs.set("--json", detumble_json(subject, d, FFSR_VERSION).dump(2) + "\n");
-  if (!o.out.csv.empty()) outputs.set("--csv", detumble_series_csv(d));
+  std::vector<DetumbleJobResult> results;
+  if (o.run.empty()) {
+    results.push_back(detumble(subject));
+    outputs.set("--json", detumble_json(subject, results.front(), FFSR_VERSION).dump(2) + "\n");
+  } else {
+    const EmbeddedUrdf embedded = builtin_urdf();
+    results = detumble_runs(subject, build_scenario(subject.keys, &embedded), o.run);
+    outputs.set("--json", detumble_runs_json(subject, results, FFSR_VERSION).dump(2) + "\n");
+  }
+  if (!o.out.csv.empty()) outputs.set("--csv", detumble_series_csv(results));
   outputs.write();
-  print_detumble_table(outputs.table(), d);
+  for (size_t i = 0; i < results.size(); ++i) {
+    if (i > 0) outputs.table() << "\n";
+    print_detumble_table(outputs.table(), results[i]);
+  }
   return 0;
 }
 
@@ -61,6 +73,9 @@ void register_detumble(CLI::App& app, Action& action) {
   // the contact law does not act here: the grasp is plastic, at the approach speed
   o->subject.add_to(*sub, scenario_key_names({KeyGroup::Detumble}),
                     {"model", "stiffness", "exponent", "restitution"});
+  sub->add_option("--run", o->run,
+                  "Start from the capture the main job plans: plain, optimized, global or all (default: the "
+                  "scenario's configuration, joints-deg)");
   add_output_flags(
       *sub, o->out,
       {"Write the grasp and the post-capture run's summary as JSON to FILE",
