@@ -45,8 +45,8 @@ using namespace test_detumble_command;
 
 TEST_CASE("detumble on the 7-DOF scenario: at rest, every torque within its limit, momentum kept", "[cli]") {
   ffsr::test::TempDir dir;
-  const auto r =
-      cli({"detumble", "--config", kDetumbleToml, "--quiet", "--json", "-", "--csv", "series.csv"}, dir.str());
+  const auto r = cli({"detumble", "--config", kDetumbleToml, "--quiet", "--json", "-", "--csv", "series.csv"},
+                     dir.str());
   const json j = ffsr::test::parse_json(r);
   const auto limits = j.at("parameters").at("joint_torque_limit").get<std::vector<double>>();
   CHECK(limits == std::vector<double>{60, 60, 60, 40, 20, 20, 20});
@@ -118,4 +118,32 @@ TEST_CASE("detumble with reaction wheels: the stack's spin stopped, the stored m
   CHECK(free.at("final_stack_rate").get<double>() >
         0.05 * M_PI / 180);  // free-floating: the stack keeps its spin
   CHECK(j.at("time_to_rest").get<double>() > free.at("time_to_rest").get<double>());
+}
+
+TEST_CASE("detumble --run: from the capture configurations of the main job's runs", "[cli]") {
+  const json main = ffsr::test::parse_json(cli({"--config", kDetumbleToml, "--quiet", "--json", "-"}));
+  const json all = ffsr::test::parse_json(
+      cli({"detumble", "--config", kDetumbleToml, "--run", "all", "--quiet", "--json", "-"}));
+  REQUIRE(all.at("runs").size() == 3);
+  for (const json& r : all.at("runs")) {
+    const std::string name = r.at("run");
+    INFO(name);
+    const auto q = r.at("joints_deg").get<std::vector<double>>();
+    const auto qm = main.at(name).at("capture_configuration_deg").get<std::vector<double>>();
+    REQUIRE(q.size() == qm.size());
+    for (size_t k = 0; k < q.size(); ++k) CHECK(q[k] == Approx(qm[k]).margin(1e-9));
+    CHECK(r.at("at_rest").get<bool>());
+    CHECK(r.at("momentum_drift").get<double>() < 1e-8);
+  }
+  // one run alone: the same result as within 'all'
+  json one = ffsr::test::parse_json(
+      cli({"detumble", "--config", kDetumbleToml, "--run", "optimized", "--quiet", "--json", "-"}));
+  CHECK(one.at("runs").at(0) == all.at("runs").at(1));
+  // the configuration differs from the scenario's start, so does the result
+  const json start =
+      ffsr::test::parse_json(cli({"detumble", "--config", kDetumbleToml, "--quiet", "--json", "-"}));
+  CHECK(start.at("time_to_rest") != one.at("runs").at(0).at("time_to_rest"));
+  const auto bad = cli({"detumble", "--config", kDetumbleToml, "--run", "best", "--quiet"});
+  CHECK(bad.exit_code == 2);
+  CHECK(bad.err.find("--run") != std::string::npos);
 }
