@@ -51,5 +51,4 @@ NB_MODULE(_ffsr, m) {
   bind_target_estimate(m);
   bind_controller(m);
   bind_detumble(m);
-  bind_detumble(m);
 }
