@@ -178,7 +178,8 @@ void bind_detumble_job(nb::module_& m) {
           "time_to_rest", [](const DetumbleJobRun& r) { return r.result.front().result.time_to_rest; },
           "The first start's time to rest, s.")
       .def_prop_ro(
-          "peak_joint_torque", [](const DetumbleJobRun& r) { return r.result.front().result.peak_joint_torque; },
+          "peak_joint_torque",
+          [](const DetumbleJobRun& r) { return r.result.front().result.peak_joint_torque; },
           "The first start's peak joint torque, N m.")
       .def_prop_ro(
           "peak_joint", [](const DetumbleJobRun& r) { return r.result.front().peak_joint_name; },
