@@ -110,12 +110,13 @@ inline DetumbleJobResult detumble(const Subject& s, const BasePose& base, const 
   if (!out.result.at_rest) {
     const DetumbleSample& e = out.result.series.back();
     constexpr double deg = 180 / M_PI;
+    const bool spin = out.options.stop_stack_spin;
     throw InputError(str("--detumble-horizon: the stack is not at rest after ", run.horizon,
                          " s under these limits (largest joint rate ", e.joint_rate * deg,
-                         " deg/s, gripper rate relative to the base ", e.relative_rate * deg,
-                         " deg/s, stack rate ", e.stack_rate * deg, " deg/s; at rest below ",
-                         s.keys.rest_rate_deg,
-                         " deg/s): raise the limits, the wheels' momentum or the horizon"));
+                         " deg/s, gripper rate relative to the base ", e.relative_rate * deg, " deg/s",
+                         spin ? str(", stack rate ", e.stack_rate * deg, " deg/s") : std::string(),
+                         "; at rest below ", s.keys.rest_rate_deg, " deg/s): raise the ",
+                         spin ? "limits, the wheels' momentum" : "joint torque limits", " or the horizon"));
   }
   out.peak_joint_name = out.result.peak_joint >= 0 ? r.model.joint(out.result.peak_joint).name : "";
   return out;
@@ -151,7 +152,11 @@ inline std::vector<DetumbleJobResult> detumble_runs(const Subject& s, const Scen
   }
   std::vector<DetumbleJobResult> out;
   for (const auto& [name, run] : runs) {
-    out.push_back(detumble(s, run.base, run.theta, target));
+    try {
+      out.push_back(detumble(s, run.base, run.theta, target));
+    } catch (const InputError& e) {  // which start it was
+      throw InputError(str(e.what(), " (from the ", name, " run's capture)"));
+    }
     out.back().run = name;
   }
   return out;
