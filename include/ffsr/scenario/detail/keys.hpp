@@ -397,12 +397,6 @@ inline void add_joint_and_shape_keys(std::vector<ScenarioKey>& keys) {
 inline void add_detumble_keys(std::vector<ScenarioKey>& keys) {
   using G = KeyGroup;
   using K = ScenarioKeys;
-  const auto positive = [](const char* name, double K::*member) {
-    return [name, member](const K& k) {
-      if (!(finite(k.*member, name) > 0))
-        throw InputError(str("--", name, ": must be positive, got ", k.*member));
-    };
-  };
   // the base's actuator acts only when the run stops the stack's spin (DetumbleOptions::stop_stack_spin)
   const auto with_actuator = [](const char* actuator) {
     return [actuator](const K& k) -> std::string {
@@ -455,24 +449,30 @@ inline void add_detumble_keys(std::vector<ScenarioKey>& keys) {
         "thruster-force", &K::thruster_force, "thrusters");
   bound(FFSR_KEY("thruster-torque", thruster_torque, "Detumble: thrusters' torque per base axis, N m"),
         "thruster-torque", &K::thruster_torque, "thrusters");
+}
+
+/// The post-capture run's settings (the detumble job): rest, horizon, tick, the stack's spin.
+inline void add_detumble_run_keys(std::vector<ScenarioKey>& keys) {
+  using G = KeyGroup;
+  using K = ScenarioKeys;
   keys.push_back(
       FFSR_KEY("rest-rate-deg", rest_rate_deg,
                "Detumble: at rest when every joint rate and the gripper's rate relative to the base "
                "(and the stack's, with stop-stack-spin) are below this, deg/s",
                "0.05")
           .in(G::Detumble)
-          .checked(positive("rest-rate-deg", &K::rest_rate_deg))
+          .checked([](const K& k) { check_positive_if_given(k, "rest-rate-deg", k.rest_rate_deg); })
           .echoed(echo_given("rest-rate-deg", &K::rest_rate_deg)));
   keys.push_back(
       FFSR_KEY("detumble-horizon", detumble_horizon, "Detumble: longest post-capture run, s", "120")
           .in(G::Detumble)
-          .checked(positive("detumble-horizon", &K::detumble_horizon))
+          .checked([](const K& k) { check_positive_if_given(k, "detumble-horizon", k.detumble_horizon); })
           .echoed(echo_given("detumble-horizon", &K::detumble_horizon)));
   keys.push_back(FFSR_KEY("detumble-tick", detumble_tick,
                           "Detumble: the controller's period, s (< detumble-horizon)", "0.01")
                      .in(G::Detumble)
-                     .checked([positive](const K& k) {
-                       positive("detumble-tick", &K::detumble_tick)(k);
+                     .checked([](const K& k) {
+                       check_positive_if_given(k, "detumble-tick", k.detumble_tick);
                        if (!(k.detumble_tick < k.detumble_horizon))
                          throw InputError(str("--detumble-tick: must be shorter than detumble-horizon (",
                                               k.detumble_horizon, " s), got ", k.detumble_tick));
@@ -494,6 +494,7 @@ inline std::vector<ScenarioKey> build_scenario_keys() {
   add_global_keys(keys);
   add_joint_and_shape_keys(keys);
   add_detumble_keys(keys);
+  add_detumble_run_keys(keys);
   // every key of the global run but the switch acts on that run only
   for (ScenarioKey& key : keys)
     if (key.group == KeyGroup::Global && key.name != "global") key.acting(on_the_global_run);
