@@ -125,6 +125,9 @@ void bind_results(nb::module_& m) {
                            g.impulse.tail<3>().norm(), " N m s, energy ", g.energy_before, " -> ",
                            g.energy_after, " J)");
       });
+}
+
+void bind_detumble_result(nb::module_& m) {
   nb::class_<DetumbleRunResult>(m, "DetumbleResult", "The post-capture run's summary and series (SI units).")
       .def_ro("at_rest", &DetumbleRunResult::at_rest)
       .def_ro("time_to_rest", &DetumbleRunResult::time_to_rest)
@@ -205,11 +208,7 @@ void bind_detumble_job(nb::module_& m) {
       "scenario's configuration.");
 }
 
-}  // namespace
-
-void bind_detumble(nb::module_& m) {
-  bind_results(m);
-  bind_detumble_job(m);
+void bind_detumble_controller(nb::module_& m) {
   nb::class_<DetumbleController>(
       m, "DetumbleController",
       "The detumbling controller on the stack model: one step per tick, no allocation.")
@@ -248,6 +247,15 @@ void bind_detumble(nb::module_& m) {
           },
           "stack"_a, "base"_a, "theta"_a, "v"_a, "wheel_momentum"_a = nb::none(),
           "One tick: the command (tau, base_wrench, status...) as a dict.");
+}
+
+}  // namespace
+
+void bind_detumble(nb::module_& m) {
+  bind_results(m);
+  bind_detumble_result(m);
+  bind_detumble_job(m);
+  bind_detumble_controller(m);
   m.def(
       "attach_body",
       [](const Model& model, const std::string& frame, double mass, nb::handle inertia, const Pose& pose,
