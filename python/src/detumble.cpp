@@ -3,10 +3,13 @@
 // (the stack's dynamics with the controller in the loop). Names and fields mirror C++.
 #include "arguments.hpp"
 #include "bindings.hpp"
+#include "job_helpers.hpp"
 #include "outputs.hpp"
 
 #include "ffsr/control/detumble_run.hpp"
+#include "ffsr/jobs/detumble.hpp"
 
+#include <nanobind/stl/optional.h>
 #include <nanobind/stl/string.h>
 
 namespace ffsr::python {
@@ -163,6 +166,48 @@ void bind_detumble_result(nb::module_& m) {
       });
 }
 
+/// The job `detumble` (ffsr/jobs/detumble.hpp): one result per start (the scenario's configuration, or
+/// each run of --run).
+using DetumbleJobRun = JobRun<std::vector<DetumbleJobResult>>;
+
+void bind_detumble_job(nb::module_& m) {
+  job_result_class<DetumbleJobRun>(
+      m, "DetumbleJobResult",
+      "The grasp and the post-capture run (ffsr-optimize detumble), one per start. to_dict() is the\n"
+      "command's --json.")
+      .def_prop_ro(
+          "runs", [](const DetumbleJobRun& r) { return r.result.size(); }, "The number of starts.")
+      .def_prop_ro(
+          "time_to_rest", [](const DetumbleJobRun& r) { return r.result.front().result.time_to_rest; },
+          "The first start's time to rest, s.")
+      .def_prop_ro(
+          "peak_joint_torque",
+          [](const DetumbleJobRun& r) { return r.result.front().result.peak_joint_torque; },
+          "The first start's peak joint torque, N m.")
+      .def_prop_ro(
+          "peak_joint", [](const DetumbleJobRun& r) { return r.result.front().peak_joint_name; },
+          "The joint of that peak.");
+  def_scenario_method(
+      "detumble",
+      [](const Scenario& sc, std::optional<std::string> run) {
+        return run_job<DetumbleJobRun>([&](DetumbleJobRun& r) {
+          const Subject s = scenario_subject(sc);
+          if (run) {
+            r.result = detumble_runs(s, sc, *run);
+            r.json = detumble_runs_json(s, r.result, FFSR_VERSION).dump();
+          } else {
+            r.result.push_back(detumble(s));
+            r.json = detumble_json(s, r.result.front(), FFSR_VERSION).dump();
+          }
+        });
+      },
+      "run"_a = nb::none(),
+      "The job `detumble` (ffsr-optimize detumble --config FILE): the grasp at the end of the approach,\n"
+      "then the stack brought to rest under the scenario's limits (joint-torque-limit, base-actuator,\n"
+      "...). run: plain, optimized, global or all (as --run: from the main job's captures); default: the\n"
+      "scenario's configuration.");
+}
+
 void bind_detumble_controller(nb::module_& m) {
   nb::class_<DetumbleController>(
       m, "DetumbleController",
@@ -209,6 +254,7 @@ void bind_detumble_controller(nb::module_& m) {
 void bind_detumble(nb::module_& m) {
   bind_grasp_result(m);
   bind_detumble_result(m);
+  bind_detumble_job(m);
   bind_detumble_controller(m);
   m.def(
       "attach_body",

@@ -12,6 +12,7 @@ import ffsr
 pin = pytest.importorskip("pinocchio", reason="Pinocchio's Python package `pin` is a test requirement")
 
 from conftest import ROBOTS  # noqa: E402
+from test_jobs import command_json, differences  # noqa: E402
 
 
 def quat_to_rot(q):  # (x, y, z, w)
@@ -129,3 +130,18 @@ def test_detumble_run_and_controller():
         ffsr.DetumbleController(stack, "ee", limits, stop_stack_spin=True)
     with pytest.raises(ffsr.InputError, match="mass must be positive"):
         ffsr.attach_body(fm, "ee", 0.0, np.eye(3), g.body.pose)
+
+
+@pytest.mark.parametrize("run", [None, "all"])
+def test_detumble_job_equals_the_command(tmp_path, run):
+    scenario = ROBOTS / "paper_7dof_detumble.toml"
+    expected = command_json(tmp_path, scenario, *(["--run", run] if run else []), subcommand="detumble")
+    result = ffsr.Scenario.load(str(scenario)).detumble(run=run)
+    got = result.to_dict()
+    assert differences(got, expected) == []
+    first = got["runs"][0] if run else got
+    assert result.time_to_rest == first["time_to_rest"]
+    assert result.peak_joint == first["peak_joint"]
+    assert result.runs == (3 if run else 1)
+    with pytest.raises(ffsr.InputError, match="--run"):
+        ffsr.Scenario.load(str(scenario)).detumble(run="best")

@@ -73,6 +73,7 @@ int main(int argc, char** argv) {
   register_robust(app, action);
   register_pareto(app, action);
   register_closed_loop(app, action);
+  register_detumble(app, action);
   register_run(app, action);
   app.require_subcommand(0, 1);
   try {

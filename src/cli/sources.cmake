@@ -8,5 +8,6 @@ set(FFSR_CLI_SUPPORT_SOURCES
     support/parse.cpp support/output.cpp support/progress.cpp support/scenario_flags.cpp support/subject.cpp)
 set(FFSR_CLI_COMMAND_SOURCES
     commands/run.cpp commands/inspect.cpp commands/contact.cpp commands/xi.cpp commands/map.cpp
-    commands/robust.cpp commands/pareto.cpp commands/closed_loop.cpp)
+    commands/robust.cpp commands/pareto.cpp commands/closed_loop.cpp
+    commands/detumble.cpp)
 set(FFSR_CLI_FIGURE_SOURCES figures/capture.cpp figures/figures.cpp figures/plot.cpp)

@@ -72,6 +72,7 @@ const Files& files() {
 
 const std::string kPosition7 = kSource + "/robots/paper_7dof_position.toml";
 const std::string kUncertain7 = kSource + "/robots/paper_7dof_position_uncertain.toml";
+const std::string kDetumble7 = kSource + "/robots/paper_7dof_detumble.toml";
 
 /// Every subcommand with a small run of it: on the built-in 3-DOF scenario, or (`seven_dof`) on the
 /// paper's 7-DOF position scenario, whose plain run tracks the pose.
@@ -84,7 +85,8 @@ std::vector<Sub> subcommands(bool seven_dof = false) {
             {"map", {"--config", kPosition7, "--vary", "1", "--step-deg", "90", "--csv", "map.csv"}},
             {"robust", {"--config", kUncertain7, "--global", "false", "--samples", "4"}},
             {"pareto", {"--config", kPosition7, "--levels", "2", "--starts", "2", "--global-starts", "2"}},
-            {"closed-loop", {"--config", kPosition7, "--control-rate", "5", "--estimate-rate", "1"}}};
+            {"closed-loop", {"--config", kPosition7, "--control-rate", "5", "--estimate-rate", "1"}},
+            {"detumble", {"--config", kDetumble7}}};
   return {{"", {"--global", "false"}},
           {"inspect", {}},
           {"contact", {}},
@@ -92,7 +94,8 @@ std::vector<Sub> subcommands(bool seven_dof = false) {
           {"map", {"--vary", "1", "--step-deg", "90", "--csv", "map.csv"}},
           {"robust", {"--config", files().uncertain_toml, "--global", "false"}},
           {"pareto", {"--levels", "2", "--starts", "2", "--global-starts", "2"}},
-          {"closed-loop", {"--control-rate", "5", "--estimate-rate", "1"}}};
+          {"closed-loop", {"--control-rate", "5", "--estimate-rate", "1"}},
+          {"detumble", {"--joint-torque-limit", "20"}}};
 }
 
 /// The arguments that set a key to another value (`alt`, with the other keys it needs) and what the
@@ -127,6 +130,15 @@ const std::map<std::string, KeyCase>& key_cases() {
   // closed-loop flies the global run's plan with --plan global (the other subcommands do not take it)
   const Args global{"--global", "true", "--global-starts", "2", "--plan", "global"};
   const Args sphere{"--target-shape", "sphere", "--target-size", "0.29154759474226504"};
+  const Args wheels{"--base-actuator",   "reaction-wheels",
+                    "--wheel-torque",    "0.2",
+                    "--wheel-momentum",  "25",
+                    "--stop-stack-spin", "true"};
+  const Args thrusters{"--base-actuator",   "thrusters", "--thruster-force",  "2",
+                       "--thruster-torque", "0.2",       "--stop-stack-spin", "true",
+                       "--target-velocity", "0.05,0,0"};
+  const Args wheels_kept{
+      "--base-actuator", "reaction-wheels", "--wheel-torque", "0.2", "--wheel-momentum", "25"};
   static const std::map<std::string, KeyCase> cases = {
       {"urdf", {{"--urdf", files().heavy_urdf, "--joints-deg", "0,150,-100"}, {}}},
       {"end-effector", {{"--end-effector", "link3"}, {}}},
@@ -136,8 +148,14 @@ const std::map<std::string, KeyCase>& key_cases() {
       {"mount-xyz", {{"--mount-xyz", "0.1,0,0"}, bus}},
       {"mount-rpy-deg", {{"--mount-rpy-deg", "0,0,5"}, bus}},
       // with two joints left the M_ie optimum also has the least base rate: pareto says so (exit 3)
-      {"lock-joints", {{"--lock-joints", "joint3=-1.7453292519943295", "--joints-deg", "0,150"}, {"--gain", "0"}, false, false, {"pareto"}}},
-      {"inertia-repair", {{"--inertia-repair", "balance"}, {"--urdf", files().bad_inertia_urdf, "--joints-deg", "0,150,-100"}}},
+      {"lock-joints",
+       {{"--lock-joints", "joint3=-1.7453292519943295", "--joints-deg", "0,150"},
+        {"--gain", "0"},
+        false,
+        false,
+        {"pareto"}}},
+      {"inertia-repair",
+       {{"--inertia-repair", "balance"}, {"--urdf", files().bad_inertia_urdf, "--joints-deg", "0,150,-100"}}},
       // link3 has 4 kg and moments (0, 0.09, 0.09) kg m^2: raised to these floors
       {"min-mass", {{"--min-mass", "4.5"}, {}}},
       {"min-inertia", {{"--min-inertia", "0.1"}, {}}},
@@ -175,23 +193,42 @@ const std::map<std::string, KeyCase>& key_cases() {
       {"global", {{"--global", "true", "--global-starts", "2"}, {"--global", "false"}}},
       {"seed", {{"--seed", "7"}, global, false, false, {}, {"closed-loop"}}},
       {"max-joint-rate-deg", {{"--max-joint-rate-deg", "5"}, global}},
-      {"global-starts", {{"--global-starts", "1"}, global, false, false, {}, {"robust", "pareto", "closed-loop"}}},
+      {"global-starts",
+       {{"--global-starts", "1"}, global, false, false, {}, {"robust", "pareto", "closed-loop"}}},
       {"max-base-rate-deg", {{"--max-base-rate-deg", "0.01"}, global}},
       {"reconfigure", {{"--reconfigure", "always"}, global}},
-      {"reconfigure-duration", {{"--reconfigure-duration", "30"}, {"--global", "true", "--global-starts", "2", "--plan", "global", "--reconfigure", "always"}}},
+      {"reconfigure-duration",
+       {{"--reconfigure-duration", "30"},
+        {"--global", "true", "--global-starts", "2", "--plan", "global", "--reconfigure", "always"}}},
       {"contact-joints", {{"--contact-joints", "locked"}, {}}},
       {"armature", {{"--armature", "0.5"}, {"--contact-joints", "armature"}}},
       {"joint-stiffness", {{"--joint-stiffness", "1000"}, {}}},
       {"joint-damping", {{"--joint-damping", "100"}, {}}},
       {"target-shape", {sphere, {}}},
       // a box whose face x = -0.25 holds the contact point, made wider towards the arm
-      {"target-size", {{"--target-size", "0.5,2,0.4"}, {"--target-shape", "box", "--target-size", "0.5,0.4,0.4"}}},
+      {"target-size",
+       {{"--target-size", "0.5,2,0.4"}, {"--target-shape", "box", "--target-size", "0.5,0.4,0.4"}}},
       // the sphere's centre moved so that the contact point stays on its surface
       {"target-shape-offset", {{"--target-shape-offset", "-0.5,0,0"}, sphere}},
       {"link-radius", {{"--link-radius", "0.08"}, sphere}},
       {"bus-box", {{"--bus-box", "1,1,1"}, sphere}},
       {"clearance", {{"--clearance", "0.09"}, sphere}},
       {"contact-exemption", {{"--contact-exemption", "0.5"}, sphere}},
+      // the post-capture phase (detumble): on the built-in robot the braking needs at most 2.3 N m
+      {"joint-torque-limit", {{"--joint-torque-limit", "1"}, {}}},
+      {"base-actuator",
+       {{"--base-actuator", "thrusters", "--thruster-force", "2", "--thruster-torque", "0.2"},
+        {"--stop-stack-spin", "true"}}},
+      {"wheel-torque", {{"--wheel-torque", "0.5"}, wheels}},
+      // the stack's angular momentum, 3.49 N m s, does not fit in wheels of 2 N m s per axis
+      {"wheel-momentum", {{"--wheel-momentum", "2"}, wheels}},
+      // the stack's linear momentum (a moving target) is what the thrusters' force removes
+      {"thruster-force", {{"--thruster-force", "0.5"}, thrusters}},
+      {"thruster-torque", {{"--thruster-torque", "0.5"}, thrusters}},
+      {"rest-rate-deg", {{"--rest-rate-deg", "0.1"}, {}}},
+      {"detumble-horizon", {{"--detumble-horizon", "2"}, {}, false, true}},
+      {"detumble-tick", {{"--detumble-tick", "0.02"}, {}}},
+      {"stop-stack-spin", {{"--stop-stack-spin", "true"}, wheels_kept}},
   };
   return cases;
 }

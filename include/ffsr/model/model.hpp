@@ -60,6 +60,7 @@ struct Joint {
   Vector3 axis = Vector3::UnitZ();  ///< unit axis in the child (joint) frame
   double lower = -std::numeric_limits<double>::infinity();
   double upper = std::numeric_limits<double>::infinity();
+  double effort = 0;  ///< the URDF's <limit effort>, N m (N prismatic); 0: not given
   bool has_limits() const { return std::isfinite(lower) || std::isfinite(upper); }
 };
 
@@ -258,7 +259,7 @@ class ModelBuilder {
   ModelBuilder& add_joint(const std::string& name, JointType type, const std::string& parent,
                           const Pose& origin, const Vector3& axis, const std::string& child,
                           const Inertia& inertia, double lower = -std::numeric_limits<double>::infinity(),
-                          double upper = std::numeric_limits<double>::infinity()) {
+                          double upper = std::numeric_limits<double>::infinity(), double effort = 0) {
     using detail::str;
     const Frame pf = find_parent(parent, name);
     check_new_name(child, name);
@@ -268,11 +269,13 @@ class ModelBuilder {
     if (std::isnan(lower) || std::isnan(upper) || lower > upper)
       throw ModelError(
           str("joint '", name, "': limits must satisfy lower <= upper, got [", lower, ", ", upper, "]"));
+    if (!(effort >= 0) || !std::isfinite(effort))
+      throw ModelError(str("joint '", name, "': effort must be finite and >= 0, got ", effort));
     validate_inertia(inertia, "link '" + child + "'", false);
     Body b;
     b.name = child;
     b.parent = pf.body;
-    b.joint = Joint{name, type, axis.normalized(), lower, upper};
+    b.joint = Joint{name, type, axis.normalized(), lower, upper, effort};
     b.tree = pf.pose * origin;
     b.inertia = inertia;
     model_.bodies_.push_back(b);

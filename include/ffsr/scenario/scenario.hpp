@@ -85,6 +85,12 @@ struct ScenarioKeys {
   std::string target_shape;  ///< box, sphere, cylinder; empty: none
   std::vector<double> target_size, target_shape_offset, link_radius{0.05}, bus_box;
   double clearance = 0, contact_exemption = 0.2;
+  // the post-capture phase (the detumble job, control/detumble_run.hpp)
+  std::vector<double> joint_torque_limit;  ///< N m per joint (one for all); empty: the URDF's effort
+  std::string base_actuator = "none";      ///< none, reaction-wheels or thrusters
+  double wheel_torque = 0, wheel_momentum = 0, thruster_force = 0, thruster_torque = 0;
+  double rest_rate_deg = 0.05, detumble_horizon = 120, detumble_tick = 0.01;
+  bool stop_stack_spin = false;
 };
 
 /// The kind of a key's value: one parser each, from a TOML node and from text.
@@ -103,6 +109,7 @@ enum class KeyGroup {
   Global,       ///< the global capture optimization
   JointModels,  ///< the joints during the contact and the multibody reference's servo
   Shapes,       ///< collision shapes and the clearance
+  Detumble,     ///< the post-capture phase: joint torque limits, base actuator, rest, horizon, tick
 };
 
 struct Scenario;

@@ -375,7 +375,11 @@ void register_run(CLI::App& app, Action& action) {
   app.add_option("--config", o->config,
                  "Scenario file (TOML); every key is also a flag. Default: the built-in paper 3-DOF scenario")
       ->check(CLI::ExistingFile);
-  o->flags.add_to(app);
+  // the post-capture phase's keys are the detumble subcommand's: the main job stops at the impact
+  o->flags.add_to(app, [](const std::string& name) {
+    const ScenarioKey* key = find_scenario_key(name);
+    return !key || key->group != KeyGroup::Detumble;
+  });
   add_output_flags(app, o->settings,
                    {"Write the result (with the resolved scenario and the version) as JSON to FILE",
                     "Write the time series of the runs as CSV to FILE",

@@ -23,5 +23,7 @@ void register_pareto(CLI::App& app, Action& action);
 void register_run(CLI::App& app, Action& action);
 /// `closed-loop`: the capture controller with the robot's dynamics and a noisy target estimate.
 void register_closed_loop(CLI::App& app, Action& action);
+/// `detumble`: the grasp and the post-capture run of robot and target as one stack.
+void register_detumble(CLI::App& app, Action& action);
 
 }  // namespace ffsr::cli

@@ -417,11 +417,13 @@ inline void add_urdf_joint(ModelBuilder& builder, const urdf::Joint& j, const ur
       builder.add_joint(j.name, j.type == urdf::Joint::REVOLUTE ? JointType::Revolute : JointType::Prismatic,
                         j.parent_link_name, origin, axis, link.name, inertia,
                         unlimited ? -std::numeric_limits<double>::infinity() : lo,
-                        unlimited ? std::numeric_limits<double>::infinity() : hi);
+                        unlimited ? std::numeric_limits<double>::infinity() : hi, j.limits->effort);
       break;
     }
     case urdf::Joint::CONTINUOUS:
-      builder.add_joint(j.name, JointType::Revolute, j.parent_link_name, origin, axis, link.name, inertia);
+      builder.add_joint(j.name, JointType::Revolute, j.parent_link_name, origin, axis, link.name, inertia,
+                        -std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
+                        j.limits ? j.limits->effort : 0.0);
       break;
     default:
       throw ModelError(str("joint '", j.name,

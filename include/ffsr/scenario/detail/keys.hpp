@@ -432,6 +432,97 @@ inline void add_joint_and_shape_keys(std::vector<ScenarioKey>& keys) {
           .echoed(echo_shape("contact-exemption", &K::contact_exemption)));
 }
 
+/// The post-capture phase (the detumble job): the hardware's bounds and the run's settings.
+inline void add_detumble_keys(std::vector<ScenarioKey>& keys) {
+  using G = KeyGroup;
+  using K = ScenarioKeys;
+  // the base's actuator acts only when the run stops the stack's spin (DetumbleOptions::stop_stack_spin)
+  const auto with_actuator = [](const char* actuator) {
+    return [actuator](const K& k) -> std::string {
+      if (k.base_actuator != actuator)
+        return str("acts with base-actuator = ", actuator, " only, and this run has ", k.base_actuator);
+      if (!k.stop_stack_spin) return "acts only when the run stops the stack's spin (stop-stack-spin = true)";
+      return "";
+    };
+  };
+  keys.push_back(
+      FFSR_KEY("joint-torque-limit", joint_torque_limit,
+               "Detumble: joint torque limit, N m (N prismatic): one value or one per joint (default: the "
+               "URDF's <limit effort>)")
+          .in(G::Detumble)
+          .checked([](const K& k) {
+            for (double v : k.joint_torque_limit)
+              if (!(finite(v, "joint-torque-limit") > 0))
+                throw InputError(str("--joint-torque-limit: every limit must be positive, got ", v));
+          })
+          .echoed(echo_given("joint-torque-limit", &K::joint_torque_limit)));
+  keys.push_back(FFSR_KEY("base-actuator", base_actuator,
+                          "Detumble: the base's actuator: none, reaction-wheels or thrusters", "none")
+                     .in(G::Detumble)
+                     .checked([](const K& k) {
+                       if (k.base_actuator != "none" && k.base_actuator != "reaction-wheels" &&
+                           k.base_actuator != "thrusters")
+                         throw InputError(
+                             str("--base-actuator: expected none, reaction-wheels or thrusters, got '",
+                                 k.base_actuator, "'"));
+                     })
+                     .echoed(echo_given("base-actuator", &K::base_actuator))
+                     .acting([](const K& k) -> std::string {
+                       return k.stop_stack_spin || k.base_actuator == "none"
+                                  ? ""
+                                  : "acts only when the run stops the stack's spin (stop-stack-spin = true)";
+                     }));
+  // a bound of the base actuator: positive, acting with its actuator only
+  const auto bound = [&](ScenarioKey key, const char* name, double K::*member, const char* actuator) {
+    keys.push_back(key.in(G::Detumble)
+                       .checked([name, member](const K& k) { check_positive_if_given(k, name, k.*member); })
+                       .echoed(echo_given(name, member))
+                       .acting(with_actuator(actuator)));
+  };
+  bound(FFSR_KEY("wheel-torque", wheel_torque, "Detumble: reaction wheels' torque per base axis, N m"),
+        "wheel-torque", &K::wheel_torque, "reaction-wheels");
+  bound(FFSR_KEY("wheel-momentum", wheel_momentum,
+                 "Detumble: reaction wheels' stored momentum per base axis, N m s"),
+        "wheel-momentum", &K::wheel_momentum, "reaction-wheels");
+  bound(FFSR_KEY("thruster-force", thruster_force, "Detumble: thrusters' force per base axis, N"),
+        "thruster-force", &K::thruster_force, "thrusters");
+  bound(FFSR_KEY("thruster-torque", thruster_torque, "Detumble: thrusters' torque per base axis, N m"),
+        "thruster-torque", &K::thruster_torque, "thrusters");
+}
+
+/// The post-capture run's settings (the detumble job): rest, horizon, tick, the stack's spin.
+inline void add_detumble_run_keys(std::vector<ScenarioKey>& keys) {
+  using G = KeyGroup;
+  using K = ScenarioKeys;
+  keys.push_back(
+      FFSR_KEY("rest-rate-deg", rest_rate_deg,
+               "Detumble: at rest when every joint rate and the gripper's rate relative to the base "
+               "(and the stack's, with stop-stack-spin) are below this, deg/s",
+               "0.05")
+          .in(G::Detumble)
+          .checked([](const K& k) { check_positive_if_given(k, "rest-rate-deg", k.rest_rate_deg); })
+          .echoed(echo_given("rest-rate-deg", &K::rest_rate_deg)));
+  keys.push_back(
+      FFSR_KEY("detumble-horizon", detumble_horizon, "Detumble: longest post-capture run, s", "120")
+          .in(G::Detumble)
+          .checked([](const K& k) { check_positive_if_given(k, "detumble-horizon", k.detumble_horizon); })
+          .echoed(echo_given("detumble-horizon", &K::detumble_horizon)));
+  keys.push_back(FFSR_KEY("detumble-tick", detumble_tick,
+                          "Detumble: the controller's period, s (< detumble-horizon)", "0.01")
+                     .in(G::Detumble)
+                     .checked([](const K& k) {
+                       check_positive_if_given(k, "detumble-tick", k.detumble_tick);
+                       if (!(k.detumble_tick < k.detumble_horizon))
+                         throw InputError(str("--detumble-tick: must be shorter than detumble-horizon (",
+                                              k.detumble_horizon, " s), got ", k.detumble_tick));
+                     })
+                     .echoed(echo_given("detumble-tick", &K::detumble_tick)));
+  keys.push_back(FFSR_KEY("stop-stack-spin", stop_stack_spin,
+                          "Detumble: also stop the stack's spin (needs a base actuator; true/false)", "false")
+                     .in(G::Detumble)
+                     .echoed(echo_given("stop-stack-spin", &K::stop_stack_spin)));
+}
+
 #undef FFSR_KEY
 
 /// The table, in the order a command lists the keys (the flags of `ffsr-optimize --help`).
@@ -441,6 +532,8 @@ inline std::vector<ScenarioKey> build_scenario_keys() {
   add_planner_keys(keys);
   add_global_keys(keys);
   add_joint_and_shape_keys(keys);
+  add_detumble_keys(keys);
+  add_detumble_run_keys(keys);
   // every key of the global run but the switch acts on that run only
   for (ScenarioKey& key : keys)
     if (key.group == KeyGroup::Global && key.name != "global")

@@ -1,0 +1,149 @@
+// ffsr-optimize detumble: the post-capture run through the command, checked against its own limits and
+// conservation laws (the series of --csv against the limits of the scenario, the momentum drift, the
+// rest threshold), the URDF's <limit effort> as the default joint torque limit, the reaction wheels.
+#include "support/command.hpp"
+
+#include <catch2/catch.hpp>
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <regex>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace test_detumble_command {
+
+using ffsr::test::Args;
+using ffsr::test::cli;
+using ffsr::test::kSource;
+using ffsr::test::kUrdf3;
+using nlohmann::json;
+
+const std::string kDetumbleToml = kSource + "/robots/paper_7dof_detumble.toml";
+
+/// The columns of a CSV with a header line.
+std::map<std::string, std::vector<double>> read_csv(const std::string& text) {
+  std::istringstream in(text);
+  std::string line, cell;
+  std::getline(in, line);
+  std::vector<std::string> names;
+  for (std::istringstream h(line); std::getline(h, cell, ',');) names.push_back(cell);
+  std::map<std::string, std::vector<double>> cols;
+  while (std::getline(in, line)) {
+    std::istringstream r(line);
+    for (size_t k = 0; std::getline(r, cell, ','); ++k) cols[names.at(k)].push_back(std::stod(cell));
+  }
+  return cols;
+}
+
+}  // namespace test_detumble_command
+
+using namespace test_detumble_command;
+
+TEST_CASE("detumble on the 7-DOF scenario: at rest, every torque within its limit, momentum kept", "[cli]") {
+  ffsr::test::TempDir dir;
+  const auto r = cli({"detumble", "--config", kDetumbleToml, "--quiet", "--json", "-", "--csv", "series.csv"},
+                     dir.str());
+  const json j = ffsr::test::parse_json(r);
+  const auto limits = j.at("parameters").at("joint_torque_limit").get<std::vector<double>>();
+  CHECK(limits == std::vector<double>{60, 60, 60, 40, 20, 20, 20});
+  CHECK(j.at("at_rest").get<bool>());
+  CHECK(j.at("status") == "at-rest");
+  CHECK(j.at("momentum_drift").get<double>() < 1e-8);  // free-floating: the stack's momentum is conserved
+  const double rest = 0.05 * M_PI / 180;
+  CHECK(j.at("final_joint_rate").get<double>() < rest);
+  CHECK(j.at("final_relative_rate").get<double>() < rest);
+  CHECK(j.at("energy_end").get<double>() < j.at("energy_start").get<double>());
+  CHECK(j.at("grasp").at("energy_after").get<double>() <= j.at("grasp").at("energy_before").get<double>());
+  const auto cols = read_csv(ffsr::test::read_file(dir.str() + "/series.csv"));
+  const std::vector<double>& t = cols.at("t");
+  REQUIRE(t.size() == size_t(j.at("ticks").get<long>()) + 1);
+  CHECK(t.back() == Approx(j.at("time_to_rest").get<double>()).margin(1e-12));
+  double peak = 0;
+  for (size_t k = 0; k < limits.size(); ++k)
+    for (double tau : cols.at("tau_" + std::to_string(k + 1))) {
+      CHECK(std::abs(tau) <= limits[k] * (1 + 1e-12));
+      peak = std::max(peak, std::abs(tau));
+    }
+  CHECK(peak == Approx(j.at("peak_joint_torque").get<double>()).epsilon(1e-9));
+  double gripper = 0;
+  for (double f : cols.at("gripper_force")) gripper = std::max(gripper, f);
+  CHECK(gripper == Approx(j.at("peak_gripper_force").get<double>()).epsilon(1e-9));
+  // the largest joint rate of each row is the largest |theta_dot_k| of the row
+  for (size_t i = 0; i < t.size(); ++i) {
+    double m = 0;
+    for (size_t k = 0; k < limits.size(); ++k)
+      m = std::max(m, std::abs(cols.at("theta_dot_" + std::to_string(k + 1))[i]));
+    CHECK(m == Approx(cols.at("joint_rate")[i]).epsilon(1e-9));
+  }
+}
+
+TEST_CASE("detumble: the URDF's <limit effort> is the joint torque limit when the key is not given",
+          "[cli]") {
+  ffsr::test::TempDir dir;
+  const std::string urdf = dir.str() + "/effort.urdf";
+  std::ofstream(urdf) << std::regex_replace(
+      ffsr::test::read_file(kUrdf3), std::regex("type=\"continuous\">"),
+      "type=\"continuous\">\n    <limit effort=\"1.5\" velocity=\"1\"/>");
+  const Args common{"detumble", "--joints-deg", "0,150,-100", "--quiet", "--json", "-"};
+  Args with_effort = common, with_key = common;
+  with_effort.insert(with_effort.end(), {"--urdf", urdf});
+  with_key.insert(with_key.end(), {"--urdf", kUrdf3, "--joint-torque-limit", "1.5"});
+  json a = ffsr::test::parse_json(cli(with_effort));
+  json b = ffsr::test::parse_json(cli(with_key));
+  CHECK(a.at("parameters").at("joint_torque_limit").get<std::vector<double>>() ==
+        std::vector<double>{1.5, 1.5, 1.5});
+  CHECK(a.at("peak_joint_torque").get<double>() <= 1.5 * (1 + 1e-12));
+  CHECK(a.at("peak_joint_torque").get<double>() == Approx(1.5));  // the limit binds: 2.2 N m unlimited
+  a.erase("version");
+  b.erase("version");
+  CHECK(a == b);
+}
+
+TEST_CASE("detumble with reaction wheels: the stack's spin stopped, the stored momentum within its bound",
+          "[cli]") {
+  const json j = ffsr::test::parse_json(
+      cli({"detumble", "--joint-torque-limit", "20", "--base-actuator", "reaction-wheels", "--wheel-torque",
+           "0.2", "--wheel-momentum", "25", "--stop-stack-spin", "true", "--quiet", "--json", "-"}));
+  CHECK(j.at("at_rest").get<bool>());
+  CHECK(j.at("final_stack_rate").get<double>() < 0.05 * M_PI / 180);
+  CHECK(j.at("peak_wheel_momentum").get<double>() <= 25.0);
+  CHECK(j.at("peak_wheel_momentum").get<double>() > 0.0);
+  // the torque bound: at least |L_c| / (sqrt(3) 0.2 N m) to remove the stack's momentum
+  const json free =
+      ffsr::test::parse_json(cli({"detumble", "--joint-torque-limit", "20", "--quiet", "--json", "-"}));
+  CHECK(free.at("final_stack_rate").get<double>() >
+        0.05 * M_PI / 180);  // free-floating: the stack keeps its spin
+  CHECK(j.at("time_to_rest").get<double>() > free.at("time_to_rest").get<double>());
+}
+
+TEST_CASE("detumble --run: from the capture configurations of the main job's runs", "[cli]") {
+  const json main = ffsr::test::parse_json(cli({"--config", kDetumbleToml, "--quiet", "--json", "-"}));
+  const json all = ffsr::test::parse_json(
+      cli({"detumble", "--config", kDetumbleToml, "--run", "all", "--quiet", "--json", "-"}));
+  REQUIRE(all.at("runs").size() == 3);
+  for (const json& r : all.at("runs")) {
+    const std::string name = r.at("run");
+    INFO(name);
+    const auto q = r.at("joints_deg").get<std::vector<double>>();
+    const auto qm = main.at(name).at("capture_configuration_deg").get<std::vector<double>>();
+    REQUIRE(q.size() == qm.size());
+    for (size_t k = 0; k < q.size(); ++k) CHECK(q[k] == Approx(qm[k]).margin(1e-9));
+    CHECK(r.at("at_rest").get<bool>());
+    CHECK(r.at("momentum_drift").get<double>() < 1e-8);
+  }
+  // one run alone: the same result as within 'all'
+  json one = ffsr::test::parse_json(
+      cli({"detumble", "--config", kDetumbleToml, "--run", "optimized", "--quiet", "--json", "-"}));
+  CHECK(one.at("runs").at(0) == all.at("runs").at(1));
+  // the configuration differs from the scenario's start, so does the result
+  const json start =
+      ffsr::test::parse_json(cli({"detumble", "--config", kDetumbleToml, "--quiet", "--json", "-"}));
+  CHECK(start.at("time_to_rest") != one.at("runs").at(0).at("time_to_rest"));
+  const auto bad = cli({"detumble", "--config", kDetumbleToml, "--run", "best", "--quiet"});
+  CHECK(bad.exit_code == 2);
+  CHECK(bad.err.find("--run") != std::string::npos);
+}
