@@ -586,11 +586,11 @@ std::vector<BadCase> bad_cases() {
       {"detumble: the contact law does not act", detumble3({"--stiffness", "1e9"}), {"--stiffness"}},
       {"detumble: scenario with a zero torque limit",
        {"detumble", "--config", kBadScenarios + "/detumble_zero_limit.toml", "--quiet", "--json", "out.json"},
-       {"detumble_zero_limit.toml:33", "--joint-torque-limit", "got 0"}},
+       {at_key("detumble_zero_limit.toml", 33, "joint-torque-limit"), "got 0"}},
       {"detumble: scenario with an unknown actuator",
        {"detumble", "--config", kBadScenarios + "/detumble_unknown_actuator.toml", "--quiet", "--json",
         "out.json"},
-       {"detumble_unknown_actuator.toml:34", "--base-actuator", "'magnetorquer'"}},
+       {at_key("detumble_unknown_actuator.toml", 34, "base-actuator"), "'magnetorquer'"}},
       // --- scenario files -------------------------------------------------------------------------
       {"scenario: missing key",
        scenario("missing_duration.toml"),

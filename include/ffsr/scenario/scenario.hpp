@@ -266,5 +266,6 @@ UncertaintySpec uncertainty_spec(const ScenarioKeys& keys, std::optional<std::ui
 #include "ffsr/scenario/geometry.hpp"
 #include "ffsr/scenario/detail/values.hpp"
 #include "ffsr/scenario/detail/keys.hpp"
+#include "ffsr/scenario/detail/reader.hpp"
 #include "ffsr/scenario/detail/scenario.hxx"
 #include "ffsr/scenario/detail/uncertainty_table.hpp"
