@@ -90,23 +90,27 @@ def _base_disturbance(d):
 
 # --- the main job: the command's rows ------------------------------------------------------------------
 
-RUN_HEADER = ["", "Capture configuration (deg)", "M_ie (kg)", "F_max (kN)", "exact (kN)", "tracking (m)"]
+RUN_HEADER = ["", "Capture configuration (deg)", "M_ie (kg)", "F_max (kN)", "exact (kN)", "tracking (m)",
+              "not applied"]
 
 
 def run_rows(r):
     """The rows of the command's table for a run: configuration, M_ie, F_max (closed form, exact),
     tracking error, then the reductions against the plain run, formatted as the command prints them."""
     rows = []
-    for label, run, failure in (("Without optimization", r.plain, r.plain_failure),
-                                ("With optimization", r.optimized, r.optimized_failure),
-                                ("Global", r.global_run, "")):
+    result = r.to_dict()
+    for label, key, run, failure in (("Without optimization", "baseline", r.plain, r.plain_failure),
+                                     ("With optimization", "optimized", r.optimized, r.optimized_failure),
+                                     ("Global", "global", r.global_run, "")):
         if run is None and not failure:
             continue  # no global run
+        # the keys the scenario gives that this row's run does not take, as the command's row ends
+        skipped = ", ".join(result.get(key, {}).get("keys_not_applied", []))
         if run is None:
-            rows.append([label, "failed (below)", "", "", "", ""])
+            rows.append([label, "failed (below)", "", "", "", "", skipped])
             continue
         rows.append([label, _deg(run.theta), f"{run.M_ie:.3f}", f"{run.f_max_closed_form / 1e3:.3f}",
-                     f"{run.f_max_exact / 1e3:.3f}", f"{run.tracking_error:.2e}"])
+                     f"{run.f_max_exact / 1e3:.3f}", f"{run.tracking_error:.2e}", skipped])
 
     def reduction(a, b):
         return f"{100.0 * (a - b) / a:.2f}%"
@@ -116,7 +120,7 @@ def run_rows(r):
             p = r.plain
             rows.append([label, "", reduction(p.M_ie, run.M_ie),
                          reduction(p.f_max_closed_form, run.f_max_closed_form),
-                         reduction(p.f_max_exact, run.f_max_exact), ""])
+                         reduction(p.f_max_exact, run.f_max_exact), "", ""])
     return rows
 
 

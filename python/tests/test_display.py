@@ -49,7 +49,8 @@ def command_table(scenario):
     rows = []
     for line in out.splitlines():
         if m := ROW.match(line):
-            rows.append([m.group(1), m.group(2)] + m.group(3).split())
+            cells, _, skipped = m.group(3).partition("not applied:")  # the row's keys it does not take
+            rows.append([m.group(1), m.group(2)] + cells.split() + ([skipped.strip()] if skipped else []))
         elif m := REDUCTION.match(line):
             rows.append([m.group(1), m.group(2), m.group(3), m.group(4)])
     return rows
@@ -61,7 +62,8 @@ def test_run_result_html_shows_the_commands_rows(name):
     expected = command_table(scenario)
     result = ffsr.Scenario.load(str(scenario)).run()
     rows = Cells(result._repr_html_()).rows
-    header = ["", "Capture configuration (deg)", "M_ie (kg)", "F_max (kN)", "exact (kN)", "tracking (m)"]
+    header = ["", "Capture configuration (deg)", "M_ie (kg)", "F_max (kN)", "exact (kN)", "tracking (m)",
+              "not applied"]
     assert rows[0] == header
     shown = [[c for c in r if c] for r in rows[1:]]  # the reductions leave the configuration cell empty
     assert len(expected) >= 4
