@@ -13,15 +13,7 @@ pin = pytest.importorskip("pinocchio", reason="Pinocchio's Python package `pin` 
 
 from conftest import ROBOTS  # noqa: E402
 from test_jobs import command_json, differences  # noqa: E402
-
-
-def quat_to_rot(q):  # (x, y, z, w)
-    x, y, z, w = q / np.linalg.norm(q)
-    return np.array([
-        [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-        [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-        [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
-    ])
+from test_pinocchio import quat_to_rot  # noqa: E402
 
 
 def random_target(rng, point):

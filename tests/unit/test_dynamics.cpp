@@ -493,18 +493,25 @@ TEST_CASE("forward kinematics: each body's pose is its parent's times tree times
   }
 }
 
+/// The k-th random SPD 6x6 matrix B B^T + shift I (shift 1e-3 for odd k: poorly conditioned), scaled by
+/// `heavy` for every third k, and a random vector.
+std::pair<Matrix6, Vector6> random_spd6(std::mt19937& gen, int k, double heavy) {
+  std::normal_distribution<double> N(0.0, 1.0);
+  Matrix6 B;
+  for (int e = 0; e < 36; ++e) B.data()[e] = N(gen);
+  const double shift = k % 2 ? 1e-3 : 1.0;
+  const double scale = k % 3 ? 1.0 : heavy;
+  Vector6 x;
+  for (int e = 0; e < 6; ++e) x(e) = N(gen);
+  return {scale * (B * B.transpose() + shift * Matrix6::Identity()), x};
+}
+
 TEST_CASE("inverse_quadratic_spd6: x^T A^-1 x against Eigen's LLT solve, refuses indefinite matrices",
           "[dynamics]") {
   std::mt19937 gen(17);
-  std::normal_distribution<double> N(0.0, 1.0);
   double worst = 0;
   for (int k = 0; k < 200; ++k) {
-    Matrix6 B;
-    for (int e = 0; e < 36; ++e) B.data()[e] = N(gen);
-    const double shift = k % 2 ? 1e-3 : 1.0;  // half of them poorly conditioned
-    const Matrix6 A = B * B.transpose() + shift * Matrix6::Identity();
-    Vector6 x;
-    for (int e = 0; e < 6; ++e) x(e) = N(gen);
+    const auto [A, x] = random_spd6(gen, k, 1.0);
     const double ref = x.dot(A.llt().solve(x));
     double q = 0;
     REQUIRE(ffsr::detail::inverse_quadratic_spd6(A, x, q));
@@ -524,20 +531,13 @@ TEST_CASE("inverse_quadratic_spd6: x^T A^-1 x against Eigen's LLT solve, refuses
 TEST_CASE("inverse_quadratic_articulated: the base's x^T A^-1 x by adjugates against Eigen's LLT solve",
           "[dynamics]") {
   std::mt19937 gen(23);
-  std::normal_distribution<double> N(0.0, 1.0);
   double worst = 0;
   for (int k = 0; k < 200; ++k) {
-    Matrix6 B;
-    for (int e = 0; e < 36; ++e) B.data()[e] = N(gen);
-    const double shift = k % 2 ? 1e-3 : 1.0;  // half of them poorly conditioned
-    const double scale = k % 3 ? 1.0 : 1e3;   // and a third with a heavy body's scale
-    const Matrix6 A = scale * (B * B.transpose() + shift * Matrix6::Identity());
+    const auto [A, x] = random_spd6(gen, k, 1e3);  // a third with a heavy body's scale
     ffsr::ArticulatedInertia IA;
     IA.ll = A.topLeftCorner<3, 3>();
     IA.la = A.topRightCorner<3, 3>();
     IA.aa = A.bottomRightCorner<3, 3>();
-    Vector6 x;
-    for (int e = 0; e < 6; ++e) x(e) = N(gen);
     const double ref = x.dot(A.llt().solve(x));
     double q = 0;
     REQUIRE(ffsr::detail::inverse_quadratic_articulated(IA, x, q));
