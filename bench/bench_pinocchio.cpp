@@ -128,7 +128,11 @@ Row compare(const std::string& name, const std::string& urdf) {
   constexpr int kPoses = 1000, kBlocks = 20, kPassPoses = 200, kPasses = 51;
   const Poses P = random_poses(n, kPoses, 1234u + static_cast<unsigned>(n));
   const auto pin = ffsr_bench::make_pinocchio_inline(fm, fee, P.base, P.theta, P.u);
+#ifdef FFSR_BENCH_PIN_LIBRARY
   const auto lib = ffsr_bench::make_pinocchio_library(fm, fee, P.base, P.theta, P.u);
+#else  // no precompiled library in this build: its columns time the templates again
+  const auto& lib = pin;
+#endif
 
   auto crba_now = [&](int k) { return ffsr::crba(fm, fd, P.base[size_t(k)], P.theta[size_t(k)])(6, 6); };
   auto crba_before = [&](int k) { return before::crba(fm, bd, P.base[size_t(k)], P.theta[size_t(k)])(6, 6); };
@@ -196,11 +200,18 @@ Row compare(const std::string& name, const std::string& urdf) {
   return row;
 }
 
+#ifdef FFSR_BENCH_PIN_LIBRARY
+constexpr bool kLibraryTimed = true;
+#else
+constexpr bool kLibraryTimed = false;
+#endif
+
 void print_tables(const std::vector<Row>& rows) {
   std::printf(
       "ns per call, minimum over 51 interleaved passes of the mean over the same 200 random poses "
       "(thread CPU time); Pinocchio's templates instantiated at the bench's flags, \"library\" its "
-      "precompiled libpinocchio_default\n\n");
+      "precompiled libpinocchio_default%s\n\n",
+      kLibraryTimed ? "" : " (not in this build: the library columns time the templates again)");
   std::printf(
       "| robot | n | CRBA ffsr / Pinocchio | before | Pinocchio LOCAL / WORLD | LOCAL + sym | library | "
       "M_ie ffsr | before | Pinocchio dense | Pinocchio Delassus | ffsr / better | library dense / "
