@@ -58,4 +58,6 @@ if ! [[ "$tag" =~ ^manylinux_2_([0-9]+)_x86_64(\.|$) ]] || [ "${BASH_REMATCH[1]}
   echo "build-wheel.sh: $wheel: platform tag $tag is not manylinux_2_N_x86_64 with N <= 36" >&2
   exit 1
 fi
+# the licence texts: ffsr's, and the Debian copyright file of every library auditwheel copied in
+"$py" scripts/wheel-licences.py "$wheel" LICENSE
 echo "build-wheel.sh: $wheel ($(du -k "$wheel" | cut -f1) KiB)"

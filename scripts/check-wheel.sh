@@ -106,7 +106,18 @@ unshare --net chroot "$root" /usr/bin/env -i PATH=/usr/bin:/bin HOME=/root LANG=
   venv/bin/python -c "
 import ffsr, ffsr._ffsr, ffsr.view as v
 print(\"import ffsr:\", ffsr.__version__, ffsr._ffsr.__file__)
-print(\"three.js in the package:\", sum(len(v._asset(\"three/\" + f)) for f in v.THREE_FILES), \"bytes\")"
+print(\"three.js in the package:\", sum(len(v._asset(\"three/\" + f)) for f in v.THREE_FILES), \"bytes\")
+import glob, os, sys
+site = os.path.dirname(os.path.dirname(ffsr.__file__))
+libs = sorted(os.path.basename(p) for p in glob.glob(os.path.join(site, \"ffsr.libs\", \"*.so*\")))
+lic = glob.glob(os.path.join(site, \"ffsr-*.dist-info\", \"licenses\"))
+index = open(os.path.join(lic[0], \"bundled-libraries.txt\")).read() if lic else \"\"
+named = [l.split(\": \")[0][len(\"ffsr.libs/\"):] for l in index.splitlines() if l.startswith(\"ffsr.libs/\")]
+texts = [l.rsplit(\", \", 1)[1] for l in index.splitlines() if l.startswith(\"ffsr.libs/\")]
+if not libs or sorted(named) != libs or not os.path.isfile(os.path.join(lic[0], \"LICENSE\")) or not all(
+        os.path.getsize(os.path.join(os.path.dirname(lic[0]), t)) > 0 for t in texts):
+    sys.exit(\"the licence texts: bundled-libraries.txt names %s, ffsr.libs holds %s\" % (named, libs))
+print(\"licence texts:\", len(libs), \"bundled libraries,\", len(set(texts)), \"copyright files and ffsr LICENSE\")"
   venv/bin/python example.py > example.out
   cat example.out
 ' || { echo "check-wheel.sh: the wheel failed in the Debian 12 root" >&2; exit 1; }
