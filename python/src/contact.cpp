@@ -197,9 +197,9 @@ void bind_single_body(nb::module_& m) {
 
 void bind_multibody_contact(nb::module_& m) {
   nb::class_<ContactBodies>(m, "ContactBodies",
-                            "Robot and target at one instant of the contact run (inertial frame): the base\n"
-                            "pose, joint angles, generalized velocity [v0, w0, theta_dot]; the target's pose,\n"
-                            "velocity and spin.")
+                            "Robot and target at one instant of the contact run (inertial frame): the\n"
+                            "base pose, joint angles, generalized velocity [v0, w0, theta_dot]; the\n"
+                            "target's pose, velocity and spin.")
       .def_ro("base", &ContactBodies::base)
       .def_prop_ro(
           "theta", [](const ContactBodies& b) { return out(b.theta); }, nb::rv_policy::automatic)

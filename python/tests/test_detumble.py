@@ -150,8 +150,8 @@ def test_detumble_run_and_controller():
 @pytest.mark.parametrize("run,grasp_after", [(None, "approach"), ("all", "approach"), (None, "contact")])
 def test_detumble_job_equals_the_command(tmp_path, run, grasp_after):
     scenario = ROBOTS / "paper_7dof_detumble.toml"
-    expected = command_json(tmp_path, scenario, *(["--run", run] if run else []), "--grasp-after", grasp_after,
-                            subcommand="detumble")
+    flags = [*(["--run", run] if run else []), "--grasp-after", grasp_after]
+    expected = command_json(tmp_path, scenario, *flags, subcommand="detumble")
     result = ffsr.Scenario.load(str(scenario), grasp_after=grasp_after).detumble(run=run)
     got = result.to_dict()
     assert differences(got, expected) == []

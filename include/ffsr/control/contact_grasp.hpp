@@ -28,13 +28,15 @@ struct ContactGraspResult {
 inline ContactGraspResult grasp_after_contact(const Model& model, int frame, const BasePose& base,
                                               const Eigen::VectorXd& theta, const Target& target,
                                               double approach_speed, const ContactParams& params,
-                                              std::string_view law, const MultibodyContactOptions& options = {}) {
+                                              std::string_view law,
+                                              const MultibodyContactOptions& options = {}) {
   ContactGraspResult r;
   r.contact = simulate_contact(model, base, theta, frame, target, approach_speed, params, law, options);
   const ContactBodies& s = r.contact.start;
   const ContactBodies& e = r.contact.end;
   const double m = target.mass;
-  r.contact_impulse = -(m * (e.target.velocity - s.target.velocity) - m * model.gravity * r.contact.contact_duration);
+  r.contact_impulse =
+      -(m * (e.target.velocity - s.target.velocity) - m * model.gravity * r.contact.contact_duration);
   Data data(model);
   r.grasp = grasp(model, data, e.base, e.theta, e.v, frame, e.target);
   return r;
