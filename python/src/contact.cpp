@@ -195,7 +195,10 @@ void bind_single_body(nb::module_& m) {
       "from first touch to separation with CVODE (scaled state; tolerances in those units).");
 }
 
-void bind_multibody_contact(nb::module_& m) {
+namespace {
+
+/// Robot and target at one instant of the contact run (MultibodyContactResult::start, end).
+void bind_contact_bodies(nb::module_& m) {
   nb::class_<ContactBodies>(m, "ContactBodies",
                             "Robot and target at one instant of the contact run (inertial frame): the\n"
                             "base pose, joint angles, generalized velocity [v0, w0, theta_dot]; the\n"
@@ -206,6 +209,12 @@ void bind_multibody_contact(nb::module_& m) {
       .def_prop_ro(
           "v", [](const ContactBodies& b) { return out(b.v); }, nb::rv_policy::automatic)
       .def_ro("target", &ContactBodies::target);
+}
+
+}  // namespace
+
+void bind_multibody_contact(nb::module_& m) {
+  bind_contact_bodies(m);
   nb::class_<MultibodyContactResult>(m, "MultibodyContactResult", "Result of simulate_contact, SI units.")
       .def_ro("model", &MultibodyContactResult::model, "Contact law name.")
       .def_ro("approach_velocity", &MultibodyContactResult::approach_velocity)

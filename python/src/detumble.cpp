@@ -251,6 +251,33 @@ void bind_detumble_controller(nb::module_& m) {
           "One tick: the command (tau, base_wrench, status...) as a dict.");
 }
 
+/// The grasp after the Hertz contact run (control/contact_grasp.hpp).
+void bind_contact_grasp(nb::module_& m) {
+  nb::class_<ContactGraspResult>(m, "ContactGraspResult",
+                                 "The Hertz contact run (contact) and the lock at its separation (grasp);\n"
+                                 "contact_impulse: the contact force's impulse on the gripper, N s.")
+      .def_ro("contact", &ContactGraspResult::contact)
+      .def_prop_ro(
+          "contact_impulse", [](const ContactGraspResult& r) { return out(r.contact_impulse); },
+          nb::rv_policy::automatic)
+      .def_ro("grasp", &ContactGraspResult::grasp);
+  m.def(
+      "grasp_after_contact",
+      [](const Model& model, nb::handle frame, const BasePose& base, nb::handle theta, const Target& target,
+         double approach_speed, const ContactParams& params, const std::string& law) {
+        const VecIn th(theta, "grasp_after_contact", "theta");
+        th.require(model.n());
+        const int f = frame_arg(model, frame, "grasp_after_contact");
+        const Eigen::VectorXd q = th.map();
+        nb::gil_scoped_release release;
+        return grasp_after_contact(model, f, base, q, target, approach_speed, params, law);
+      },
+      "model"_a, "frame"_a = nb::none(), "base"_a, "theta"_a, "target"_a, "approach_speed"_a,
+      "params"_a = ContactParams(), "law"_a = "herbert-mcwhannell",
+      "The grasp after the Hertz contact: simulate_contact from the first touch to the separation, then\n"
+      "grasp() from the state it ends in (robot and target where the penetration returns to zero).");
+}
+
 }  // namespace
 
 void bind_detumble(nb::module_& m) {
@@ -258,6 +285,7 @@ void bind_detumble(nb::module_& m) {
   bind_detumble_result(m);
   bind_detumble_job(m);
   bind_detumble_controller(m);
+  bind_contact_grasp(m);
   m.def(
       "attach_body",
       [](const Model& model, const std::string& frame, double mass, nb::handle inertia, const Pose& pose,
@@ -291,29 +319,6 @@ void bind_detumble(nb::module_& m) {
       "model"_a, "frame"_a = nb::none(), "base"_a, "theta"_a, "target"_a, "approach_speed"_a,
       "The grasp at the end of the approach (contact point moving at approach_speed along the normal\n"
       "under zero momentum, the target's contact point on the frame's origin).");
-  nb::class_<ContactGraspResult>(m, "ContactGraspResult",
-                                 "The Hertz contact run (contact) and the lock at its separation (grasp);\n"
-                                 "contact_impulse: the contact force's impulse on the gripper, N s.")
-      .def_ro("contact", &ContactGraspResult::contact)
-      .def_prop_ro(
-          "contact_impulse", [](const ContactGraspResult& r) { return out(r.contact_impulse); },
-          nb::rv_policy::automatic)
-      .def_ro("grasp", &ContactGraspResult::grasp);
-  m.def(
-      "grasp_after_contact",
-      [](const Model& model, nb::handle frame, const BasePose& base, nb::handle theta, const Target& target,
-         double approach_speed, const ContactParams& params, const std::string& law) {
-        const VecIn th(theta, "grasp_after_contact", "theta");
-        th.require(model.n());
-        const int f = frame_arg(model, frame, "grasp_after_contact");
-        const Eigen::VectorXd q = th.map();
-        nb::gil_scoped_release release;
-        return grasp_after_contact(model, f, base, q, target, approach_speed, params, law);
-      },
-      "model"_a, "frame"_a = nb::none(), "base"_a, "theta"_a, "target"_a, "approach_speed"_a,
-      "params"_a = ContactParams(), "law"_a = "herbert-mcwhannell",
-      "The grasp after the Hertz contact: simulate_contact from the first touch to the separation, then\n"
-      "grasp() from the state it ends in (robot and target where the penetration returns to zero).");
   m.def(
       "run_detumble",
       [](const Model& stack, nb::handle gripper, const AttachedBody& body, const BasePose& base,
