@@ -195,7 +195,26 @@ void bind_single_body(nb::module_& m) {
       "from first touch to separation with CVODE (scaled state; tolerances in those units).");
 }
 
+namespace {
+
+/// Robot and target at one instant of the contact run (MultibodyContactResult::start, end).
+void bind_contact_bodies(nb::module_& m) {
+  nb::class_<ContactBodies>(m, "ContactBodies",
+                            "Robot and target at one instant of the contact run (inertial frame): the\n"
+                            "base pose, joint angles, generalized velocity [v0, w0, theta_dot]; the\n"
+                            "target's pose, velocity and spin.")
+      .def_ro("base", &ContactBodies::base)
+      .def_prop_ro(
+          "theta", [](const ContactBodies& b) { return out(b.theta); }, nb::rv_policy::automatic)
+      .def_prop_ro(
+          "v", [](const ContactBodies& b) { return out(b.v); }, nb::rv_policy::automatic)
+      .def_ro("target", &ContactBodies::target);
+}
+
+}  // namespace
+
 void bind_multibody_contact(nb::module_& m) {
+  bind_contact_bodies(m);
   nb::class_<MultibodyContactResult>(m, "MultibodyContactResult", "Result of simulate_contact, SI units.")
       .def_ro("model", &MultibodyContactResult::model, "Contact law name.")
       .def_ro("approach_velocity", &MultibodyContactResult::approach_velocity)
@@ -222,6 +241,9 @@ void bind_multibody_contact(nb::module_& m) {
       .def_prop_ro(
           "base_velocity_end", [](const MultibodyContactResult& r) { return out(r.base_velocity_end); },
           nb::rv_policy::automatic)
+      .def_ro("start", &MultibodyContactResult::start, "Robot and target at the first touch.")
+      .def_ro("end", &MultibodyContactResult::end,
+              "Robot and target at the separation (the penetration back to zero).")
       .def_prop_ro(
           "t", [](const MultibodyContactResult& r) { return series_of(r, &ContactSample::t); },
           "Series (record_series): time, s.", nb::rv_policy::automatic)

@@ -1,11 +1,12 @@
-// python/src/detumble.cpp -- the post-capture phase: attach_body (the stack model), grasp and
-// grasp_at_capture (the plastic lock), the DetumbleController (one step per tick) and run_detumble
-// (the stack's dynamics with the controller in the loop). Names and fields mirror C++.
+// python/src/detumble.cpp -- the post-capture phase: attach_body (the stack model), grasp,
+// grasp_at_capture and grasp_after_contact (the plastic lock), the DetumbleController (one step per
+// tick) and run_detumble (the stack's dynamics with the controller in the loop). Names mirror C++.
 #include "arguments.hpp"
 #include "bindings.hpp"
 #include "job_helpers.hpp"
 #include "outputs.hpp"
 
+#include "ffsr/control/contact_grasp.hpp"
 #include "ffsr/control/detumble_run.hpp"
 #include "ffsr/jobs/detumble.hpp"
 
@@ -202,7 +203,8 @@ void bind_detumble_job(nb::module_& m) {
         });
       },
       "run"_a = nb::none(),
-      "The job `detumble` (ffsr-optimize detumble --config FILE): the grasp at the end of the approach,\n"
+      "The job `detumble` (ffsr-optimize detumble --config FILE): the grasp at the end of the approach\n"
+      "(or, with the key grasp_after = 'contact', after the Hertz contact run at its separation),\n"
       "then the stack brought to rest under the scenario's limits (joint-torque-limit, base-actuator,\n"
       "...). run: plain, optimized, global or all (as --run: from the main job's captures); default: the\n"
       "scenario's configuration.");
@@ -249,6 +251,33 @@ void bind_detumble_controller(nb::module_& m) {
           "One tick: the command (tau, base_wrench, status...) as a dict.");
 }
 
+/// The grasp after the Hertz contact run (control/contact_grasp.hpp).
+void bind_contact_grasp(nb::module_& m) {
+  nb::class_<ContactGraspResult>(m, "ContactGraspResult",
+                                 "The Hertz contact run (contact) and the lock at its separation (grasp);\n"
+                                 "contact_impulse: the contact force's impulse on the gripper, N s.")
+      .def_ro("contact", &ContactGraspResult::contact)
+      .def_prop_ro(
+          "contact_impulse", [](const ContactGraspResult& r) { return out(r.contact_impulse); },
+          nb::rv_policy::automatic)
+      .def_ro("grasp", &ContactGraspResult::grasp);
+  m.def(
+      "grasp_after_contact",
+      [](const Model& model, nb::handle frame, const BasePose& base, nb::handle theta, const Target& target,
+         double approach_speed, const ContactParams& params, const std::string& law) {
+        const VecIn th(theta, "grasp_after_contact", "theta");
+        th.require(model.n());
+        const int f = frame_arg(model, frame, "grasp_after_contact");
+        const Eigen::VectorXd q = th.map();
+        nb::gil_scoped_release release;
+        return grasp_after_contact(model, f, base, q, target, approach_speed, params, law);
+      },
+      "model"_a, "frame"_a = nb::none(), "base"_a, "theta"_a, "target"_a, "approach_speed"_a,
+      "params"_a = ContactParams(), "law"_a = "herbert-mcwhannell",
+      "The grasp after the Hertz contact: simulate_contact from the first touch to the separation, then\n"
+      "grasp() from the state it ends in (robot and target where the penetration returns to zero).");
+}
+
 }  // namespace
 
 void bind_detumble(nb::module_& m) {
@@ -256,6 +285,7 @@ void bind_detumble(nb::module_& m) {
   bind_detumble_result(m);
   bind_detumble_job(m);
   bind_detumble_controller(m);
+  bind_contact_grasp(m);
   m.def(
       "attach_body",
       [](const Model& model, const std::string& frame, double mass, nb::handle inertia, const Pose& pose,

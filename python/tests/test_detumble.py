@@ -2,7 +2,8 @@
 free-flyer base plus the target as a second free-flyer, the 6-D lock's Jacobian from Pinocchio's frame
 Jacobians (the gripper frame minus a frame of the target at the same point), and the plastic impulse
 from the KKT system [M J^T; J 0][v+; -p] = [M v-; 0] solved with numpy. The velocities after the lock
-agree to 1e-9 on both paper robots. Also the post-capture run and the controller through Python."""
+agree to 1e-9 on both paper robots, from random states and from the end of the Hertz contact run. Also
+the post-capture run and the controller through Python."""
 
 import numpy as np
 import pytest
@@ -104,6 +105,28 @@ def test_grasp_against_pinocchio(urdf):
         assert np.array_equal(d["v_after"], g.v_after)
 
 
+@pytest.mark.parametrize("name", ["paper_3dof", "paper_7dof_position"])
+def test_grasp_after_contact_against_pinocchio(name):
+    """The lock from the state the Hertz contact run ends in (its separation) against Pinocchio's KKT
+    system at that state; the contact's and the lock's impulses add up to the approach lock's (to first
+    order in the contact's duration, docs/detumble.md)."""
+    sc = ffsr.Scenario.load(str(ROBOTS / f"{name}.toml"))
+    urdf = ROBOTS / ("paper_3dof.urdf" if name == "paper_3dof" else "paper_7dof.urdf")
+    fm = ffsr.Model.from_urdf(str(urdf), end_effector="ee")
+    r = ffsr.grasp_after_contact(fm, None, sc.base, sc.theta, sc.target, 0.2)
+    e = r.contact.end
+    assert r.contact.contact_duration > 0 and r.contact.separation_velocity < 0
+    assert np.array_equal(r.grasp.v_before, e.v)
+    v_ref, tw_ref, p_ref = pinocchio_grasp(urdf, fm, e.base, e.theta, e.v, e.target, "ee")
+    assert np.max(np.abs(r.grasp.v_after - v_ref)) / max(1.0, np.max(np.abs(v_ref))) < 1e-9
+    assert np.max(np.abs(r.grasp.target_after - tw_ref)) / max(1.0, np.max(np.abs(tw_ref))) < 1e-9
+    assert np.max(np.abs(r.grasp.impulse - p_ref)) / max(1.0, np.max(np.abs(p_ref))) < 1e-9
+    a = ffsr.grasp_at_capture(fm, None, sc.base, sc.theta, sc.target, 0.2)
+    total = r.grasp.impulse.copy()
+    total[:3] += r.contact_impulse
+    assert np.linalg.norm(total - a.impulse) < 1e-3 * np.linalg.norm(a.impulse)
+
+
 def test_detumble_run_and_controller():
     fm = ffsr.Model.from_urdf(str(ROBOTS / "paper_7dof.urdf"), end_effector="ee")
     theta = np.radians([0, 90, 90, -90, 90, 90, 0])
@@ -124,16 +147,18 @@ def test_detumble_run_and_controller():
         ffsr.attach_body(fm, "ee", 0.0, np.eye(3), g.body.pose)
 
 
-@pytest.mark.parametrize("run", [None, "all"])
-def test_detumble_job_equals_the_command(tmp_path, run):
+@pytest.mark.parametrize("run,grasp_after", [(None, "approach"), ("all", "approach"), (None, "contact")])
+def test_detumble_job_equals_the_command(tmp_path, run, grasp_after):
     scenario = ROBOTS / "paper_7dof_detumble.toml"
-    expected = command_json(tmp_path, scenario, *(["--run", run] if run else []), subcommand="detumble")
-    result = ffsr.Scenario.load(str(scenario)).detumble(run=run)
+    flags = [*(["--run", run] if run else []), "--grasp-after", grasp_after]
+    expected = command_json(tmp_path, scenario, *flags, subcommand="detumble")
+    result = ffsr.Scenario.load(str(scenario), grasp_after=grasp_after).detumble(run=run)
     got = result.to_dict()
     assert differences(got, expected) == []
     first = got["runs"][0] if run else got
     assert result.time_to_rest == first["time_to_rest"]
     assert result.peak_joint == first["peak_joint"]
     assert result.runs == (3 if run else 1)
+    assert first["grasp"]["start"] == grasp_after
     with pytest.raises(ffsr.InputError, match="--run"):
         ffsr.Scenario.load(str(scenario)).detumble(run="best")

@@ -172,10 +172,11 @@ const std::map<std::string, KeyCase>& key_cases() {
       {"target-velocity", {{"--target-velocity", "0.001,0,0"}, {}}},
       {"contact-offset", {{"--contact-offset", "-0.25,0.1,0"}, {}}},
       {"normal", {{"--normal", "1,0.1,0"}, {}}},
-      {"model", {{"--model", "hunt-crossley"}, {}}},
-      {"stiffness", {{"--stiffness", "2e9"}, {}}},
-      {"exponent", {{"--exponent", "1.2"}, {}}},
-      {"restitution", {{"--restitution", "0.5"}, {}}},
+      // the contact law acts on detumble with grasp-after = contact only (refused there without it)
+      {"model", {{"--model", "hunt-crossley"}, {"--grasp-after", "contact"}}},
+      {"stiffness", {{"--stiffness", "2e9"}, {"--grasp-after", "contact"}}},
+      {"exponent", {{"--exponent", "1.2"}, {"--grasp-after", "contact"}}},
+      {"restitution", {{"--restitution", "0.5"}, {"--grasp-after", "contact"}}},
       {"approach-speed", {{"--approach-speed", "0.3"}, {}}},
       {"task", {{"--task", "pose"}, {}, true}},
       // three rows on three joints: no null space, so the gain must be 0
@@ -229,6 +230,8 @@ const std::map<std::string, KeyCase>& key_cases() {
       {"detumble-horizon", {{"--detumble-horizon", "2"}, {}, false, true}},
       {"detumble-tick", {{"--detumble-tick", "0.02"}, {}}},
       {"stop-stack-spin", {{"--stop-stack-spin", "true"}, wheels_kept}},
+      // the grasp after the Hertz contact run: another lock impulse and start state
+      {"grasp-after", {{"--grasp-after", "contact"}, {}}},
   };
   return cases;
 }

@@ -6,6 +6,7 @@
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <map>
@@ -146,4 +147,55 @@ TEST_CASE("detumble --run: from the capture configurations of the main job's run
   const auto bad = cli({"detumble", "--config", kDetumbleToml, "--run", "best", "--quiet"});
   CHECK(bad.exit_code == 2);
   CHECK(bad.err.find("--run") != std::string::npos);
+}
+
+TEST_CASE("detumble --grasp-after contact: the Hertz phase before the lock, reported and checked", "[cli]") {
+  const Args base{"detumble", "--config", kDetumbleToml, "--quiet", "--json", "-"};
+  auto with = [&base](const Args& more) {
+    Args a = base;
+    a.insert(a.end(), more.begin(), more.end());
+    return cli(a);
+  };
+  const json approach = ffsr::test::parse_json(with({}));
+  const json contact = ffsr::test::parse_json(with({"--grasp-after", "contact"}));
+  CHECK(approach.at("grasp").at("start") == "approach");
+  CHECK(!approach.at("grasp").contains("contact"));
+  REQUIRE(contact.at("grasp").at("start") == "contact");
+  const json& c = contact.at("grasp").at("contact");
+  // the contact phase is the contact subcommand's multibody run of the same scenario
+  const json ref =
+      ffsr::test::parse_json(cli({"contact", "--config", kDetumbleToml, "--quiet", "--json", "-"}));
+  CHECK(c.at("model") == ref.at("model"));
+  CHECK(c.at("peak_force").get<double>() == Approx(ref.at("f_max_multibody").get<double>()).epsilon(1e-12));
+  CHECK(c.at("duration").get<double>() == Approx(ref.at("contact_duration").get<double>()).epsilon(1e-12));
+  // the grasp starts where the contact ends: its energy before the lock is the contact's at separation
+  CHECK(contact.at("grasp").at("energy_before").get<double>() ==
+        Approx(c.at("energy_end").get<double>()).epsilon(1e-12));
+  // contact impulse + lock impulse = the approach lock's impulse, to first order in the contact's
+  // duration (docs/detumble.md; tests/unit/test_contact_grasp.cpp checks the order)
+  const auto pa = approach.at("grasp").at("impulse_force").get<std::vector<double>>();
+  const auto pl = contact.at("grasp").at("impulse_force").get<std::vector<double>>();
+  const auto pc = c.at("impulse_force").get<std::vector<double>>();
+  double diff = 0, size = 0;
+  for (int k = 0; k < 3; ++k) {
+    diff += std::pow(pl[k] + pc[k] - pa[k], 2);
+    size += pa[k] * pa[k];
+  }
+  CHECK(std::sqrt(diff) < 1e-3 * std::sqrt(size));
+  CHECK(contact.at("at_rest").get<bool>());
+  CHECK(contact.at("momentum_drift").get<double>() < 1e-8);
+  // the contact law's flags act with grasp-after = contact: refused without it, one line naming the flag
+  const auto refused = with({"--model", "hunt-crossley"});
+  CHECK(refused.exit_code == 2);
+  CHECK(refused.err.find("--model: acts on detumble only with grasp-after = contact") != std::string::npos);
+  CHECK(std::count(refused.err.begin(), refused.err.end(), '\n') == 1);
+  CHECK(refused.out.empty());
+  const json hc = ffsr::test::parse_json(with({"--grasp-after", "contact", "--model", "hunt-crossley"}));
+  CHECK(hc.at("grasp").at("contact").at("model") == "hunt-crossley");
+  const auto all = with({"--grasp-after", "contact", "--model", "all"});
+  CHECK(all.exit_code == 2);
+  CHECK(all.err.find("--model") != std::string::npos);
+  const auto bad = with({"--grasp-after", "impact"});
+  CHECK(bad.exit_code == 2);
+  CHECK(bad.err.find("--grasp-after: expected approach or contact, got 'impact'") != std::string::npos);
 }

@@ -1,11 +1,12 @@
-// ffsr/jobs/detumble.hpp -- the job `detumble`: the grasp at the end of the approach of a subject
-// (jobs/subject.hpp: the robot at its configuration, the target, the approach speed), the target
+// ffsr/jobs/detumble.hpp -- the job `detumble`: the grasp at the end of the approach (or of the Hertz
+// contact run) of a subject (jobs/subject.hpp: the robot at its configuration, the target), the target
 // attached at the gripper (the stack), then the post-capture run under the scenario's limits
 // (the Detumble keys); that result as JSON (`ffsr-optimize detumble --json`) and its series as CSV.
 // Component ffsr::scenario (and SUNDIALS: ffsr::cvode). Never prints.
 #pragma once
 
 #include "ffsr/algorithm/joint_models.hpp"
+#include "ffsr/control/contact_grasp.hpp"
 #include "ffsr/control/detumble_run.hpp"
 #include "ffsr/jobs/detail/json_values.hpp"
 #include "ffsr/jobs/scenario_run.hpp"
@@ -14,6 +15,7 @@
 
 #include <cmath>
 #include <iomanip>
+#include <optional>
 #include <sstream>
 #include <string>
 
@@ -25,6 +27,9 @@ struct DetumbleJobResult {
       run;  ///< the main job's run it starts from (baseline, optimized, global); empty: a configuration
   Eigen::VectorXd theta;  ///< the capture configuration, rad
   GraspResult grasp;
+  /// grasp-after = contact: the Hertz contact run before the lock and its impulse on the gripper (N s)
+  std::optional<MultibodyContactResult> contact;
+  Vector3 contact_impulse = Vector3::Zero();
   DetumbleRunResult result;
   DetumbleLimits limits;
   DetumbleOptions options;
@@ -74,8 +79,41 @@ inline void detumble_settings(const ScenarioKeys& k, const Model& model, Detumbl
   o.stop_stack_spin = k.stop_stack_spin;
 }
 
-/// The job: grasp_at_capture at the subject's configuration (the contact point moving at the approach
-/// speed along the target's normal), the stack, run_detumble. InputError for bad keys, an actuator too
+/// The grasp the run starts from (the key grasp-after) at the capture configuration (base, theta) with
+/// the target (its position is not used: it is placed touching): approach, grasp_at_capture (the lock
+/// at the end of the approach); contact, grasp_after_contact (the multibody Hertz run of the scenario's
+/// contact law, the lock at its separation). Writes out.grasp, out.contact, out.contact_impulse; returns
+/// the stack's start state (with contact: the configuration at the separation). InputError naming the key.
+inline DetumbleState detumble_start(const Subject& s, const BasePose& base, const Eigen::VectorXd& theta,
+                                    const Target& target, DetumbleJobResult& out) {
+  using detail::str;
+  const Robot& r = s.robot;
+  const int ee = r.end_effector;
+  if (s.keys.grasp_after != "contact") {
+    out.grasp = grasp_at_capture(r.model, ee, base, theta, target, s.approach_speed);
+    return {base, theta, out.grasp.v_after, Vector3::Zero()};
+  }
+  try {  // one law: 'all' or an unknown name is refused naming the key
+    if (s.law == "all") throw InputError("expected one contact law with grasp-after = contact, got 'all'");
+    make_contact_law(s.law, s.params, 1.0);
+  } catch (const InputError& e) {
+    throw InputError(located_key_message(s.keys, str("--model: ", e.what())));
+  }
+  ContactGraspResult c;
+  try {
+    c = grasp_after_contact(r.model, ee, base, theta, target, s.approach_speed, s.params, s.law);
+  } catch (const InputError& e) {  // the bodies do not approach
+    throw InputError(located_key_message(s.keys, str("--grasp-after: the contact run: ", e.what())));
+  }
+  out.grasp = c.grasp;
+  out.contact = std::move(c.contact);
+  out.contact_impulse = c.contact_impulse;
+  return {out.contact->end.base, out.contact->end.theta, out.grasp.v_after, Vector3::Zero()};
+}
+
+/// The job: the grasp of detumble_start at the subject's configuration (grasp_at_capture: the contact
+/// point moving at the approach speed along the target's normal; or after the Hertz contact run), the
+/// stack, run_detumble. InputError for bad keys, an actuator too
 /// small for the horizon (check_detumble_feasible), or a stack not at rest at the horizon.
 inline DetumbleJobResult detumble(const Subject& s, const BasePose& base, const Eigen::VectorXd& theta,
                                   const Target& target) {
@@ -89,9 +127,8 @@ inline DetumbleJobResult detumble(const Subject& s, const BasePose& base, const 
     throw InputError(located_key_message(s.keys, e.what()));
   }
   const int ee = r.end_effector;
-  out.grasp = grasp_at_capture(r.model, ee, base, theta, target, s.approach_speed);
+  const DetumbleState start = detumble_start(s, base, theta, target, out);
   const Model stack = attach_body(r.model, r.model.frame(ee).name, out.grasp.body);
-  const DetumbleState start{base, theta, out.grasp.v_after, Vector3::Zero()};
   DetumbleRunOptions run;
   run.tick = s.keys.detumble_tick;
   run.horizon = s.keys.detumble_horizon;
@@ -178,7 +215,19 @@ inline nlohmann::json detumble_json(const Subject& s, const DetumbleJobResult& d
                 {"base_velocity_jump", vector_json(Eigen::VectorXd(g.base_velocity_jump.head<3>()))},
                 {"base_angular_velocity_jump", vector_json(Eigen::VectorXd(g.base_velocity_jump.tail<3>()))},
                 {"energy_before", g.energy_before},
-                {"energy_after", g.energy_after}};
+                {"energy_after", g.energy_after},
+                {"start", d.contact ? "contact" : "approach"}};
+  if (d.contact) {  // the Hertz phase before the lock
+    const MultibodyContactResult& c = *d.contact;
+    j["grasp"]["contact"] = {{"model", c.model},
+                             {"peak_force", c.f_max},
+                             {"duration", c.contact_duration},
+                             {"impulse_force", vector_json(Eigen::VectorXd(d.contact_impulse))},
+                             {"approach_velocity", c.approach_velocity},
+                             {"separation_velocity", c.separation_velocity},
+                             {"energy_start", c.energy_start},
+                             {"energy_end", c.energy_end}};
+  }
   // the settings as resolved (inputs, not results)
   j["parameters"] = {{"joint_torque_limit", vector_json(d.limits.joint_torque)},
                      {"base_actuator", actuator_name(d.limits.actuator)},

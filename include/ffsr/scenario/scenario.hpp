@@ -91,6 +91,7 @@ struct ScenarioKeys {
   double wheel_torque = 0, wheel_momentum = 0, thruster_force = 0, thruster_torque = 0;
   double rest_rate_deg = 0.05, detumble_horizon = 120, detumble_tick = 0.01;
   bool stop_stack_spin = false;
+  std::string grasp_after = "approach";  ///< the grasp's start: approach, or contact (the Hertz run first)
 };
 
 /// The kind of a key's value: one parser each, from a TOML node and from text.

@@ -56,6 +56,13 @@ struct ContactSample {
   double t = 0, force = 0, delta = 0;
 };
 
+/// Robot and target at one instant of the contact run (inertial frame): what a phase after it starts from.
+struct ContactBodies {
+  BasePose base;             ///< the robot's base pose
+  Eigen::VectorXd theta, v;  ///< joint angles (rad) and generalized velocity [v_0; w_0; theta_dot]
+  Target target;             ///< the target's pose, velocity and spin (its other fields as given)
+};
+
 struct MultibodyContactResult {
   std::string model;                     ///< contact law name
   double approach_velocity = 0;          ///< delta_dot^- (m/s)
@@ -75,6 +82,7 @@ struct MultibodyContactResult {
   std::vector<ContactSample> series;         ///< when requested
   Vector6 base_velocity_start = Vector6::Zero();  ///< robot base [v_0; w_0] at first touch (inertial)
   Vector6 base_velocity_end = Vector6::Zero();    ///< the same at separation
+  ContactBodies start, end;  ///< robot and target at the first touch and at the separation (delta = 0)
 };
 
 namespace detail {
@@ -220,6 +228,24 @@ struct ContactSystem {
     ydot.segment<3>(t0 + 3) = rotation_vector_rate(y.segment<3>(t0 + 3), k.wt);
     ydot.segment<3>(t0 + 6) = f / target.mass + model.gravity;
     ydot.segment<3>(t0 + 9) = I.ldlt().solve((k.pe - k.ct).cross(f) - k.wt.cross(I * k.wt));
+  }
+
+  /// Robot and target at state y: the displacements added to the first touch's poses.
+  ContactBodies bodies(const Eigen::Ref<const Eigen::VectorXd>& y) const {
+    ContactBodies s;
+    s.base.position = base0.position + y.segment<3>(0);
+    s.base.orientation =
+        Quaternion(rotation_from_vector(y.segment<3>(3)) * base0.orientation.toRotationMatrix());
+    s.theta = theta0 + y.segment(6, n);
+    s.v = y.segment(iv(), 6 + n);
+    const Eigen::Index t0 = it();
+    const Matrix3 Rt = rotation_from_vector(y.segment<3>(t0 + 3)) * Rt0;
+    s.target = target;
+    s.target.position = ct0 + y.segment<3>(t0);
+    s.target.attitude = Quaternion(Rt);
+    s.target.velocity = y.segment<3>(t0 + 6);
+    s.target.angular_velocity = Rt.transpose() * y.segment<3>(t0 + 9);
+    return s;
   }
 
   /// Kinetic energy of robot + target (bodies summed).
@@ -389,7 +415,8 @@ inline void record_contact_sample(MultibodyContactResult& res, double t, double 
 }
 
 /// Writes the separation into `res`: the time, delta_dot (and restitution against `vin`), the
-/// momentum and energy of the state `y`, the number of CVODE steps, the robot's base velocity.
+/// momentum and energy of the state `y`, the number of CVODE steps, the robot's base velocity, the
+/// bodies' state.
 inline void record_separation(MultibodyContactResult& res, ContactSystem& sys, const cvode::Integrator& integ,
                               double delta_dot, double vin) {
   res.contact_duration = integ.t();
@@ -399,6 +426,7 @@ inline void record_separation(MultibodyContactResult& res, ContactSystem& sys, c
   res.energy_end = sys.total_energy(integ.y());
   res.steps = integ.num_steps();
   res.base_velocity_end = integ.y().segment<6>(sys.iv());
+  res.end = sys.bodies(integ.y());
 }
 
 }  // namespace detail
@@ -456,6 +484,7 @@ inline MultibodyContactResult simulate_contact(const Model& model, const BasePos
   res.momentum_start = sys.total_momentum(y0);
   res.energy_start = sys.total_energy(y0);
   res.base_velocity_start = y0.segment<6>(sys.iv());
+  res.start = sys.bodies(y0);
   auto record = [&](double t, const Eigen::VectorXd& y) {
     const auto k = sys.kinematics(y);
     detail::record_contact_sample(res, t, sys.force(law, k), k.delta, options.record_series);

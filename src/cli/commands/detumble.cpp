@@ -1,5 +1,6 @@
-// ffsr-optimize detumble: the grasp at the end of the approach, then the post-capture run of robot and
-// target as one stack under the scenario's limits (the job is the library's, ffsr/jobs/detumble.hpp).
+// ffsr-optimize detumble: the grasp (after the approach or the Hertz contact), then the post-capture run
+// of robot and target as one stack under the scenario's limits (the job is the library's,
+// ffsr/jobs/detumble.hpp).
 #include "support/output.hpp"
 #include "support/parse.hpp"
 #include "support/progress.hpp"
@@ -26,7 +27,14 @@ void print_detumble_table(std::ostream& out, const DetumbleJobResult& d) {
   const DetumbleRunResult& r = d.result;
   constexpr double deg = 180.0 / M_PI;
   if (!d.run.empty()) out << "-- " << d.run << " run's capture\n";
-  out << std::setprecision(4) << "grasp impulse            " << g.impulse.head<3>().norm() << " N s, "
+  out << std::setprecision(4);
+  if (d.contact)  // the Hertz phase before the lock
+    out << "contact before the grasp " << d.contact->model << ": peak " << d.contact->f_max << " N, "
+        << d.contact->contact_duration * 1e3 << " ms, impulse " << d.contact_impulse.norm()
+        << " N s; the grasp locks at the separation\n";
+  else
+    out << "grasp start              the end of the approach (no contact phase)\n";
+  out << "grasp impulse            " << g.impulse.head<3>().norm() << " N s, "
       << g.impulse.tail<3>().norm() << " N m s\n"
       << "base velocity jump       " << g.base_velocity_jump.head<3>().norm() * 1e3 << " mm/s, "
       << g.base_velocity_jump.tail<3>().norm() * deg << " deg/s\n"
@@ -42,10 +50,23 @@ void print_detumble_table(std::ostream& out, const DetumbleJobResult& d) {
       << "momentum drift           " << r.momentum_drift << " (relative)\n";
 }
 
+/// The contact law's flags act with grasp-after = contact only (the Hertz run before the grasp); the
+/// file's keys of the law are the scenario's and stay.
+void refuse_law_flags_without_contact(const DetumbleCommandOptions& o, const ScenarioKeys& keys) {
+  if (keys.grasp_after == "contact") return;
+  for (const char* name : {"model", "stiffness", "exponent", "restitution"})
+    if (o.subject.flags.given(name))
+      throw InputError(detail::str("--", name,
+                                   ": acts on detumble only with grasp-after = contact (the Hertz contact "
+                                   "run before the grasp), and this run has grasp-after = ",
+                                   keys.grasp_after));
+}
+
 int run_detumble_command(const DetumbleCommandOptions& o) {
   set_quiet(o.out.quiet);
   Outputs outputs = o.out.outputs();  // an output on standard output: the table goes to standard error
   const Subject subject = load_subject(o.subject);
+  refuse_law_flags_without_contact(o, subject.keys);
   std::vector<DetumbleJobResult> results;
   if (o.run.empty()) {
     results.push_back(detumble(subject));
@@ -70,9 +91,8 @@ void register_detumble(CLI::App& app, Action& action) {
   auto o = std::make_shared<DetumbleCommandOptions>();
   CLI::App* sub = app.add_subcommand(
       "detumble", "After the capture: the grasp, then robot and target brought to rest within the limits");
-  // the contact law does not act here: the grasp is plastic, at the approach speed
-  o->subject.add_to(*sub, scenario_key_names({KeyGroup::Detumble}),
-                    {"model", "stiffness", "exponent", "restitution"});
+  // the contact law acts with grasp-after = contact only (refuse_law_flags_without_contact)
+  o->subject.add_to(*sub, scenario_key_names({KeyGroup::Detumble}));
   sub->add_option("--run", o->run,
                   "Start from the capture the main job plans: plain, optimized, global or all (default: the "
                   "scenario's configuration, joints-deg)");

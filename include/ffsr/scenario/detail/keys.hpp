@@ -517,6 +517,17 @@ inline void add_detumble_run_keys(std::vector<ScenarioKey>& keys) {
                                               k.detumble_horizon, " s), got ", k.detumble_tick));
                      })
                      .echoed(echo_given("detumble-tick", &K::detumble_tick)));
+  keys.push_back(
+      FFSR_KEY("grasp-after", grasp_after,
+               "Detumble: the grasp locks at the end of the approach, or after the Hertz contact run (the "
+               "contact law's keys) at the separation: approach or contact",
+               "approach")
+          .in(G::Detumble)
+          .checked([](const K& k) {
+            if (k.grasp_after != "approach" && k.grasp_after != "contact")
+              throw InputError(str("--grasp-after: expected approach or contact, got '", k.grasp_after, "'"));
+          })
+          .echoed(echo_given("grasp-after", &K::grasp_after)));
   keys.push_back(FFSR_KEY("stop-stack-spin", stop_stack_spin,
                           "Detumble: also stop the stack's spin (needs a base actuator; true/false)", "false")
                      .in(G::Detumble)
