@@ -153,8 +153,8 @@ TEST_CASE("detumble --csv: the joint angles, the base's, the target's and the bo
           "[cli]") {
   // the built-in 3-DOF scenario from its three captures: the target held by the gripper (body 3)
   ffsr::test::TempDir dir;
-  const json j = ffsr::test::parse_json(cli({"detumble", "--run", "all", "--joint-torque-limit", "20", "--quiet",
-                                             "--json", "-", "--csv", "series.csv"},
+  const json j = ffsr::test::parse_json(cli({"detumble", "--run", "all", "--joint-torque-limit", "20",
+                                             "--quiet", "--json", "-", "--csv", "series.csv"},
                                             dir.str()));
   const std::string text = ffsr::test::read_file(dir.str() + "/series.csv");
   // the runs one after the other: split on the run column (the first), keep the numbers
@@ -173,7 +173,8 @@ TEST_CASE("detumble --csv: the joint angles, the base's, the target's and the bo
     INFO(name);
     const auto c = read_csv(columns + per_run.at(name));
     const auto pose = [&c](const std::string& p, size_t i) {
-      const Eigen::Quaterniond q(c.at(p + "_qw")[i], c.at(p + "_qx")[i], c.at(p + "_qy")[i], c.at(p + "_qz")[i]);
+      const Eigen::Quaterniond q(c.at(p + "_qw")[i], c.at(p + "_qx")[i], c.at(p + "_qy")[i],
+                                 c.at(p + "_qz")[i]);
       return std::make_pair(Eigen::Vector3d(c.at(p + "_x")[i], c.at(p + "_y")[i], c.at(p + "_z")[i]), q);
     };
     const auto q0 = r.at("joints_deg").get<std::vector<double>>();
@@ -198,7 +199,8 @@ TEST_CASE("detumble --csv: the joint angles, the base's, the target's and the bo
         const auto& th = c.at("theta_" + std::to_string(k));
         const auto& rate = c.at("theta_dot_" + std::to_string(k));
         if (i == 0) CHECK(th[0] == Approx(q0[k - 1] * M_PI / 180).margin(1e-10));
-        if (i > 0) CHECK(th[i] - th[i - 1] == Approx(0.5 * (rate[i] + rate[i - 1]) * (t[i] - t[i - 1])).margin(1e-7));
+        if (i > 0)
+          CHECK(th[i] - th[i - 1] == Approx(0.5 * (rate[i] + rate[i - 1]) * (t[i] - t[i - 1])).margin(1e-7));
       }
     }
     const auto a = r.at("grasp").at("attachment");

@@ -555,8 +555,8 @@ TEST_CASE("detumble figure: joints by colour and runs by style, the threshold, t
   CHECK(f.name == "detumble");
   REQUIRE(f.panels.size() == 6);
   const auto& rates = std::get<plot::Panel>(f.panels[0]);
-  REQUIRE(rates.curves.size() == 2 * 2 + 2);  // joint x run, then one style key per run
-  CHECK(rates.curves[1].color == rates.curves[0].color);           // joint a, both runs: one colour
+  REQUIRE(rates.curves.size() == 2 * 2 + 2);                        // joint x run, then one style key per run
+  CHECK(rates.curves[1].color == rates.curves[0].color);            // joint a, both runs: one colour
   CHECK(rates.curves[1].line_style != rates.curves[0].line_style);  // ... two styles
   CHECK(rates.curves[2].y.front() == Approx(-0.2 * 180 / M_PI));    // deg/s
   CHECK(rates.curves[4].label == "plain");
@@ -583,7 +583,7 @@ TEST_CASE("detumble figure: joints by colour and runs by style, the threshold, t
   const auto& wheels = std::get<plot::Panel>(w.panels[5]);
   CHECK(wheels.curves.back().label == "bound");
   CHECK(wheels.curves.back().y.front() == 5.0);
-  CHECK(wheels.curves[1].y.back() == Approx(2 * (1 - std::exp(-5.0))));  // |h_y| of the plain run
+  CHECK(wheels.curves[1].y.back() == Approx(2 * (1 - std::exp(-5.0))));          // |h_y| of the plain run
   CHECK(std::get<plot::Panel>(w.panels[1]).curves.size() == 3 * 2 + 2 + 3 + 1);  // 3 rates, keys, threshold
 
   s.runs[1].torque.pop_back();
@@ -593,10 +593,11 @@ TEST_CASE("detumble figure: joints by colour and runs by style, the threshold, t
   CHECK_THROWS_AS(figures::detumble(s), InputError);
 }
 
-TEST_CASE("detumble --plot: the post-capture runs of the three captures in one figure", "[plot][cli][detumble]") {
+TEST_CASE("detumble --plot: the post-capture runs of the three captures in one figure",
+          "[plot][cli][detumble]") {
   TempDir dir;
-  const auto r = run_command({kCli, "detumble", "--run", "all", "--joint-torque-limit", "20", "--plot", dir.str(),
-                              "--json", dir / "d.json", "--quiet"});
+  const auto r = run_command({kCli, "detumble", "--run", "all", "--joint-torque-limit", "20", "--plot",
+                              dir.str(), "--json", dir / "d.json", "--quiet"});
   REQUIRE(r.exit_code == 0);
   check_png(dir / "detumble.png", 1200, 1100, 8);
   std::ifstream in(dir / "d.json");

@@ -77,9 +77,9 @@ plot::Figure detumble_figure(const Subject& subject, const std::vector<DetumbleJ
   }
   f.title = results.size() > 1 || !first.run.empty()
                 ? "After the capture: the grasp, then robot and target brought to rest (per run's capture)"
-                : detail::str("After the capture: at rest in ", std::setprecision(3), first.result.time_to_rest,
-                              " s, peak joint torque ", first.result.peak_joint_torque, " N m (joint ",
-                              first.peak_joint_name, ")");
+                : detail::str("After the capture: at rest in ", std::setprecision(3),
+                              first.result.time_to_rest, " s, peak joint torque ",
+                              first.result.peak_joint_torque, " N m (joint ", first.peak_joint_name, ")");
   return figures::detumble(f);
 }
 

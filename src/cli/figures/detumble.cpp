@@ -124,8 +124,10 @@ void check(const DetumbleSeries& s) {
     const size_t m = r.t.size();
     const bool equal = r.joint_rate.size() == m && r.relative_rate.size() == m && r.stack_rate.size() == m &&
                        r.force.size() == m && r.moment.size() == m && r.attitude.size() == m &&
-                       r.energy.size() == m && r.rate.size() == m && r.torque.size() == m && r.wheel.size() == m;
-    if (m == 0 || !equal) throw InputError(str("detumble plot: the series of run '", r.label, "' have different lengths"));
+                       r.energy.size() == m && r.rate.size() == m && r.torque.size() == m &&
+                       r.wheel.size() == m;
+    if (m == 0 || !equal)
+      throw InputError(str("detumble plot: the series of run '", r.label, "' have different lengths"));
     for (size_t i = 0; i < m; ++i)
       if (static_cast<size_t>(r.rate[i].size()) != n || static_cast<size_t>(r.torque[i].size()) != n)
         throw InputError(str("detumble plot: run '", r.label, "' has another number of joints than ", n));
@@ -157,8 +159,8 @@ plot::Figure detumble(const DetumbleSeries& s) {
         load = labelled("gripper's load on the target", time, "force (N), moment (N m)"),
         attitude = labelled("base rotation since the grasp", time, "rotation (deg)"),
         last = s.wheel_bound > 0
-                   ? labelled(str("reaction wheels' momentum (bound ", s.wheel_bound, " N m s per axis)"), time,
-                              "|h| per base axis (N m s)")
+                   ? labelled(str("reaction wheels' momentum (bound ", s.wheel_bound, " N m s per axis)"),
+                              time, "|h| per base axis (N m s)")
                    : labelled("kinetic energy of robot and target", time, "energy (J)");
   add_joints(rates, s, true, true);
   rates.legend_outside = true;  // one entry per joint (and run): inside, it would hide the curves
@@ -170,7 +172,8 @@ plot::Figure detumble(const DetumbleSeries& s) {
       for (double& x : v) x *= kDeg;
       return v;
     };
-    rest_q.push_back({{"largest joint rate", deg(r.joint_rate)}, {"gripper relative to the base", deg(r.relative_rate)}});
+    rest_q.push_back(
+        {{"largest joint rate", deg(r.joint_rate)}, {"gripper relative to the base", deg(r.relative_rate)}});
     if (s.stack_rate) rest_q.back().push_back({"stack", deg(r.stack_rate)});
     load_q.push_back({{"force (N)", r.force}, {"moment (N m)", r.moment}});
     attitude_q.push_back({{"rotation", deg(r.attitude)}});
