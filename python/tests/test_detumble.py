@@ -4,6 +4,8 @@ Jacobians (the gripper frame minus a frame of the target at the same point), and
 from the KKT system [M J^T; J 0][v+; -p] = [M v-; 0] solved with numpy. The velocities after the lock
 agree to 1e-9 on both paper robots. Also the post-capture run and the controller through Python."""
 
+import subprocess
+
 import numpy as np
 import pytest
 
@@ -12,7 +14,7 @@ import ffsr
 pin = pytest.importorskip("pinocchio", reason="Pinocchio's Python package `pin` is a test requirement")
 
 from conftest import ROBOTS  # noqa: E402
-from test_jobs import command_json, differences  # noqa: E402
+from test_jobs import command, command_json, differences  # noqa: E402
 from test_pinocchio import quat_to_rot  # noqa: E402
 
 
@@ -137,3 +139,12 @@ def test_detumble_job_equals_the_command(tmp_path, run):
     assert result.runs == (3 if run else 1)
     with pytest.raises(ffsr.InputError, match="--run"):
         ffsr.Scenario.load(str(scenario)).detumble(run="best")
+
+
+def test_detumble_series_equals_the_command(tmp_path):
+    """series_csv() is the command's --csv (the poses the 3-D view animates after the capture)."""
+    scenario = ROBOTS / "paper_7dof_detumble.toml"
+    out = tmp_path / "series.csv"
+    subprocess.run([command(), "detumble", "--config", str(scenario), "--run", "optimized", "--quiet", "--csv",
+                    str(out)], check=True, timeout=900)
+    assert ffsr.Scenario.load(str(scenario)).detumble(run="optimized").series_csv() == out.read_text()
