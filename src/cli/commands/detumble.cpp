@@ -56,9 +56,7 @@ plot::Figure detumble_figure(const Subject& subject, const std::vector<DetumbleJ
   if (first.limits.actuator == BaseActuator::ReactionWheels) f.wheel_bound = first.limits.wheel_momentum;
   for (const DetumbleJobResult& d : results) {
     figures::DetumbleSeries::Run r;
-    const std::string name = d.run == "baseline" ? "plain" : d.run;
-    r.label = detail::str(name.empty() ? "from joints-deg" : name + " capture", ": at rest in ",
-                          std::setprecision(3), d.result.time_to_rest, " s");
+    r.label = d.run == "baseline" ? "plain" : d.run.empty() ? "joints-deg" : d.run;
     r.color = d.run == "optimized" ? 1 : d.run == "global" ? 2 : 0;  // the runs' colours of the main job
     for (const DetumbleSample& x : d.result.series) {
       r.t.push_back(x.t);
@@ -75,11 +73,16 @@ plot::Figure detumble_figure(const Subject& subject, const std::vector<DetumbleJ
     }
     f.runs.push_back(std::move(r));
   }
-  f.title = results.size() > 1 || !first.run.empty()
-                ? "After the capture: the grasp, then robot and target brought to rest (per run's capture)"
-                : detail::str("After the capture: at rest in ", std::setprecision(3),
-                              first.result.time_to_rest, " s, peak joint torque ",
-                              first.result.peak_joint_torque, " N m (joint ", first.peak_joint_name, ")");
+  if (first.run.empty()) {
+    f.title = detail::str("After the capture: at rest in ", std::setprecision(3), first.result.time_to_rest,
+                          " s, peak joint torque ", first.result.peak_joint_torque, " N m (joint ",
+                          first.peak_joint_name, ")");
+  } else {
+    f.title = "After each run's capture: at rest in ";
+    for (size_t i = 0; i < results.size(); ++i)
+      f.title += detail::str(i ? ", " : "", std::setprecision(3), results[i].result.time_to_rest, " s (",
+                             f.runs[i].label, ")");
+  }
   return figures::detumble(f);
 }
 

@@ -84,7 +84,7 @@ void add_joints(Panel& p, const DetumbleSeries& s, bool rates, bool labels) {
       p.curves.push_back(std::move(c));
     }
   if (!labels || s.runs.size() < 2) return;
-  for (size_t r = 0; r < s.runs.size(); ++r) {
+  for (size_t r = 0; r < s.runs.size(); ++r) {  // the runs' line styles, in black
     Curve key;
     key.label = s.runs[r].label;
     key.color = kBlack;
@@ -149,7 +149,7 @@ plot::Figure detumble(const DetumbleSeries& s) {
   fig.rows = 3;
   fig.cols = 2;
   fig.width = 1200;
-  fig.height = 1100;
+  fig.height = s.runs.size() > 1 ? 1250 : 1100;  // room for the joints' and the runs' legend
   const std::string time;  // the rows share the time axis: named under the last row only (below)
   Panel rates = labelled(s.runs.size() > 1 ? "joint rates (runs by line style)" : "joint rates", time,
                          "joint rate (deg/s)"),

@@ -72,9 +72,8 @@ struct DetumbleSeries {
   bool stack_rate = false;           ///< the stack's rate is part of the rest test (stop-stack-spin)
   double wheel_bound = 0;            ///< the wheels' momentum per axis, N m s; 0: no reaction wheels
   struct Run {
-    std::string
-        label;      ///< the main job's run it starts from (plain, ...); empty: the scenario's configuration
-    int color = 0;  ///< palette index
+    std::string label;  ///< in legends: the main job's run it starts from (plain, optimized, global)
+    int color = 0;      ///< palette index
     std::vector<double> t, joint_rate, relative_rate, stack_rate;  ///< s, rad/s
     std::vector<double> force, moment, attitude, energy;           ///< N, N m, rad, J
     std::vector<Eigen::VectorXd> rate, torque;                     ///< rad/s, N m; one per t
