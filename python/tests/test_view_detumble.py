@@ -199,3 +199,22 @@ def test_bad_post_capture_input(captured, tmp_path):
     two = dict(d, runs=d["runs"][:2])
     with pytest.raises(view.ViewInputError, match=r"detumble series: its runs \(baseline, global, optimized\)"):
         view.page_data(j, series, detumble=two, detumble_series=post_series)
+
+
+def test_the_python_job_result_continues_the_view(captured, tmp_path):
+    """capture(..., detumble=Scenario.detumble(run="all")) takes the series from its series_csv(): the
+    page's data equal those of the command's two files."""
+    pytest.importorskip("ffsr._ffsr", reason="the compiled module (scripts/install-python.sh)")
+    import ffsr
+
+    result, series, post, post_series = captured
+    urdf = ROOT / "robots" / "paper_3dof.urdf"
+    scenario = tmp_path / "paper_3dof_detumble.toml"
+    scenario.write_text(SCENARIO.read_text().replace('urdf = "paper_3dof.urdf"', f'urdf = "{urdf}"')
+                        + "\njoint-torque-limit = 50\n")
+    job = ffsr.Scenario.load(str(scenario)).detumble(run="all")
+    j = json.loads(result.read_text())
+    from_object = view.page_data(j, series, detumble=job, frames=100)
+    from_files = view.page_data(j, series, detumble=str(post), detumble_series=post_series, frames=100)
+    assert from_object == from_files
+    assert view.capture(j, tmp_path / "job.html", series, detumble=job, frames=100).path.is_file()
