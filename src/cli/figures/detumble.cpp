@@ -106,7 +106,7 @@ void add_limits(Panel& p, const DetumbleSeries& s, double t0, double t1) {
       joints += (joints.empty() ? "" : ", ") + std::to_string(j + 1);
     }
   }
-  if (near.empty()) p.title += ": every joint below 30 % of its limit";
+  if (near.empty()) p.title = "joint torques (below 30 % of the limits)";
   int style = 2;
   for (const auto& [limit, joints] : near) {
     p.curves.push_back(level(limit, t0, t1, str("limit ±", limit, " N m (joint ", joints, ")"), style));
@@ -158,10 +158,9 @@ plot::Figure detumble(const DetumbleSeries& s) {
         torque = labelled("joint torques (colours as above)", time, "torque (N m)"),
         load = labelled("gripper's load on the target", time, "force (N), moment (N m)"),
         attitude = labelled("base rotation since the grasp", time, "rotation (deg)"),
-        last = s.wheel_bound > 0
-                   ? labelled(str("reaction wheels' momentum (bound ", s.wheel_bound, " N m s per axis)"),
-                              time, "|h| per base axis (N m s)")
-                   : labelled("kinetic energy of robot and target", time, "energy (J)");
+        last = s.wheel_bound > 0 ? labelled(str("wheels' momentum (bound ", s.wheel_bound, " N m s)"), time,
+                                            "|h| per base axis (N m s)")
+                                 : labelled("kinetic energy of robot and target", time, "energy (J)");
   add_joints(rates, s, true, true);
   rates.legend_outside = true;  // one entry per joint (and run): inside, it would hide the curves
   add_joints(torque, s, false, false);
@@ -187,11 +186,11 @@ plot::Figure detumble(const DetumbleSeries& s) {
     }
   }
   add_runs(rest, s, rest_q);
-  rest.curves.push_back(level(s.rest_rate * kDeg, t0, t1, "rest threshold"));
+  rest.curves.push_back(level(s.rest_rate * kDeg, t0, t1, "rest threshold", 4));  // styles 1-3: quantities
   add_runs(load, s, load_q);
   add_runs(attitude, s, attitude_q);
   add_runs(last, s, last_q);
-  if (s.wheel_bound > 0) last.curves.push_back(level(s.wheel_bound, t0, t1, "bound"));
+  if (s.wheel_bound > 0) last.curves.push_back(level(s.wheel_bound, t0, t1, "bound", 4));
   attitude.xlabel = last.xlabel = "time since the grasp (s)";
   fig.panels = {rates, rest, torque, load, attitude, last};
   return fig;
