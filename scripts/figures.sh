@@ -8,7 +8,7 @@ cli="${1:-$root/build/src/cli/ffsr-optimize}"
 out="$root/docs/figures"
 tmp="$(mktemp -d)"
 trap 'rm -rf "$tmp"' EXIT
-mkdir -p "$out" "$tmp/3dof" "$tmp/7dof" "$tmp/contact" "$tmp/xi" "$tmp/map" "$tmp/robust" "$tmp/pareto"
+mkdir -p "$out" "$tmp/3dof" "$tmp/7dof" "$tmp/contact" "$tmp/xi" "$tmp/map" "$tmp/robust" "$tmp/pareto" "$tmp/detumble"
 
 # Figures 10 and 11: the 3-DOF robot, plain and optimized (Table 4)
 "$cli" --config "$root/robots/paper_3dof.toml" --plot "$tmp/3dof" --quiet > /dev/null
@@ -43,4 +43,7 @@ cp "$tmp/robust/robust.png" "$out/7dof_robust.png"
 # beyond the paper: M_ie against the base's angular rate jump at the impact, the three runs marked
 "$cli" pareto --config "$root/robots/paper_7dof_position.toml" --plot "$tmp/pareto" > /dev/null
 cp "$tmp/pareto/pareto.png" "$out/7dof_pareto.png"
+# beyond the paper: the post-capture runs after the three captures (docs/detumble.md)
+"$cli" detumble --config "$root/robots/paper_7dof_detumble.toml" --run all --plot "$tmp/detumble" --quiet > /dev/null
+cp "$tmp/detumble/detumble.png" "$out/7dof_detumble.png"
 ls -l "$out"

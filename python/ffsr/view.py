@@ -19,6 +19,10 @@ From the command's outputs::
     ffsr-optimize --config robots/paper_3dof.toml --json result.json --csv series.csv
     python -m ffsr.view result.json --csv series.csv -o capture.html
 
+After the capture the page can go on with the post-capture runs (``ffsr-optimize detumble --run all``,
+its ``--json`` and ``--csv``: ``--detumble`` and ``--detumble-csv``; from Python ``detumble=``): the
+target carried by the gripper, the joints and the base following that series.
+
 From Python: ``ffsr.view.capture(result, "capture.html", series)`` where ``result`` is the job's
 result (an object with ``to_dict()``, or the dict of the command's ``--json``) and ``series`` the
 time series (a path to the ``--csv`` file, its text, or a mapping of its columns; by default
@@ -217,6 +221,135 @@ def _check_series(result: Dict[str, Any], runs: List[str], header: List[str], ro
     return col, series
 
 
+# --- after the capture: the post-capture runs of ffsr-optimize detumble --run --------------------------
+
+
+def _detumble_dict(detumble: Any, name: str) -> Dict[str, Any]:
+    if isinstance(detumble, (str, os.PathLike)):
+        d = load_result(detumble)
+    else:
+        d = detumble.to_dict() if hasattr(detumble, "to_dict") else detumble
+    if not isinstance(d, Mapping):
+        raise ViewInputError(f"{name}: expected the result of ffsr-optimize detumble --run (to_dict(), its JSON "
+                             f"dict or its file), got {type(d).__name__}")
+    if "runs" not in d:
+        if "grasp" in d and "at_rest" in d:
+            raise ViewInputError(f"{name}: a post-capture run from the scenario's configuration does not continue "
+                                 f"a capture of the main job: run ffsr-optimize detumble --run all (or plain, "
+                                 f"optimized, global)")
+        keys = ", ".join(sorted(d)[:6]) or "none"
+        raise ViewInputError(f"{name}: not the --json of ffsr-optimize detumble --run (its keys: {keys})")
+    for r in d["runs"]:
+        if not isinstance(r, Mapping) or "run" not in r or "attachment" not in r.get("grasp", {}):
+            raise ViewInputError(f"{name}: a run without 'run' or 'grasp.attachment': written by an "
+                                 f"ffsr-optimize older than the post-capture view; run it again")
+    return dict(d)
+
+
+def _detumble_table(header: List[str], rows: List[List[Any]], joints: int, bodies: int,
+                    name: str) -> Tuple[Dict[str, int], Dict[str, List[List[float]]]]:
+    """The post-capture series' columns by name and its numbers by run (checked)."""
+    expected = (["run", "t", "joint_rate", "gripper_force"] + [f"theta_{k}" for k in range(1, joints + 1)]
+                + [f"{p}_{k}" for p in ["base", "target"] + [f"body{b}" for b in range(1, bodies)] for k in POSE])
+    col = {h: i for i, h in enumerate(header)}
+    missing = [h for h in expected if h not in col]
+    if missing:
+        shown = ", ".join(missing[:4]) + (", ..." if len(missing) > 4 else "")
+        raise ViewInputError(f"{name}: {len(missing)} column(s) missing ({shown}): not the --csv of ffsr-optimize "
+                             f"detumble --run of this robot, or written by an older ffsr-optimize")
+    if f"theta_{joints + 1}" in col:
+        raise ViewInputError(f"{name}: more joints than the main job's {joints}: the series of another robot")
+    table: Dict[str, List[List[float]]] = {}
+    for line, row in enumerate(rows, start=2):
+        if not row:
+            continue
+        if len(row) != len(header):
+            raise ViewInputError(f"{name}: line {line} has {len(row)} fields, the header {len(header)}")
+        values = [0.0] * len(header)
+        for h in expected[1:]:
+            values[col[h]] = _number(row[col[h]], f"{name}: line {line}, column {h}")
+        rows_of = table.setdefault(row[col["run"]], [])
+        if rows_of and values[col["t"]] < rows_of[-1][col["t"]]:
+            raise ViewInputError(f"{name}: line {line}: time goes back in the {row[col['run']]} run")
+        rows_of.append(values)
+    return col, table
+
+
+def _detumble_runs(res: Dict[str, Any], runs: List[str], table: Dict[str, _Series], col: Dict[str, int],
+                   detumble: Any, series: Any, result_name: str, name: str,
+                   series_name: str) -> Dict[str, Dict[str, Any]]:
+    """Each post-capture run by the main job's run it continues, checked to start where that run ends."""
+    d = _detumble_dict(detumble, name)
+    if series is None:
+        series = getattr(detumble, "series_csv", None)
+        series = series() if callable(series) else series
+    if series is None:
+        raise ViewInputError(f"{series_name}: missing: the view needs the post-capture series "
+                             f"(ffsr-optimize detumble --run all --csv)")
+    joints = res["scenario"].get("joint_names", [])
+    header, rows = _series_table(series, series_name)
+    dcol, dtable = _detumble_table(header, rows, len(joints), len(res["scene"]["bodies"]), series_name)
+    if sorted(dtable) != sorted(r["run"] for r in d["runs"]):
+        raise ViewInputError(f"{series_name}: its runs ({', '.join(sorted(dtable)) or 'none'}) are not those of "
+                             f"{name} ({', '.join(sorted(r['run'] for r in d['runs']))})")
+    out: Dict[str, Dict[str, Any]] = {}
+    for r in d["runs"]:
+        label = r["run"]
+        if label not in runs:
+            raise ViewInputError(f"{name}: its {label} run is not a run of {result_name} ({', '.join(runs)})")
+        last, first = table[label].rows[-1], dtable[label][0]
+        capture = [last[col[f"{j}_deg"]] for j in joints]
+        start = [math.degrees(first[dcol[f"theta_{k}"]]) for k in range(1, len(joints) + 1)]
+        stated = list(r.get("joints_deg", []))
+        same = (len(stated) == len(capture) and all(_close(a, b, atol=1e-6) for a, b in zip(capture, stated))
+                and all(_close(a, b, atol=1e-6) for a, b in zip(capture, start))
+                and all(_close(last[col[f"base_{k}"]], first[dcol[f"base_{k}"]], atol=1e-6) for k in "xyz")
+                and first[dcol["t"]] == 0)
+        if not same:
+            shown = ", ".join(f"{x:.4f}" for x in start)
+            want = ", ".join(f"{x:.4f}" for x in capture)
+            raise ViewInputError(f"{series_name}: its {label} run starts at [{shown}] deg; {result_name}'s {label} "
+                                 f"run captures at [{want}] deg: the post-capture run of another capture")
+        out[label] = {"rows": dtable[label], "col": dcol, "time_to_rest": r.get("time_to_rest")}
+    return out
+
+
+def _rotate(q: Sequence[float], v: Sequence[float]) -> List[float]:
+    """v turned by the unit quaternion q = (w, x, y, z)."""
+    w, x, y, z = q
+    t = [2 * (y * v[2] - z * v[1]), 2 * (z * v[0] - x * v[2]), 2 * (x * v[1] - y * v[0])]
+    return [v[0] + w * t[0] + y * t[2] - z * t[1], v[1] + w * t[1] + z * t[0] - x * t[2],
+            v[2] + w * t[2] + x * t[1] - y * t[0]]
+
+
+def _append_post_capture(d: Dict[str, Any], post: Dict[str, Any], scene: Dict[str, Any], frames: int) -> None:
+    """Appends the post-capture frames to a run's frames: times from the capture instant on, the poses of
+    the series, the end-effector from its body's pose, the gripper's force and the largest joint rate."""
+    rows, col = post["rows"], post["col"]
+    T = d["t"][-1]
+    nb = len(scene["bodies"])
+    ee_body, ee_point = scene["end_effector_body"], scene["end_effector_point"]
+    n = len(d["t"])
+    d["grip"] = [0.0] * n
+    d["jrate"] = [0.0] * n
+    for k in _frames(len(rows), [], frames)[1:]:  # the first sample is the capture instant itself
+        row = rows[k]
+        d["t"].append(round(T + row[col["t"]], 6))
+        for prefix, out in [("base", d["base"])] + [(f"body{b}", d["bodies"]) for b in range(1, nb)] + [
+                ("target", d["target"])]:
+            out.extend(round(row[col[f"{prefix}_{c}"]], 5) for c in POSE[:3])
+            out.extend(round(row[col[f"{prefix}_{c}"]], 6) for c in POSE[3:])
+        prefix = "base" if ee_body == 0 else f"body{ee_body}"
+        p = [row[col[f"{prefix}_{c}"]] for c in "xyz"]
+        q = [row[col[f"{prefix}_q{c}"]] for c in "wxyz"]
+        d["ee"].extend(round(a + b, 5) for a, b in zip(p, _rotate(q, ee_point)))
+        d["mie"].append(d["mie"][d["capture_index"]])
+        d["fmax"].append(d["fmax"][d["capture_index"]])
+        d["grip"].append(round(row[col["gripper_force"]], 4))
+        d["jrate"].append(round(math.degrees(row[col["joint_rate"]]), 5))
+    d["time_to_rest"] = post["time_to_rest"]
+
+
 # --- the page's data ------------------------------------------------------------------------------------
 
 
@@ -237,8 +370,11 @@ def _schematic_target(result: Dict[str, Any]) -> Dict[str, Any]:
 
 
 def page_data(result: Any, series: Any = None, *, run: Optional[str] = None, frames: int = DEFAULT_FRAMES,
-              result_name: str = "result", series_name: str = "series") -> Dict[str, Any]:
-    """The data the page animates (checked): every run's frames, the bodies and shapes, the capture."""
+              result_name: str = "result", series_name: str = "series", detumble: Any = None,
+              detumble_series: Any = None, detumble_name: str = "detumble",
+              detumble_series_name: str = "detumble series") -> Dict[str, Any]:
+    """The data the page animates (checked): every run's frames, the bodies and shapes, the capture, and
+    with `detumble` (the post-capture runs, ffsr-optimize detumble --run) the frames after it."""
     if isinstance(frames, bool) or not isinstance(frames, int) or frames < 2:
         raise ViewInputError(f"frames: must be an integer >= 2, got {frames!r}")
     res = _result_dict(result)
@@ -285,7 +421,16 @@ def page_data(result: Any, series: Any = None, *, run: Optional[str] = None, fra
         for key in ("integrated_effective_mass", "f_max_closed_form", "f_max_exact"):
             d[key] = res[r].get(key)
         d["reconfigured"] = bool(res[r].get("reconfigured", False))
+        d["capture_index"] = len(d["t"]) - 1
         out_runs.append(d)
+    if detumble is not None:
+        post = _detumble_runs(res, runs, table, col, detumble, detumble_series, result_name, detumble_name,
+                              detumble_series_name)
+        for d in out_runs:
+            if d["name"] in post:
+                _append_post_capture(d, post[d["name"]], scene, frames)
+    elif detumble_series is not None:
+        raise ViewInputError(f"{detumble_series_name}: given without the post-capture result (detumble)")
     target_shape = scene.get("target_shape") or _schematic_target(res)
     source = str(res["scenario"].get("source", ""))
     return {
@@ -413,7 +558,8 @@ class CaptureView:
 
 
 def capture(result: Any, path: Optional[Union[str, os.PathLike]] = None, series: Any = None, *,
-            run: Optional[str] = None, frames: int = DEFAULT_FRAMES, height: int = 600) -> CaptureView:
+            run: Optional[str] = None, frames: int = DEFAULT_FRAMES, height: int = 600, detumble: Any = None,
+            detumble_series: Any = None) -> CaptureView:
     """The 3-D view of a capture (a CaptureView, shown inline in Jupyter), written to `path` if given.
 
     path: the HTML file to write (one self-contained file); None: nothing is written.
@@ -424,6 +570,12 @@ def capture(result: Any, path: Optional[Union[str, os.PathLike]] = None, series:
     frames: at most this many samples per run go into the page (evenly spread; the first, the last
         and the phase boundary always).
     height: the inline frame's height in Jupyter, in CSS pixels.
+    detumble: the post-capture runs that continue the captures (``Scenario.detumble(run="all")``, or the
+        dict or the file of ``ffsr-optimize detumble --run all --json``): after the capture instant the page goes on
+        with the target carried by the gripper, the joints and the base following that series. Each of its
+        runs must start at its main job's run's capture configuration and base position.
+    detumble_series: its series: a path to ``detumble --csv``, the text, or a mapping of its columns;
+        None: ``detumble.series_csv()``.
     Raises ViewInputError (a ValueError) naming the argument on bad input; nothing is written then.
     """
     if isinstance(height, bool) or not isinstance(height, int) or height < 100:
@@ -432,7 +584,8 @@ def capture(result: Any, path: Optional[Union[str, os.PathLike]] = None, series:
         series = getattr(result, "series", None)
         if callable(series):
             series = series()
-    view = CaptureView(page(page_data(result, series, run=run, frames=frames)), height=height)
+    data = page_data(result, series, run=run, frames=frames, detumble=detumble, detumble_series=detumble_series)
+    view = CaptureView(page(data), height=height)
     if path is not None:
         view.save(path)
     return view
@@ -455,15 +608,23 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     p.add_argument("--run", choices=RUNS, help="the run the page opens on (default: global, else the last held)")
     p.add_argument("--frames", type=int, default=DEFAULT_FRAMES,
                    help=f"at most this many samples per run in the page (default {DEFAULT_FRAMES})")
+    p.add_argument("--detumble", metavar="RESULT",
+                   help="the post-capture runs that continue the captures (ffsr-optimize detumble --run all --json)")
+    p.add_argument("--detumble-csv", metavar="SERIES", help="their series (ffsr-optimize detumble --run all --csv)")
     a = p.parse_args(argv)
     try:
         if a.frames < 2:
             raise ViewInputError(f"--frames: must be >= 2, got {a.frames}")
+        if (a.detumble is None) != (a.detumble_csv is None):
+            raise ViewInputError("--detumble and --detumble-csv: give both (the post-capture result and its series)")
         result = load_result(a.result)
         if not isinstance(result, dict):
             raise ViewInputError(f"{a.result}: not the --json of the main job of ffsr-optimize (not a JSON object)")
+        post = load_result(a.detumble) if a.detumble else None
         try:
-            data = page_data(result, a.csv, run=a.run, frames=a.frames, result_name=a.result, series_name=a.csv)
+            data = page_data(result, a.csv, run=a.run, frames=a.frames, result_name=a.result, series_name=a.csv,
+                             detumble=post, detumble_series=a.detumble_csv, detumble_name=a.detumble or "detumble",
+                             detumble_series_name=a.detumble_csv or "detumble series")
         except ViewInputError as e:
             msg = str(e)
             if msg.startswith("run: "):

@@ -169,7 +169,10 @@ void bind_detumble_result(nb::module_& m) {
 
 /// The job `detumble` (ffsr/jobs/detumble.hpp): one result per start (the scenario's configuration, or
 /// each run of --run).
-using DetumbleJobRun = JobRun<std::vector<DetumbleJobResult>>;
+/// With the series as the command's --csv writes it (made from the same subject).
+struct DetumbleJobRun : JobRun<std::vector<DetumbleJobResult>> {
+  std::string series_csv;
+};
 
 void bind_detumble_job(nb::module_& m) {
   job_result_class<DetumbleJobRun>(
@@ -187,7 +190,11 @@ void bind_detumble_job(nb::module_& m) {
           "The first start's peak joint torque, N m.")
       .def_prop_ro(
           "peak_joint", [](const DetumbleJobRun& r) { return r.result.front().peak_joint_name; },
-          "The joint of that peak.");
+          "The joint of that peak.")
+      .def(
+          "series_csv", [](const DetumbleJobRun& r) { return r.series_csv; },
+          "The post-capture series as the command's --csv writes it (with the joint angles and the\n"
+          "base's, the target's and every body's pose: ffsr.view.capture(..., detumble=this) animates it).");
   def_scenario_method(
       "detumble",
       [](const Scenario& sc, std::optional<std::string> run) {
@@ -200,6 +207,7 @@ void bind_detumble_job(nb::module_& m) {
             r.result.push_back(detumble(s));
             r.json = detumble_json(s, r.result.front(), FFSR_VERSION).dump();
           }
+          r.series_csv = detumble_series_csv(s, r.result);
         });
       },
       "run"_a = nb::none(),

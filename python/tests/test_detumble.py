@@ -5,6 +5,8 @@ from the KKT system [M J^T; J 0][v+; -p] = [M v-; 0] solved with numpy. The velo
 agree to 1e-9 on both paper robots, from random states and from the end of the Hertz contact run. Also
 the post-capture run and the controller through Python."""
 
+import subprocess
+
 import numpy as np
 import pytest
 
@@ -13,7 +15,7 @@ import ffsr
 pin = pytest.importorskip("pinocchio", reason="Pinocchio's Python package `pin` is a test requirement")
 
 from conftest import ROBOTS  # noqa: E402
-from test_jobs import command_json, differences  # noqa: E402
+from test_jobs import command, command_json, differences  # noqa: E402
 from test_pinocchio import quat_to_rot  # noqa: E402
 
 
@@ -162,3 +164,12 @@ def test_detumble_job_equals_the_command(tmp_path, run, grasp_after):
     assert first["grasp"]["start"] == grasp_after
     with pytest.raises(ffsr.InputError, match="--run"):
         ffsr.Scenario.load(str(scenario)).detumble(run="best")
+
+
+def test_detumble_series_equals_the_command(tmp_path):
+    """series_csv() is the command's --csv (the poses the 3-D view animates after the capture)."""
+    scenario = ROBOTS / "paper_7dof_detumble.toml"
+    out = tmp_path / "series.csv"
+    subprocess.run([command(), "detumble", "--config", str(scenario), "--run", "optimized", "--quiet", "--csv",
+                    str(out)], check=True, timeout=900)
+    assert ffsr.Scenario.load(str(scenario)).detumble(run="optimized").series_csv() == out.read_text()

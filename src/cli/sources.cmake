@@ -10,4 +10,4 @@ set(FFSR_CLI_COMMAND_SOURCES
     commands/run.cpp commands/inspect.cpp commands/contact.cpp commands/xi.cpp commands/map.cpp
     commands/robust.cpp commands/pareto.cpp commands/closed_loop.cpp
     commands/detumble.cpp)
-set(FFSR_CLI_FIGURE_SOURCES figures/capture.cpp figures/figures.cpp figures/plot.cpp)
+set(FFSR_CLI_FIGURE_SOURCES figures/capture.cpp figures/detumble.cpp figures/figures.cpp figures/plot.cpp)

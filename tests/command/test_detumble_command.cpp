@@ -3,6 +3,7 @@
 // rest threshold), the URDF's <limit effort> as the default joint torque limit, the reaction wheels.
 #include "support/command.hpp"
 
+#include <Eigen/Geometry>
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
 
@@ -198,4 +199,64 @@ TEST_CASE("detumble --grasp-after contact: the Hertz phase before the lock, repo
   const auto bad = with({"--grasp-after", "impact"});
   CHECK(bad.exit_code == 2);
   CHECK(bad.err.find("--grasp-after: expected approach or contact, got 'impact'") != std::string::npos);
+}
+
+TEST_CASE("detumble --csv: the joint angles, the base's, the target's and the bodies' poses move rigidly",
+          "[cli]") {
+  // the built-in 3-DOF scenario from its three captures: the target held by the gripper (body 3)
+  ffsr::test::TempDir dir;
+  const json j = ffsr::test::parse_json(cli({"detumble", "--run", "all", "--joint-torque-limit", "20",
+                                             "--quiet", "--json", "-", "--csv", "series.csv"},
+                                            dir.str()));
+  const std::string text = ffsr::test::read_file(dir.str() + "/series.csv");
+  // the runs one after the other: split on the run column (the first), keep the numbers
+  std::map<std::string, std::string> per_run;
+  std::istringstream in(text);
+  std::string header, line;
+  std::getline(in, header);
+  while (std::getline(in, line)) {
+    const auto comma = line.find(',');
+    per_run[line.substr(0, comma)] += line.substr(comma + 1) + "\n";
+  }
+  REQUIRE(per_run.size() == 3);
+  const std::string columns = header.substr(header.find(',') + 1) + "\n";
+  for (const json& r : j.at("runs")) {
+    const std::string name = r.at("run");
+    INFO(name);
+    const auto c = read_csv(columns + per_run.at(name));
+    const auto pose = [&c](const std::string& p, size_t i) {
+      const Eigen::Quaterniond q(c.at(p + "_qw")[i], c.at(p + "_qx")[i], c.at(p + "_qy")[i],
+                                 c.at(p + "_qz")[i]);
+      return std::make_pair(Eigen::Vector3d(c.at(p + "_x")[i], c.at(p + "_y")[i], c.at(p + "_z")[i]), q);
+    };
+    const auto q0 = r.at("joints_deg").get<std::vector<double>>();
+    const auto& t = c.at("t");
+    const auto [pt0, qt0] = pose("target", 0);
+    const auto [pb0, qb0] = pose("body3", 0);
+    const Eigen::Vector3d held = qb0.conjugate() * (pt0 - pb0);  // the target in the gripper's body
+    const Eigen::Quaterniond turn = qb0.conjugate() * qt0;
+    const auto [base0p, base0] = pose("base", 0);
+    for (size_t i = 0; i < t.size(); ++i) {
+      for (const char* p : {"base", "target", "body1", "body2", "body3"})
+        CHECK(pose(p, i).second.norm() == Approx(1.0).margin(1e-10));
+      // held rigidly by the gripper's body
+      const auto [pt, qt] = pose("target", i);
+      const auto [pb, qb] = pose("body3", i);
+      CHECK((qb.conjugate() * (pt - pb) - held).norm() < 1e-9);
+      CHECK(std::abs((qb.conjugate() * qt).dot(turn)) == Approx(1.0).margin(1e-10));
+      // the base's rotation since the grasp, from its attitude column
+      CHECK(base0.angularDistance(pose("base", i).second) == Approx(c.at("base_attitude")[i]).margin(1e-9));
+      // the joint angles advance with the joint rates (trapezoid over a 0.01 s tick)
+      for (size_t k = 1; k <= q0.size(); ++k) {
+        const auto& th = c.at("theta_" + std::to_string(k));
+        const auto& rate = c.at("theta_dot_" + std::to_string(k));
+        if (i == 0) CHECK(th[0] == Approx(q0[k - 1] * M_PI / 180).margin(1e-10));
+        if (i > 0)
+          CHECK(th[i] - th[i - 1] == Approx(0.5 * (rate[i] + rate[i - 1]) * (t[i] - t[i - 1])).margin(1e-7));
+      }
+    }
+    const auto a = r.at("grasp").at("attachment");
+    CHECK(a.at("frame") == "ee");
+    CHECK(a.at("mass").get<double>() > 0);
+  }
 }

@@ -1,5 +1,6 @@
 // Figures (--plot): the plotting module and the pictures of the command, each picture decoded (PNG)
 // or parsed (SVG) and checked against independent computations.
+#include "cli/figures/figure_tools.hpp"
 #include "cli/figures/figures.hpp"
 #include "cli/figures/plot.hpp"
 #include "support/image_check.hpp"
@@ -516,6 +517,103 @@ TEST_CASE("closed-loop figure: one curve per joint and run, the limit lines, equ
   CHECK_THROWS_AS(figures::closed_loop(s), InputError);
 }
 
+/// Two runs of a 2-joint stack: rates decaying as exp(-t), torques near joint 2's limit only.
+figures::DetumbleSeries detumble_series(bool wheels) {
+  figures::DetumbleSeries s;
+  s.joint_names = {"a", "b"};
+  s.torque_limit = {100, 10};
+  s.rest_rate = 0.01;
+  s.wheel_bound = wheels ? 5 : 0;
+  s.stack_rate = wheels;
+  for (int r = 0; r < 2; ++r) {
+    figures::DetumbleSeries::Run run;
+    run.label = r == 0 ? "plain" : "global";
+    run.color = 2 * r;
+    for (int i = 0; i <= 10; ++i) {
+      const double t = 0.5 * i, e = std::exp(-t);
+      run.t.push_back(t);
+      run.rate.push_back(Eigen::Vector2d(0.1 * e, -0.2 * e));
+      run.torque.push_back(Eigen::Vector2d(1.0 * e, -8.0 * e));
+      run.joint_rate.push_back(0.2 * e);
+      run.relative_rate.push_back(0.1 * e);
+      run.stack_rate.push_back(0.05 * e);
+      run.force.push_back(3 * e);
+      run.moment.push_back(2 * e);
+      run.attitude.push_back(0.01 * t);
+      run.energy.push_back(e * e);
+      run.wheel.push_back(Eigen::Vector3d(1, -2, 3) * (1 - e));
+    }
+    s.runs.push_back(run);
+  }
+  return s;
+}
+
+TEST_CASE("detumble figure: joints by colour and runs by style, the threshold, the limits near, the wheels",
+          "[plot][detumble]") {
+  auto s = detumble_series(false);
+  const plot::Figure f = figures::detumble(s);
+  CHECK(f.name == "detumble");
+  REQUIRE(f.panels.size() == 6);
+  const auto& rates = std::get<plot::Panel>(f.panels[0]);
+  REQUIRE(rates.curves.size() == 2 * 2 + 2);              // joint x run, then the runs' styles in black
+  CHECK(rates.curves[1].color == rates.curves[0].color);  // joint a, both runs: one colour
+  CHECK(rates.curves[1].line_style != rates.curves[0].line_style);  // ... two styles
+  CHECK(rates.curves[2].y.front() == Approx(-0.2 * 180 / M_PI));    // deg/s
+  CHECK(rates.curves[0].label == "a");
+  CHECK(rates.curves[1].label.empty());
+  CHECK(rates.curves[5].label == "global");
+  CHECK(rates.curves[5].line_style == 2);
+  const auto& rest = std::get<plot::Panel>(f.panels[1]);
+  const plot::Curve& threshold = rest.curves.back();
+  CHECK(threshold.label == "rest threshold");
+  CHECK(threshold.y == std::vector<double>{0.01 * 180 / M_PI, 0.01 * 180 / M_PI});
+  CHECK(rest.curves.front().color == 0);  // runs by colour: the plain run's
+  CHECK(rest.curves[2].color == 2);
+  // joint b's torque peaks at 80 % of its 10 N m limit: its lines; joint a's at 1 % of 100: none
+  const auto& torque = std::get<plot::Panel>(f.panels[2]);
+  long limits = 0;
+  for (const auto& c : torque.curves) {
+    limits += c.color == figures::tools::kBlack;
+    CHECK(c.y.front() != Approx(100.0));
+  }
+  CHECK(limits == 2);
+  CHECK(torque.curves[4].label == "limit ±10 N m (joint 2)");
+  CHECK(std::get<plot::Panel>(f.panels[3]).curves.front().y.front() == Approx(3.0));  // N
+  CHECK(std::get<plot::Panel>(f.panels[4]).curves.front().y.back() == Approx(0.05 * 180 / M_PI));
+  CHECK(std::get<plot::Panel>(f.panels[5]).ylabel == "energy (J)");
+
+  const plot::Figure w = figures::detumble(detumble_series(true));
+  const auto& wheels = std::get<plot::Panel>(w.panels[5]);
+  CHECK(wheels.curves.back().label == "bound");
+  CHECK(wheels.curves.back().y.front() == 5.0);
+  CHECK(wheels.curves[1].y.back() == Approx(2 * (1 - std::exp(-5.0))));          // |h_y| of the plain run
+  CHECK(std::get<plot::Panel>(w.panels[1]).curves.size() == 3 * 2 + 2 + 3 + 1);  // 3 rates, keys, threshold
+
+  s.runs[1].torque.pop_back();
+  CHECK_THROWS_WITH(figures::detumble(s), Catch::Contains("run 'global'"));
+  s = detumble_series(false);
+  s.torque_limit.pop_back();
+  CHECK_THROWS_AS(figures::detumble(s), InputError);
+}
+
+TEST_CASE("detumble --plot: the post-capture runs of the three captures in one figure",
+          "[plot][cli][detumble]") {
+  TempDir dir;
+  const auto r = run_command({kCli, "detumble", "--run", "all", "--joint-torque-limit", "20", "--plot",
+                              dir.str(), "--json", dir / "d.json", "--quiet"});
+  REQUIRE(r.exit_code == 0);
+  check_png(dir / "detumble.png", 1200, 1250, 8);
+  std::ifstream in(dir / "d.json");
+  const nlohmann::json j = nlohmann::json::parse(in);
+  CHECK(j["runs"].size() == 3);
+  // SVG, from the scenario's configuration of the 7-DOF detumble scenario
+  fs::create_directory(dir / "svg");
+  const auto s = run_command({kCli, "detumble", "--config", ffsr::test::kRobots + "paper_7dof_detumble.toml",
+                              "--plot", dir / "svg", "--plot-format", "svg", "--quiet"});
+  REQUIRE(s.exit_code == 0);
+  check_svg(dir / "svg/detumble.svg");
+}
+
 TEST_CASE("pareto figure: the front, its ends and knee, the runs near it beside it and every run below",
           "[plot][pareto]") {
   figures::ParetoSeries s;
@@ -621,6 +719,9 @@ TEST_CASE("plot bad inputs: a missing folder or an unknown format give one error
       {{kCli, "closed-loop", "--plot", missing, "--quiet"}, "--plot: folder '" + missing},
       {{kCli, "pareto", "--plot", missing, "--json", dir / "front.json"}, "--plot: folder '" + missing},
       {{kCli, "pareto", "--plot", dir.str(), "--plot-format", "gif"}, "--plot-format: unknown format 'gif'"},
+      {{kCli, "detumble", "--joint-torque-limit", "20", "--plot", missing}, "--plot: folder '" + missing},
+      {{kCli, "detumble", "--joint-torque-limit", "20", "--plot", dir.str(), "--plot-format", "gif"},
+       "--plot-format: unknown format 'gif'"},
       {{kCli, "xi", "--points", "1"}, "--points: expected 2 to 100000, got 1"},
   };
   for (const auto& c : cases) {

@@ -26,6 +26,8 @@ struct DetumbleRunOptions {
 /// One recorded tick (inertial frame unless said).
 struct DetumbleSample {
   double t = 0;
+  BasePose base;          ///< the base's pose
+  Eigen::VectorXd theta;  ///< joint angles, rad
   Eigen::VectorXd theta_dot, tau;
   Vector3 gripper_force = Vector3::Zero();   ///< on the target by the gripper, N
   Vector3 gripper_moment = Vector3::Zero();  ///< the same, moment about the contact point, N m

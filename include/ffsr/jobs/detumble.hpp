@@ -9,6 +9,7 @@
 #include "ffsr/control/contact_grasp.hpp"
 #include "ffsr/control/detumble_run.hpp"
 #include "ffsr/jobs/detail/json_values.hpp"
+#include "ffsr/jobs/detail/scenario_series.hpp"
 #include "ffsr/jobs/scenario_run.hpp"
 #include "ffsr/jobs/subject.hpp"
 #include "ffsr/model/attach.hpp"
@@ -199,6 +200,21 @@ inline std::vector<DetumbleJobResult> detumble_runs(const Subject& s, const Scen
   return out;
 }
 
+/// The grasped target as attached at the gripper (grasp.attachment of the JSON): the gripper frame's
+/// name, the target's mass and inertia (its own axes), the pose of its centre-of-mass frame in the
+/// gripper frame. The target's pose at a sample is the gripper frame's pose composed with this one.
+inline nlohmann::json attachment_json(const Model& model, int gripper, const AttachedBody& b) {
+  using detail::vector_json;
+  const Quaternion q(b.pose.R);
+  nlohmann::json inertia = nlohmann::json::array();
+  for (int i = 0; i < 3; ++i) inertia.push_back(vector_json(Eigen::VectorXd(b.inertia.row(i).transpose())));
+  return {{"frame", model.frame(gripper).name},
+          {"mass", b.mass},
+          {"inertia", inertia},
+          {"position", vector_json(Eigen::VectorXd(b.pose.p))},
+          {"quaternion_wxyz", {q.w(), q.x(), q.y(), q.z()}}};
+}
+
 /// The result as JSON: the keys and values of `ffsr-optimize detumble --json` (`version` as given).
 inline nlohmann::json detumble_json(const Subject& s, const DetumbleJobResult& d,
                                     const std::string& version) {
@@ -216,7 +232,8 @@ inline nlohmann::json detumble_json(const Subject& s, const DetumbleJobResult& d
                 {"base_angular_velocity_jump", vector_json(Eigen::VectorXd(g.base_velocity_jump.tail<3>()))},
                 {"energy_before", g.energy_before},
                 {"energy_after", g.energy_after},
-                {"start", d.contact ? "contact" : "approach"}};
+                {"start", d.contact ? "contact" : "approach"},
+                {"attachment", attachment_json(s.robot.model, s.robot.end_effector, g.body)}};
   if (d.contact) {  // the Hertz phase before the lock
     const MultibodyContactResult& c = *d.contact;
     j["grasp"]["contact"] = {{"model", c.model},
@@ -267,18 +284,27 @@ inline nlohmann::json detumble_runs_json(const Subject& s, const std::vector<Det
 }
 
 /// The series as the CSV of `ffsr-optimize detumble --csv`: (with runs: the run's name first) time,
-/// the rates, the gripper load, the base's rotation, the wheels' momentum, the energy, then each
-/// joint's rate and torque.
-inline std::string detumble_series_csv(const std::vector<DetumbleJobResult>& results) {
+/// the rates, the gripper load, the base's rotation, the wheels' momentum, the energy, each joint's
+/// rate and torque; then each joint's angle (rad), the base's pose, the target's (the gripper frame's
+/// pose composed with the grasp's attachment) and every moving body's (its joint frame, numbered as the
+/// main job's body<i> columns). Poses: x, y, z, qw, qx, qy, qz in the inertial frame.
+inline std::string detumble_series_csv(const Subject& s, const std::vector<DetumbleJobResult>& results) {
+  const Model& model = s.robot.model;
+  const int gripper = s.robot.end_effector;
+  Data data(model);
   std::ostringstream o;
-  o << std::setprecision(10);
+  o << std::setprecision(12);
   const bool runs = !results.empty() && !results.front().run.empty();
-  const int n = results.empty() ? 0 : int(results.front().limits.joint_torque.size());
+  const int n = model.n();
   o << (runs ? "run," : "")
     << "t,joint_rate,relative_rate,stack_rate,gripper_force,gripper_moment,base_attitude,wheel_momentum,"
        "energy";
   for (int k = 0; k < n; ++k) o << ",theta_dot_" << k + 1;
   for (int k = 0; k < n; ++k) o << ",tau_" << k + 1;
+  for (int k = 0; k < n; ++k) o << ",theta_" << k + 1;
+  detail::pose_header(o, "base");
+  detail::pose_header(o, "target");
+  for (int b = 1; b < model.nb(); ++b) detail::pose_header(o, "body" + std::to_string(b));
   o << "\n";
   for (const DetumbleJobResult& d : results)
     for (const DetumbleSample& x : d.result.series) {
@@ -288,6 +314,15 @@ inline std::string detumble_series_csv(const std::vector<DetumbleJobResult>& res
         << x.wheel_momentum.norm() << ',' << x.energy;
       for (int k = 0; k < n; ++k) o << ',' << x.theta_dot(k);
       for (int k = 0; k < n; ++k) o << ',' << x.tau(k);
+      for (int k = 0; k < n; ++k) o << ',' << x.theta(k);
+      detail::pose_csv(o, x.base.position, x.base.orientation.normalized());
+      forward_kinematics(model, data, x.base, x.theta);
+      const Pose target = frame_pose(model, data, gripper) * d.grasp.body.pose;
+      detail::pose_csv(o, target.p, Quaternion(target.R).normalized());
+      for (int b = 1; b < model.nb(); ++b) {
+        const auto k = static_cast<size_t>(b);
+        detail::pose_csv(o, data.p[k], Quaternion(data.R[k]));
+      }
       o << "\n";
     }
   return o.str();

@@ -11,7 +11,7 @@ window.ffsrView = function (THREE, OrbitControls, data) {
   const COLOURS = {
     baseline: 0x0072b2, optimized: 0xd55e00, global: 0x009e73,  // the runs, as in the figures
     target: 0xcc79a7, reconfiguration: 0xe69f00, normal: 0x882255, bus: 0x9aa4b1, busEdge: 0x4b5360,
-    link: 0xdfe3e8,
+    link: 0xdfe3e8, detumble: 0x56b4e9,
   };
   const hex = (c) => '#' + c.toString(16).padStart(6, '0');
 
@@ -33,6 +33,10 @@ window.ffsrView = function (THREE, OrbitControls, data) {
 
   // --- data helpers --------------------------------------------------------------------------------
   const runs = data.runs;
+  // the capture instant of a run, and the last time it shows (after the capture with a post-capture run)
+  const captureTime = (r) => r.t[r.capture_index];
+  const endTime = (r) => r.t[r.t.length - 1];
+  const hasPost = (r) => r.capture_index < r.t.length - 1;
   const bodies = data.bodies;
   const nb = bodies.length;
   const v3 = (a, k = 0) => new THREE.Vector3(a[k], a[k + 1], a[k + 2]);
@@ -242,10 +246,12 @@ window.ffsrView = function (THREE, OrbitControls, data) {
     const pts = [];
     for (let k = 0; k < r.t.length; ++k) pts.push(v3(r.ee, 3 * k));
     const split = r.approach_begin;  // first sample of the approach (0: no reconfiguration)
+    const c = r.capture_index;
     pathObjects = [];
     const re = split > 0 ? tube(pts.slice(0, split + 1), COLOURS.reconfiguration, 'path-reconfiguration') : null;
-    const ap = tube(pts.slice(split), COLOURS[r.name] || 0x444444, 'path-approach');
-    for (const o of [re, ap]) if (o) pathObjects.push(o);
+    const ap = tube(pts.slice(split, c + 1), COLOURS[r.name] || 0x444444, 'path-approach');
+    const post = hasPost(r) ? tube(pts.slice(c), COLOURS.detumble, 'path-detumble') : null;
+    for (const o of [re, ap, post]) if (o) pathObjects.push(o);
   }
 
   // --- camera ---------------------------------------------------------------------------------------
@@ -293,7 +299,7 @@ window.ffsrView = function (THREE, OrbitControls, data) {
   }
   const eePoint = v3(data.end_effector_point);
   function setTime(t) {
-    time = Math.min(Math.max(t, run.t[0]), run.t[run.t.length - 1]);
+    time = Math.min(Math.max(t, run.t[0]), endTime(run));
     const [k, s] = frameAt(run, time);
     const k1 = Math.min(k + 1, run.t.length - 1);
     for (let b = 0; b < nb; ++b) {
@@ -325,21 +331,27 @@ window.ffsrView = function (THREE, OrbitControls, data) {
     const k1 = Math.min(k + 1, r.t.length - 1);
     const mie = r.mie[k] + s * (r.mie[k1] - r.mie[k]);
     const f = r.fmax[k] + s * (r.fmax[k1] - r.fmax[k]);
-    const T = r.t[r.t.length - 1];
-    const captured = time >= T - 1e-9;
+    const T = captureTime(r), end = endTime(r);
+    const after = hasPost(r) && time > T + 1e-9;
+    const captured = !after && time >= T - 1e-9;
     const phase = r.approach_begin > 0 && k < r.approach_begin ? 'reconfiguration' : 'approach';
-    $('clock').textContent = `t = ${fmt(time, 1)} s of ${fmt(T, 1)} s`;
+    $('clock').textContent = `t = ${fmt(time, 1)} s of ${fmt(end, 1)} s`;
     const ph = $('phase');
-    ph.textContent = captured ? 'capture' : phase;
-    ph.className = 'badge ' + (captured ? 'capture' : phase);
+    ph.textContent = after ? 'after the capture' : captured ? 'capture' : phase;
+    ph.className = 'badge ' + (after ? 'post-capture' : captured ? 'capture' : phase);
     $('mie').textContent = fmt(mie, 3);
     $('fmax').textContent = fmt(f / 1000, 3);
+    for (const id of ['grip-row', 'grip-key', 'jrate-row', 'jrate-key']) $(id).style.display = after ? '' : 'none';
+    if (after) {
+      $('grip').textContent = fmt(r.grip[k] + s * (r.grip[k1] - r.grip[k]), 2);
+      $('jrate').textContent = fmt(r.jrate[k] + s * (r.jrate[k1] - r.jrate[k]), 3);
+    }
     slider.value = String(time);
   }
   function selectRun(name) {
     run = runs.find((r) => r.name === name) || runs[0];
     buildPath(run);
-    const T = run.t[run.t.length - 1];
+    const T = endTime(run);
     slider.min = String(run.t[0]);
     slider.max = String(T);
     slider.step = String((T - run.t[0]) / 2000);
@@ -354,10 +366,12 @@ window.ffsrView = function (THREE, OrbitControls, data) {
       marks.appendChild(m);
     };
     if (run.approach_begin > 0) mark(run.t[run.approach_begin], 'reconfiguration', 'end of the reconfiguration');
-    mark(T, 'capture', 'capture');
+    mark(captureTime(run), 'capture', 'capture');
+    if (hasPost(run)) mark(T, 'rest', 'at rest');
     for (const b of document.querySelectorAll('#runs button')) b.classList.toggle('on', b.dataset.run === run.name);
     $('legend-approach').style.background = hex(COLOURS[run.name] || 0x444444);
     $('legend-reconfiguration-row').style.display = run.approach_begin > 0 ? '' : 'none';
+    $('legend-detumble-row').style.display = hasPost(run) ? '' : 'none';
     setTime(Math.min(time, T));
   }
 
@@ -375,6 +389,7 @@ window.ffsrView = function (THREE, OrbitControls, data) {
   $('legend-target').style.background = hex(COLOURS.target);
   $('legend-normal').style.background = hex(COLOURS.normal);
   $('legend-reconfiguration').style.background = hex(COLOURS.reconfiguration);
+  $('legend-detumble').style.background = hex(COLOURS.detumble);
   $('legend-bus').style.background = hex(COLOURS.bus);
   $('legend-links').style.background = hex(COLOURS.link);
 
@@ -385,7 +400,7 @@ window.ffsrView = function (THREE, OrbitControls, data) {
     playButton.textContent = p ? '❚❚' : '▶';
     playButton.title = p ? 'pause' : 'play';
     last = performance.now();
-    if (p && time >= run.t[run.t.length - 1] - 1e-9) setTime(run.t[0]);
+    if (p && time >= endTime(run) - 1e-9) setTime(run.t[0]);
   }
   playButton.addEventListener('click', () => setPlaying(!playing));
   slider.addEventListener('input', () => {
@@ -409,12 +424,14 @@ window.ffsrView = function (THREE, OrbitControls, data) {
 
   function loop(now) {
     if (playing) {
-      const T = run.t[run.t.length - 1], t0 = run.t[0];
-      const rate = playSeconds() > 0 ? (T - t0) / playSeconds() : 1;
+      // the approach in the chosen time, the post-capture run (seconds, not minutes) in half of it
+      const T = captureTime(run), end = endTime(run), t0 = run.t[0];
+      const after = time >= T - 1e-9 && end > T;
+      const rate = playSeconds() > 0 ? (after ? (end - T) / (0.5 * playSeconds()) : (T - t0) / playSeconds()) : 1;
       const t = time + ((now - last) / 1000) * rate;
       last = now;
       setTime(t);
-      if (t >= T) setPlaying(false);
+      if (t >= end) setPlaying(false);
     }
     controls.update();
     renderer.render(scene, camera);
@@ -426,7 +443,7 @@ window.ffsrView = function (THREE, OrbitControls, data) {
   const hash = new URLSearchParams(window.location.hash.slice(1));
   selectRun(hash.get('run') || data.initial_run);
   const t0 = Number(hash.get('t'));
-  setTime(hash.has('t') && Number.isFinite(t0) ? t0 : run.t[run.t.length - 1]);
+  setTime(hash.has('t') && Number.isFinite(t0) ? t0 : captureTime(run));
   renderer.render(scene, camera);
   requestAnimationFrame(loop);
 
@@ -447,7 +464,12 @@ window.ffsrView = function (THREE, OrbitControls, data) {
     run: run.name,
     frames: run.t.length,
     time,
-    capture_time: run.t[run.t.length - 1],
+    capture_time: captureTime(run),
+    end_time: endTime(run),
+    post_capture: runs.filter(hasPost).map((r) => r.name),
+    phase: $('phase').textContent,
+    target_pose: [targetGroup.position.x, targetGroup.position.y, targetGroup.position.z, targetGroup.quaternion.w,
+                  targetGroup.quaternion.x, targetGroup.quaternion.y, targetGroup.quaternion.z],
     webgl: gl.getParameter(gl.VERSION),
   };
 };

@@ -5,6 +5,8 @@
 #include "support/parse.hpp"
 #include "support/progress.hpp"
 #include "support/subject.hpp"
+#include "figures/figures.hpp"
+#include "figures/plot.hpp"
 #include "commands/subcommands.hpp"
 
 #include "ffsr/jobs/detumble.hpp"
@@ -18,7 +20,7 @@ namespace {
 
 struct DetumbleCommandOptions {
   SubjectOptions subject;
-  OutputKeys out;   ///< --json, --csv, --quiet
+  OutputKeys out;   ///< --json, --csv, --plot, --plot-format, --quiet
   std::string run;  ///< --run: plain, optimized, global or all; empty: the scenario's configuration
 };
 
@@ -62,11 +64,54 @@ void refuse_law_flags_without_contact(const DetumbleCommandOptions& o, const Sce
                                    keys.grasp_after));
 }
 
+/// The figure of the runs: their series as recorded, the limits and the rest threshold they ran under.
+plot::Figure detumble_figure(const Subject& subject, const std::vector<DetumbleJobResult>& results) {
+  figures::DetumbleSeries f;
+  const DetumbleJobResult& first = results.front();
+  f.joint_names = subject.robot.model.joint_names();
+  f.torque_limit.assign(first.limits.joint_torque.data(),
+                        first.limits.joint_torque.data() + first.limits.joint_torque.size());
+  f.rest_rate = first.options.rest_rate;
+  f.stack_rate = first.options.stop_stack_spin;
+  if (first.limits.actuator == BaseActuator::ReactionWheels) f.wheel_bound = first.limits.wheel_momentum;
+  for (const DetumbleJobResult& d : results) {
+    figures::DetumbleSeries::Run r;
+    r.label = d.run == "baseline" ? "plain" : d.run.empty() ? "joints-deg" : d.run;
+    r.color = d.run == "optimized" ? 1 : d.run == "global" ? 2 : 0;  // the runs' colours of the main job
+    for (const DetumbleSample& x : d.result.series) {
+      r.t.push_back(x.t);
+      r.joint_rate.push_back(x.joint_rate);
+      r.relative_rate.push_back(x.relative_rate);
+      r.stack_rate.push_back(x.stack_rate);
+      r.force.push_back(x.gripper_force.norm());
+      r.moment.push_back(x.gripper_moment.norm());
+      r.attitude.push_back(x.base_attitude);
+      r.energy.push_back(x.energy);
+      r.rate.push_back(x.theta_dot);
+      r.torque.push_back(x.tau);
+      r.wheel.push_back(x.wheel_momentum);
+    }
+    f.runs.push_back(std::move(r));
+  }
+  if (first.run.empty()) {
+    f.title = detail::str("After the capture: at rest in ", std::setprecision(3), first.result.time_to_rest,
+                          " s, peak joint torque ", first.result.peak_joint_torque, " N m (joint ",
+                          first.peak_joint_name, ")");
+  } else {
+    f.title = "After each run's capture: at rest in ";
+    for (size_t i = 0; i < results.size(); ++i)
+      f.title += detail::str(i ? ", " : "", std::setprecision(3), results[i].result.time_to_rest, " s (",
+                             f.runs[i].label, ")");
+  }
+  return figures::detumble(f);
+}
+
 int run_detumble_command(const DetumbleCommandOptions& o) {
   set_quiet(o.out.quiet);
   Outputs outputs = o.out.outputs();  // an output on standard output: the table goes to standard error
   const Subject subject = load_subject(o.subject);
   refuse_law_flags_without_contact(o, subject.keys);
+  const plot::Format plot_format = plot::check_request(o.out.plot, o.out.plot_format);  // before the run
   std::vector<DetumbleJobResult> results;
   if (o.run.empty()) {
     results.push_back(detumble(subject));
@@ -76,7 +121,8 @@ int run_detumble_command(const DetumbleCommandOptions& o) {
     results = detumble_runs(subject, build_scenario(subject.keys, &embedded), o.run);
     outputs.set("--json", detumble_runs_json(subject, results, FFSR_VERSION).dump(2) + "\n");
   }
-  if (!o.out.csv.empty()) outputs.set("--csv", detumble_series_csv(results));
+  if (!o.out.plot.empty()) plot::render({detumble_figure(subject, results)}, o.out.plot, plot_format);
+  if (!o.out.csv.empty()) outputs.set("--csv", detumble_series_csv(subject, results));
   outputs.write();
   for (size_t i = 0; i < results.size(); ++i) {
     if (i > 0) outputs.table() << "\n";
@@ -99,7 +145,10 @@ void register_detumble(CLI::App& app, Action& action) {
   add_output_flags(
       *sub, o->out,
       {"Write the grasp and the post-capture run's summary as JSON to FILE",
-       "Write the post-capture series (rates, gripper load, joint rates and torques) as CSV to FILE"});
+       "Write the post-capture series (rates, gripper load, joint rates, torques and angles, the base's, the "
+       "target's and every body's pose) as CSV to FILE",
+       "Draw the post-capture run against time (joint rates and torques, the rest test, gripper load, base "
+       "attitude, wheels)"});
   sub->callback([o, &action] { action = [o] { return run_detumble_command(*o); }; });
 }
 

@@ -62,6 +62,33 @@ struct ClosedLoopSeries {
 /// rate loops' lag, against time.
 plot::Figure closed_loop(const ClosedLoopSeries& s);
 
+/// The post-capture runs of `detumble` (plain data: the command copies them from the runs' series),
+/// SI units and radians as recorded.
+struct DetumbleSeries {
+  std::string title;
+  std::vector<std::string> joint_names;
+  std::vector<double> torque_limit;  ///< N m, one per joint
+  double rest_rate = 0;              ///< rad/s, the at-rest threshold
+  bool stack_rate = false;           ///< the stack's rate is part of the rest test (stop-stack-spin)
+  double wheel_bound = 0;            ///< the wheels' momentum per axis, N m s; 0: no reaction wheels
+  struct Run {
+    std::string label;  ///< in legends: the main job's run it starts from (plain, optimized, global)
+    int color = 0;      ///< palette index
+    std::vector<double> t, joint_rate, relative_rate, stack_rate;  ///< s, rad/s
+    std::vector<double> force, moment, attitude, energy;           ///< N, N m, rad, J
+    std::vector<Eigen::VectorXd> rate, torque;                     ///< rad/s, N m; one per t
+    std::vector<Eigen::Vector3d> wheel;                            ///< N m s, base frame; one per t
+  };
+  std::vector<Run> runs;
+};
+/// "detumble" (three rows of two panels): against time, the joint rates; the rest test's rates (largest joint rate, the gripper's
+/// rate relative to the base, the stack's) with the threshold; the joint torques with their limits;
+/// the gripper's force and moment on the target; the base's rotation since the grasp; the wheels'
+/// momentum per axis with its bound (with reaction wheels), else the kinetic energy. Joints by colour
+/// and runs by line style in the joint panels, runs by colour elsewhere. InputError on series of
+/// unequal lengths or joint counts.
+plot::Figure detumble(const DetumbleSeries& s);
+
 /// One contact run of `contact`: F(t), delta(t) and the two marked points of Figure 3.
 struct ContactCurve {
   std::string law;

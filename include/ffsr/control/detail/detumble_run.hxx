@@ -37,6 +37,8 @@ inline DetumbleSample detumble_sample(DetumbleSystem& sys, const Eigen::VectorXd
   DetumbleSample s;
   const int n = sys.n;
   s.t = t;
+  s.base = sys.base(y);
+  s.theta = y.segment(7, n);
   s.theta_dot = y.segment(13 + n, n);
   s.tau = cmd.tau;
   s.base_wrench = cmd.base_wrench;
