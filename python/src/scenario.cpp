@@ -110,9 +110,7 @@ void bind_run_result(nb::module_& m) {
               d[x.run.c_str()] = nb::cast(x.result, nb::rv_policy::copy);
             return d;
           },
-          "The post-capture phase of each run (a Detumble key given: joint_torque_limit, base_actuator,\n"
-          "...): {'baseline' | 'optimized' | 'global': DetumbleResult}, as Scenario.detumble(run='all');\n"
-          "empty without those keys. to_dict()[run]['post_capture'] holds the same figures.");
+          "Each run's post-capture phase with a Detumble key, {run: DetumbleResult}; else empty.");
 }
 
 void bind_scenario(nb::module_& m) {

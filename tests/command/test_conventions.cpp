@@ -342,6 +342,19 @@ TEST_CASE("every key of the table has a case in this test", "[cli][conventions]"
   }
 }
 
+TEST_CASE("the main job takes every key of the post-capture phase (the walk below: each changes it)",
+          "[cli][conventions]") {
+  const std::set<std::string> flags = accepted_flags("");
+  int keys = 0;
+  for (const ffsr::ScenarioKey& key : ffsr::scenario_keys()) {
+    if (key.group != ffsr::KeyGroup::Detumble) continue;
+    INFO(key.name);
+    CHECK(flags.count("--" + key.name) == 1);
+    ++keys;
+  }
+  CHECK(keys == 10);
+}
+
 TEST_CASE("each key a subcommand accepts changes its result, or the subcommand refuses it",
           "[cli][conventions]") {
   // the runs first (two at a time, each distinct run once), then the verdicts
