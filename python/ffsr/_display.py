@@ -92,13 +92,36 @@ def _base_disturbance(d):
 
 RUN_HEADER = ["", "Capture configuration (deg)", "M_ie (kg)", "F_max (kN)", "exact (kN)", "tracking (m)",
               "not applied"]
+# with the post-capture phase (a Detumble key given): after "tracking (m)"
+POST_CAPTURE_HEADER = ["rest (s)", "torque (N m)", "joint", "force (N)", "moment (N m)", "attitude (deg)",
+                       "wheels (N m s)"]
+
+
+def run_header(r):
+    """The header of the command's table for a run: with the post-capture columns when it has them."""
+    return RUN_HEADER[:-1] + POST_CAPTURE_HEADER + RUN_HEADER[-1:] if r.post_capture else RUN_HEADER
+
+
+def _post_capture_cells(post, result, key):
+    """A run's post-capture cells as the command prints them: time to rest, peak joint torque and its
+    joint, peak gripper force and moment, base attitude excursion (deg), peak wheel momentum (- without)."""
+    if not post:
+        return []
+    x, d = post[key], result[key]["post_capture"]
+    wheels = f"{x.peak_wheel_momentum:.3f}" if d["parameters"]["base_actuator"] == "reaction-wheels" else "-"
+    return [f"{x.time_to_rest:.2f}", f"{x.peak_joint_torque:.2f}", d["peak_joint"],
+            f"{x.peak_gripper_force:.2f}", f"{x.peak_gripper_moment:.2f}",
+            f"{x.base_attitude_excursion * 57.29577951308232:.3f}", wheels]
 
 
 def run_rows(r):
     """The rows of the command's table for a run: configuration, M_ie, F_max (closed form, exact),
-    tracking error, then the reductions against the plain run, formatted as the command prints them."""
+    tracking error, the post-capture figures when the run has them, then the reductions against the
+    plain run, formatted as the command prints them."""
     rows = []
     result = r.to_dict()
+    post = r.post_capture
+    blank = [""] * (len(POST_CAPTURE_HEADER) if post else 0)  # a failed or reduction row's post-capture cells
     for label, key, run, failure in (("Without optimization", "baseline", r.plain, r.plain_failure),
                                      ("With optimization", "optimized", r.optimized, r.optimized_failure),
                                      ("Global", "global", r.global_run, "")):
@@ -107,10 +130,11 @@ def run_rows(r):
         # the keys the scenario gives that this row's run does not take, as the command's row ends
         skipped = ", ".join(result.get(key, {}).get("keys_not_applied", []))
         if run is None:
-            rows.append([label, "failed (below)", "", "", "", "", skipped])
+            rows.append([label, "failed (below)", "", "", "", ""] + blank + [skipped])
             continue
         rows.append([label, _deg(run.theta), f"{run.M_ie:.3f}", f"{run.f_max_closed_form / 1e3:.3f}",
-                     f"{run.f_max_exact / 1e3:.3f}", f"{run.tracking_error:.2e}", skipped])
+                     f"{run.f_max_exact / 1e3:.3f}", f"{run.tracking_error:.2e}"]
+                    + _post_capture_cells(post, result, key) + [skipped])
 
     def reduction(a, b):
         return f"{100.0 * (a - b) / a:.2f}%"
@@ -120,7 +144,7 @@ def run_rows(r):
             p = r.plain
             rows.append([label, "", reduction(p.M_ie, run.M_ie),
                          reduction(p.f_max_closed_form, run.f_max_closed_form),
-                         reduction(p.f_max_exact, run.f_max_exact), "", ""])
+                         reduction(p.f_max_exact, run.f_max_exact), ""] + blank + [""])
     return rows
 
 
@@ -129,18 +153,18 @@ def _failures(r):
 
 
 def _run_result(r):
-    rows = run_rows(r)
-    widths = [max(len(row[i]) for row in rows + [RUN_HEADER]) for i in range(len(RUN_HEADER))]
+    rows, header = run_rows(r), run_header(r)
+    widths = [max(len(row[i]) for row in rows + [header]) for i in range(len(header))]
     def line(row):  # labels and configurations left-aligned, numbers right-aligned, as the command
         return "  ".join(c.ljust(w) if i < 2 else c.rjust(w) for i, (c, w) in enumerate(zip(row, widths)))
 
-    lines = [line(row).rstrip() for row in [RUN_HEADER] + rows]
+    lines = [line(row).rstrip() for row in [header] + rows]
     return "RunResult(\n" + "\n".join("  " + x for x in lines + _failures(r)) + ")"
 
 
 def _run_result_html(r):
     notes = "".join(f"<p>{html.escape(f)}</p>" for f in _failures(r))
-    return _table(RUN_HEADER, run_rows(r)) + notes
+    return _table(run_header(r), run_rows(r)) + notes
 
 
 def _capture_result(c):

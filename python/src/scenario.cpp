@@ -1,7 +1,8 @@
 // python/src/scenario.cpp -- scenario files and the command's jobs in ffsr._ffsr: Scenario.load(path,
 // **overrides) (the library's reader and validation, a keyword for each key the command takes as a flag)
 // and Scenario.run(), the main job of `ffsr-optimize` (plain, paper's-method and global runs), whose
-// result's to_dict() is the command's --json for the same scenario.
+// result's to_dict() is the command's --json for the same scenario (with each run's post-capture phase
+// when the scenario gives a Detumble key).
 #include "bindings.hpp"
 #include "job_helpers.hpp"
 
@@ -100,7 +101,16 @@ void bind_run_result(nb::module_& m) {
           },
           "The global run, or None when the scenario has global = false.")
       .def_prop_ro("plain_failure", [](const RunResult& r) { return r.result.plain_failure; })
-      .def_prop_ro("optimized_failure", [](const RunResult& r) { return r.result.optimized_failure; });
+      .def_prop_ro("optimized_failure", [](const RunResult& r) { return r.result.optimized_failure; })
+      .def_prop_ro(
+          "post_capture",
+          [](const RunResult& r) {
+            nb::dict d;  // a copy of each run's summary and series
+            for (const DetumbleJobResult& x : r.result.post_capture)
+              d[x.run.c_str()] = nb::cast(x.result, nb::rv_policy::copy);
+            return d;
+          },
+          "Each run's post-capture phase with a Detumble key, {run: DetumbleResult}; else empty.");
 }
 
 void bind_scenario(nb::module_& m) {
@@ -143,13 +153,15 @@ void bind_scenario(nb::module_& m) {
             return run_job<RunResult>([&sc](RunResult& r) {
               ScenarioRunOptions o;
               o.keep_going = true;  // as the command: a failed plain or paper's-method row is reported
+              o.post_capture = true;  // with a Detumble key: each run's post-capture phase
               r.result = run_scenario(sc, o);
               r.json = scenario_json(sc, r.result, FFSR_VERSION).dump();
             });
           },
           "The main job (ffsr-optimize --config FILE): the plain run, the paper's method (Eq. 29-31) and, "
           "unless\n"
-          "global = false, the global run; M_ie (Eq. 14) and the peak force (Eq. 24, Eq. 16) of each.");
+          "global = false, the global run; M_ie (Eq. 14) and the peak force (Eq. 24, Eq. 16) of each;\n"
+          "with a Detumble key, each run's post-capture phase (RunResult.post_capture).");
 }
 
 }  // namespace ffsr::python

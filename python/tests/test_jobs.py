@@ -77,6 +77,32 @@ def test_run_equals_the_command(tmp_path, name):
     assert result.optimized.M_ie == got["optimized"]["integrated_effective_mass"]
 
 
+def test_run_with_post_capture_equals_the_command_and_the_detumble_job(tmp_path):
+    """The main job of a scenario with Detumble keys: each run's post_capture is the command's, and the
+    figures of Scenario.detumble(run='all') (a separate run), to the bit."""
+    scenario = ROBOTS / "paper_7dof_detumble.toml"
+    expected = command_json(tmp_path, scenario)
+    result = ffsr.Scenario.load(str(scenario)).run()
+    got = result.to_dict()
+    assert differences(got, expected) == []
+    assert sorted(result.post_capture) == ["baseline", "global", "optimized"]
+    alone = {r.pop("run"): r for r in ffsr.Scenario.load(str(scenario)).detumble(run="all").to_dict()["runs"]}
+    for name, figures in result.post_capture.items():
+        assert got[name]["post_capture"] == alone[name]
+        assert figures.time_to_rest == got[name]["post_capture"]["time_to_rest"]
+        assert figures.peak_joint_torque == got[name]["post_capture"]["peak_joint_torque"]
+        assert figures.at_rest and figures.ticks == got[name]["post_capture"]["ticks"]
+    # without a Detumble key the runs stop at the impact
+    plain = ffsr.Scenario.load(str(ROBOTS / "paper_3dof.toml"), **{"global": False}).run()
+    assert plain.post_capture == {} and "post_capture" not in plain.to_dict()["baseline"]
+
+
+def test_run_with_post_capture_error_names_the_key_and_the_run():
+    scenario = ROBOTS / "paper_7dof_detumble.toml"
+    with pytest.raises(ffsr.InputError, match=r"--detumble-horizon: .*not at rest after 2 s.*baseline run"):
+        ffsr.Scenario.load(str(scenario), detumble_horizon=2, **{"global": False}).run()
+
+
 @pytest.mark.parametrize("name", SCENARIOS)
 def test_inspect_equals_the_command(tmp_path, name):
     scenario = ROBOTS / f"{name}.toml"

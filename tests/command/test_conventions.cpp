@@ -130,15 +130,17 @@ const std::map<std::string, KeyCase>& key_cases() {
   // closed-loop flies the global run's plan with --plan global (the other subcommands do not take it)
   const Args global{"--global", "true", "--global-starts", "2", "--plan", "global"};
   const Args sphere{"--target-shape", "sphere", "--target-size", "0.29154759474226504"};
-  const Args wheels{"--base-actuator",   "reaction-wheels",
-                    "--wheel-torque",    "0.2",
-                    "--wheel-momentum",  "25",
-                    "--stop-stack-spin", "true"};
-  const Args thrusters{"--base-actuator",   "thrusters", "--thruster-force",  "2",
-                       "--thruster-torque", "0.2",       "--stop-stack-spin", "true",
-                       "--target-velocity", "0.05,0,0"};
-  const Args wheels_kept{
-      "--base-actuator", "reaction-wheels", "--wheel-torque", "0.2", "--wheel-momentum", "25"};
+  // the post-capture phase: the main job runs it for each run when a Detumble key is given; the built-in
+  // robot's URDF gives no <limit effort>, so every case names the joint torque limit
+  const Args torque{"--joint-torque-limit", "20"};
+  const Args wheels{"--joint-torque-limit", "20",  "--base-actuator",  "reaction-wheels",
+                    "--wheel-torque",       "0.2", "--wheel-momentum", "25",
+                    "--stop-stack-spin",    "true"};
+  const Args thrusters{"--joint-torque-limit", "20",   "--base-actuator",   "thrusters",
+                       "--thruster-force",     "2",    "--thruster-torque", "0.2",
+                       "--stop-stack-spin",    "true", "--target-velocity", "0.001,0,0"};
+  const Args wheels_kept{"--joint-torque-limit", "20",  "--base-actuator",  "reaction-wheels",
+                         "--wheel-torque",       "0.2", "--wheel-momentum", "25"};
   static const std::map<std::string, KeyCase> cases = {
       {"urdf", {{"--urdf", files().heavy_urdf, "--joints-deg", "0,150,-100"}, {}}},
       {"end-effector", {{"--end-effector", "link3"}, {}}},
@@ -215,20 +217,21 @@ const std::map<std::string, KeyCase>& key_cases() {
       {"bus-box", {{"--bus-box", "1,1,1"}, sphere}},
       {"clearance", {{"--clearance", "0.09"}, sphere}},
       {"contact-exemption", {{"--contact-exemption", "0.5"}, sphere}},
-      // the post-capture phase (detumble): on the built-in robot the braking needs at most 2.3 N m
-      {"joint-torque-limit", {{"--joint-torque-limit", "1"}, {}}},
+      // the post-capture phase (detumble; the main job's post_capture): on the built-in robot the
+      // braking needs about 3 N m
+      {"joint-torque-limit", {{"--joint-torque-limit", "1"}, torque}},
       {"base-actuator",
        {{"--base-actuator", "thrusters", "--thruster-force", "2", "--thruster-torque", "0.2"},
-        {"--stop-stack-spin", "true"}}},
+        {"--joint-torque-limit", "20", "--stop-stack-spin", "true"}}},
       {"wheel-torque", {{"--wheel-torque", "0.5"}, wheels}},
       // the stack's angular momentum, 3.49 N m s, does not fit in wheels of 2 N m s per axis
       {"wheel-momentum", {{"--wheel-momentum", "2"}, wheels}},
-      // the stack's linear momentum (a moving target) is what the thrusters' force removes
-      {"thruster-force", {{"--thruster-force", "0.5"}, thrusters}},
+      // the stack's linear momentum (a moving target, 0.2 N s) is what the thrusters' force removes
+      {"thruster-force", {{"--thruster-force", "0.001"}, thrusters}},
       {"thruster-torque", {{"--thruster-torque", "0.5"}, thrusters}},
-      {"rest-rate-deg", {{"--rest-rate-deg", "0.1"}, {}}},
-      {"detumble-horizon", {{"--detumble-horizon", "2"}, {}, false, true}},
-      {"detumble-tick", {{"--detumble-tick", "0.02"}, {}}},
+      {"rest-rate-deg", {{"--rest-rate-deg", "0.1"}, torque}},
+      {"detumble-horizon", {{"--detumble-horizon", "2"}, torque, false, true}},
+      {"detumble-tick", {{"--detumble-tick", "0.02"}, torque}},
       {"stop-stack-spin", {{"--stop-stack-spin", "true"}, wheels_kept}},
       // the grasp after the Hertz contact run: another lock impulse and start state
       {"grasp-after", {{"--grasp-after", "contact"}, {}}},
@@ -340,6 +343,19 @@ TEST_CASE("every key of the table has a case in this test", "[cli][conventions]"
     INFO("key '" << key.name << "': add an alternative value to key_cases()");
     CHECK(key_cases().count(key.name) == 1);
   }
+}
+
+TEST_CASE("the main job takes every key of the post-capture phase (the walk below: each changes it)",
+          "[cli][conventions]") {
+  const std::set<std::string> flags = accepted_flags("");
+  int keys = 0;
+  for (const ffsr::ScenarioKey& key : ffsr::scenario_keys()) {
+    if (key.group != ffsr::KeyGroup::Detumble) continue;
+    INFO(key.name);
+    CHECK(flags.count("--" + key.name) == 1);
+    ++keys;
+  }
+  CHECK(keys == 10);
 }
 
 TEST_CASE("each key a subcommand accepts changes its result, or the subcommand refuses it",

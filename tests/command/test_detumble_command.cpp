@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <map>
 #include <regex>
@@ -123,7 +124,12 @@ TEST_CASE("detumble with reaction wheels: the stack's spin stopped, the stored m
 }
 
 TEST_CASE("detumble --run: from the capture configurations of the main job's runs", "[cli]") {
-  const json main = ffsr::test::parse_json(cli({"--config", kDetumbleToml, "--quiet", "--json", "-"}));
+  // the main job with the Detumble keys of the file runs each run's post-capture phase: its table
+  // (standard output) and its JSON (a file) from one run, `detumble --run all` from another process
+  ffsr::test::TempDir dir;
+  const auto main_run = cli({"--config", kDetumbleToml, "--json", "main.json"}, dir.str());
+  REQUIRE(main_run.exit_code == 0);
+  const json main = json::parse(ffsr::test::read_existing_file(dir.str() + "/main.json"));
   const json all = ffsr::test::parse_json(
       cli({"detumble", "--config", kDetumbleToml, "--run", "all", "--quiet", "--json", "-"}));
   REQUIRE(all.at("runs").size() == 3);
@@ -136,6 +142,23 @@ TEST_CASE("detumble --run: from the capture configurations of the main job's run
     for (size_t k = 0; k < q.size(); ++k) CHECK(q[k] == Approx(qm[k]).margin(1e-9));
     CHECK(r.at("at_rest").get<bool>());
     CHECK(r.at("momentum_drift").get<double>() < 1e-8);
+    // the main job's figures of the run: the same names and values, to the last bit
+    json expected = r;
+    expected.erase("run");
+    CHECK(main.at(name).at("post_capture") == expected);
+    // its row of the table: time to rest, peak torque and joint, peak gripper force and moment, base
+    // attitude excursion (deg), no wheels
+    const std::string label = name == "baseline"    ? "Without optimization"
+                              : name == "optimized" ? "With optimization"
+                                                    : "Global";
+    char cells[256];
+    std::snprintf(cells, sizeof cells, "e-\\d+ +%.2f +%.2f +%s +%.2f +%.2f +%.3f +-\\s",
+                  r.at("time_to_rest").get<double>(), r.at("peak_joint_torque").get<double>(),
+                  r.at("peak_joint").get<std::string>().c_str(), r.at("peak_gripper_force").get<double>(),
+                  r.at("peak_gripper_moment").get<double>(),
+                  r.at("base_attitude_excursion").get<double>() * 180 / M_PI);
+    INFO(main_run.out);
+    CHECK(std::regex_search(main_run.out, std::regex("\n" + label + " +\\[[^\n]*" + cells)));
   }
   // one run alone: the same result as within 'all'
   json one = ffsr::test::parse_json(
@@ -259,4 +282,80 @@ TEST_CASE("detumble --csv: the joint angles, the base's, the target's and the bo
     CHECK(a.at("frame") == "ee");
     CHECK(a.at("mass").get<double>() > 0);
   }
+}
+
+TEST_CASE("main job: each run's post-capture phase when a Detumble key is given; the CSV unchanged",
+          "[cli]") {
+  ffsr::test::TempDir dir;
+  const Args run{"--global", "false", "--quiet", "--json", "-"};
+  Args plain = run, post = run;
+  plain.insert(plain.end(), {"--csv", "plain.csv"});
+  post.insert(post.end(), {"--csv", "post.csv", "--joint-torque-limit", "2"});
+  const json a = ffsr::test::parse_json(cli(plain, dir.str()));
+  const json b = ffsr::test::parse_json(cli(post, dir.str()));
+  for (const char* name : {"baseline", "optimized"}) {
+    INFO(name);
+    CHECK_FALSE(a.at(name).contains("post_capture"));  // no Detumble key: the runs stop at the impact
+    const json& p = b.at(name).at("post_capture");
+    CHECK(p.at("parameters").at("joint_torque_limit") == json({2.0, 2.0, 2.0}));
+    CHECK(p.at("at_rest").get<bool>());
+    CHECK(p.at("peak_joint_torque").get<double>() <= 2.0 * (1 + 1e-12));
+    CHECK(p.at("momentum_drift").get<double>() < 1e-8);
+    // the grasp starts from the run's capture configuration
+    const auto q = p.at("joints_deg").get<std::vector<double>>();
+    const auto qm = b.at(name).at("capture_configuration_deg").get<std::vector<double>>();
+    REQUIRE(q.size() == qm.size());
+    for (size_t k = 0; k < q.size(); ++k) CHECK(q[k] == Approx(qm[k]).margin(1e-9));
+    CHECK_FALSE(p.contains("version"));
+    // the capture itself does not change
+    CHECK(a.at(name).at("integrated_effective_mass") == b.at(name).at("integrated_effective_mass"));
+  }
+  CHECK(b.at("scenario").at("joint-torque-limit") == json({2.0}));
+  // the CSV holds the approach's series only (detumble --csv holds the post-capture series)
+  CHECK(ffsr::test::read_existing_file(dir.str() + "/plain.csv") ==
+        ffsr::test::read_existing_file(dir.str() + "/post.csv"));
+}
+
+TEST_CASE("main job: an error of the post-capture phase names the key and the run and writes nothing",
+          "[cli]") {
+  ffsr::test::TempDir dir;
+  const std::string old = "{\"earlier\": true}\n";
+  std::ofstream(dir.str() + "/out.json") << old;
+  struct Case {
+    Args args;
+    std::vector<std::string> says;
+  };
+  const std::vector<Case> cases = {
+      {{"--joint-torque-limit", "20", "--detumble-horizon", "2"},
+       {"--detumble-horizon", "not at rest after 2 s", "baseline run"}},
+      {{"--joint-torque-limit", "20", "--stop-stack-spin", "true"}, {"--stop-stack-spin", "baseline run"}},
+      {{"--joint-torque-limit", "20", "--base-actuator", "reaction-wheels", "--wheel-torque", "0.2",
+        "--wheel-momentum", "1", "--stop-stack-spin", "true"},
+       {"--wheel-momentum", "cannot store", "baseline run"}},
+      {{"--rest-rate-deg", "0.1"}, {"--joint-torque-limit", "<limit effort>", "baseline run"}}};
+  for (const Case& c : cases) {
+    Args a{"--global", "false", "--quiet", "--json", "out.json", "--csv", "out.csv"};
+    a.insert(a.end(), c.args.begin(), c.args.end());
+    const auto r = cli(a, dir.str());
+    INFO(r.err);
+    CHECK(r.exit_code == 2);
+    CHECK(r.out.empty());
+    CHECK(std::count(r.err.begin(), r.err.end(), '\n') == 1);
+    for (const std::string& part : c.says) CHECK(r.err.find(part) != std::string::npos);
+    CHECK(ffsr::test::read_file(dir.str() + "/out.json") == old);  // the earlier file survives
+    CHECK_FALSE(std::ifstream(dir.str() + "/out.csv").good());
+  }
+  // a key of the file is named where the file gives it
+  std::string toml =
+      std::regex_replace(ffsr::test::read_file(kDetumbleToml), std::regex("base-actuator = \"none\""),
+                         "base-actuator = \"none\"\nstop-stack-spin = true");
+  toml = std::regex_replace(toml, std::regex("urdf = \"paper_7dof.urdf\""),
+                            "urdf = \"" + ffsr::test::kUrdf7 + "\"");
+  std::ofstream(dir.str() + "/spin.toml") << toml;
+  const auto r =
+      cli({"--config", "spin.toml", "--global", "false", "--quiet", "--json", "out.json"}, dir.str());
+  INFO(r.err);
+  CHECK(r.exit_code == 2);
+  CHECK(std::regex_search(r.err, std::regex("spin\\.toml:\\d+: stop-stack-spin: .*conserved.*baseline run")));
+  CHECK(ffsr::test::read_file(dir.str() + "/out.json") == old);
 }

@@ -8,6 +8,7 @@
 #include "ffsr/algorithm/joint_models.hpp"
 #include "ffsr/control/contact_grasp.hpp"
 #include "ffsr/control/detumble_run.hpp"
+#include "ffsr/jobs/detail/detumble_result.hpp"
 #include "ffsr/jobs/detail/json_values.hpp"
 #include "ffsr/jobs/detail/scenario_series.hpp"
 #include "ffsr/jobs/scenario_run.hpp"
@@ -21,21 +22,6 @@
 #include <string>
 
 namespace ffsr {
-
-/// The job's result: the grasp, the run's summary and series, the limits it ran under.
-struct DetumbleJobResult {
-  std::string
-      run;  ///< the main job's run it starts from (baseline, optimized, global); empty: a configuration
-  Eigen::VectorXd theta;  ///< the capture configuration, rad
-  GraspResult grasp;
-  /// grasp-after = contact: the Hertz contact run before the lock and its impulse on the gripper (N s)
-  std::optional<MultibodyContactResult> contact;
-  Vector3 contact_impulse = Vector3::Zero();
-  DetumbleRunResult result;
-  DetumbleLimits limits;
-  DetumbleOptions options;
-  std::string peak_joint_name;  ///< the joint of the peak torque
-};
 
 /// The limits and the law's settings of a scenario's Detumble keys for `model`: joint-torque-limit
 /// (one value or one per joint; when not given, the URDF's <limit effort> of every joint), the base
@@ -165,6 +151,29 @@ inline DetumbleJobResult detumble(const Subject& s) {
   return detumble(s, s.robot.base, s.robot.theta, s.target);
 }
 
+namespace detail {
+
+/// The post-capture run from the capture of each of `runs` (the main job's run's name, its result) of
+/// the scenario `sc` built from the subject's keys: each run's configuration and base pose at T, the
+/// target at T. InputError naming the run it started from.
+inline std::vector<DetumbleJobResult> detumble_each_run(
+    const Subject& s, const Scenario& sc,
+    const std::vector<std::pair<std::string, const CaptureResult*>>& runs) {
+  const Target target = prepare_capture(sc.problem, sc.task, sc.capture).capture_target;
+  std::vector<DetumbleJobResult> out;
+  for (const auto& [name, run] : runs) {
+    try {
+      out.push_back(detumble(s, run->base, run->theta, target));
+    } catch (const InputError& e) {  // which start it was
+      throw InputError(str(e.what(), " (from the ", name, " run's capture)"));
+    }
+    out.back().run = name;
+  }
+  return out;
+}
+
+}  // namespace detail
+
 /// From the capture of the main job's runs (jobs/scenario_run.hpp) of the scenario `sc` (built from
 /// the subject's keys): `which` is plain, optimized, global or all (every run the scenario has); each
 /// run's capture configuration and base pose at T, the target at T. InputError naming --run.
@@ -175,49 +184,28 @@ inline std::vector<DetumbleJobResult> detumble_runs(const Subject& s, const Scen
     throw InputError(str("--run: expected plain, optimized, global or all, got '", which, "'"));
   if (which == "global" && !sc.keys.global)
     throw InputError("--run: global asks for the global run, and this scenario has none (global = false)");
-  const Target target = prepare_capture(sc.problem, sc.task, sc.capture).capture_target;
-  std::vector<std::pair<std::string, CaptureResult>> runs;
+  std::pair<CaptureResult, CaptureResult> rows;
+  ScenarioResult r;
+  std::vector<std::pair<std::string, const CaptureResult*>> runs;
   if (which == "plain" || which == "optimized") {
-    auto [plain, optimized] = plan_plain_and_optimized(sc);
-    runs.emplace_back(which == "plain" ? "baseline" : "optimized", which == "plain" ? plain : optimized);
+    rows = plan_plain_and_optimized(sc);
+    runs.emplace_back(which == "plain" ? "baseline" : "optimized",
+                      which == "plain" ? &rows.first : &rows.second);
   } else {
-    const ScenarioResult r = run_scenario(sc);
+    r = run_scenario(sc);
     if (which == "all") {
-      runs.emplace_back("baseline", r.plain);
-      runs.emplace_back("optimized", r.optimized);
+      runs.emplace_back("baseline", &r.plain);
+      runs.emplace_back("optimized", &r.optimized);
     }
-    if (r.global) runs.emplace_back("global", r.global->result.run);
+    if (r.global) runs.emplace_back("global", &r.global->result.run);
   }
-  std::vector<DetumbleJobResult> out;
-  for (const auto& [name, run] : runs) {
-    try {
-      out.push_back(detumble(s, run.base, run.theta, target));
-    } catch (const InputError& e) {  // which start it was
-      throw InputError(str(e.what(), " (from the ", name, " run's capture)"));
-    }
-    out.back().run = name;
-  }
-  return out;
+  return detail::detumble_each_run(s, sc, runs);
 }
 
-/// The grasped target as attached at the gripper (grasp.attachment of the JSON): the gripper frame's
-/// name, the target's mass and inertia (its own axes), the pose of its centre-of-mass frame in the
-/// gripper frame. The target's pose at a sample is the gripper frame's pose composed with this one.
-inline nlohmann::json attachment_json(const Model& model, int gripper, const AttachedBody& b) {
-  using detail::vector_json;
-  const Quaternion q(b.pose.R);
-  nlohmann::json inertia = nlohmann::json::array();
-  for (int i = 0; i < 3; ++i) inertia.push_back(vector_json(Eigen::VectorXd(b.inertia.row(i).transpose())));
-  return {{"frame", model.frame(gripper).name},
-          {"mass", b.mass},
-          {"inertia", inertia},
-          {"position", vector_json(Eigen::VectorXd(b.pose.p))},
-          {"quaternion_wxyz", {q.w(), q.x(), q.y(), q.z()}}};
-}
-
-/// The result as JSON: the keys and values of `ffsr-optimize detumble --json` (`version` as given).
-inline nlohmann::json detumble_json(const Subject& s, const DetumbleJobResult& d,
-                                    const std::string& version) {
+/// The result as JSON: the keys and values of `ffsr-optimize detumble --json` (`version` as given) for
+/// the scenario's keys `keys`, the robot `model` and its gripper frame `gripper`.
+inline nlohmann::json detumble_json(const ScenarioKeys& keys, const Model& model, int gripper,
+                                    const DetumbleJobResult& d, const std::string& version) {
   const GraspResult& g = d.grasp;
   using detail::vector_json;
   const DetumbleRunResult& r = d.result;
@@ -233,7 +221,7 @@ inline nlohmann::json detumble_json(const Subject& s, const DetumbleJobResult& d
                 {"energy_before", g.energy_before},
                 {"energy_after", g.energy_after},
                 {"start", d.contact ? "contact" : "approach"},
-                {"attachment", attachment_json(s.robot.model, s.robot.end_effector, g.body)}};
+                {"attachment", attachment_json(model, gripper, g.body)}};
   if (d.contact) {  // the Hertz phase before the lock
     const MultibodyContactResult& c = *d.contact;
     j["grasp"]["contact"] = {{"model", c.model},
@@ -250,8 +238,8 @@ inline nlohmann::json detumble_json(const Subject& s, const DetumbleJobResult& d
                      {"base_actuator", actuator_name(d.limits.actuator)},
                      {"stop_stack_spin", d.options.stop_stack_spin},
                      {"rest_rate", d.options.rest_rate},
-                     {"tick", s.keys.detumble_tick},
-                     {"horizon", s.keys.detumble_horizon}};
+                     {"tick", keys.detumble_tick},
+                     {"horizon", keys.detumble_horizon}};
   j["status"] = status_name(e.status);
   j["at_rest"] = r.at_rest;
   j["time_to_rest"] = r.time_to_rest;
@@ -269,6 +257,12 @@ inline nlohmann::json detumble_json(const Subject& s, const DetumbleJobResult& d
   j["final_stack_rate"] = e.stack_rate;
   j["ticks"] = r.ticks;
   return j;
+}
+
+/// As above, for the subject's keys.
+inline nlohmann::json detumble_json(const Subject& s, const DetumbleJobResult& d,
+                                    const std::string& version) {
+  return detumble_json(s.keys, s.robot.model, s.robot.end_effector, d, version);
 }
 
 /// The results of detumble_runs as JSON: {"version", "runs": [each run's detumble_json]}.
@@ -326,6 +320,38 @@ inline std::string detumble_series_csv(const Subject& s, const std::vector<Detum
       o << "\n";
     }
   return o.str();
+}
+
+/// The subject of a scenario (its keys, robot as loaded, start state, target, contact law), without
+/// loading the robot again: what the detumble job reads of it.
+inline Subject subject_of_scenario(const Scenario& sc) {
+  Subject s;
+  s.keys = sc.keys;
+  s.robot.model = *sc.model;
+  s.robot.end_effector = sc.problem.frame;
+  s.robot.base = sc.problem.base;
+  s.robot.theta = sc.problem.theta;
+  s.robot.report = sc.report;
+  s.target = sc.problem.target;
+  s.params = sc.problem.contact;
+  s.law = sc.problem.law;
+  s.approach_speed = sc.problem.approach_speed;
+  return s;
+}
+
+inline std::vector<DetumbleJobResult> post_capture_runs(const Scenario& sc, const ScenarioResult& r) {
+  std::vector<std::pair<std::string, const CaptureResult*>> runs;  // a failed row has no capture
+  if (r.plain_ok()) runs.emplace_back("baseline", &r.plain);
+  if (r.optimized_ok()) runs.emplace_back("optimized", &r.optimized);
+  if (r.global) runs.emplace_back("global", &r.global->result.run);
+  return detail::detumble_each_run(subject_of_scenario(sc), sc, runs);
+}
+
+inline nlohmann::json post_capture_json(const Scenario& sc, const DetumbleJobResult& d) {
+  nlohmann::json j = detumble_json(sc.keys, *sc.model, sc.problem.frame, d, "");
+  j.erase("version");
+  j.erase("run");
+  return j;
 }
 
 }  // namespace ffsr

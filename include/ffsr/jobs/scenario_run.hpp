@@ -6,6 +6,7 @@
 #pragma once
 
 #include "ffsr/scenario/scenario.hpp"
+#include "ffsr/jobs/detail/detumble_result.hpp"
 #include "ffsr/jobs/scenario_clearance.hpp"
 #include "ffsr/optimize/branches.hpp"
 #include "ffsr/optimize/pareto.hpp"
@@ -59,6 +60,10 @@ struct ScenarioResult {
   /// with shapes (scenario/geometry.hpp, jobs/scenario_clearance.hpp): each run's smallest
   /// distances along its path
   std::vector<std::pair<std::string, ClearanceReport>> clearances;  ///< baseline, optimized, global
+  /// With ScenarioRunOptions::post_capture and a Detumble key given (scenario_has_post_capture): the
+  /// post-capture phase of each run that holds a result, as the job `detumble --run all` runs it
+  /// (jobs/detumble.hpp), in the order baseline, optimized, global (DetumbleJobResult::run)
+  std::vector<DetumbleJobResult> post_capture;
 };
 
 struct ScenarioRunOptions {
@@ -71,7 +76,28 @@ struct ScenarioRunOptions {
   /// global run then has no paper's-method start; when it fails too, the error names both failures.
   /// Default: the first failure is thrown (plan_plain_and_optimized).
   bool keep_going = false;
+  /// Runs the post-capture phase of every run (ScenarioResult::post_capture) when the scenario gives a
+  /// key of the Detumble group (scenario_has_post_capture): the command's main job and Scenario.run.
+  /// An error of that phase (an actuator too small, not at rest by the horizon) is an InputError
+  /// naming the key and the run. Default: the runs stop at the impact.
+  bool post_capture = false;
 };
+
+/// Whether a scenario asks for the post-capture phase: it gives (file or override) a key of the
+/// Detumble group (joint-torque-limit, base-actuator, rest-rate-deg, ...).
+inline bool scenario_has_post_capture(const ScenarioKeys& keys) {
+  for (const ScenarioKey& key : scenario_keys())
+    if (key.group == KeyGroup::Detumble && keys.given.count(key.name)) return true;
+  return false;
+}
+
+/// The post-capture phase of each run of `r` that holds a result (jobs/detumble.hpp: the grasp at the
+/// run's capture, the target at T, the stack brought to rest under the Detumble keys). InputError
+/// naming the key and the run.
+inline std::vector<DetumbleJobResult> post_capture_runs(const Scenario& sc, const ScenarioResult& r);
+/// One run's `post_capture` object of the main job's JSON: the run's `detumble --json` (detumble_json)
+/// without `version` and `run`.
+inline nlohmann::json post_capture_json(const ScenarioKeys& keys, const DetumbleJobResult& d);
 
 /// The plain and the optimized run. A NumericalError names the run ("plain run: ...").
 std::pair<CaptureResult, CaptureResult> plan_plain_and_optimized(const Scenario& sc,
@@ -123,3 +149,4 @@ inline double reduction_percent(double before, double after) { return 100.0 * (b
 #include "ffsr/jobs/detail/base_disturbance_json.hpp"
 #include "ffsr/jobs/detail/scenario_series.hpp"
 #include "ffsr/jobs/detail/result_json.hpp"
+#include "ffsr/jobs/detumble.hpp"  // post_capture_runs, post_capture_json

@@ -14,6 +14,7 @@
 
 #include "ffsr/jobs/scenario_run.hpp"
 
+#include <algorithm>
 #include <iomanip>
 #include <iostream>
 #include <memory>
@@ -97,6 +98,7 @@ ScenarioResult compute(Scenario& sc, const RunSettings& o) {
   Progress p1{"plain"}, p2{"optimized"};
   ScenarioRunOptions run;
   run.keep_going = true;  // a plain or paper's-method row that fails is reported; the global row decides
+  run.post_capture = true;  // with a Detumble key: each run's post-capture phase
   if (!o.quiet) {
     run.plain_progress = std::ref(p1);
     run.optimized_progress = std::ref(p2);
@@ -215,15 +217,61 @@ void print_robust_note(std::ostream& out, const ScenarioResult& r) {
   out << "\n";
 }
 
-/// The rows of the table: configuration, M_ie, F_max (closed form and exact), tracking error.
+/// The post-capture columns (ScenarioResult::post_capture): the widths and the header.
+struct PostCaptureColumns {
+  const ScenarioResult& r;
+  int joint = 7;  ///< the joint column: its longest name + 2
+  explicit PostCaptureColumns(const ScenarioResult& result) : r(result) {
+    for (const DetumbleJobResult& d : r.post_capture)
+      joint = std::max(joint, int(d.peak_joint_name.size()) + 2);
+  }
+  void header(std::ostream& out) const {
+    if (r.post_capture.empty()) return;
+    out << std::setw(10) << "rest (s)" << std::setw(14) << "torque (N m)" << std::setw(joint) << "joint"
+        << std::setw(11) << "force (N)" << std::setw(14) << "moment (N m)" << std::setw(16)
+        << "attitude (deg)" << std::setw(16) << "wheels (N m s)";
+  }
+  /// The cells of the run `name` (baseline, optimized, global): time to rest, peak joint torque and its
+  /// joint, peak gripper force and moment, base attitude excursion, peak wheel momentum (- without wheels).
+  void cells(std::ostream& out, const std::string& name) const {
+    for (const DetumbleJobResult& d : r.post_capture) {
+      if (d.run != name) continue;
+      const DetumbleRunResult& x = d.result;
+      std::ostringstream wheels;
+      wheels << std::fixed << std::setprecision(3) << x.peak_wheel_momentum;
+      out << std::fixed << std::setprecision(2) << std::setw(10) << x.time_to_rest << std::setw(14)
+          << x.peak_joint_torque << std::setw(joint) << d.peak_joint_name << std::setw(11)
+          << x.peak_gripper_force << std::setw(14) << x.peak_gripper_moment << std::setprecision(3)
+          << std::setw(16) << x.base_attitude_excursion * 180.0 / M_PI << std::setw(16)
+          << (d.limits.actuator == BaseActuator::ReactionWheels ? wheels.str() : "-");
+    }
+  }
+};
+
+/// The legend of the post-capture columns.
+void print_post_capture_note(std::ostream& out, const Scenario& sc, const ScenarioResult& r) {
+  if (r.post_capture.empty()) return;
+  const DetumbleJobResult& d = r.post_capture.front();
+  out << std::defaultfloat << "after the capture (base actuator " << actuator_name(d.limits.actuator)
+      << (d.options.stop_stack_spin ? ", stopping the stack's spin" : "") << ", at rest below "
+      << sc.keys.rest_rate_deg
+      << " deg/s):\n  rest = time to rest, torque = peak joint torque (at joint), force and moment = peak "
+         "gripper load,\n  attitude = base attitude excursion, wheels = peak momentum stored in the reaction "
+         "wheels (- without)\n";
+}
+
+/// The rows of the table: configuration, M_ie, F_max (closed form and exact), tracking error, and
+/// with the post-capture phase its figures.
 void print_rows(std::ostream& out, const Scenario& sc, const ScenarioResult& r) {
   const int w = 8 * sc.model->n() + 4;
   if (sc.problem.joints.model != JointModel::Free)  // joint models of the contact
     out << "M_ie with " << joint_model_name(sc.problem.joints.model) << " joints during the contact\n";
   out << std::left << std::setw(24) << "" << std::setw(w) << "Capture configuration (deg)" << std::right
       << std::setw(11) << "M_ie (kg)" << std::setw(14) << "F_max (kN)" << std::setw(14) << "exact (kN)"
-      << std::setw(15) << "tracking (m)"
-      << "\n";
+      << std::setw(15) << "tracking (m)";
+  const PostCaptureColumns post(r);
+  post.header(out);
+  out << "\n";
   auto row = [&](const char* label, ScenarioRow which, const CaptureResult& x,
                  const std::string& failure = {}) {
     if (!failure.empty()) {  // the message follows the table
@@ -233,6 +281,9 @@ void print_rows(std::ostream& out, const Scenario& sc, const ScenarioResult& r) 
           << std::fixed << std::setprecision(3) << std::setw(11) << x.M_ie << std::setw(14)
           << x.f_max_closed_form / 1e3 << std::setw(14) << x.f_max_exact / 1e3 << std::setw(15)
           << std::scientific << std::setprecision(2) << x.tracking_error << std::fixed;
+      post.cells(out, which == ScenarioRow::Plain       ? "baseline"
+                      : which == ScenarioRow::Optimized ? "optimized"
+                                                        : "global");
     }
     const char* sep = "  not applied: ";  // the keys of the scenario this row's run does not take
     for (const std::string& key : keys_not_applied(sc.keys, which)) {
@@ -327,6 +378,7 @@ void print_table(std::ostream& out, const Scenario& sc, const ScenarioResult& r)
   out << "tasks: plain " << (sc.baseline_task.kind == CaptureTask::Kind::Pose ? "pose" : "position")
       << ", optimized " << (sc.task.kind == CaptureTask::Kind::Pose ? "pose" : "position")
       << "; F_max: Eq. 24 closed form; exact: peak of the single-body model (Eq. 16)\n";
+  print_post_capture_note(out, sc, r);
   // a failed run's CaptureResult is empty: no damped evaluations, and its smallest singular value (0) is not one
   const long damped = r.plain.damped_steps + r.optimized.damped_steps;
   if (damped > 0)
@@ -375,11 +427,8 @@ void register_run(CLI::App& app, Action& action) {
   app.add_option("--config", o->config,
                  "Scenario file (TOML); every key is also a flag. Default: the built-in paper 3-DOF scenario")
       ->check(CLI::ExistingFile);
-  // the post-capture phase's keys are the detumble subcommand's: the main job stops at the impact
-  o->flags.add_to(app, [](const std::string& name) {
-    const ScenarioKey* key = find_scenario_key(name);
-    return !key || key->group != KeyGroup::Detumble;
-  });
+  // every key: the Detumble keys add each run's post-capture phase (ScenarioRunOptions::post_capture)
+  o->flags.add_to(app);
   add_output_flags(app, o->settings,
                    {"Write the result (with the resolved scenario and the version) as JSON to FILE",
                     "Write the time series of the runs as CSV to FILE",

@@ -211,6 +211,7 @@ inline nlohmann::json scenario_json(const Scenario& sc, const ScenarioResult& r,
                                   {"optimized", ScenarioRow::Optimized},
                                   {"global", ScenarioRow::Global}})
     if (j.contains(name)) j[name]["keys_not_applied"] = keys_not_applied(sc.keys, row);
+  for (const DetumbleJobResult& d : r.post_capture) j[d.run]["post_capture"] = post_capture_json(sc, d);
   detail::add_base_disturbance_json(j, sc, r);
   if (sc.geometry) detail::add_clearance_json(j, r);
   j["scene"] = detail::scene_json(sc);

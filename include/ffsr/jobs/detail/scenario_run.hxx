@@ -170,7 +170,10 @@ inline void add_robust_rows(const Scenario& sc, ScenarioResult& r) {
 
 }  // namespace detail
 
-inline ScenarioResult run_scenario(const Scenario& sc, const ScenarioRunOptions& options) {
+namespace detail {
+
+/// The runs of the main job, up to the impact (run_scenario without the post-capture phase).
+inline ScenarioResult run_captures(const Scenario& sc, const ScenarioRunOptions& options) {
   ScenarioResult r;
   if (!options.keep_going || !sc.keys.global) {
     std::tie(r.plain, r.optimized) = plan_plain_and_optimized(sc, options);
@@ -200,6 +203,14 @@ inline ScenarioResult run_scenario(const Scenario& sc, const ScenarioRunOptions&
   }
   if (sc.geometry) r.clearances.emplace_back("global", run_clearance(sc, r.global->result.run));
   if (r.robust) detail::add_robust_rows(sc, r);
+  return r;
+}
+
+}  // namespace detail
+
+inline ScenarioResult run_scenario(const Scenario& sc, const ScenarioRunOptions& options) {
+  ScenarioResult r = detail::run_captures(sc, options);
+  if (options.post_capture && scenario_has_post_capture(sc.keys)) r.post_capture = post_capture_runs(sc, r);
   return r;
 }
 
