@@ -8,6 +8,7 @@
 #include "ffsr/algorithm/joint_models.hpp"
 #include "ffsr/control/detumble_run.hpp"
 #include "ffsr/jobs/detail/json_values.hpp"
+#include "ffsr/jobs/detail/post_capture.hpp"
 #include "ffsr/jobs/scenario_run.hpp"
 #include "ffsr/jobs/subject.hpp"
 #include "ffsr/model/attach.hpp"
@@ -30,49 +31,6 @@ struct DetumbleJobResult {
   DetumbleOptions options;
   std::string peak_joint_name;  ///< the joint of the peak torque
 };
-
-/// The limits and the law's settings of a scenario's Detumble keys for `model`: joint-torque-limit
-/// (one value or one per joint; when not given, the URDF's <limit effort> of every joint), the base
-/// actuator and its bounds (each needed by its actuator, refused without it, from a file too),
-/// rest-rate-deg, stop-stack-spin. InputError naming the key.
-inline void detumble_settings(const ScenarioKeys& k, const Model& model, DetumbleLimits& l,
-                              DetumbleOptions& o) {
-  using detail::str;
-  for (const ScenarioKey& key : scenario_keys()) {  // the Detumble keys' own checks, and where they act
-    if (key.group != KeyGroup::Detumble) continue;
-    if (key.check) key.check(k);
-    const std::string why = key.acts && k.given.count(key.name) ? key.acts(k) : "";
-    if (!why.empty()) throw InputError(str("--", key.name, ": ", why));
-  }
-  if (k.joint_torque_limit.empty()) {
-    l.joint_torque.resize(model.n());
-    for (int j = 0; j < model.n(); ++j) {
-      l.joint_torque(j) = model.joint(j).effort;
-      if (!(l.joint_torque(j) > 0))
-        throw InputError(
-            str("--joint-torque-limit: not given, and the URDF gives no <limit effort> for joint '",
-                model.joint(j).name, "'"));
-    }
-  } else {
-    l.joint_torque = per_joint_values(k.joint_torque_limit, model, "--joint-torque-limit");
-  }
-  const auto needed = [&k](const char* name, double value) {
-    if (!k.given.count(name))
-      throw InputError(str("--", name, ": needed with base-actuator = ", k.base_actuator));
-    return value;
-  };
-  if (k.base_actuator == "reaction-wheels") {
-    l.actuator = BaseActuator::ReactionWheels;
-    l.wheel_torque = needed("wheel-torque", k.wheel_torque);
-    l.wheel_momentum = needed("wheel-momentum", k.wheel_momentum);
-  } else if (k.base_actuator == "thrusters") {
-    l.actuator = BaseActuator::Thrusters;
-    l.thruster_force = needed("thruster-force", k.thruster_force);
-    l.thruster_torque = needed("thruster-torque", k.thruster_torque);
-  }
-  o.rest_rate = k.rest_rate_deg * M_PI / 180.0;
-  o.stop_stack_spin = k.stop_stack_spin;
-}
 
 /// The job: grasp_at_capture at the subject's configuration (the contact point moving at the approach
 /// speed along the target's normal), the stack, run_detumble. InputError for bad keys, an actuator too

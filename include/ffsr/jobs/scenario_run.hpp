@@ -6,6 +6,7 @@
 #pragma once
 
 #include "ffsr/scenario/scenario.hpp"
+#include "ffsr/jobs/detail/post_capture.hpp"
 #include "ffsr/jobs/scenario_clearance.hpp"
 #include "ffsr/optimize/branches.hpp"
 #include "ffsr/optimize/pareto.hpp"
@@ -31,6 +32,10 @@ struct GlobalRun {
   double paper_objective = 0;
   /// the distinct local optima of the last search (at the reached base pose), sorted by objective
   std::vector<CaptureBranch> branches;
+  /// With post-capture constraints (max-time-to-rest, ...): the post-capture figures at the reached
+  /// capture configuration, and the candidate runs of the search (how many met the constraints).
+  std::optional<PostCaptureFigures> post_capture;
+  int post_capture_candidates = 0, post_capture_admitted = 0;
 };
 
 /// The tail measure of one row over the robust-force objective's sample set, N.

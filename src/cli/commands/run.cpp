@@ -277,6 +277,15 @@ void print_base_jump(std::ostream& out, const Scenario& sc, const ScenarioResult
   if (r.global && sc.keys.max_base_rate_deg > 0)
     out << std::defaultfloat << " (searched within max-base-rate-deg " << sc.keys.max_base_rate_deg << ")";
   out << "\n";
+  if (r.global && r.global->post_capture) {  // the post-capture constraints
+    const PostCaptureFigures& f = *r.global->post_capture;
+    out << std::defaultfloat << std::setprecision(4) << "global run after the capture (detumble run): rest in "
+        << f.time_to_rest << " s, peak joint torque " << f.peak_joint_torque << " N m ("
+        << sc.model->joint(f.peak_joint).name << "), peak gripper force " << f.peak_gripper_force
+        << " N, moment " << f.peak_gripper_moment << " N m; " << r.global->post_capture_admitted << " of "
+        << r.global->post_capture_candidates << " candidate runs met " << post_capture_constraints(sc.keys).flags()
+        << "\n";
+  }
   out.flags(flags);
   out.precision(precision);
 }
@@ -357,8 +366,21 @@ int report(const Scenario& sc, const ScenarioResult& r, const RunSettings& o, Ru
   return check_expected(o, q, j);
 }
 
+/// The post-capture keys (Detumble) act in the main job through the global search's post-capture
+/// constraints only: a flag of one without a constraint is refused, naming it.
+void check_post_capture_flags(const ScenarioKeys& keys) {
+  if (post_capture_constraints(keys).any()) return;
+  for (const ScenarioKey& key : scenario_keys())
+    if (key.group == KeyGroup::Detumble && keys.overridden.count(key.name))
+      throw InputError("--" + key.name +
+                       ": the main job runs the post-capture phase only for the global search's post-capture "
+                       "constraints (max-time-to-rest, max-peak-joint-torque, max-gripper-force, "
+                       "max-gripper-moment), and none is given; `ffsr-optimize detumble` runs it alone");
+}
+
 int run_main(const RunOptions& o, const CLI::App& app) {
   ScenarioKeys keys = command_scenario_keys(o.config, o.flags, kCommandKeys);
+  check_post_capture_flags(keys);
   const RunSettings settings = settings_of(o.settings, keys, app);
   set_quiet(settings.quiet);  // the flag, or the file's quiet key
   Scenario sc = command_scenario(std::move(keys));
@@ -375,11 +397,8 @@ void register_run(CLI::App& app, Action& action) {
   app.add_option("--config", o->config,
                  "Scenario file (TOML); every key is also a flag. Default: the built-in paper 3-DOF scenario")
       ->check(CLI::ExistingFile);
-  // the post-capture phase's keys are the detumble subcommand's: the main job stops at the impact
-  o->flags.add_to(app, [](const std::string& name) {
-    const ScenarioKey* key = find_scenario_key(name);
-    return !key || key->group != KeyGroup::Detumble;
-  });
+  // every key: the post-capture phase's (Detumble) for the global search's post-capture constraints
+  o->flags.add_to(app);
   add_output_flags(app, o->settings,
                    {"Write the result (with the resolved scenario and the version) as JSON to FILE",
                     "Write the time series of the runs as CSV to FILE",

@@ -88,6 +88,11 @@ inline GlobalRun run_global(const Scenario& sc, const CaptureResult* paper_run, 
   if (sc.keys.max_base_rate_deg > 0)  // the impact's base-rate jump as a constraint of every search
     g.search.inequalities = base_rate_inequality(sc.problem, prepare_capture(sc.problem, sc.task, opt),
                                                  sc.keys.max_base_rate_deg * M_PI / 180.0);
+  std::shared_ptr<PostCaptureScreen> screen;  // the post-capture constraints: a candidate constraint
+  if (post_capture_constraints(sc.keys).any()) {
+    screen = std::make_shared<PostCaptureScreen>(sc, prepare_capture(sc.problem, sc.task, opt).capture_target);
+    g.admit = [screen](const BasePose& b, const std::vector<Eigen::VectorXd>& t) { return (*screen)(b, t); };
+  }
   g.reconfigure.mode = reconfigure_mode_of(sc.keys.reconfigure, "--reconfigure");
   g.reconfigure.duration = sc.keys.reconfigure_duration;
   opt.record_series = opt.record_series || sc.geometry;
@@ -105,12 +110,20 @@ inline GlobalRun run_global(const Scenario& sc, const CaptureResult* paper_run, 
             "jump within ",
             std::setprecision(6), sc.keys.max_base_rate_deg, " deg/s",
             sc.geometry ? " and the clearance" : "", " (`ffsr-optimize pareto` shows the least)"));
+  } catch (const NoAdmittedCandidateError&) {
+    throw InputError(screen->shortfall());
   } catch (const JointRateLimitError& e) {
     throw InputError(str("--max-joint-rate-deg: ", e.what()));
   } catch (const InputError& e) {
     throw InputError(str("global run: ", e.what()));
   } catch (const NumericalError& e) {
+    if (screen && screen->admitted() == 0) throw InputError(screen->shortfall());
     throw NumericalError(str("global run: ", e.what()));
+  }
+  if (screen) {  // the figures at the capture reached (check_reached admitted it)
+    r.post_capture = screen->figures(r.result.run.base, r.result.run.theta);
+    r.post_capture_candidates = screen->evaluated();
+    r.post_capture_admitted = screen->admitted();
   }
   const CaptureSetup setup = prepare_capture(sc.problem, sc.task, opt);
   r.paper_objective = paper_run ? evaluate_capture(sc.problem, setup, paper_run->base, paper_run->theta,
