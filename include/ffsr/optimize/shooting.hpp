@@ -118,7 +118,8 @@ inline void drop_turned_optima(const CaptureProblem& pb, const CaptureTask& task
 }
 
 /// The points of `points` that meet g.admit at `base` (all of them without it), order kept.
-inline void admitted_only(const GlobalCaptureOptions& g, const BasePose& base, std::vector<ManifoldPoint>& points) {
+inline void admitted_only(const GlobalCaptureOptions& g, const BasePose& base,
+                          std::vector<ManifoldPoint>& points) {
   if (!g.admit || points.empty()) return;
   std::vector<Eigen::VectorXd> thetas;
   for (const ManifoldPoint& p : points) thetas.push_back(p.theta);

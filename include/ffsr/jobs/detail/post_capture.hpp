@@ -68,19 +68,21 @@ inline void detumble_settings(const ScenarioKeys& k, const Model& model, Detumbl
 
 /// The post-capture figures of one capture configuration that the constraints read.
 struct PostCaptureFigures {
-  bool at_rest = false;           ///< within detumble-horizon
-  double time_to_rest = 0;        ///< s; the horizon when not at rest, infinity when not run
-  double peak_joint_torque = 0;   ///< N m
-  int peak_joint = -1;            ///< its joint (coordinate)
-  double peak_gripper_force = 0;  ///< N
-  double peak_gripper_moment = 0; ///< N m
-  std::string failure;            ///< not run: the base actuator cannot stop the stack's spin
+  bool at_rest = false;            ///< within detumble-horizon
+  double time_to_rest = 0;         ///< s; the horizon when not at rest, infinity when not run
+  double peak_joint_torque = 0;    ///< N m
+  int peak_joint = -1;             ///< its joint (coordinate)
+  double peak_gripper_force = 0;   ///< N
+  double peak_gripper_moment = 0;  ///< N m
+  std::string failure;             ///< not run: the base actuator cannot stop the stack's spin
 };
 
 /// The global run's post-capture constraints; 0: not set.
 struct PostCaptureConstraints {
   double time_to_rest = 0, peak_joint_torque = 0, gripper_force = 0, gripper_moment = 0;
-  bool any() const { return time_to_rest > 0 || peak_joint_torque > 0 || gripper_force > 0 || gripper_moment > 0; }
+  bool any() const {
+    return time_to_rest > 0 || peak_joint_torque > 0 || gripper_force > 0 || gripper_moment > 0;
+  }
   /// The keys set, as flags joined by '/' ("--max-time-to-rest/--max-gripper-force").
   std::string flags() const {
     std::string out;
@@ -144,21 +146,27 @@ class PostCaptureScreen {
   /// `target`: the target at the capture time. InputError naming the first constraint key when the
   /// Detumble keys do not give a post-capture run (no joint torque limit, say) or a bound cannot bind.
   PostCaptureScreen(const Scenario& sc, const Target& target)
-      : model_(sc.model.get()), frame_(sc.problem.frame), target_(target), speed_(sc.problem.approach_speed),
+      : model_(sc.model.get()),
+        frame_(sc.problem.frame),
+        target_(target),
+        speed_(sc.problem.approach_speed),
         constraints_(post_capture_constraints(sc.keys)) {
     using detail::str;
     const std::string first = constraints_.flags().substr(0, constraints_.flags().find('/'));
     try {
       detumble_settings(sc.keys, *model_, limits_, options_);
     } catch (const InputError& e) {
-      throw InputError(str(first, ": the post-capture constraints need the post-capture run, and its keys "
-                                  "do not give it: ", e.what()));
+      throw InputError(str(first,
+                           ": the post-capture constraints need the post-capture run, and its keys "
+                           "do not give it: ",
+                           e.what()));
     }
     run_.tick = sc.keys.detumble_tick;
     run_.horizon = sc.keys.detumble_horizon;
     if (constraints_.peak_joint_torque >= limits_.joint_torque.maxCoeff())
       throw InputError(str("--max-peak-joint-torque: ", constraints_.peak_joint_torque,
-                           " N m is not below the largest joint torque limit (", limits_.joint_torque.maxCoeff(),
+                           " N m is not below the largest joint torque limit (",
+                           limits_.joint_torque.maxCoeff(),
                            " N m): the controller keeps every torque within its limit, so it cannot bind"));
     if (constraints_.time_to_rest > run_.horizon)
       throw InputError(str("--max-time-to-rest: ", constraints_.time_to_rest,
@@ -196,17 +204,18 @@ class PostCaptureScreen {
     const auto add = [&best](double bound, const char* what, double value, const char* unit) {
       if (!(bound > 0)) return;
       std::ostringstream o;
-      o << std::setprecision(4) << (best.empty() ? "" : ", ") << what << " " << value << " " << unit << " (limit "
-        << bound << ")";
+      o << std::setprecision(4) << (best.empty() ? "" : ", ") << what << " " << value << " " << unit
+        << " (limit " << bound << ")";
       best += o.str();
     };
     add(constraints_.time_to_rest, "time to rest", least_.time_to_rest, "s");
     add(constraints_.peak_joint_torque, "peak joint torque", least_.peak_joint_torque, "N m");
     add(constraints_.gripper_force, "peak gripper force", least_.peak_gripper_force, "N");
     add(constraints_.gripper_moment, "peak gripper moment", least_.peak_gripper_moment, "N m");
-    return str(constraints_.flags(), ": no capture configuration of the global search meets the post-capture ",
-               "constraints (", evaluated_, " candidate runs, ", at_rest_, " at rest within detumble-horizon ",
-               run_.horizon, " s); the least each candidate reached: ", best);
+    return str(constraints_.flags(),
+               ": no capture configuration of the global search meets the post-capture ", "constraints (",
+               evaluated_, " candidate runs, ", at_rest_, " at rest within detumble-horizon ", run_.horizon,
+               " s); the least each candidate reached: ", best);
   }
 
  private:
@@ -230,9 +239,10 @@ class PostCaptureScreen {
   DetumbleOptions options_;
   DetumbleRunOptions run_;
   int evaluated_ = 0, admitted_ = 0, at_rest_ = 0;
-  PostCaptureFigures least_{false, std::numeric_limits<double>::infinity(),
-                            std::numeric_limits<double>::infinity(), -1,
-                            std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(), ""};
+  PostCaptureFigures least_{
+      false, std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
+      -1,    std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
+      ""};
 };
 
 }  // namespace ffsr

@@ -90,7 +90,8 @@ inline GlobalRun run_global(const Scenario& sc, const CaptureResult* paper_run, 
                                                  sc.keys.max_base_rate_deg * M_PI / 180.0);
   std::shared_ptr<PostCaptureScreen> screen;  // the post-capture constraints: a candidate constraint
   if (post_capture_constraints(sc.keys).any()) {
-    screen = std::make_shared<PostCaptureScreen>(sc, prepare_capture(sc.problem, sc.task, opt).capture_target);
+    const Target at_capture = prepare_capture(sc.problem, sc.task, opt).capture_target;
+    screen = std::make_shared<PostCaptureScreen>(sc, at_capture);
     g.admit = [screen](const BasePose& b, const std::vector<Eigen::VectorXd>& t) { return (*screen)(b, t); };
   }
   g.reconfigure.mode = reconfigure_mode_of(sc.keys.reconfigure, "--reconfigure");
@@ -118,7 +119,11 @@ inline GlobalRun run_global(const Scenario& sc, const CaptureResult* paper_run, 
     throw InputError(str("global run: ", e.what()));
   } catch (const NumericalError& e) {
     if (screen && screen->admitted() == 0) throw InputError(screen->shortfall());
-    throw NumericalError(str("global run: ", e.what()));
+    throw NumericalError(str("global run: ", e.what(),
+                             screen ? str(" (", screen->admitted(), " of ", screen->evaluated(),
+                                          " candidate runs met the post-capture constraints ",
+                                          screen->constraints().flags(), ")")
+                                    : std::string()));
   }
   if (screen) {  // the figures at the capture reached (check_reached admitted it)
     r.post_capture = screen->figures(r.result.run.base, r.result.run.theta);

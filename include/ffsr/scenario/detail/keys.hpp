@@ -543,8 +543,8 @@ inline void add_post_capture_keys(std::vector<ScenarioKey>& keys) {
                  "below the largest joint-torque-limit)"),
         "max-peak-joint-torque", &K::max_peak_joint_torque);
   bound(FFSR_KEY("max-gripper-force", max_gripper_force,
-                 "Global search: largest force of the gripper on the target after the grasp, N (a constraint; "
-                 "> 0)"),
+                 "Global search: largest force of the gripper on the target after the grasp, N (a "
+                 "constraint; > 0)"),
         "max-gripper-force", &K::max_gripper_force);
   bound(FFSR_KEY("max-gripper-moment", max_gripper_moment,
                  "Global search: largest moment of the gripper on the target after the grasp, N m (a "
