@@ -118,3 +118,47 @@ TEST_CASE("whole capture: bad constraints are one error line naming the key", "[
         std::string::npos);
   CHECK(r.err.find("--joint-torque-limit") != std::string::npos);
 }
+
+TEST_CASE("pareto --axis: the front of M_ie against a figure of the post-capture run", "[cli][whole-capture]") {
+  const ffsr::test::TempDir dir;
+  const std::string file = scenario_file(dir, "");
+  const std::string csv = dir.str() + "/front.csv";
+  const ffsr::test::CommandResult r = cli({"pareto", "--config", file, "--levels", "3", "--starts", "2", "--axis",
+                                           "peak-joint-torque", "--json", "-", "--csv", csv, "--quiet"});
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  CHECK(j.at("axis") == "peak-joint-torque");
+  const nlohmann::json& pc = j.at("post_capture");
+  CHECK(pc.at("unit") == "N m");
+  const nlohmann::json& front = pc.at("front");
+  REQUIRE(front.size() >= 1);
+  CHECK(pc.at("candidates").get<int>() >= int(front.size()));
+  for (size_t i = 1; i < front.size(); ++i) {  // non-dominated: M_ie up, the torque down
+    CHECK(front[i].at("integrated_effective_mass") > front[i - 1].at("integrated_effective_mass"));
+    CHECK(front[i].at("value") < front[i - 1].at("value"));
+  }
+  // each point's value is the peak torque of a detumble run at its configuration, the base at the
+  // global run's pose at T
+  const ffsr::Scenario sc = ffsr::load_scenario(file);
+  const std::vector<double> p = j.at("base_position").get<std::vector<double>>();
+  const std::vector<double> q = j.at("base_quaternion_wxyz").get<std::vector<double>>();
+  ffsr::BasePose base;
+  base.position = ffsr::Vector3(p[0], p[1], p[2]);
+  base.orientation = Eigen::Quaterniond(q[0], q[1], q[2], q[3]);
+  for (const nlohmann::json& x : {front.front(), front.back()}) {
+    const std::vector<double> deg = x.at("capture_configuration_deg").get<std::vector<double>>();
+    Eigen::VectorXd theta(deg.size());
+    for (size_t k = 0; k < deg.size(); ++k) theta(Eigen::Index(k)) = deg[k] * M_PI / 180;
+    const ffsr::DetumbleRunResult d = detumble_at(sc, base, theta);
+    CHECK(x.at("value").get<double>() == Approx(d.peak_joint_torque).epsilon(1e-6));
+  }
+  CHECK(ffsr::test::read_file(csv).rfind("index,M_ie_kg,peak_joint_torque_N_m,base_rate_deg_s,knee", 0) == 0);
+  // the post-capture keys with the impact's axis, and an unknown axis: refused, naming the flag
+  const ffsr::test::CommandResult keys = cli({"pareto", "--config", file, "--rest-rate-deg", "0.1", "--quiet"});
+  CHECK(keys.exit_code == 2);
+  CHECK(keys.err.find("--rest-rate-deg: acts on the post-capture axes of pareto only") != std::string::npos);
+  const ffsr::test::CommandResult axis = cli({"pareto", "--axis", "torque", "--quiet"});
+  CHECK(axis.exit_code == 2);
+  CHECK(axis.err.find("--axis: expected base-rate") != std::string::npos);
+}

@@ -145,14 +145,16 @@ class PostCaptureScreen {
  public:
   /// `target`: the target at the capture time. InputError naming the first constraint key when the
   /// Detumble keys do not give a post-capture run (no joint torque limit, say) or a bound cannot bind.
-  PostCaptureScreen(const Scenario& sc, const Target& target)
+  /// `who`: the flag the errors name (default: the first constraint key).
+  PostCaptureScreen(const Scenario& sc, const Target& target, std::string who = "")
       : model_(sc.model.get()),
         frame_(sc.problem.frame),
         target_(target),
         speed_(sc.problem.approach_speed),
         constraints_(post_capture_constraints(sc.keys)) {
     using detail::str;
-    const std::string first = constraints_.flags().substr(0, constraints_.flags().find('/'));
+    const std::string first =
+        who.empty() ? constraints_.flags().substr(0, constraints_.flags().find('/')) : std::move(who);
     try {
       detumble_settings(sc.keys, *model_, limits_, options_);
     } catch (const InputError& e) {
@@ -173,12 +175,19 @@ class PostCaptureScreen {
                            " s is beyond detumble-horizon (", run_.horizon, " s), where the run stops"));
   }
 
-  std::vector<char> operator()(const BasePose& base, const std::vector<Eigen::VectorXd>& thetas) {
+  /// The figures at each configuration at `base`, on all cores (not counted).
+  std::vector<PostCaptureFigures> figures(const BasePose& base,
+                                          const std::vector<Eigen::VectorXd>& thetas) const {
     std::vector<PostCaptureFigures> f(thetas.size());
     const unsigned threads = std::max(1u, std::thread::hardware_concurrency());
     detail::parallel_for(thetas.size(), threads, [&](std::uint64_t i) {
       f[i] = post_capture_figures(*model_, frame_, limits_, options_, run_, base, thetas[i], target_, speed_);
     });
+    return f;
+  }
+
+  std::vector<char> operator()(const BasePose& base, const std::vector<Eigen::VectorXd>& thetas) {
+    const std::vector<PostCaptureFigures> f = figures(base, thetas);
     std::vector<char> ok(thetas.size());
     for (size_t i = 0; i < f.size(); ++i) {
       ok[i] = meets(f[i], constraints_);
