@@ -119,12 +119,14 @@ TEST_CASE("whole capture: bad constraints are one error line naming the key", "[
   CHECK(r.err.find("--joint-torque-limit") != std::string::npos);
 }
 
-TEST_CASE("pareto --axis: the front of M_ie against a figure of the post-capture run", "[cli][whole-capture]") {
+TEST_CASE("pareto --axis: the front of M_ie against a figure of the post-capture run",
+          "[cli][whole-capture]") {
   const ffsr::test::TempDir dir;
   const std::string file = scenario_file(dir, "");
   const std::string csv = dir.str() + "/front.csv";
-  const ffsr::test::CommandResult r = cli({"pareto", "--config", file, "--levels", "3", "--starts", "2", "--axis",
-                                           "peak-joint-torque", "--json", "-", "--csv", csv, "--quiet"});
+  const ffsr::test::CommandResult r =
+      cli({"pareto", "--config", file, "--levels", "3", "--starts", "2", "--axis", "peak-joint-torque",
+           "--json", "-", "--csv", csv, "--quiet"});
   INFO(r.err);
   REQUIRE(r.exit_code == 0);
   const nlohmann::json j = nlohmann::json::parse(r.out);
@@ -155,7 +157,8 @@ TEST_CASE("pareto --axis: the front of M_ie against a figure of the post-capture
   }
   CHECK(ffsr::test::read_file(csv).rfind("index,M_ie_kg,peak_joint_torque_N_m,base_rate_deg_s,knee", 0) == 0);
   // the post-capture keys with the impact's axis, and an unknown axis: refused, naming the flag
-  const ffsr::test::CommandResult keys = cli({"pareto", "--config", file, "--rest-rate-deg", "0.1", "--quiet"});
+  const ffsr::test::CommandResult keys =
+      cli({"pareto", "--config", file, "--rest-rate-deg", "0.1", "--quiet"});
   CHECK(keys.exit_code == 2);
   CHECK(keys.err.find("--rest-rate-deg: acts on the post-capture axes of pareto only") != std::string::npos);
   const ffsr::test::CommandResult axis = cli({"pareto", "--axis", "torque", "--quiet"});

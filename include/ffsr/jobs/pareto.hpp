@@ -109,7 +109,8 @@ inline ParetoJobResult pareto(const Scenario& sc, const ParetoJobOptions& o) {
     out.runs.push_back(detail::pareto_point(*sc.model, data, sc.problem, setup, x->base, x->theta, e));
   out.base = g.base;
   out.axis = o.axis;
-  if (o.axis != "base-rate") out.post_capture = detail::pareto_post_capture(sc, r, out.front, setup, o.axis, e);
+  if (o.axis != "base-rate")
+    out.post_capture = detail::pareto_post_capture(sc, r, out.front, setup, o.axis, e);
   return out;
 }
 

@@ -107,7 +107,8 @@ plot::Figure post_capture_figure(const Scenario& sc, const PostCaptureFront& f) 
   }
   s.knee = f.knee;
   for (size_t i = 0; i < f.runs.size(); ++i)
-    if (std::isfinite(f.runs[i].value)) s.runs.push_back({kRunNames[i], f.runs[i].point.M_ie, f.runs[i].value});
+    if (std::isfinite(f.runs[i].value))
+      s.runs.push_back({kRunNames[i], f.runs[i].point.M_ie, f.runs[i].value});
   s.y_unit = detail::pareto_axis_unit(f.axis);
   s.y_name = f.axis;
   s.y_label = "post-capture " + f.axis + " (" + s.y_unit + ")";

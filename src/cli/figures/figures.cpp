@@ -230,7 +230,8 @@ plot::Figure pareto(const ParetoSeries& s) {
   front.curves.push_back(marker("least M_ie: " + mass_rate(s.mass.front(), s.rate.front(), s.y_unit),
                                 {s.mass.front()},
                                 {s.rate.front()}, kBlack, "■", 0.9));
-  front.curves.push_back(marker("least " + s.y_name + ": " + mass_rate(s.mass.back(), s.rate.back(), s.y_unit),
+  front.curves.push_back(marker("least " + s.y_name + ": " +
+                                    mass_rate(s.mass.back(), s.rate.back(), s.y_unit),
                                 {s.mass.back()},
                                 {s.rate.back()}, kBlack, "□", 0.9));
   front.curves.push_back(marker("knee: " + mass_rate(s.mass[s.knee], s.rate[s.knee], s.y_unit),

@@ -44,9 +44,10 @@ inline const char* pareto_axis_unit(const std::string& axis) {
 inline void check_pareto_axis(const std::string& axis) {
   const auto& a = pareto_axes();
   if (std::find(a.begin(), a.end(), axis) == a.end())
-    throw InputError(str("--axis: expected base-rate, time-to-rest, peak-joint-torque, gripper-force or "
-                         "gripper-moment, got '",
-                         axis, "'"));
+    throw InputError(
+        str("--axis: expected base-rate, time-to-rest, peak-joint-torque, gripper-force or "
+            "gripper-moment, got '",
+            axis, "'"));
 }
 
 /// The axis' figure; infinity when the run is not at rest (such a candidate is on no front).
@@ -98,9 +99,11 @@ inline PostCaptureFront post_capture_front(const Scenario& sc, const CaptureSetu
     all.push_back({detail::pareto_point(*sc.model, data, sc.problem, setup, base, thetas[i], e), f[i], v});
   }
   if (all.empty())
-    throw InputError(detail::str("--axis: no candidate of the ", axis, " front is at rest within detumble-horizon (",
-                                 out.candidates, " candidate runs)"));
-  std::stable_sort(all.begin(), all.end(), [](const auto& a, const auto& b) { return a.point.M_ie < b.point.M_ie; });
+    throw InputError(detail::str("--axis: no candidate of the ", axis,
+                                 " front is at rest within detumble-horizon (", out.candidates,
+                                 " candidate runs)"));
+  std::stable_sort(all.begin(), all.end(),
+                   [](const auto& a, const auto& b) { return a.point.M_ie < b.point.M_ie; });
   for (const PostCaptureFrontPoint& p : all)
     if (out.points.empty() || p.value < out.points.back().value * (1 - 1e-9)) out.points.push_back(p);
   out.knee = detail::post_capture_knee(out.points);
