@@ -191,6 +191,19 @@ def test_pareto_equals_the_command(tmp_path, name):
         ffsr.Scenario.load(str(scenario)).pareto(levels=0)
 
 
+def test_run_with_post_capture_constraints_equals_the_command(tmp_path):
+    # the global search keeps the captures whose post-capture run holds every joint within 3 N m
+    scenario = ROBOTS / "paper_3dof.toml"
+    expected = command_json(tmp_path, scenario, "--global-starts", "2", "--joint-torque-limit", "20",
+                            "--max-peak-joint-torque", "3")
+    got = ffsr.Scenario.load(str(scenario), global_starts=2, joint_torque_limit=20,
+                             max_peak_joint_torque=3).run().to_dict()
+    assert differences(got, expected) == []
+    assert 0 < got["global"]["post_capture"]["peak_joint_torque"] <= 3
+    with pytest.raises(ffsr.InputError, match="--max-peak-joint-torque: must be positive"):
+        ffsr.Scenario.load(str(scenario), max_peak_joint_torque=-1)
+
+
 def test_pareto_post_capture_axis_equals_the_command(tmp_path):
     # the 3-DOF robot with 20 N m joints: the front of M_ie against the time to rest
     scenario = ROBOTS / "paper_3dof.toml"
