@@ -232,8 +232,7 @@ inline std::optional<GlobalCaptureResult> reach_goal(const CaptureProblem& pb, c
     // the servo leaves ~e^-10 of the error; the rest is the move of the manifold with the base pose,
     // small against the distance between components
     if (detail::configuration_distance(*pb.model, run.theta, local.best.theta) > 0.5) return std::nullopt;
-    if (detail::exceeds_reach_tolerance(g.search.inequalities.get(), run.base,
-                                        run.theta)) {  // outside the constraints
+    if (detail::exceeds_reach_tolerance(g.search.inequalities.get(), run.base, run.theta)) {  // outside
       goal = local.best.theta;
       continue;
     }
