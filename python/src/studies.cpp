@@ -264,27 +264,37 @@ void bind_pareto(nb::module_& m) {
       .def_prop_ro(
           "hypervolume_normalized", [](const ParetoRun& r) { return r.result.front.hypervolume_normalized; },
           "Area the front dominates up to the nadir of its ends, divided by the nadir box (0..1).")
+      .def_prop_ro(
+          "axis", [](const ParetoRun& r) { return r.result.axis; },
+          "The second objective: base-rate, or a post-capture figure (to_dict()['post_capture']).")
       .def(
-          "front_csv", [](const ParetoRun& r) { return pareto_csv(r.result.front); },
-          "The front as the command's --csv.");
+          "front_csv",
+          [](const ParetoRun& r) {
+            return r.result.post_capture ? post_capture_front_csv(*r.result.post_capture)
+                                         : pareto_csv(r.result.front);
+          },
+          "The front as the command's --csv (of the post-capture axis when one is chosen).");
 
   const ParetoJobOptions d;
   def_scenario_method(
       "pareto",
-      [](const Scenario& sc, int levels, int starts) {
+      [](const Scenario& sc, int levels, int starts, const std::string& axis) {
         ParetoJobOptions o;
         o.levels = levels;
         o.starts = starts;
+        o.axis = axis;
         return run_job<ParetoRun>([&](ParetoRun& r) {
           r.result = pareto(sc, o);
           r.json = pareto_json(sc, r.result, FFSR_VERSION).dump();
         });
       },
-      "levels"_a = d.levels, "starts"_a = d.starts,
+      "levels"_a = d.levels, "starts"_a = d.starts, "axis"_a = d.axis,
       "The job `pareto` (ffsr-optimize pareto --config FILE): the main job's runs, then the front of M_ie\n"
       "(Eq. 14) against the base's angular rate jump at the impact on the capture manifold at the global\n"
       "run's base pose (levels: epsilon levels between the two ends; starts: random starts of the two\n"
-      "single-objective searches).");
+      "single-objective searches; axis: base-rate, or time-to-rest, peak-joint-torque, gripper-force or\n"
+      "gripper-moment for the front of M_ie against that figure of the post-capture run, the Detumble\n"
+      "keys' run at the global search's local optima and the sweep's points).");
 }
 
 }  // namespace ffsr::python

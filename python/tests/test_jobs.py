@@ -217,6 +217,39 @@ def test_pareto_equals_the_command(tmp_path, name):
         ffsr.Scenario.load(str(scenario)).pareto(levels=0)
 
 
+def test_run_with_post_capture_constraints_equals_the_command(tmp_path):
+    # the global search keeps the captures whose post-capture run holds every joint within 3 N m
+    scenario = ROBOTS / "paper_3dof.toml"
+    expected = command_json(tmp_path, scenario, "--global-starts", "2", "--joint-torque-limit", "20",
+                            "--max-peak-joint-torque", "3")
+    got = ffsr.Scenario.load(str(scenario), global_starts=2, joint_torque_limit=20,
+                             max_peak_joint_torque=3).run().to_dict()
+    assert differences(got, expected) == []
+    assert 0 < got["global"]["post_capture"]["peak_joint_torque"] <= 3
+    with pytest.raises(ffsr.InputError, match="--max-peak-joint-torque: must be positive"):
+        ffsr.Scenario.load(str(scenario), max_peak_joint_torque=-1)
+
+
+def test_pareto_post_capture_axis_equals_the_command(tmp_path):
+    # the 3-DOF robot with 20 N m joints: the front of M_ie against the time to rest
+    scenario = ROBOTS / "paper_3dof.toml"
+    flags = ("--levels", "3", "--starts", "2", "--global-starts", "2", "--axis", "time-to-rest",
+             "--joint-torque-limit", "20")
+    expected = command_json(tmp_path, scenario, *flags, subcommand="pareto")
+    result = ffsr.Scenario.load(str(scenario), global_starts=2, joint_torque_limit=20).pareto(
+        levels=3, starts=2, axis="time-to-rest")
+    got = result.to_dict()
+    assert differences(got, expected) == []
+    assert result.axis == got["axis"] == "time-to-rest"
+    front = got["post_capture"]["front"]
+    assert [p["value"] for p in front] == [p["time_to_rest"] for p in front]
+    assert all(a["integrated_effective_mass"] < b["integrated_effective_mass"] and a["value"] > b["value"]
+               for a, b in zip(front, front[1:]))
+    assert result.front_csv().splitlines()[0].startswith("index,M_ie_kg,time_to_rest_s,")
+    with pytest.raises(ffsr.InputError, match="--axis: expected"):
+        ffsr.Scenario.load(str(scenario)).pareto(axis="torque")
+
+
 def map_csv(path, header):
     """The rows of a map CSV as an array (one row per point); header: whether the file starts with one."""
     return np.loadtxt(path, delimiter=",", skiprows=1 if header else 0, ndmin=2)

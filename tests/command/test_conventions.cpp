@@ -43,7 +43,7 @@ struct Sub {
 /// Files the cases use, written once into a scratch folder that lives for the test run.
 struct Files {
   ffsr::test::TempDir dir;
-  std::string heavy_urdf, bad_inertia_urdf, uncertain_toml;
+  std::string heavy_urdf, bad_inertia_urdf, uncertain_toml, post_capture_toml;
   Files() {
     const std::string urdf = ffsr::test::read_file(kUrdf3);
     // the same robot with a heavier first link: another URDF for the urdf key
@@ -58,6 +58,9 @@ struct Files {
     // the built-in scenario with an [uncertainty] table: robust's input
     std::string toml = ffsr::test::read_file(kSource + "/robots/paper_3dof.toml");
     toml = std::regex_replace(toml, std::regex("urdf = \"paper_3dof.urdf\""), "urdf = \"" + kUrdf3 + "\"");
+    // the built-in scenario with joint torque limits: the post-capture constraints' input
+    post_capture_toml = dir.str() + "/post_capture.toml";
+    std::ofstream(post_capture_toml) << toml << "\njoint-torque-limit = 20\n";
     uncertain_toml = dir.str() + "/uncertain.toml";
     std::ofstream(uncertain_toml) << toml
                                   << "\n[uncertainty]\nsamples = 8\nseed = 3\n"
@@ -141,6 +144,8 @@ const std::map<std::string, KeyCase>& key_cases() {
                        "--stop-stack-spin",    "true", "--target-velocity", "0.001,0,0"};
   const Args wheels_kept{"--joint-torque-limit", "20",  "--base-actuator",  "reaction-wheels",
                          "--wheel-torque",       "0.2", "--wheel-momentum", "25"};
+  Args post_capture{"--config", files().post_capture_toml};
+  post_capture.insert(post_capture.end(), global.begin(), global.end());
   static const std::map<std::string, KeyCase> cases = {
       {"urdf", {{"--urdf", files().heavy_urdf, "--joints-deg", "0,150,-100"}, {}}},
       {"end-effector", {{"--end-effector", "link3"}, {}}},
@@ -234,7 +239,14 @@ const std::map<std::string, KeyCase>& key_cases() {
       {"detumble-tick", {{"--detumble-tick", "0.02"}, torque}},
       {"stop-stack-spin", {{"--stop-stack-spin", "true"}, wheels_kept}},
       // the grasp after the Hertz contact run: another lock impulse and start state
-      {"grasp-after", {{"--grasp-after", "contact"}, {}}},
+      {"grasp-after", {{"--grasp-after", "contact"}, torque}},
+      // the global search's post-capture constraints (20 N m joints): the impact-best capture needs
+      // 3.59 N m and 1.57 N (another capture is chosen); no candidate rests within 3.3 s or holds the
+      // gripper's moment within 1 N m (refused, naming the key, with the least each candidate reached)
+      {"max-time-to-rest", {{"--max-time-to-rest", "3.3"}, post_capture}},
+      {"max-peak-joint-torque", {{"--max-peak-joint-torque", "3"}, post_capture}},
+      {"max-gripper-force", {{"--max-gripper-force", "1.55"}, post_capture}},
+      {"max-gripper-moment", {{"--max-gripper-moment", "1"}, post_capture}},
   };
   return cases;
 }

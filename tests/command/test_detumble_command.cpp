@@ -284,7 +284,7 @@ TEST_CASE("detumble --csv: the joint angles, the base's, the target's and the bo
   }
 }
 
-TEST_CASE("main job: each run's post-capture phase when a Detumble key is given; the CSV unchanged",
+TEST_CASE("main job: each run's post-capture phase when a Detumble key is given, the CSV unchanged",
           "[cli]") {
   ffsr::test::TempDir dir;
   const Args run{"--global", "false", "--quiet", "--json", "-"};

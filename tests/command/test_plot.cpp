@@ -644,6 +644,17 @@ TEST_CASE("pareto figure: the front, its ends and knee, the runs near it beside 
 
   s.runs.pop_back();  // every run near the front: one panel
   CHECK(figures::pareto(s).panels.size() == 1);
+  // a post-capture axis (pareto --axis): its label, its name and unit in the legend
+  figures::ParetoSeries t = s;
+  t.rate = {4.6, 4.4, 4.0, 3.9};
+  t.y_label = "post-capture time-to-rest (s)";
+  t.y_name = "time-to-rest";
+  t.y_unit = "s";
+  const plot::Figure g = figures::pareto(t);
+  const auto& tp = std::get<plot::Panel>(g.panels[0]);
+  CHECK(tp.ylabel == "post-capture time-to-rest (s)");
+  CHECK(tp.curves[2].label == "least time-to-rest: 1.4000 kg, 3.900 s");
+  CHECK(tp.curves[3].label == "knee: 1.2000 kg, 4.000 s");
   s.runs.push_back({"a quarter beyond the front's rate", 1.2, 5.01e-3});
   CHECK(figures::pareto(s).panels.size() == 2);
 

@@ -11,6 +11,7 @@
 #include "ffsr/jobs/detail/detumble_result.hpp"
 #include "ffsr/jobs/detail/json_values.hpp"
 #include "ffsr/jobs/detail/scenario_series.hpp"
+#include "ffsr/jobs/detail/post_capture.hpp"
 #include "ffsr/jobs/scenario_run.hpp"
 #include "ffsr/jobs/subject.hpp"
 #include "ffsr/model/attach.hpp"
@@ -22,49 +23,6 @@
 #include <string>
 
 namespace ffsr {
-
-/// The limits and the law's settings of a scenario's Detumble keys for `model`: joint-torque-limit
-/// (one value or one per joint; when not given, the URDF's <limit effort> of every joint), the base
-/// actuator and its bounds (each needed by its actuator, refused without it, from a file too),
-/// rest-rate-deg, stop-stack-spin. InputError naming the key.
-inline void detumble_settings(const ScenarioKeys& k, const Model& model, DetumbleLimits& l,
-                              DetumbleOptions& o) {
-  using detail::str;
-  for (const ScenarioKey& key : scenario_keys()) {  // the Detumble keys' own checks, and where they act
-    if (key.group != KeyGroup::Detumble) continue;
-    if (key.check) key.check(k);
-    const std::string why = key.acts && k.given.count(key.name) ? key.acts(k) : "";
-    if (!why.empty()) throw InputError(str("--", key.name, ": ", why));
-  }
-  if (k.joint_torque_limit.empty()) {
-    l.joint_torque.resize(model.n());
-    for (int j = 0; j < model.n(); ++j) {
-      l.joint_torque(j) = model.joint(j).effort;
-      if (!(l.joint_torque(j) > 0))
-        throw InputError(
-            str("--joint-torque-limit: not given, and the URDF gives no <limit effort> for joint '",
-                model.joint(j).name, "'"));
-    }
-  } else {
-    l.joint_torque = per_joint_values(k.joint_torque_limit, model, "--joint-torque-limit");
-  }
-  const auto needed = [&k](const char* name, double value) {
-    if (!k.given.count(name))
-      throw InputError(str("--", name, ": needed with base-actuator = ", k.base_actuator));
-    return value;
-  };
-  if (k.base_actuator == "reaction-wheels") {
-    l.actuator = BaseActuator::ReactionWheels;
-    l.wheel_torque = needed("wheel-torque", k.wheel_torque);
-    l.wheel_momentum = needed("wheel-momentum", k.wheel_momentum);
-  } else if (k.base_actuator == "thrusters") {
-    l.actuator = BaseActuator::Thrusters;
-    l.thruster_force = needed("thruster-force", k.thruster_force);
-    l.thruster_torque = needed("thruster-torque", k.thruster_torque);
-  }
-  o.rest_rate = k.rest_rate_deg * M_PI / 180.0;
-  o.stop_stack_spin = k.stop_stack_spin;
-}
 
 /// The grasp the run starts from (the key grasp-after) at the capture configuration (base, theta) with
 /// the target (its position is not used: it is placed touching): approach, grasp_at_capture (the lock
@@ -200,6 +158,21 @@ inline std::vector<DetumbleJobResult> detumble_runs(const Subject& s, const Scen
     if (r.global) runs.emplace_back("global", &r.global->result.run);
   }
   return detail::detumble_each_run(s, sc, runs);
+}
+
+/// The grasped target as attached at the gripper (grasp.attachment of the JSON): the gripper frame's
+/// name, the target's mass and inertia (its own axes), the pose of its centre-of-mass frame in the
+/// gripper frame. The target's pose at a sample is the gripper frame's pose composed with this one.
+inline nlohmann::json attachment_json(const Model& model, int gripper, const AttachedBody& b) {
+  using detail::vector_json;
+  const Quaternion q(b.pose.R);
+  nlohmann::json inertia = nlohmann::json::array();
+  for (int i = 0; i < 3; ++i) inertia.push_back(vector_json(Eigen::VectorXd(b.inertia.row(i).transpose())));
+  return {{"frame", model.frame(gripper).name},
+          {"mass", b.mass},
+          {"inertia", inertia},
+          {"position", vector_json(Eigen::VectorXd(b.pose.p))},
+          {"quaternion_wxyz", {q.w(), q.x(), q.y(), q.z()}}};
 }
 
 /// The result as JSON: the keys and values of `ffsr-optimize detumble --json` (`version` as given) for

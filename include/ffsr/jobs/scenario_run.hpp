@@ -7,6 +7,7 @@
 
 #include "ffsr/scenario/scenario.hpp"
 #include "ffsr/jobs/detail/detumble_result.hpp"
+#include "ffsr/jobs/detail/post_capture.hpp"
 #include "ffsr/jobs/scenario_clearance.hpp"
 #include "ffsr/optimize/branches.hpp"
 #include "ffsr/optimize/pareto.hpp"
@@ -32,6 +33,10 @@ struct GlobalRun {
   double paper_objective = 0;
   /// the distinct local optima of the last search (at the reached base pose), sorted by objective
   std::vector<CaptureBranch> branches;
+  /// With post-capture constraints (max-time-to-rest, ...): the post-capture figures at the reached
+  /// capture configuration, and the candidate runs of the search (how many met the constraints).
+  std::optional<PostCaptureFigures> post_capture;
+  int post_capture_candidates = 0, post_capture_admitted = 0;
 };
 
 /// The tail measure of one row over the robust-force objective's sample set, N.
@@ -97,7 +102,7 @@ inline bool scenario_has_post_capture(const ScenarioKeys& keys) {
 inline std::vector<DetumbleJobResult> post_capture_runs(const Scenario& sc, const ScenarioResult& r);
 /// One run's `post_capture` object of the main job's JSON: the run's `detumble --json` (detumble_json)
 /// without `version` and `run`.
-inline nlohmann::json post_capture_json(const ScenarioKeys& keys, const DetumbleJobResult& d);
+inline nlohmann::json post_capture_json(const Scenario& sc, const DetumbleJobResult& d);
 
 /// The plain and the optimized run. A NumericalError names the run ("plain run: ...").
 std::pair<CaptureResult, CaptureResult> plan_plain_and_optimized(const Scenario& sc,

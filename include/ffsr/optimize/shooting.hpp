@@ -32,6 +32,16 @@ struct GlobalCaptureOptions {
   /// the end of its reconfiguration): a message rejects the run, whose goal is then given up (e.g.
   /// the clearance along the path, optimize/clearance.hpp).
   std::function<std::optional<std::string>(const CaptureResult&, double approach_begin)> check_run;
+  /// Optional constraint on candidate capture configurations that the search cannot take as an
+  /// inequality (not smooth: the post-capture phase, jobs/detail/post_capture.hpp): one flag per
+  /// configuration at the base pose, true when it meets the constraint (batched, so that it may run
+  /// them in parallel). The goals, each full search's optimum and the reached run must meet it.
+  std::function<std::vector<char>(const BasePose&, const std::vector<Eigen::VectorXd>&)> admit;
+};
+
+/// No candidate capture configuration of the search meets GlobalCaptureOptions::admit.
+struct NoAdmittedCandidateError : InputError {
+  using InputError::InputError;
 };
 
 struct GlobalCaptureResult {
@@ -107,6 +117,28 @@ inline void drop_turned_optima(const CaptureProblem& pb, const CaptureTask& task
   res.best = res.local_optima.front();
 }
 
+/// The points of `points` that meet g.admit at `base` (all of them without it), order kept.
+inline void admitted_only(const GlobalCaptureOptions& g, const BasePose& base,
+                          std::vector<ManifoldPoint>& points) {
+  if (!g.admit || points.empty()) return;
+  std::vector<Eigen::VectorXd> thetas;
+  for (const ManifoldPoint& p : points) thetas.push_back(p.theta);
+  const std::vector<char> ok = g.admit(base, thetas);
+  std::vector<ManifoldPoint> kept;
+  for (size_t i = 0; i < points.size(); ++i)
+    if (i < ok.size() && ok[i]) kept.push_back(points[i]);
+  points = std::move(kept);
+}
+
+/// The best local optimum of `full` (sorted by objective) that meets g.admit at `base` becomes
+/// full.best; the local optima stay as found. Unchanged when none meets it.
+inline void best_admitted(const GlobalCaptureOptions& g, const BasePose& base, ManifoldSearchResult& full) {
+  if (!g.admit) return;
+  std::vector<ManifoldPoint> kept = full.local_optima;
+  admitted_only(g, base, kept);
+  if (!kept.empty()) full.best = kept.front();
+}
+
 /// The goals of plan_capture_global at the base pose of the task-only run: the best max_goals local
 /// optima of a search from `extra` and random starts (multibody-force: the ranked ones), and the
 /// local optima next to each extra start (on the component of the self-motion manifold the arm is
@@ -126,15 +158,22 @@ inline std::vector<ManifoldPoint> capture_goals(const CaptureProblem& pb, const 
     return a.objective < b.objective;
   };
   std::stable_sort(goals.begin(), goals.end(), by_objective);
+  admitted_only(g, base, goals);
   if (goals.size() > static_cast<size_t>(g.max_goals)) goals.resize(static_cast<size_t>(g.max_goals));
+  std::vector<ManifoldPoint> near_goals;
   for (const Eigen::VectorXd& x : extra) {
     try {
       const ManifoldSearchResult near = detail::search_manifold(pb, task, setup, base, g.search, {x}, 0);
       account(res, near);
-      goals.push_back(near.best);
+      near_goals.push_back(near.best);
     } catch (const InputError&) {
     }
   }
+  admitted_only(g, base, near_goals);
+  goals.insert(goals.end(), near_goals.begin(), near_goals.end());
+  if (goals.empty() && g.admit)
+    throw NoAdmittedCandidateError(
+        "no local optimum of the search at the first base pose meets the candidate constraint");
   std::stable_sort(goals.begin(), goals.end(), by_objective);
   return goals;
 }
@@ -193,8 +232,7 @@ inline std::optional<GlobalCaptureResult> reach_goal(const CaptureProblem& pb, c
     // the servo leaves ~e^-10 of the error; the rest is the move of the manifold with the base pose,
     // small against the distance between components
     if (detail::configuration_distance(*pb.model, run.theta, local.best.theta) > 0.5) return std::nullopt;
-    if (detail::exceeds_reach_tolerance(g.search.inequalities.get(), run.base,
-                                        run.theta)) {  // outside the constraints
+    if (detail::exceeds_reach_tolerance(g.search.inequalities.get(), run.base, run.theta)) {  // outside
       goal = local.best.theta;
       continue;
     }
@@ -210,6 +248,7 @@ inline std::optional<GlobalCaptureResult> reach_goal(const CaptureProblem& pb, c
     ManifoldSearchResult full = search_capture_manifold(pb, task, setup, run.base, g.search, ex);
     account(res, full);
     drop_turned_optima(pb, task, setup, run.base, g, full);
+    best_admitted(g, run.base, full);
     const double gap = 100.0 * (reached.objective - full.best.objective) / full.best.objective;
     if (t_r > 0 && gap > g.gap_percent && it < g.max_iterations) {
       goal = full.best.theta;  // reachable too: the reconfiguration moves to its component
@@ -298,10 +337,15 @@ inline std::optional<GlobalCaptureResult> reach_reconfigured(
   return std::nullopt;
 }
 
-/// Drops a reached goal's run that g.check_run rejects (e.g. the clearance along the path), counted
+/// Drops a reached goal's run that g.admit or g.check_run rejects (the clearance along the path), counted
 /// with its message in res.
 inline void check_reached(const GlobalCaptureOptions& g, GlobalCaptureResult& res,
                           std::optional<GlobalCaptureResult>& r) {
+  if (r && g.admit && !g.admit(r->run.base, {r->run.theta}).at(0)) {
+    ++res.goals_rejected;
+    res.rejection = "the reached capture configuration does not meet the candidate constraint";
+    r.reset();
+  }
   if (!r || !g.check_run) return;
   if (std::optional<std::string> why = g.check_run(r->run, r->reconfigured ? r->phases.front().t_end : 0.0)) {
     ++res.goals_rejected;

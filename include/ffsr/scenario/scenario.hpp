@@ -92,6 +92,8 @@ struct ScenarioKeys {
   double rest_rate_deg = 0.05, detumble_horizon = 120, detumble_tick = 0.01;
   bool stop_stack_spin = false;
   std::string grasp_after = "approach";  ///< the grasp's start: approach, or contact (the Hertz run first)
+  // the global search's post-capture constraints (jobs/detail/post_capture.hpp); 0: not set
+  double max_time_to_rest = 0, max_peak_joint_torque = 0, max_gripper_force = 0, max_gripper_moment = 0;
 };
 
 /// The kind of a key's value: one parser each, from a TOML node and from text.
@@ -111,6 +113,7 @@ enum class KeyGroup {
   JointModels,  ///< the joints during the contact and the multibody reference's servo
   Shapes,       ///< collision shapes and the clearance
   Detumble,     ///< the post-capture phase: joint torque limits, base actuator, rest, horizon, tick
+  PostCapture,  ///< the global search's constraints on the post-capture phase (time to rest, loads)
 };
 
 struct Scenario;

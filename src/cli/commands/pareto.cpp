@@ -11,6 +11,7 @@
 
 #include "ffsr/jobs/pareto.hpp"
 
+#include <cmath>
 #include <iomanip>
 #include <iostream>
 #include <memory>
@@ -70,6 +71,50 @@ plot::Figure pareto_figure(const Scenario& sc, const ParetoFront& f, const std::
   return figures::pareto(s);
 }
 
+/// A post-capture front: the table (its ends, knee and the runs, each with M_ie, the axis' value and
+/// the impact's base rate) and the picture's data.
+void print_post_capture_front(std::ostream& out, const Scenario& sc, const PostCaptureFront& f) {
+  const std::string unit = detail::pareto_axis_unit(f.axis);
+  auto row = [&](const char* label, const PostCaptureFrontPoint& p) {
+    out << std::left << std::setw(32) << label << std::right << std::fixed << std::setprecision(4)
+        << std::setw(11) << p.point.M_ie << std::setw(26);
+    if (std::isfinite(p.value))
+      out << p.value;
+    else
+      out << "not at rest";
+    out << std::scientific << std::setprecision(4) << std::setw(16) << p.point.base_rate * kDeg
+        << std::defaultfloat << "\n";
+  };
+  out << "ffsr-optimize pareto --axis " << f.axis << ": " << sc.where << ": " << f.points.size()
+      << " non-dominated of " << f.candidates << " candidate capture configurations (" << f.at_rest
+      << " at rest) at the global run's base pose\n\n"
+      << std::left << std::setw(32) << "" << std::right << std::setw(11) << "M_ie (kg)" << std::setw(26)
+      << (f.axis + " (" + unit + ")") << std::setw(16) << "|dw_0| (deg/s)" << "\n";
+  row("least M_ie (end)", f.points.front());
+  row("knee", f.points[f.knee]);
+  row(("least " + f.axis + " (end)").c_str(), f.points.back());
+  for (size_t i = 0; i < f.runs.size(); ++i) row(kRunNames[i], f.runs[i]);
+  out << "\ncandidates: the global search's local optima and the (M_ie, base rate) sweep's points, each run "
+         "through the grasp and the detumbling (docs/whole-capture.md)\n";
+}
+
+plot::Figure post_capture_figure(const Scenario& sc, const PostCaptureFront& f) {
+  figures::ParetoSeries s;
+  s.title = sc.where;
+  for (const PostCaptureFrontPoint& p : f.points) {
+    s.mass.push_back(p.point.M_ie);
+    s.rate.push_back(p.value);
+  }
+  s.knee = f.knee;
+  for (size_t i = 0; i < f.runs.size(); ++i)
+    if (std::isfinite(f.runs[i].value))
+      s.runs.push_back({kRunNames[i], f.runs[i].point.M_ie, f.runs[i].value});
+  s.y_unit = detail::pareto_axis_unit(f.axis);
+  s.y_name = f.axis;
+  s.y_label = "post-capture " + f.axis + " (" + s.y_unit + ")";
+  return figures::pareto(s);
+}
+
 int run_pareto(const ParetoCliOptions& o) {
   set_quiet(o.out.quiet);
   Outputs outputs = o.out.outputs();
@@ -81,13 +126,19 @@ int run_pareto(const ParetoCliOptions& o) {
   const ParetoJobResult job = pareto(sc, o.job);  // the main job's runs, then the front
   const ParetoFront& f = job.front;
   const std::vector<ParetoPoint>& runs = job.runs;
+  const PostCaptureFront* pc = job.post_capture ? &*job.post_capture : nullptr;
   outputs.set("--json", pareto_json(sc, job, FFSR_VERSION).dump(2) + "\n");
-  outputs.set("--csv", pareto_csv(f));
+  outputs.set("--csv", pc ? post_capture_front_csv(*pc) : pareto_csv(f));
   std::vector<std::string> drawn;
-  if (!o.out.plot.empty()) drawn = plot::render({pareto_figure(sc, f, runs)}, o.out.plot, plot_format);
+  if (!o.out.plot.empty())
+    drawn = plot::render({pc ? post_capture_figure(sc, *pc) : pareto_figure(sc, f, runs)}, o.out.plot,
+                         plot_format);
   outputs.write();
   std::ostream& out = outputs.table();
-  print_front(out, sc, f, runs);
+  if (pc)
+    print_post_capture_front(out, sc, *pc);
+  else
+    print_front(out, sc, f, runs);
   for (const std::string& d : drawn) out << "wrote " << d << "\n";
   return 0;
 }
@@ -104,13 +155,17 @@ void register_pareto(CLI::App& app, Action& action) {
   // reference's servo keys act with the global run's objective multibody-force only (refused otherwise)
   o->flags.add_groups(*sub, {KeyGroup::Robot, KeyGroup::Start, KeyGroup::Target, KeyGroup::TargetPlace,
                              KeyGroup::Contact, KeyGroup::Planner, KeyGroup::Global, KeyGroup::JointModels,
-                             KeyGroup::Shapes},
+                             KeyGroup::Shapes, KeyGroup::Detumble},
                       // the front is of M_ie and the base's jump (the impulse of the law's damping): the
                       // stiffness and the exponent of the law change neither
                       {"stiffness", "exponent"});
   sub->add_option("--levels", o->job.levels, "Epsilon levels of the sweep between the two ends")
       ->capture_default_str();
   sub->add_option("--starts", o->job.starts, "Random starts of the two single-objective searches")
+      ->capture_default_str();
+  sub->add_option("--axis", o->job.axis,
+                  "Second objective: base-rate (the impact's), or a figure of the post-capture run under the "
+                  "Detumble keys: time-to-rest, peak-joint-torque, gripper-force, gripper-moment")
       ->capture_default_str();
   add_output_flags(*sub, o->out,
                    {"Write the front (configurations, ends, knee, hypervolume) as JSON to FILE",

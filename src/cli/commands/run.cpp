@@ -328,6 +328,16 @@ void print_base_jump(std::ostream& out, const Scenario& sc, const ScenarioResult
   if (r.global && sc.keys.max_base_rate_deg > 0)
     out << std::defaultfloat << " (searched within max-base-rate-deg " << sc.keys.max_base_rate_deg << ")";
   out << "\n";
+  if (r.global && r.global->post_capture) {  // the post-capture constraints
+    const PostCaptureFigures& f = *r.global->post_capture;
+    out << std::defaultfloat << std::setprecision(4)
+        << "global run after the capture (detumble run): rest in " << f.time_to_rest
+        << " s, peak joint torque " << f.peak_joint_torque << " N m ("
+        << sc.model->joint(f.peak_joint).name << "), peak gripper force " << f.peak_gripper_force
+        << " N, moment " << f.peak_gripper_moment << " N m; " << r.global->post_capture_admitted << " of "
+        << r.global->post_capture_candidates << " candidate runs met "
+        << post_capture_constraints(sc.keys).flags() << "\n";
+  }
   out.flags(flags);
   out.precision(precision);
 }

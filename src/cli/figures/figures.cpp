@@ -169,8 +169,8 @@ std::string scientific(double x, int digits) {
 }
 
 /// "1.2866 kg, 1.72e-03 deg/s"
-std::string mass_rate(double mass, double rate) {
-  return fixed(mass, 4) + " kg, " + scientific(rate, 2) + " deg/s";
+std::string mass_rate(double mass, double rate, const std::string& unit = "deg/s") {
+  return fixed(mass, 4) + " kg, " + (unit == "deg/s" ? scientific(rate, 2) : fixed(rate, 3)) + " " + unit;
 }
 
 Curve marker(std::string label, std::vector<double> x, std::vector<double> y, int color, const char* symbol,
@@ -212,7 +212,7 @@ plot::Figure pareto(const ParetoSeries& s) {
   constexpr int kRunColors[] = {2, 3, 4, 5, 7};
   auto run_marker = [&](size_t i) {
     const auto& r = s.runs[i];
-    return marker(r.label + ": " + mass_rate(r.mass, r.rate), {r.mass}, {r.rate},
+    return marker(r.label + ": " + mass_rate(r.mass, r.rate, s.y_unit), {r.mass}, {r.rate},
                   kRunColors[i % std::size(kRunColors)], "▲", 1.0);
   };
   Curve line;
@@ -222,16 +222,20 @@ plot::Figure pareto(const ParetoSeries& s) {
   line.width = 1.5;
   line.symbol = "●";
 
-  const std::string ylabel = "base angular rate jump |Δω#d0#u| (deg/s)";
+  const std::string& ylabel = s.y_label;
   Panel front = labelled("the front at the global run's base pose, the runs at their own", "M_ie (kg)", ylabel);
   line.label = str("front (", n, " points)");
   line.symbol_scale = 0.55;
   front.curves.push_back(line);
-  front.curves.push_back(marker("least M_ie: " + mass_rate(s.mass.front(), s.rate.front()), {s.mass.front()},
+  front.curves.push_back(marker("least M_ie: " + mass_rate(s.mass.front(), s.rate.front(), s.y_unit),
+                                {s.mass.front()},
                                 {s.rate.front()}, kBlack, "■", 0.9));
-  front.curves.push_back(marker("least rate: " + mass_rate(s.mass.back(), s.rate.back()), {s.mass.back()},
+  front.curves.push_back(marker("least " + s.y_name + ": " +
+                                    mass_rate(s.mass.back(), s.rate.back(), s.y_unit),
+                                {s.mass.back()},
                                 {s.rate.back()}, kBlack, "□", 0.9));
-  front.curves.push_back(marker("knee: " + mass_rate(s.mass[s.knee], s.rate[s.knee]), {s.mass[s.knee]},
+  front.curves.push_back(marker("knee: " + mass_rate(s.mass[s.knee], s.rate[s.knee], s.y_unit),
+                                {s.mass[s.knee]},
                                 {s.rate[s.knee]}, 1, "◆", 1.2));
   for (size_t i = 0; i < s.runs.size(); ++i)
     if (near(s.runs[i])) front.curves.push_back(run_marker(i));

@@ -120,6 +120,8 @@ struct ParetoSeries {
     double mass = 0, rate = 0;
   };
   std::vector<Run> runs;
+  /// the second axis (`rate` holds its values): its label, its name in the legend and its unit
+  std::string y_label = "base angular rate jump |Δω#d0#u| (deg/s)", y_name = "rate", y_unit = "deg/s";
 };
 /// "pareto": the front as a line with markers, its two ends (the single-objective optima) and its
 /// knee marked, the runs as points with their values in the legend. When a run lies far from the

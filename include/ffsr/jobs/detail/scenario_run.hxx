@@ -60,6 +60,24 @@ inline std::shared_ptr<RobustForceObjective> scenario_robust_objective(const Sce
 
 namespace detail {
 
+/// The post-capture constraints (max-time-to-rest, ...) as the search's candidate constraint g.admit;
+/// null without them.
+inline std::shared_ptr<PostCaptureScreen> post_capture_screen(const Scenario& sc, const CaptureOptions& opt,
+                                                              GlobalCaptureOptions& g) {
+  if (!post_capture_constraints(sc.keys).any()) return nullptr;
+  const Target at_capture = prepare_capture(sc.problem, sc.task, opt).capture_target;
+  auto screen = std::make_shared<PostCaptureScreen>(sc, at_capture);
+  g.admit = [screen](const BasePose& b, const std::vector<Eigen::VectorXd>& t) { return (*screen)(b, t); };
+  return screen;
+}
+
+/// The figures at the capture reached (check_reached admitted it) and the screen's counts, into r.
+inline void add_post_capture(const PostCaptureScreen& screen, GlobalRun& r) {
+  r.post_capture = screen.figures(r.result.run.base, r.result.run.theta);
+  r.post_capture_candidates = screen.evaluated();
+  r.post_capture_admitted = screen.admitted();
+}
+
 /// run_global with the paper's-method run, or without it (null).
 inline GlobalRun run_global(const Scenario& sc, const CaptureResult* paper_run, GlobalObjective objective,
                             std::shared_ptr<RobustForceObjective> robust, bool tight_reaching) {
@@ -88,6 +106,7 @@ inline GlobalRun run_global(const Scenario& sc, const CaptureResult* paper_run, 
   if (sc.keys.max_base_rate_deg > 0)  // the impact's base-rate jump as a constraint of every search
     g.search.inequalities = base_rate_inequality(sc.problem, prepare_capture(sc.problem, sc.task, opt),
                                                  sc.keys.max_base_rate_deg * M_PI / 180.0);
+  const std::shared_ptr<PostCaptureScreen> screen = post_capture_screen(sc, opt, g);
   g.reconfigure.mode = reconfigure_mode_of(sc.keys.reconfigure, "--reconfigure");
   g.reconfigure.duration = sc.keys.reconfigure_duration;
   opt.record_series = opt.record_series || sc.geometry;
@@ -105,13 +124,21 @@ inline GlobalRun run_global(const Scenario& sc, const CaptureResult* paper_run, 
             "jump within ",
             std::setprecision(6), sc.keys.max_base_rate_deg, " deg/s",
             sc.geometry ? " and the clearance" : "", " (`ffsr-optimize pareto` shows the least)"));
+  } catch (const NoAdmittedCandidateError&) {
+    throw InputError(screen->shortfall());
   } catch (const JointRateLimitError& e) {
     throw InputError(str("--max-joint-rate-deg: ", e.what()));
   } catch (const InputError& e) {
     throw InputError(str("global run: ", e.what()));
   } catch (const NumericalError& e) {
-    throw NumericalError(str("global run: ", e.what()));
+    if (screen && screen->admitted() == 0) throw InputError(screen->shortfall());
+    throw NumericalError(str("global run: ", e.what(),
+                             screen ? str(" (", screen->admitted(), " of ", screen->evaluated(),
+                                          " candidate runs met the post-capture constraints ",
+                                          screen->constraints().flags(), ")")
+                                    : std::string()));
   }
+  if (screen) add_post_capture(*screen, r);
   const CaptureSetup setup = prepare_capture(sc.problem, sc.task, opt);
   r.paper_objective = paper_run ? evaluate_capture(sc.problem, setup, paper_run->base, paper_run->theta,
                                                    objective, g.search.multibody, robust.get())

@@ -534,6 +534,35 @@ inline void add_detumble_run_keys(std::vector<ScenarioKey>& keys) {
                      .echoed(echo_given("stop-stack-spin", &K::stop_stack_spin)));
 }
 
+/// The global search's constraints on the post-capture phase (jobs/detail/post_capture.hpp): each a
+/// bound on a figure of the detumble run at the candidate capture configurations.
+inline void add_post_capture_keys(std::vector<ScenarioKey>& keys) {
+  using K = ScenarioKeys;
+  const auto bound = [&keys](ScenarioKey key, const char* name, double K::*member) {
+    keys.push_back(key.in(KeyGroup::PostCapture)
+                       .checked([name, member](const K& k) { check_positive_if_given(k, name, k.*member); })
+                       .echoed(echo_given(name, member))
+                       .acting(on_the_global_run)
+                       .skipping(skips_but_global));
+  };
+  bound(FFSR_KEY("max-time-to-rest", max_time_to_rest,
+                 "Global search: longest post-capture run to rest, s (a constraint on the capture "
+                 "configuration, by the detumble run under the Detumble keys; > 0; default: not limited)"),
+        "max-time-to-rest", &K::max_time_to_rest);
+  bound(FFSR_KEY("max-peak-joint-torque", max_peak_joint_torque,
+                 "Global search: largest joint torque of the post-capture run, N m (a constraint; > 0, "
+                 "below the largest joint-torque-limit)"),
+        "max-peak-joint-torque", &K::max_peak_joint_torque);
+  bound(FFSR_KEY("max-gripper-force", max_gripper_force,
+                 "Global search: largest force of the gripper on the target after the grasp, N (a "
+                 "constraint; > 0)"),
+        "max-gripper-force", &K::max_gripper_force);
+  bound(FFSR_KEY("max-gripper-moment", max_gripper_moment,
+                 "Global search: largest moment of the gripper on the target after the grasp, N m (a "
+                 "constraint; > 0)"),
+        "max-gripper-moment", &K::max_gripper_moment);
+}
+
 #undef FFSR_KEY
 
 /// The table, in the order a command lists the keys (the flags of `ffsr-optimize --help`).
@@ -545,6 +574,7 @@ inline std::vector<ScenarioKey> build_scenario_keys() {
   add_joint_and_shape_keys(keys);
   add_detumble_keys(keys);
   add_detumble_run_keys(keys);
+  add_post_capture_keys(keys);
   // every key of the global run but the switch acts on that run only
   for (ScenarioKey& key : keys)
     if (key.group == KeyGroup::Global && key.name != "global")
