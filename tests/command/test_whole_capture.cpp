@@ -107,8 +107,6 @@ TEST_CASE("whole capture: bad constraints are one error line naming the key", "[
   refused({"--max-time-to-rest", "3", "--global", "false"}, "--max-time-to-rest", "global run only");
   // a constraint no candidate meets: the least each figure reached
   refused({"--max-peak-joint-torque", "0.5"}, "--max-peak-joint-torque", "the least each candidate reached");
-  // the post-capture keys alone: the main job stops at the impact
-  refused({"--rest-rate-deg", "0.1"}, "--rest-rate-deg", "none is given");
   // without joint torque limits (the URDF gives no <limit effort>)
   const ffsr::test::CommandResult r =
       cli({"--max-time-to-rest", "4", "--global-starts", "2", "--quiet"});  // the built-in scenario
