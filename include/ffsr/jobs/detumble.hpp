@@ -89,7 +89,11 @@ inline DetumbleJobResult detumble(const Subject& s, const BasePose& base, const 
     throw InputError(located_key_message(s.keys, e.what()));
   }
   const int ee = r.end_effector;
-  out.grasp = grasp_at_capture(r.model, ee, base, theta, target, s.approach_speed);
+  try {  // a degenerate pair of bodies (a target inertia near zero): name the keys that set it
+    out.grasp = grasp_at_capture(r.model, ee, base, theta, target, s.approach_speed);
+  } catch (const NumericalError& e) {
+    throw NumericalError(str(e.what(), " (--target-mass, --target-inertia: the target it grasps)"));
+  }
   const Model stack = attach_body(r.model, r.model.frame(ee).name, out.grasp.body);
   const DetumbleState start{base, theta, out.grasp.v_after, Vector3::Zero()};
   DetumbleRunOptions run;
@@ -97,14 +101,13 @@ inline DetumbleJobResult detumble(const Subject& s, const BasePose& base, const 
   run.horizon = s.keys.detumble_horizon;
   try {  // an actuator that cannot stop the stack's spin: the key of the bound that is too small
     check_detumble_feasible(stack, start, out.limits, out.options, run.horizon);
-  } catch (const InputError& e) {
-    const std::string why = e.what();
-    const BaseActuator a = out.limits.actuator;
-    const char* key = a == BaseActuator::None                         ? "stop-stack-spin"
-                      : a == BaseActuator::Thrusters                  ? "thruster-torque"
-                      : why.find("cannot store") != std::string::npos ? "wheel-momentum"
-                                                                      : "wheel-torque";
-    throw InputError(located_key_message(s.keys, str("--", key, ": ", why)));
+  } catch (const DetumbleInfeasibleError& e) {
+    const bool wheels = out.limits.actuator == BaseActuator::ReactionWheels;
+    const char* key = e.bound == DetumbleBound::Actuator        ? "stop-stack-spin"
+                      : e.bound == DetumbleBound::WheelMomentum ? "wheel-momentum"
+                      : wheels                                  ? "wheel-torque"
+                                                                : "thruster-torque";
+    throw InputError(located_key_message(s.keys, str("--", key, ": ", e.what())));
   }
   out.result = run_detumble(stack, ee, out.grasp.body, start, out.limits, out.options, run);
   if (!out.result.at_rest) {
