@@ -208,3 +208,7 @@ def test_detumble_controller_and_attach_refuse_bad_input():
         ffsr.run_detumble(stack, "ee", g.body, base, theta, g.v_after, limits, horizon=1e6, tick=1e-3)
     with pytest.raises(ffsr.InputError, match="tick"):
         ffsr.run_detumble(stack, "ee", g.body, base, theta, g.v_after, limits, horizon=1.0, tick=2.0)
+    with pytest.raises(ffsr.InputError, match="'nope'"):
+        ffsr.grasp_at_capture(fm, "nope", base, theta, target, 0.2)
+    with pytest.raises(ffsr.InputError, match="'nope'"):
+        ffsr.run_detumble(stack, "nope", g.body, base, theta, g.v_after, limits)

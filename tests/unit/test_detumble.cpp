@@ -430,6 +430,7 @@ TEST_CASE("check_detumble_feasible says which bound is too small, at thresholds 
       x.*field = std::sqrt(lo * hi);
       (bound(x) == b ? lo : hi) = x.*field;
     }
+    x.*field = hi;
     REQUIRE(bound(x) != b);
     return hi;
   };
@@ -483,6 +484,21 @@ TEST_CASE("detumble refuses bad limits, a spin it cannot stop and an actuator to
   DetumbleRunOptions bad = run;
   bad.tick = 0;
   CHECK_THROWS_AS(run_detumble(g.stack, g.gripper, g.grasp.body, g.start, lim, opt, bad), InputError);
+  auto run_refused = [&](const DetumbleRunOptions& r, const std::string& words) {
+    try {
+      run_detumble(g.stack, g.gripper, g.grasp.body, g.start, lim, opt, r);
+      FAIL("accepted: " << words);
+    } catch (const InputError& e) {
+      CHECK_THAT(e.what(), Catch::Contains(words));
+    }
+  };
+  bad = run;
+  bad.horizon = 1;
+  bad.tick = 2;
+  run_refused(bad, "the tick (2 s) must be shorter than the horizon (1 s)");
+  bad.horizon = 1e6;
+  bad.tick = 0.01;
+  run_refused(bad, "more than 1e7 ticks: horizon 1000000 s / tick 0.01 s = 100000000");
 }
 
 }  // namespace test_detumble

@@ -85,9 +85,10 @@ inline bool reaches_without_reconfiguration(const CaptureProblem& pb, const Capt
 }
 
 /// The local optima of `search` (made at base pose `base`, sorted by objective) as branches, in the
-/// same order but for ties, which go in a fixed order (order_ties): the orientation and position errors at `base`, and for the best `max_tested`
-/// whether the approach reaches each from the initial configuration (reaches_without_reconfiguration;
-/// one run each, on `threads` threads). Reads the model; runs crba per branch.
+/// same order but for ties, which go in a fixed order (order_ties): the orientation and position
+/// errors at `base`, and for the best `max_tested` whether the approach reaches each from the initial
+/// configuration (reaches_without_reconfiguration; one run each, on `threads` threads). Reads the
+/// model; runs crba per branch.
 inline std::vector<CaptureBranch> capture_branches(const CaptureProblem& pb, const CaptureTask& task,
                                                    const CaptureOptions& opt, const CaptureSetup& setup,
                                                    const ManifoldSearchResult& search, const BasePose& base,
