@@ -3,10 +3,15 @@
 
 #include <Eigen/Core>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 
 // The library never prints and never exits: every failure is thrown as one of these types.
 //   InputError       -- a caller's argument is wrong (size, non-finite value, range, unknown name)
@@ -51,12 +56,67 @@ class IntegrationError : public Error {
 
 namespace detail {
 
-/// Joins the arguments into one string with operator<<.
+/// x with `digits` significant digits (1..17): positional from 1e-5 to below 1e16 (200, 0.05,
+/// 1000000000), else with an exponent (1e-07, 2.5e+20); no trailing zeros. Non-finite: inf, -inf, nan.
+inline std::string number_with_digits(double x, int digits) {
+  if (!std::isfinite(x)) return std::isnan(x) ? "nan" : x > 0 ? "inf" : "-inf";
+  char e_form[40], out[400];
+  std::snprintf(e_form, sizeof e_form, "%.*e", digits - 1, x);
+  const int exponent = std::atoi(std::strchr(e_form, 'e') + 1);  // of x rounded to `digits`
+  if (exponent < -5 || exponent >= 16) {
+    std::string t(e_form);  // drop the mantissa's trailing zeros: 1.50000e-07 -> 1.5e-07
+    const size_t e = t.find('e'), dot = t.find('.');
+    if (dot == std::string::npos) return t;
+    size_t end = e;
+    while (end > dot + 1 && t[end - 1] == '0') --end;
+    if (end == dot + 1) --end;
+    return t.substr(0, end) + t.substr(e);
+  }
+  std::snprintf(out, sizeof out, "%.*f", std::max(digits - 1 - exponent, 0), x);
+  std::string t(out);
+  if (t.find('.') != std::string::npos) {
+    while (t.back() == '0') t.pop_back();
+    if (t.back() == '.') t.pop_back();
+  }
+  return t;
+}
+
+/// The fewest significant digits (1..17) that read back as x exactly.
+inline int shortest_digits(double x) {
+  if (!std::isfinite(x) || x == 0) return 1;
+  char buf[40];
+  for (int p = 1; p < 17; ++p) {
+    std::snprintf(buf, sizeof buf, "%.*e", p - 1, x);
+    if (std::strtod(buf, nullptr) == x) return p;
+  }
+  return 17;
+}
+
+/// The shortest text that reads back as x exactly (0.05, not 0.050000000000000003).
+inline std::string shortest_number(double x) { return number_with_digits(x, shortest_digits(x)); }
+
+/// A number as a message shows it: as a person writes it when that reads back as x exactly with at
+/// most 9 significant digits (a value a user gave: 0.05, 120, 1e-07), else 6 significant digits (a
+/// computed value: 3.4641, not 3.4641016151377544).
+inline std::string message_number(double x) {
+  const int p = shortest_digits(x);
+  return number_with_digits(x, p <= 9 ? p : 6);
+}
+
+/// One argument of str: floating-point numbers as message_number, everything else with operator<<.
+template <class T>
+void put_message_part(std::ostream& os, const T& x) {
+  if constexpr (std::is_floating_point_v<T>)
+    os << message_number(static_cast<double>(x));
+  else
+    os << x;
+}
+
+/// Joins the arguments into one string (numbers as message_number; Eigen matrices with 6 digits).
 template <class... Args>
 std::string str(const Args&... args) {
   std::ostringstream os;
-  os.precision(17);
-  (os << ... << args);
+  (put_message_part(os, args), ...);
   return os.str();
 }
 

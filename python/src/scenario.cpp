@@ -19,18 +19,13 @@ namespace {
 using namespace nb::literals;
 using detail::str;
 
-/// A keyword's value as the text a flag would give: numbers with 17 digits, booleans as true/false,
-/// lists (and 1-D arrays) joined with commas.
+/// A keyword's value as the text a flag would give: numbers as the shortest text that reads back as the
+/// same double, booleans as true/false, lists (and 1-D arrays) joined with commas.
 std::string flag_text(nb::handle v, const std::string& key) {
   auto number = [&](nb::handle x) -> std::string {
     if (PyBool_Check(x.ptr())) return x.ptr() == Py_True ? "true" : "false";
     if (PyLong_Check(x.ptr())) return nb::cast<std::string>(nb::str(x));
-    if (PyFloat_Check(x.ptr())) {
-      std::ostringstream os;
-      os.precision(17);
-      os << PyFloat_AsDouble(x.ptr());
-      return os.str();
-    }
+    if (PyFloat_Check(x.ptr())) return detail::shortest_number(PyFloat_AsDouble(x.ptr()));
     if (PyUnicode_Check(x.ptr())) return nb::cast<std::string>(x);
     if (nb::hasattr(x, "item") && nb::hasattr(x, "ndim") && nb::cast<int>(x.attr("ndim")) == 0)
       return flag_text(x.attr("item")(), key);  // a numpy scalar

@@ -173,3 +173,78 @@ def test_detumble_series_equals_the_command(tmp_path):
     subprocess.run([command(), "detumble", "--config", str(scenario), "--run", "optimized", "--quiet", "--csv",
                     str(out)], check=True, timeout=900)
     assert ffsr.Scenario.load(str(scenario)).detumble(run="optimized").series_csv() == out.read_text()
+
+
+def test_detumble_keys_from_python_name_the_bound_too_small():
+    """Scenario.detumble with the Detumble keys as keywords: the key of the bound that is too small,
+    numbers as written (0.05, not 0.050000000000000003), no NaN accepted."""
+    scenario = str(ROBOTS / "paper_7dof_detumble.toml")
+    wheels = dict(base_actuator="reaction-wheels", stop_stack_spin=True)
+    cases = [
+        (dict(stop_stack_spin=True), r"stop-stack-spin: .*conserved"),
+        (dict(wheels, wheel_torque=0.2, wheel_momentum=0.05), r"wheel-momentum: .*\(0\.05 per axis\)"),
+        (dict(wheels, wheel_torque=1e-4, wheel_momentum=25), r"wheel-torque: .*\(0\.0001 N m per axis\)"),
+        (dict(base_actuator="thrusters", stop_stack_spin=True, thruster_force=1.0, thruster_torque=1e-4),
+         r"thruster-torque: .*the horizon is 120 s"),
+        (dict(wheels, wheel_torque=float("nan"), wheel_momentum=1), r"wheel-torque: must be finite"),
+        (dict(wheels, wheel_torque=0.2, wheel_momentum=float("inf")), r"wheel-momentum: must be finite"),
+        (dict(wheels, wheel_torque="strong", wheel_momentum=1), r"wheel-torque: 'strong' is not a number"),
+        (dict(joint_torque_limit=[60, 60, 60]), r"joint-torque-limit: 3 values for 7 joints"),
+        (dict(joint_torque_limit=-1.0), r"joint-torque-limit: every limit must be positive, got -1"),
+        (dict(base_actuator="magnetorquer"), r"base-actuator: .*'magnetorquer'"),
+        (dict(rest_rate_deg=0.0), r"rest-rate-deg: must be positive"),
+        (dict(detumble_horizon=1.0, detumble_tick=1.0), r"detumble-tick: must be shorter"),
+        (dict(detumble_horizon=1e6), r"detumble-tick: at most 1e7 ticks"),
+        (dict(detumble_horizon=0.5), r"detumble-horizon: the stack is not at rest after 0\.5 s"),
+    ]
+    for keys, words in cases:
+        with pytest.raises(ffsr.InputError, match=words) as e:
+            ffsr.Scenario.load(scenario, **keys).detumble()
+        assert "nan" not in str(e.value).replace("must be finite, got nan", "")
+        assert not any(len(x.split(".")[-1]) >= 10 for x in str(e.value).split() if x[:1].isdigit())
+
+
+def test_detumble_controller_and_attach_refuse_bad_input():
+    fm = ffsr.Model.from_urdf(str(ROBOTS / "paper_7dof.urdf"), end_effector="ee")
+    theta = np.radians([0, 90, 90, -90, 90, 90, 0])
+    target = ffsr.Target(angular_velocity=np.radians([1, -0.5, 2]), contact_offset=[-0.25, 0.15, 0.1])
+    base = ffsr.BasePose()
+    g = ffsr.grasp_at_capture(fm, None, base, theta, target, 0.2)
+    stack = ffsr.attach_body(fm, "ee", g.body.mass, g.body.inertia, g.body.pose)
+    limits = [60, 60, 60, 40, 20, 20, 20]
+    bad = [
+        (dict(joint_torque=limits[:3]), r"joint_torque"),
+        (dict(joint_torque=[60, 60, 60, 40, 20, 20, float("nan")]), r"joint7|finite"),
+        (dict(joint_torque=[60, 60, 60, 0, 20, 20, 20]), r"joint4.* must be positive"),
+        (dict(actuator="ion-drive"), r"unknown actuator 'ion-drive'"),
+        (dict(actuator="reaction-wheels", wheel_torque=float("nan"), wheel_momentum=1.0, stop_stack_spin=True),
+         r"wheels' torque must be positive and finite"),
+        (dict(actuator="thrusters", thruster_force=1.0, thruster_torque=-1.0, stop_stack_spin=True),
+         r"thrusters' torque must be positive"),
+        (dict(rest_rate=0.0), r"rest"),
+        (dict(rest_rate=float("nan")), r"rest"),
+    ]
+    for kw, words in bad:
+        args = dict(joint_torque=limits)
+        args.update(kw)
+        with pytest.raises(ffsr.InputError, match=words):
+            ffsr.DetumbleController(stack, "ee", **args)
+    with pytest.raises(ffsr.InputError, match="'nope'"):
+        ffsr.DetumbleController(stack, "nope", limits)
+    c = ffsr.DetumbleController(stack, "ee", limits)
+    with pytest.raises(ffsr.InputError, match="theta"):
+        c.step(stack, base, theta[:3], g.v_after)
+    with pytest.raises(ffsr.InputError, match="triangle inequality"):
+        ffsr.attach_body(fm, "ee", 10.0, np.diag([1.0, 1.0, 5.0]), g.body.pose)
+    with pytest.raises(ffsr.InputError, match="'nope'"):
+        ffsr.attach_body(fm, "nope", 10.0, np.eye(3), g.body.pose)
+    with pytest.raises(ffsr.InputError):
+        ffsr.attach_body(fm, "ee", float("nan"), np.eye(3), g.body.pose)
+    with pytest.raises(ffsr.InputError, match="1e7 ticks|tick"):
+        ffsr.run_detumble(stack, "ee", g.body, base, theta, g.v_after, limits, horizon=1e6, tick=1e-3)
+    with pytest.raises(ffsr.InputError, match="tick"):
+        ffsr.run_detumble(stack, "ee", g.body, base, theta, g.v_after, limits, horizon=1.0, tick=2.0)
+    with pytest.raises(ffsr.InputError, match="'nope'"):
+        ffsr.grasp_at_capture(fm, "nope", base, theta, target, 0.2)
+    with pytest.raises(ffsr.InputError, match="'nope'"):
+        ffsr.run_detumble(stack, "nope", g.body, base, theta, g.v_after, limits)

@@ -567,13 +567,17 @@ std::vector<BadCase> bad_cases() {
        detumble3({"--stop-stack-spin", "true"}),
        {"--stop-stack-spin", "conserved"}},
       {"detumble: wheels too small to store the stack's momentum",
-       detumble3({"--base-actuator", "reaction-wheels", "--wheel-torque", "0.2", "--wheel-momentum", "1",
+       detumble3({"--base-actuator", "reaction-wheels", "--wheel-torque", "0.2", "--wheel-momentum", "0.05",
                   "--stop-stack-spin", "true"}),
-       {"--wheel-momentum", "cannot store"}},
+       {"--wheel-momentum", "cannot store", "(0.05 per axis)"}},
       {"detumble: wheel torque too small for the horizon",
        detumble3({"--base-actuator", "reaction-wheels", "--wheel-torque", "0.001", "--wheel-momentum", "25",
                   "--stop-stack-spin", "true"}),
        {"--wheel-torque", "the horizon is 120 s"}},
+      {"detumble: thruster torque too small for the horizon",
+       detumble3({"--base-actuator", "thrusters", "--thruster-force", "1", "--thruster-torque", "0.001",
+                  "--stop-stack-spin", "true"}),
+       {"--thruster-torque", "the horizon is 120 s"}},
       {"detumble: not at rest within the horizon",
        detumble3({"--detumble-horizon", "1"}),
        {"--detumble-horizon", "not at rest after 1 s"}},
@@ -591,6 +595,39 @@ std::vector<BadCase> bad_cases() {
        {"detumble", "--config", kBadScenarios + "/detumble_unknown_actuator.toml", "--quiet", "--json",
         "out.json"},
        {at_key("detumble_unknown_actuator.toml", 34, "base-actuator"), "'magnetorquer'"}},
+      {"detumble: more ticks than the run takes",
+       detumble3({"--detumble-horizon", "1e6"}),
+       {"--detumble-tick", "at most 1e7 ticks", "(100000000 ticks)"}},
+      {"detumble: wheel torque not a number",
+       detumble3({"--base-actuator", "reaction-wheels", "--wheel-torque", "nan", "--wheel-momentum", "1",
+                  "--stop-stack-spin", "true"}),
+       {"--wheel-torque", "finite"}},
+      {"detumble: thruster force given text",
+       detumble3({"--base-actuator", "thrusters", "--thruster-force", "strong", "--thruster-torque", "1",
+                  "--stop-stack-spin", "true"}),
+       {"--thruster-force", "'strong' is not a number"}},
+      {"detumble: zero rest rate",
+       detumble3({"--rest-rate-deg", "0"}),
+       {"--rest-rate-deg", "positive, got 0"}},
+      {"detumble: a target inertia near zero",
+       detumble3({"--target-inertia", "1e-300,1e-300,1e-300"}),
+       {"grasp:", "--target-inertia"},
+       3},
+      // a scenario file's key of another job is checked by every subcommand (not used there)
+      {"inspect: a file's bad detumble key",
+       {"inspect", "--config", kBadScenarios + "/detumble_zero_limit.toml", "--quiet", "--json", "out.json"},
+       {at_key("detumble_zero_limit.toml", 33, "joint-torque-limit"), "got 0"}},
+      {"contact: a file's bad detumble key",
+       {"contact", "--config", kBadScenarios + "/detumble_unknown_actuator.toml", "--quiet", "--json",
+        "out.json"},
+       {at_key("detumble_unknown_actuator.toml", 34, "base-actuator"), "'magnetorquer'"}},
+      {"xi: a file's bad detumble key",
+       {"xi", "--config", kBadScenarios + "/detumble_unknown_actuator.toml", "--quiet", "--json", "out.json"},
+       {at_key("detumble_unknown_actuator.toml", 34, "base-actuator"), "'magnetorquer'"}},
+      {"map: a file's bad detumble key",
+       {"map", "--config", kBadScenarios + "/detumble_zero_limit.toml", "--vary", "1", "--quiet", "--csv",
+        "out.csv"},
+       {at_key("detumble_zero_limit.toml", 33, "joint-torque-limit"), "got 0"}},
       // --- scenario files -------------------------------------------------------------------------
       {"scenario: missing key",
        scenario("missing_duration.toml"),
@@ -695,6 +732,10 @@ void check_bad(const CommandResult& r, int exit_code, const std::vector<std::str
   }
   CHECK(r.out.empty());  // no result, no table, no JSON
   CHECK(dir.entries() == expected_entries);
+  // numbers as a person writes them: a value given with at most 9 digits, a computed one with 6
+  // (not 0.050000000000000003 or 1.7320508075688772)
+  static const std::regex long_number("[0-9]*\\.[0-9]{10,}");
+  CHECK_FALSE(std::regex_search(r.err, long_number));
 }
 
 }  // namespace

@@ -305,4 +305,57 @@ TEST_CASE("UR5 pose task: the main job's JSON lists the branches", "[branches]")
   }
 }
 
+TEST_CASE("order_ties: tied optima in a fixed order, kept under rounding-level noise", "[branches]") {
+  // groups of optima with one M_ie each (as the 7-DOF position task's: joints 1-6 shared up to SLSQP's
+  // noise, the last joint free), the groups' values apart by more than the tie tolerance
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> u(-3.0, 3.0), noise(-1.0, 1.0);
+  std::vector<ManifoldPoint> points;
+  const std::vector<double> masses{1.2764065182458, 1.2802743782277, 1.3448467139430, 2.4723316613};
+  for (size_t g = 0; g < masses.size(); ++g) {
+    Eigen::VectorXd shared(7);
+    for (int k = 0; k < 6; ++k) shared(k) = u(rng);
+    for (int i = 0; i < 12; ++i) {
+      ManifoldPoint p;
+      p.theta = shared;
+      for (int k = 0; k < 6; ++k) p.theta(k) += 1e-7 * noise(rng);
+      p.theta(6) = u(rng);
+      p.M_ie = p.objective = masses[g] * (1 + 1e-11 * noise(rng));
+      points.push_back(p);
+    }
+  }
+  const auto by_objective = [](const ManifoldPoint& a, const ManifoldPoint& b) {
+    return a.objective < b.objective;
+  };
+  std::shuffle(points.begin(), points.end(), rng);
+  std::vector<ManifoldPoint> sorted = points;
+  std::sort(sorted.begin(), sorted.end(), by_objective);  // as the search sorts them
+  detail::order_ties(sorted);
+  // the rule: groups by objective, within a group by the last joint (the first six are tied)
+  for (size_t i = 1; i < sorted.size(); ++i) {
+    const bool same_group = std::abs(sorted[i].objective / sorted[i - 1].objective - 1) < 1e-9;
+    if (same_group)
+      CHECK(sorted[i - 1].theta(6) < sorted[i].theta(6));
+    else
+      CHECK(sorted[i - 1].objective < sorted[i].objective);
+  }
+  // the same optima as another run's roundoff leaves them (SLSQP ends within ~1e-11 in M_ie and
+  // ~1e-7 rad in the shared joints: redrawn), given in another order: the same order. Sorting by the
+  // objective alone would follow the redrawn noise.
+  for (int trial = 0; trial < 5; ++trial) {
+    std::vector<ManifoldPoint> perturbed = points;
+    for (ManifoldPoint& p : perturbed) {
+      p.objective *= 1 + 1e-11 * noise(rng);
+      p.M_ie = p.objective;
+      for (int k = 0; k < 6; ++k) p.theta(k) += 1e-7 * noise(rng);
+    }
+    std::shuffle(perturbed.begin(), perturbed.end(), rng);
+    std::sort(perturbed.begin(), perturbed.end(), by_objective);
+    detail::order_ties(perturbed);
+    REQUIRE(perturbed.size() == sorted.size());
+    for (size_t i = 0; i < sorted.size(); ++i)
+      CHECK(std::abs(perturbed[i].theta(6) - sorted[i].theta(6)) < 1e-12);
+  }
+}
+
 }  // namespace test_branches

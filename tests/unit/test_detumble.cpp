@@ -15,6 +15,7 @@
 
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <string>
 
 namespace test_detumble {
@@ -380,6 +381,66 @@ TEST_CASE("detumble: the gripper load is the rate of the target's momentum", "[d
   CHECK(f.norm() > 1e-2);
 }
 
+TEST_CASE("check_detumble_feasible says which bound is too small, at thresholds that agree", "[detumble]") {
+  const Grasped g = grasped_7dof();
+  DetumbleLimits l;
+  l.joint_torque = limits_7dof();
+  DetumbleOptions o;
+  o.stop_stack_spin = true;
+  const double horizon = 120;
+  // the bound it names, or nothing when feasible; an error that is not DetumbleInfeasibleError fails
+  auto bound = [&](const DetumbleLimits& x) -> std::optional<DetumbleBound> {
+    try {
+      check_detumble_feasible(g.stack, g.start, x, o, horizon);
+      return std::nullopt;
+    } catch (const DetumbleInfeasibleError& e) {
+      return e.bound;
+    }
+  };
+  CHECK(bound(l) == DetumbleBound::Actuator);
+  o.stop_stack_spin = false;
+  CHECK_FALSE(bound(l));  // the stack may keep its spin
+  o.stop_stack_spin = true;
+  l.actuator = BaseActuator::ReactionWheels;
+  l.wheel_torque = 0.2;
+  l.wheel_momentum = 0.05;
+  CHECK(bound(l) == DetumbleBound::WheelMomentum);
+  l.wheel_momentum = 25;
+  CHECK_FALSE(bound(l));
+  l.wheel_torque = 1e-4;
+  CHECK(bound(l) == DetumbleBound::ActuatorTorque);
+  l = DetumbleLimits{};
+  l.joint_torque = limits_7dof();
+  l.actuator = BaseActuator::Thrusters;
+  l.thruster_force = 1;
+  l.thruster_torque = 1e-4;
+  CHECK(bound(l) == DetumbleBound::ActuatorTorque);
+  l.thruster_torque = 1;
+  CHECK_FALSE(bound(l));
+  // the thresholds, by bisection on each bound: the wheels store |L_c| / sqrt(3) per axis, and a
+  // torque t removes |L_c| in |L_c| / (sqrt(3) t), so the momentum threshold over the torque
+  // threshold is the horizon
+  auto threshold = [&](double DetumbleLimits::*field, DetumbleBound b) {
+    DetumbleLimits x;
+    x.joint_torque = limits_7dof();
+    x.actuator = BaseActuator::ReactionWheels;
+    x.wheel_torque = x.wheel_momentum = 1e6;
+    double lo = 1e-9, hi = 1e6;  // refused at lo, accepted at hi
+    for (int k = 0; k < 200; ++k) {
+      x.*field = std::sqrt(lo * hi);
+      (bound(x) == b ? lo : hi) = x.*field;
+    }
+    x.*field = hi;
+    REQUIRE(bound(x) != b);
+    return hi;
+  };
+  const double m = threshold(&DetumbleLimits::wheel_momentum, DetumbleBound::WheelMomentum);
+  const double t = threshold(&DetumbleLimits::wheel_torque, DetumbleBound::ActuatorTorque);
+  CHECK(m > 0.05);
+  CHECK(m < 25);
+  CHECK(m / t == Approx(horizon).epsilon(1e-9));
+}
+
 TEST_CASE("detumble refuses bad limits, a spin it cannot stop and an actuator too small", "[detumble]") {
   const Grasped g = grasped_7dof();
   DetumbleLimits lim;
@@ -423,6 +484,21 @@ TEST_CASE("detumble refuses bad limits, a spin it cannot stop and an actuator to
   DetumbleRunOptions bad = run;
   bad.tick = 0;
   CHECK_THROWS_AS(run_detumble(g.stack, g.gripper, g.grasp.body, g.start, lim, opt, bad), InputError);
+  auto run_refused = [&](const DetumbleRunOptions& r, const std::string& words) {
+    try {
+      run_detumble(g.stack, g.gripper, g.grasp.body, g.start, lim, opt, r);
+      FAIL("accepted: " << words);
+    } catch (const InputError& e) {
+      CHECK_THAT(e.what(), Catch::Contains(words));
+    }
+  };
+  bad = run;
+  bad.horizon = 1;
+  bad.tick = 2;
+  run_refused(bad, "the tick (2 s) must be shorter than the horizon (1 s)");
+  bad.horizon = 1e6;
+  bad.tick = 0.01;
+  run_refused(bad, "more than 1e7 ticks: horizon 1000000 s / tick 0.01 s = 100000000");
 }
 
 }  // namespace test_detumble

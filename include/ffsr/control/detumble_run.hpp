@@ -151,10 +151,25 @@ struct DetumbleSystem {
 
 }  // namespace detail
 
-/// Refuses a run that cannot stop the stack's spin, with InputError naming L_c, the stack's angular
-/// momentum about its centre of mass: without an actuator (L_c is conserved), with wheels that cannot
-/// store it (|L_c| above sqrt(3) times the bound per axis), or when removing it needs longer than the
-/// horizon at the actuator's largest torque (|L_c| / (sqrt(3) t_max)).
+/// The bound that cannot stop the stack's spin (DetumbleInfeasibleError::bound).
+enum class DetumbleBound {
+  Actuator,        ///< no base actuator (the stack's angular momentum is conserved)
+  WheelMomentum,   ///< the reaction wheels cannot store the stack's angular momentum
+  ActuatorTorque,  ///< the actuator's torque (wheels or thrusters) needs longer than the horizon
+};
+
+/// check_detumble_feasible's refusal: an InputError that says which bound is too small, so that a
+/// caller can name the setting of that bound.
+class DetumbleInfeasibleError : public InputError {
+ public:
+  DetumbleInfeasibleError(DetumbleBound b, const std::string& what) : InputError(what), bound(b) {}
+  DetumbleBound bound;
+};
+
+/// Refuses a run that cannot stop the stack's spin, with DetumbleInfeasibleError naming L_c, the stack's
+/// angular momentum about its centre of mass: without an actuator (L_c is conserved), with wheels that
+/// cannot store it (|L_c| above sqrt(3) times the bound per axis), or when removing it needs longer than
+/// the horizon at the actuator's largest torque (|L_c| / (sqrt(3) t_max)).
 inline void check_detumble_feasible(const Model& stack, const DetumbleState& s, const DetumbleLimits& l,
                                     const DetumbleOptions& o, double horizon) {
   if (!o.stop_stack_spin) return;
@@ -165,20 +180,25 @@ inline void check_detumble_feasible(const Model& stack, const DetumbleState& s, 
   const Vector3 rc(d.H(5, 1) / M, d.H(3, 2) / M, d.H(4, 0) / M);
   const double L = (h.tail<3>() - rc.cross(h.head<3>())).norm();
   if (l.actuator == BaseActuator::None)
-    throw InputError(
+    throw DetumbleInfeasibleError(
+        DetumbleBound::Actuator,
         detail::str("detumble: the stack's spin cannot be stopped without a base actuator: its "
                     "angular momentum about its centre of mass, ",
                     L, " N m s, is conserved (name reaction wheels or thrusters)"));
   const double tmax = l.actuator == BaseActuator::ReactionWheels ? l.wheel_torque : l.thruster_torque;
   const double axes = std::sqrt(3.0);
   if (l.actuator == BaseActuator::ReactionWheels && L > axes * l.wheel_momentum)
-    throw InputError(detail::str("detumble: the reaction wheels cannot store the stack's angular momentum: ",
-                                 L, " N m s about its centre of mass, at most ", axes * l.wheel_momentum,
-                                 " N m s (", l.wheel_momentum, " per axis)"));
+    throw DetumbleInfeasibleError(
+        DetumbleBound::WheelMomentum,
+        detail::str("detumble: the reaction wheels cannot store the stack's angular momentum: ", L,
+                    " N m s about its centre of mass, at most ", axes * l.wheel_momentum, " N m s (",
+                    l.wheel_momentum, " per axis)"));
   if (L / (axes * tmax) > horizon)
-    throw InputError(detail::str(
-        "detumble: the base actuator's torque (", tmax, " N m per axis) needs at least ", L / (axes * tmax),
-        " s to remove the stack's angular momentum ", L, " N m s; the horizon is ", horizon, " s"));
+    throw DetumbleInfeasibleError(
+        DetumbleBound::ActuatorTorque,
+        detail::str("detumble: the base actuator's torque (", tmax, " N m per axis) needs at least ",
+                    L / (axes * tmax), " s to remove the stack's angular momentum ", L,
+                    " N m s; the horizon is ", horizon, " s"));
 }
 
 /// The post-capture run from `start` (the grasp's state on the stack model; see the top of the file).

@@ -72,33 +72,38 @@ inline DetumbleJobResult detumble(const Subject& s, const BasePose& base, const 
     throw InputError(located_key_message(s.keys, e.what()));
   }
   const int ee = r.end_effector;
-  const DetumbleState start = detumble_start(s, base, theta, target, out);
+  DetumbleState start;
+  try {  // a degenerate pair of bodies (a target inertia near zero): name the keys that set it
+    start = detumble_start(s, base, theta, target, out);
+  } catch (const NumericalError& e) {
+    throw NumericalError(str(e.what(), " (--target-mass, --target-inertia: the target it grasps)"));
+  }
   const Model stack = attach_body(r.model, r.model.frame(ee).name, out.grasp.body);
   DetumbleRunOptions run;
   run.tick = s.keys.detumble_tick;
   run.horizon = s.keys.detumble_horizon;
   try {  // an actuator that cannot stop the stack's spin: the key of the bound that is too small
     check_detumble_feasible(stack, start, out.limits, out.options, run.horizon);
-  } catch (const InputError& e) {
-    const std::string why = e.what();
-    const BaseActuator a = out.limits.actuator;
-    const char* key = a == BaseActuator::None                         ? "stop-stack-spin"
-                      : a == BaseActuator::Thrusters                  ? "thruster-torque"
-                      : why.find("cannot store") != std::string::npos ? "wheel-momentum"
-                                                                      : "wheel-torque";
-    throw InputError(located_key_message(s.keys, str("--", key, ": ", why)));
+  } catch (const DetumbleInfeasibleError& e) {
+    const bool wheels = out.limits.actuator == BaseActuator::ReactionWheels;
+    const char* key = e.bound == DetumbleBound::Actuator        ? "stop-stack-spin"
+                      : e.bound == DetumbleBound::WheelMomentum ? "wheel-momentum"
+                      : wheels                                  ? "wheel-torque"
+                                                                : "thruster-torque";
+    throw InputError(located_key_message(s.keys, str("--", key, ": ", e.what())));
   }
   out.result = run_detumble(stack, ee, out.grasp.body, start, out.limits, out.options, run);
   if (!out.result.at_rest) {
     const DetumbleSample& e = out.result.series.back();
     constexpr double deg = 180 / M_PI;
     const bool spin = out.options.stop_stack_spin;
-    throw InputError(str("--detumble-horizon: the stack is not at rest after ", run.horizon,
-                         " s under these limits (largest joint rate ", e.joint_rate * deg,
-                         " deg/s, gripper rate relative to the base ", e.relative_rate * deg, " deg/s",
-                         spin ? str(", stack rate ", e.stack_rate * deg, " deg/s") : std::string(),
-                         "; at rest below ", s.keys.rest_rate_deg, " deg/s): raise the ",
-                         spin ? "limits, the wheels' momentum" : "joint torque limits", " or the horizon"));
+    throw InputError(located_key_message(
+        s.keys, str("--detumble-horizon: the stack is not at rest after ", run.horizon,
+                    " s under these limits (largest joint rate ", e.joint_rate * deg,
+                    " deg/s, gripper rate relative to the base ", e.relative_rate * deg, " deg/s",
+                    spin ? str(", stack rate ", e.stack_rate * deg, " deg/s") : std::string(),
+                    "; at rest below ", s.keys.rest_rate_deg, " deg/s): raise the ",
+                    spin ? "limits, the wheels' momentum" : "joint torque limits", " or the horizon")));
   }
   out.peak_joint_name = out.result.peak_joint >= 0 ? r.model.joint(out.result.peak_joint).name : "";
   return out;

@@ -50,7 +50,8 @@ struct Subject {
 };
 
 /// Builds the subject of `keys` (the robot and its start state, the bus and the loader, the target,
-/// the contact law); `embedded`: the URDF of a built-in scenario (scenario/scenario.hpp). `on_load` is
+/// the contact law), after the check of every key (ScenarioKey::check: a file's keys for other jobs
+/// too); `embedded`: the URDF of a built-in scenario (scenario/scenario.hpp). `on_load` is
 /// called with the loader's report as soon as the robot is loaded (the command warns about every
 /// repair there). InputError naming the key (located in the file when the file gave it) or the file,
 /// ModelError from the loader.
@@ -60,6 +61,8 @@ inline Subject load_subject(ScenarioKeys keys, const EmbeddedUrdf* embedded = nu
   s.keys = std::move(keys);
   try {  // an error of a key the file gave names the file and the key's line, as build_scenario's
     ScenarioKeys& k = s.keys;
+    for (const ScenarioKey& key : scenario_keys())  // every key read is checked, those of other jobs too
+      if (key.check) key.check(k);
     s.robot.model = std::move(*detail::model_of(k, embedded, s.robot.report));
     if (on_load) on_load(s.robot.report);
     CaptureProblem pb;

@@ -7,6 +7,8 @@
 #include "ffsr/detail/parallel.hpp"
 #include "ffsr/optimize/global.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <optional>
 #include <vector>
 
@@ -32,6 +34,37 @@ struct CaptureBranch {
   std::optional<bool> reachable_without_reconfiguration;
 };
 
+namespace detail {
+
+/// Puts the ties of a search's sorted local optima in a fixed order (docs/branches.md): neighbours whose
+/// M_ie and objective are both within a relative 1e-9 are tied (the optima of a joint the objective
+/// does not depend on differ only by SLSQP's roundoff, ~1e-11), and tied optima go by configuration,
+/// joint by joint, a joint's values within 1e-5 (rad or m) counting as equal (SLSQP leaves ~1e-7 rad).
+/// So rounding-level changes keep the order. The rest of the order stays (by objective; multibody-force:
+/// by M_ie). Insertion sort: the tolerance comparison is not a strict weak order, and ties are few.
+inline void order_ties(std::vector<ManifoldPoint>& p) {
+  const auto close = [](double a, double b) {
+    return std::abs(b - a) <= 1e-9 * std::max(std::abs(a), std::abs(b));
+  };
+  const auto tied = [&](const ManifoldPoint& a, const ManifoldPoint& b) {
+    return close(a.M_ie, b.M_ie) && close(a.objective, b.objective);
+  };
+  const auto before = [](const ManifoldPoint& a, const ManifoldPoint& b) {
+    for (Eigen::Index i = 0; i < std::min(a.theta.size(), b.theta.size()); ++i)
+      if (std::abs(a.theta(i) - b.theta(i)) > 1e-5) return a.theta(i) < b.theta(i);
+    return false;
+  };
+  for (size_t first = 0; first < p.size();) {
+    size_t end = first + 1;
+    while (end < p.size() && tied(p[end - 1], p[end])) ++end;
+    for (size_t i = first + 1; i < end; ++i)
+      for (size_t j = i; j > first && before(p[j], p[j - 1]); --j) std::swap(p[j], p[j - 1]);
+    first = end;
+  }
+}
+
+}  // namespace detail
+
 /// Does the reaching run (see the notes after the includes) from pb.theta end on `goal`? Runs
 /// integrate_capture once (series off); joint-limit and tracking failures count as not reached.
 inline bool reaches_without_reconfiguration(const CaptureProblem& pb, const CaptureTask& task,
@@ -52,9 +85,10 @@ inline bool reaches_without_reconfiguration(const CaptureProblem& pb, const Capt
 }
 
 /// The local optima of `search` (made at base pose `base`, sorted by objective) as branches, in the
-/// same order: the orientation and position errors at `base`, and for the best `max_tested`
-/// whether the approach reaches each from the initial configuration (reaches_without_reconfiguration;
-/// one run each, on `threads` threads). Reads the model; runs crba per branch.
+/// same order but for ties, which go in a fixed order (order_ties): the orientation and position
+/// errors at `base`, and for the best `max_tested` whether the approach reaches each from the initial
+/// configuration (reaches_without_reconfiguration; one run each, on `threads` threads). Reads the
+/// model; runs crba per branch.
 inline std::vector<CaptureBranch> capture_branches(const CaptureProblem& pb, const CaptureTask& task,
                                                    const CaptureOptions& opt, const CaptureSetup& setup,
                                                    const ManifoldSearchResult& search, const BasePose& base,
@@ -62,7 +96,9 @@ inline std::vector<CaptureBranch> capture_branches(const CaptureProblem& pb, con
   const Model& model = *pb.model;
   Data data(model);
   std::vector<CaptureBranch> out;
-  for (const ManifoldPoint& p : search.local_optima) {
+  std::vector<ManifoldPoint> optima = search.local_optima;
+  detail::order_ties(optima);
+  for (const ManifoldPoint& p : optima) {
     CaptureBranch b;
     b.theta = p.theta;
     b.M_ie = p.M_ie;

@@ -61,6 +61,12 @@ XiSetup parse(const XiOptions& o) {
   if (o.points < 2 || o.points > 100000)
     throw InputError(str("--points: expected 2 to 100000, got ", o.points));
   const ScenarioKeys k = command_scenario_keys(o.config, o.flags);
+  try {  // every key read is checked, a file's keys for other jobs too (as load_subject does)
+    for (const ScenarioKey& key : scenario_keys())
+      if (key.check) key.check(k);
+  } catch (const InputError& e) {
+    throw InputError(located_key_message(k, e.what()));
+  }
   XiSetup s;
   s.base = {k.stiffness, k.exponent, k.restitution};
   try {

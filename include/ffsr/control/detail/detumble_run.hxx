@@ -14,7 +14,12 @@ inline void check_detumble_run(const Model& stack, int gripper, const AttachedBo
     throw InputError(str(w, ": the tick must be positive and finite, got ", r.tick));
   if (!std::isfinite(r.horizon) || !(r.horizon > 0))
     throw InputError(str(w, ": the horizon must be positive and finite, got ", r.horizon));
-  if (r.horizon / r.tick > 1e7) throw InputError(str(w, ": more than 1e7 ticks (horizon / tick)"));
+  if (!(r.tick < r.horizon))
+    throw InputError(
+        str(w, ": the tick (", r.tick, " s) must be shorter than the horizon (", r.horizon, " s)"));
+  if (r.horizon / r.tick > 1e7)
+    throw InputError(str(w, ": more than 1e7 ticks: horizon ", r.horizon, " s / tick ", r.tick,
+                         " s = ", r.horizon / r.tick));
   if (r.record_every < 0) throw InputError(str(w, ": record_every must be >= 0, got ", r.record_every));
   if (!(r.rtol > 0) || !(r.atol > 0) || !std::isfinite(r.rtol) || !std::isfinite(r.atol))
     throw InputError(str(w, ": the tolerances must be positive and finite"));

@@ -515,6 +515,10 @@ inline void add_detumble_run_keys(std::vector<ScenarioKey>& keys) {
                        if (!(k.detumble_tick < k.detumble_horizon))
                          throw InputError(str("--detumble-tick: must be shorter than detumble-horizon (",
                                               k.detumble_horizon, " s), got ", k.detumble_tick));
+                       if (k.detumble_horizon / k.detumble_tick > 1e7)  // run_detumble's bound
+                         throw InputError(str("--detumble-tick: at most 1e7 ticks in detumble-horizon (",
+                                              k.detumble_horizon, " s), got ", k.detumble_tick, " s (",
+                                              k.detumble_horizon / k.detumble_tick, " ticks)"));
                      })
                      .echoed(echo_given("detumble-tick", &K::detumble_tick)));
   keys.push_back(

@@ -85,11 +85,7 @@ inline bool boolean_from_text(const std::string& text, const std::string& key) {
 inline std::optional<std::string> text_of(const toml::node& n) {
   if (auto s = n.value_exact<std::string>()) return *s;
   if (auto i = n.value_exact<int64_t>()) return std::to_string(*i);
-  if (auto d = n.value_exact<double>()) {
-    std::ostringstream os;
-    os << std::setprecision(17) << *d;
-    return os.str();
-  }
+  if (auto d = n.value_exact<double>()) return shortest_number(*d);
   if (auto b = n.value_exact<bool>()) return std::string(*b ? "true" : "false");
   return std::nullopt;
 }
