@@ -72,6 +72,8 @@ TEST_CASE("whole capture: the least M_ie among the captures whose post-capture r
   REQUIRE(g.post_capture);
   CHECK(g.post_capture->peak_joint_torque == Approx(at_chosen.peak_joint_torque).epsilon(1e-9));
   CHECK(g.post_capture->time_to_rest == Approx(at_chosen.time_to_rest));
+  // no clearance here: a reached goal the constraints turn away is not counted as the clearance's
+  CHECK(g.result.goals_rejected == 0);
   // another capture than the impact-best one, of no lower M_ie (on this planar arm the mirrored
   // posture has the same M_ie to 1e-4)
   CHECK(ffsr::detail::configuration_distance(*whole.model, g.result.run.theta, best.theta) > 0.5);

@@ -63,6 +63,7 @@ struct GlobalCaptureResult {
   std::vector<RunPhase> phases;
   bool reconfigured = false;  ///< `run` begins with a reconfiguration
   int goals_rejected = 0;     ///< reached goals whose run check_run rejected
+  int goals_not_admitted = 0;  ///< reached goals whose configuration admit rejected
   std::string rejection;      ///< the last rejection's message
   /// With a clearance (scenario/geometry.hpp): the distance bound of the searches, m (the
   /// clearance plus the margin of the round that planned the run); manifold_optimum is the optimum
@@ -284,6 +285,7 @@ inline GlobalCaptureResult with_counters(GlobalCaptureResult best, const GlobalC
   best.objective_evaluations = counts.objective_evaluations;
   best.search_seconds = counts.search_seconds;
   best.goals_rejected = counts.goals_rejected;
+  best.goals_not_admitted = counts.goals_not_admitted;
   best.run_failure = counts.run_failure;
   return best;
 }
@@ -342,7 +344,7 @@ inline std::optional<GlobalCaptureResult> reach_reconfigured(
 inline void check_reached(const GlobalCaptureOptions& g, GlobalCaptureResult& res,
                           std::optional<GlobalCaptureResult>& r) {
   if (r && g.admit && !g.admit(r->run.base, {r->run.theta}).at(0)) {
-    ++res.goals_rejected;
+    ++res.goals_not_admitted;
     res.rejection = "the reached capture configuration does not meet the candidate constraint";
     r.reset();
   }
@@ -359,7 +361,8 @@ inline NumericalError no_goal_reached(const GlobalCaptureResult& res, const char
   return NumericalError(str(
       where, ": no capture configuration chosen by the search was reached (", res.goals_tried, " goals, ",
       res.goals_out_of_limits, " of them behind a joint limit, ", res.shooting_iterations, " reaching runs)",
-      res.goals_rejected ? str("; the last reached goal was rejected: ", res.rejection) : "",
+      res.goals_rejected + res.goals_not_admitted ? str("; the last reached goal was rejected: ", res.rejection)
+                                                  : "",
       res.task_alone_failure.empty() ? "" : str("; the task alone failed: ", res.task_alone_failure),
       res.run_failure.empty() ? "" : str("; the last reaching run that failed: ", res.run_failure)));
 }

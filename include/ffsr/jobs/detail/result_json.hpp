@@ -163,7 +163,8 @@ inline void add_global_json(nlohmann::json& j, const Scenario& sc, const GlobalR
                          {"peak_gripper_force", f.peak_gripper_force},
                          {"peak_gripper_moment", f.peak_gripper_moment},
                          {"candidates", g.post_capture_candidates},
-                         {"candidates_meeting_constraints", g.post_capture_admitted}};
+                         {"candidates_meeting_constraints", g.post_capture_admitted},
+                         {"reached_goals_rejected", g.result.goals_not_admitted}};
   }
   j["global"] = x;
   add_reductions_json(j, "global_", base_run, &r.run);
