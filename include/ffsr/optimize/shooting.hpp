@@ -61,10 +61,10 @@ struct GlobalCaptureResult {
   double search_seconds = 0;       ///< over every search
   /// The phases of `run`: the approach alone, or the reconfiguration then the approach.
   std::vector<RunPhase> phases;
-  bool reconfigured = false;  ///< `run` begins with a reconfiguration
-  int goals_rejected = 0;     ///< reached goals whose run check_run rejected
+  bool reconfigured = false;   ///< `run` begins with a reconfiguration
+  int goals_rejected = 0;      ///< reached goals whose run check_run rejected
   int goals_not_admitted = 0;  ///< reached goals whose configuration admit rejected
-  std::string rejection;      ///< the last rejection's message
+  std::string rejection;       ///< the last rejection's message
   /// With a clearance (scenario/geometry.hpp): the distance bound of the searches, m (the
   /// clearance plus the margin of the round that planned the run); manifold_optimum is the optimum
   /// under it. 0: no distance bound.
@@ -361,8 +361,9 @@ inline NumericalError no_goal_reached(const GlobalCaptureResult& res, const char
   return NumericalError(str(
       where, ": no capture configuration chosen by the search was reached (", res.goals_tried, " goals, ",
       res.goals_out_of_limits, " of them behind a joint limit, ", res.shooting_iterations, " reaching runs)",
-      res.goals_rejected + res.goals_not_admitted ? str("; the last reached goal was rejected: ", res.rejection)
-                                                  : "",
+      res.goals_rejected + res.goals_not_admitted
+          ? str("; the last reached goal was rejected: ", res.rejection)
+          : "",
       res.task_alone_failure.empty() ? "" : str("; the task alone failed: ", res.task_alone_failure),
       res.run_failure.empty() ? "" : str("; the last reaching run that failed: ", res.run_failure)));
 }
