@@ -147,7 +147,7 @@ void bind_scenario(nb::module_& m) {
           [](const Scenario& sc) {
             return run_job<RunResult>([&sc](RunResult& r) {
               ScenarioRunOptions o;
-              o.keep_going = true;  // as the command: a failed plain or paper's-method row is reported
+              o.keep_going = true;    // as the command: a failed plain or paper's-method row is reported
               o.post_capture = true;  // with a Detumble key: each run's post-capture phase
               r.result = run_scenario(sc, o);
               r.json = scenario_json(sc, r.result, FFSR_VERSION).dump();

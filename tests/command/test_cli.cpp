@@ -153,8 +153,9 @@ TEST_CASE("xi holds a scenario's contact law fixed (--config), flags override it
   };
   for (const auto& [args, c_r, v] :
        {std::make_tuple(std::vector<std::string>{"xi", "--config", file, "--points", "2"}, 0.3, 0.2),
-        std::make_tuple(std::vector<std::string>{"xi", "--config", file, "--points", "2", "--restitution", "0.6"},
-                        0.6, 0.2)}) {
+        std::make_tuple(
+            std::vector<std::string>{"xi", "--config", file, "--points", "2", "--restitution", "0.6"}, 0.6,
+            0.2)}) {
     const auto [law, xi] = first_row(cli(args));
     const double expected =
         ffsr::relative_error(ffsr::make_contact_law(law, ffsr::ContactParams{1e7, 1.5, c_r}, v));
@@ -211,12 +212,14 @@ TEST_CASE("inspect: the distances of a configuration with shapes, against a clos
 // 2. contact
 // ------------------------------------------------------------------------------------------------
 
-TEST_CASE("the main job names a plain or paper's-method run that the clearance barrier could not keep", "[cli]") {
+TEST_CASE("the main job names a plain or paper's-method run that the clearance barrier could not keep",
+          "[cli]") {
   // robots/paper_7dof_position_clearance.toml with 9 cm: the plain run tracks the pose (one null-space
   // direction) and its last link passes closer to the target; the paper's method (position task, four
   // directions) keeps 9 cm. The distances come from the JSON, the line from the table.
   const std::string file = kSource + "/robots/paper_7dof_position_clearance.toml";
-  const auto j = cli({"--config", file, "--clearance", "0.09", "--global", "false", "--quiet", "--json", "-"});
+  const auto j =
+      cli({"--config", file, "--clearance", "0.09", "--global", "false", "--quiet", "--json", "-"});
   INFO(j.err);
   REQUIRE(j.exit_code == 0);
   const auto res = nlohmann::json::parse(j.out);
@@ -225,20 +228,22 @@ TEST_CASE("the main job names a plain or paper's-method run that the clearance b
   CHECK(res.at("optimized").at("min_clearance").at("distance").get<double>() >= 0.09 - 1e-6);
   const auto t = cli({"--config", file, "--clearance", "0.09", "--global", "false"});
   REQUIRE(t.exit_code == 0);
-  const std::string line = "clearance: the plain run comes closer than the clearance (the clearance barrier could "
-                           "not keep it with the freedom its task leaves): " +
-                           res.at("baseline").at("min_clearance").at("pair").get<std::string>() + " ";
+  const std::string line =
+      "clearance: the plain run comes closer than the clearance (the clearance barrier could "
+      "not keep it with the freedom its task leaves): " +
+      res.at("baseline").at("min_clearance").at("pair").get<std::string>() + " ";
   CHECK(t.out.find(line) != std::string::npos);
   CHECK(t.out.find("clearance: the optimized run") == std::string::npos);
 }
 
-TEST_CASE("the main job reports a plain and a paper's-method row that fail and goes on to the global row", "[cli]") {
+TEST_CASE("the main job reports a plain and a paper's-method row that fail and goes on to the global row",
+          "[cli]") {
   // robots/paper_7dof_grasp.toml: a grasp orientation 134 deg from the initial one; the straight line
   // alone loses it, the global run reconfigures first. Exit 0, the failed rows' errors in the JSON,
   // table and no CSV rows for them; the global row's series has both phases.
   TempDir tmp;
-  const auto r = cli({"--config", kSource + "/robots/paper_7dof_grasp.toml", "--quiet", "--json", "out.json", "--csv",
-                      "out.csv"},
+  const auto r = cli({"--config", kSource + "/robots/paper_7dof_grasp.toml", "--quiet", "--json", "out.json",
+                      "--csv", "out.csv"},
                      tmp.str());
   INFO(r.err);
   REQUIRE(r.exit_code == 0);
@@ -263,7 +268,8 @@ TEST_CASE("the main job reports a plain and a paper's-method row that fail and g
   CHECK(csv.find(",approach\n") != std::string::npos);
 
   // without the global row the first failure is the job's error (exit 3, as a point out of reach)
-  const auto off = cli({"--config", kSource + "/robots/paper_7dof_grasp.toml", "--global", "false", "--quiet"});
+  const auto off =
+      cli({"--config", kSource + "/robots/paper_7dof_grasp.toml", "--global", "false", "--quiet"});
   CHECK(off.exit_code == 3);
   CHECK(off.err.rfind(kErrorPrefix + " plain run: ", 0) == 0);
   CHECK(off.out.empty());

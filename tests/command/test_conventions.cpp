@@ -257,7 +257,8 @@ std::set<std::string> accepted_flags(const std::string& sub) {
   REQUIRE(r.exit_code == 0);
   std::set<std::string> flags;
   const std::regex flag("(--[a-z][a-z0-9-]*)");
-  for (std::sregex_iterator it(r.out.begin(), r.out.end(), flag), end; it != end; ++it) flags.insert((*it)[1]);
+  for (std::sregex_iterator it(r.out.begin(), r.out.end(), flag), end; it != end; ++it)
+    flags.insert((*it)[1]);
   return flags;
 }
 
@@ -391,9 +392,17 @@ TEST_CASE("each key a subcommand accepts changes its result, or the subcommand r
         const auto it = key_cases().find(key.name);
         if (it == key_cases().end() || it->second.seven_dof != seven) continue;
         const KeyCase& c = it->second;
-        Check k{sub, (sub.name.empty() ? "main job" : sub.name) + " --" + key.name, "--" + key.name,
-                accepted.count("--" + key.name) > 0, c.limit, c.verdict_in.count(sub.name) > 0,
-                c.same_optimum_in.count(sub.name) > 0, {}, {}, {}, {}};
+        Check k{sub,
+                (sub.name.empty() ? "main job" : sub.name) + " --" + key.name,
+                "--" + key.name,
+                accepted.count("--" + key.name) > 0,
+                c.limit,
+                c.verdict_in.count(sub.name) > 0,
+                c.same_optimum_in.count(sub.name) > 0,
+                {},
+                {},
+                {},
+                {}};
         const Args context = k.accepted ? only_accepted(c.context, accepted) : Args{};
         k.before = command_line(sub, context);
         Args changed = context;
@@ -436,17 +445,18 @@ TEST_CASE("each key a subcommand accepts changes its result, or the subcommand r
   for (const Check& k : checks) {
     const CommandResult& after = results.at(k.after);
     if (!k.accepted) {  // refused by the parser, naming the flag
-      if (!refused(after, k.flag)) problems += k.where + ": not accepted, but not refused either: " + after.err + "\n";
+      if (!refused(after, k.flag))
+        problems += k.where + ": not accepted, but not refused either: " + after.err + "\n";
       continue;
     }
     const CommandResult& before = results.at(k.before);
-    if (refused(after, k.flag)) continue;                          // refused by the library, naming the key
+    if (refused(after, k.flag)) continue;                         // refused by the library, naming the key
     if (before.exit_code != 0 && after.exit_code == 0) continue;  // the key makes the run work
-    if (k.limit && before.exit_code == 0 && after.exit_code != 0) continue;  // a tolerance the run misses
+    if (k.limit && before.exit_code == 0 && after.exit_code != 0) continue;    // a tolerance the run misses
     if (k.verdict && before.exit_code == 0 && after.exit_code == 3) continue;  // the problem's verdict
     if (before.exit_code != 0 || after.exit_code != 0)
-      problems += k.where + ": exit " + std::to_string(before.exit_code) + " -> " + std::to_string(after.exit_code) +
-                  ": " + before.err + " / " + after.err + "\n";
+      problems += k.where + ": exit " + std::to_string(before.exit_code) + " -> " +
+                  std::to_string(after.exit_code) + ": " + before.err + " / " + after.err + "\n";
     else if (result_of(before) == result_of(after) &&
              (!k.same_optimum || global_optimum_moved(results.at(k.main_before), results.at(k.main_after))))
       problems += k.where + ": accepted and ignored\n";
@@ -481,7 +491,8 @@ TEST_CASE("a key of one kind of task is refused where no run has that task", "[c
     for (const Sub& sub : w.subs) {
       if (!accepted_flags(sub.name).count(w.alt[0])) continue;  // the parser refuses it (the walk above)
       const CommandResult r = cli(command_line(sub, w.alt));
-      INFO((sub.name.empty() ? "main job" : sub.name) << " " << w.alt[0] << ": exit " << r.exit_code << ": " << r.err);
+      INFO((sub.name.empty() ? "main job" : sub.name)
+           << " " << w.alt[0] << ": exit " << r.exit_code << ": " << r.err);
       CHECK(refused(r, w.alt[0]));
       CHECK(r.err.find(w.says) != std::string::npos);
       CHECK(r.out.empty());
@@ -592,7 +603,8 @@ TEST_CASE("conventions: map without --csv evaluates the grid for its summary", "
   CHECK(t.out.find("wrote") == std::string::npos);
 }
 
-TEST_CASE("conventions: --csv - is the only thing on standard output, where a subcommand has series", "[cli][conventions]") {
+TEST_CASE("conventions: --csv - is the only thing on standard output, where a subcommand has series",
+          "[cli][conventions]") {
   for (const Sub& sub : subcommands()) {
     if (sub.name == "inspect") continue;  // one configuration: no series
     INFO(sub.name);
@@ -629,7 +641,8 @@ TEST_CASE("a bad value in a scenario file names the file, the key and its line",
   }
   SECTION("a value out of range, found when the scenario is built") {
     std::ofstream(file) << std::regex_replace(toml, std::regex("duration = 180"), "duration = -5");
-    for (const Args& a : {Args{"--config", file, "--global", "false", "--quiet"}, Args{"pareto", "--config", file}}) {
+    for (const Args& a :
+         {Args{"--config", file, "--global", "false", "--quiet"}, Args{"pareto", "--config", file}}) {
       const CommandResult r = cli(a);
       CHECK(r.exit_code == 2);
       CHECK(r.err.find("scenario " + file + ":27: duration: must be positive") != std::string::npos);
@@ -652,7 +665,8 @@ TEST_CASE("a bad value in a scenario file names the file, the key and its line",
   }
 }
 
-TEST_CASE("conventions: --config with --urdf keeps the file's end-effector and joints in every subcommand", "[cli][conventions]") {
+TEST_CASE("conventions: --config with --urdf keeps the file's end-effector and joints in every subcommand",
+          "[cli][conventions]") {
   // the file names end-effector = "ee" and its joints; --urdf gives the same robot under another
   // path: every subcommand evaluates the file's end-effector, as the main job does
   ffsr::test::TempDir tmp;
@@ -663,7 +677,8 @@ TEST_CASE("conventions: --config with --urdf keeps the file's end-effector and j
   const json b = ffsr::test::parse_json(cli({"inspect", "--config", scenario, "--urdf", copy, "--json"}));
   CHECK(b.at("end_effector") == a.at("end_effector"));
   CHECK(b.at("integrated_effective_mass") == a.at("integrated_effective_mass"));
-  const json c = ffsr::test::parse_json(cli({"contact", "--config", scenario, "--urdf", copy, "--json", "-"}));
+  const json c =
+      ffsr::test::parse_json(cli({"contact", "--config", scenario, "--urdf", copy, "--json", "-"}));
   CHECK(c.at("integrated_effective_mass").get<double>() == a.at("integrated_effective_mass").get<double>());
   const json m = ffsr::test::parse_json(
       cli({"--config", scenario, "--urdf", copy, "--global", "false", "--quiet", "--json", "-"}));

@@ -29,8 +29,9 @@ struct ParetoJobOptions {
 
 struct ParetoJobResult {
   ParetoFront front;
-  std::vector<ParetoPoint> runs;  ///< the plain run, the paper's method and the global run on the front's axes
-  BasePose base;                  ///< the global run's base pose (the front's)
+  std::vector<ParetoPoint>
+      runs;       ///< the plain run, the paper's method and the global run on the front's axes
+  BasePose base;  ///< the global run's base pose (the front's)
   std::string axis = "base-rate";
   /// a post-capture axis: its front over the global search's local optima and the sweep's points
   std::optional<PostCaptureFront> post_capture;
@@ -149,7 +150,7 @@ inline nlohmann::json post_capture_front_json(const Scenario& sc, const PostCapt
   nlohmann::json runs;
   for (size_t i = 0; i < f.runs.size(); ++i) runs[names[i]] = post_capture_point_json(sc, f.runs[i]);
   return {{"axis", f.axis},       {"unit", pareto_axis_unit(f.axis)}, {"front", pts},
-          {"knee_index", f.knee}, {"candidates", f.candidates},        {"candidates_at_rest", f.at_rest},
+          {"knee_index", f.knee}, {"candidates", f.candidates},       {"candidates_at_rest", f.at_rest},
           {"runs", runs}};
 }
 
@@ -170,20 +171,20 @@ inline nlohmann::json pareto_json(const Scenario& sc, const ParetoJobResult& r, 
     rj[names[i]]["keys_not_applied"] = keys_not_applied(sc.keys, rows[i]);  // as the main job's rows
   }
   nlohmann::json j = {{"version", version},
-          {"scenario", sc.where},
-          {"axis", r.axis},
-          {"base_position", detail::vector_json(Eigen::VectorXd(r.base.position))},
-          {"base_quaternion_wxyz", {q(3), q(0), q(1), q(2)}},
-          {"front", pts},
-          {"min_mass_end", pareto_point_json(f.min_mass)},
-          {"min_rate_end", pareto_point_json(f.min_rate)},
-          {"knee", pareto_point_json(f.points[f.knee])},
-          {"knee_index", f.knee},
-          {"hypervolume_kg_deg_s", f.hypervolume * kParetoDeg},
-          {"hypervolume_normalized", f.hypervolume_normalized},
-          {"runs", rj},
-          {"evaluations", f.evaluations},
-          {"seconds", f.seconds}};
+                      {"scenario", sc.where},
+                      {"axis", r.axis},
+                      {"base_position", detail::vector_json(Eigen::VectorXd(r.base.position))},
+                      {"base_quaternion_wxyz", {q(3), q(0), q(1), q(2)}},
+                      {"front", pts},
+                      {"min_mass_end", pareto_point_json(f.min_mass)},
+                      {"min_rate_end", pareto_point_json(f.min_rate)},
+                      {"knee", pareto_point_json(f.points[f.knee])},
+                      {"knee_index", f.knee},
+                      {"hypervolume_kg_deg_s", f.hypervolume * kParetoDeg},
+                      {"hypervolume_normalized", f.hypervolume_normalized},
+                      {"runs", rj},
+                      {"evaluations", f.evaluations},
+                      {"seconds", f.seconds}};
   if (r.post_capture) j["post_capture"] = detail::post_capture_front_json(sc, *r.post_capture);
   return j;
 }

@@ -74,12 +74,12 @@ struct MultibodyContactResult {
   double contact_duration = 0;           ///< time to separation (s)
   double separation_velocity = 0;        ///< delta_dot at separation (m/s, negative)
   double restitution = 0;                ///< realized coefficient: -separation_velocity / approach_velocity
-  Vector6 momentum_start = Vector6::Zero();  ///< [P; L about o] of robot + target at first touch
-  Vector6 momentum_end = Vector6::Zero();    ///< the same at separation
-  double energy_start = 0;                   ///< kinetic energy of robot + target at first touch (J)
-  double energy_end = 0;                     ///< the same at separation (equal for c_r = 1)
-  long steps = 0;                            ///< CVODE internal steps
-  std::vector<ContactSample> series;         ///< when requested
+  Vector6 momentum_start = Vector6::Zero();       ///< [P; L about o] of robot + target at first touch
+  Vector6 momentum_end = Vector6::Zero();         ///< the same at separation
+  double energy_start = 0;                        ///< kinetic energy of robot + target at first touch (J)
+  double energy_end = 0;                          ///< the same at separation (equal for c_r = 1)
+  long steps = 0;                                 ///< CVODE internal steps
+  std::vector<ContactSample> series;              ///< when requested
   Vector6 base_velocity_start = Vector6::Zero();  ///< robot base [v_0; w_0] at first touch (inertial)
   Vector6 base_velocity_end = Vector6::Zero();    ///< the same at separation
   ContactBodies start, end;  ///< robot and target at the first touch and at the separation (delta = 0)

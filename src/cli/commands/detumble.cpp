@@ -36,8 +36,8 @@ void print_detumble_table(std::ostream& out, const DetumbleJobResult& d) {
         << " N s; the grasp locks at the separation\n";
   else
     out << "grasp start              the end of the approach (no contact phase)\n";
-  out << "grasp impulse            " << g.impulse.head<3>().norm() << " N s, "
-      << g.impulse.tail<3>().norm() << " N m s\n"
+  out << "grasp impulse            " << g.impulse.head<3>().norm() << " N s, " << g.impulse.tail<3>().norm()
+      << " N m s\n"
       << "base velocity jump       " << g.base_velocity_jump.head<3>().norm() * 1e3 << " mm/s, "
       << g.base_velocity_jump.tail<3>().norm() * deg << " deg/s\n"
       << "kinetic energy           " << g.energy_before << " J before the grasp, " << g.energy_after

@@ -67,7 +67,8 @@ plot::Figure pareto_figure(const Scenario& sc, const ParetoFront& f, const std::
     s.rate.push_back(p.base_rate * kDeg);
   }
   s.knee = f.knee;
-  for (size_t i = 0; i < runs.size(); ++i) s.runs.push_back({kRunNames[i], runs[i].M_ie, runs[i].base_rate * kDeg});
+  for (size_t i = 0; i < runs.size(); ++i)
+    s.runs.push_back({kRunNames[i], runs[i].M_ie, runs[i].base_rate * kDeg});
   return figures::pareto(s);
 }
 
@@ -89,7 +90,8 @@ void print_post_capture_front(std::ostream& out, const Scenario& sc, const PostC
       << " non-dominated of " << f.candidates << " candidate capture configurations (" << f.at_rest
       << " at rest) at the global run's base pose\n\n"
       << std::left << std::setw(32) << "" << std::right << std::setw(11) << "M_ie (kg)" << std::setw(26)
-      << (f.axis + " (" + unit + ")") << std::setw(16) << "|dw_0| (deg/s)" << "\n";
+      << (f.axis + " (" + unit + ")") << std::setw(16) << "|dw_0| (deg/s)"
+      << "\n";
   row("least M_ie (end)", f.points.front());
   row("knee", f.points[f.knee]);
   row(("least " + f.axis + " (end)").c_str(), f.points.back());
@@ -153,12 +155,13 @@ void register_pareto(CLI::App& app, Action& action) {
       ->check(CLI::ExistingFile);
   // the front is of M_ie under the scenario's joint model (the capture objective's); the multibody
   // reference's servo keys act with the global run's objective multibody-force only (refused otherwise)
-  o->flags.add_groups(*sub, {KeyGroup::Robot, KeyGroup::Start, KeyGroup::Target, KeyGroup::TargetPlace,
-                             KeyGroup::Contact, KeyGroup::Planner, KeyGroup::Global, KeyGroup::JointModels,
-                             KeyGroup::Shapes, KeyGroup::Detumble},
-                      // the front is of M_ie and the base's jump (the impulse of the law's damping): the
-                      // stiffness and the exponent of the law change neither
-                      {"stiffness", "exponent"});
+  o->flags.add_groups(
+      *sub,
+      {KeyGroup::Robot, KeyGroup::Start, KeyGroup::Target, KeyGroup::TargetPlace, KeyGroup::Contact,
+       KeyGroup::Planner, KeyGroup::Global, KeyGroup::JointModels, KeyGroup::Shapes, KeyGroup::Detumble},
+      // the front is of M_ie and the base's jump (the impulse of the law's damping): the
+      // stiffness and the exponent of the law change neither
+      {"stiffness", "exponent"});
   sub->add_option("--levels", o->job.levels, "Epsilon levels of the sweep between the two ends")
       ->capture_default_str();
   sub->add_option("--starts", o->job.starts, "Random starts of the two single-objective searches")

@@ -97,7 +97,7 @@ ScenarioResult compute(Scenario& sc, const RunSettings& o) {
   sc.capture.record_series = !o.csv.empty() || !o.plot.empty();
   Progress p1{"plain"}, p2{"optimized"};
   ScenarioRunOptions run;
-  run.keep_going = true;  // a plain or paper's-method row that fails is reported; the global row decides
+  run.keep_going = true;    // a plain or paper's-method row that fails is reported; the global row decides
   run.post_capture = true;  // with a Detumble key: each run's post-capture phase
   if (!o.quiet) {
     run.plain_progress = std::ref(p1);
@@ -165,7 +165,8 @@ std::string metres4(double x) {
 }  // namespace
 
 /// The global row's notes; `opt_run`: the paper's-method run (null when it failed).
-void print_global_notes(std::ostream& out, const Scenario& sc, const GlobalRun& g, const CaptureResult* opt_run) {
+void print_global_notes(std::ostream& out, const Scenario& sc, const GlobalRun& g,
+                        const CaptureResult* opt_run) {
   const GlobalCaptureResult& r = g.result;
   const ScenarioKeys& o = sc.keys;
   const bool mb = o.objective == "multibody-force";
@@ -332,11 +333,10 @@ void print_base_jump(std::ostream& out, const Scenario& sc, const ScenarioResult
     const PostCaptureFigures& f = *r.global->post_capture;
     out << std::defaultfloat << std::setprecision(4)
         << "global run after the capture (detumble run): rest in " << f.time_to_rest
-        << " s, peak joint torque " << f.peak_joint_torque << " N m ("
-        << sc.model->joint(f.peak_joint).name << "), peak gripper force " << f.peak_gripper_force
-        << " N, moment " << f.peak_gripper_moment << " N m; " << r.global->post_capture_admitted << " of "
-        << r.global->post_capture_candidates << " candidate runs met "
-        << post_capture_constraints(sc.keys).flags() << "\n";
+        << " s, peak joint torque " << f.peak_joint_torque << " N m (" << sc.model->joint(f.peak_joint).name
+        << "), peak gripper force " << f.peak_gripper_force << " N, moment " << f.peak_gripper_moment
+        << " N m; " << r.global->post_capture_admitted << " of " << r.global->post_capture_candidates
+        << " candidate runs met " << post_capture_constraints(sc.keys).flags() << "\n";
   }
   out.flags(flags);
   out.precision(precision);
@@ -358,8 +358,8 @@ void print_clearance(std::ostream& out, const Scenario& sc, const ScenarioResult
       out << "clearance: the " << (name == "baseline" ? "plain" : name)
           << " run comes closer than the clearance (the clearance barrier could not keep it with the freedom "
              "its task leaves): "
-          << c.overall.pair << " " << c.overall.distance << " m at t = " << std::setprecision(1) << c.overall.time
-          << " s\n"
+          << c.overall.pair << " " << c.overall.distance << " m at t = " << std::setprecision(1)
+          << c.overall.time << " s\n"
           << std::setprecision(4);
   if (r.global && r.global->result.goals_rejected > 0)
     out << "clearance: " << r.global->result.goals_rejected
@@ -439,10 +439,10 @@ void register_run(CLI::App& app, Action& action) {
       ->check(CLI::ExistingFile);
   // every key: the Detumble keys add each run's post-capture phase (ScenarioRunOptions::post_capture)
   o->flags.add_to(app);
-  add_output_flags(app, o->settings,
-                   {"Write the result (with the resolved scenario and the version) as JSON to FILE",
-                    "Write the time series of the runs as CSV to FILE",
-                    "Draw the capture process and time histories"});
+  add_output_flags(
+      app, o->settings,
+      {"Write the result (with the resolved scenario and the version) as JSON to FILE",
+       "Write the time series of the runs as CSV to FILE", "Draw the capture process and time histories"});
   app.add_option("--expect", o->settings.expect,
                  "Regression run: compare every number of the result with this stored --json result; exit 4 "
                  "when one moved (relative to the scenario file)");

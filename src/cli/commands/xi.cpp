@@ -185,10 +185,11 @@ void register_xi(CLI::App& app, Action& action) {
   // against both)
   o->flags.add_to(*sub, [](const std::string& name) { return name == "exponent" || name == "restitution"; });
   sub->add_option("--points", o->points, "Values per study")->capture_default_str();
-  add_output_flags(*sub, o->out,
-                   {"Write the studies (the fixed parameters, xi of each law against each value) as JSON to FILE",
-                    "Write study,parameter,law,xi_percent as CSV to FILE (default: the table, on standard output)",
-                    "Draw the three studies"});
+  add_output_flags(
+      *sub, o->out,
+      {"Write the studies (the fixed parameters, xi of each law against each value) as JSON to FILE",
+       "Write study,parameter,law,xi_percent as CSV to FILE (default: the table, on standard output)",
+       "Draw the three studies"});
   sub->callback([o, &action] { action = [o] { return run_xi(*o); }; });
 }
 

@@ -197,7 +197,8 @@ plot::Figure pareto(const ParetoSeries& s) {
     if (bad(s.mass[i], s.rate[i]))
       throw InputError(str("pareto plot: front point ", i, " is (", s.mass[i], ", ", s.rate[i], ")"));
   for (const auto& r : s.runs)
-    if (bad(r.mass, r.rate)) throw InputError(str("pareto plot: ", r.label, " is (", r.mass, ", ", r.rate, ")"));
+    if (bad(r.mass, r.rate))
+      throw InputError(str("pareto plot: ", r.label, " is (", r.mass, ", ", r.rate, ")"));
 
   // the front's extent grown by a quarter on every side: the runs inside are drawn beside the front
   const auto mass = std::minmax_element(s.mass.begin(), s.mass.end());
@@ -223,20 +224,18 @@ plot::Figure pareto(const ParetoSeries& s) {
   line.symbol = "●";
 
   const std::string& ylabel = s.y_label;
-  Panel front = labelled("the front at the global run's base pose, the runs at their own", "M_ie (kg)", ylabel);
+  Panel front =
+      labelled("the front at the global run's base pose, the runs at their own", "M_ie (kg)", ylabel);
   line.label = str("front (", n, " points)");
   line.symbol_scale = 0.55;
   front.curves.push_back(line);
   front.curves.push_back(marker("least M_ie: " + mass_rate(s.mass.front(), s.rate.front(), s.y_unit),
-                                {s.mass.front()},
-                                {s.rate.front()}, kBlack, "■", 0.9));
-  front.curves.push_back(marker("least " + s.y_name + ": " +
-                                    mass_rate(s.mass.back(), s.rate.back(), s.y_unit),
-                                {s.mass.back()},
-                                {s.rate.back()}, kBlack, "□", 0.9));
+                                {s.mass.front()}, {s.rate.front()}, kBlack, "■", 0.9));
+  front.curves.push_back(
+      marker("least " + s.y_name + ": " + mass_rate(s.mass.back(), s.rate.back(), s.y_unit), {s.mass.back()},
+             {s.rate.back()}, kBlack, "□", 0.9));
   front.curves.push_back(marker("knee: " + mass_rate(s.mass[s.knee], s.rate[s.knee], s.y_unit),
-                                {s.mass[s.knee]},
-                                {s.rate[s.knee]}, 1, "◆", 1.2));
+                                {s.mass[s.knee]}, {s.rate[s.knee]}, 1, "◆", 1.2));
   for (size_t i = 0; i < s.runs.size(); ++i)
     if (near(s.runs[i])) front.curves.push_back(run_marker(i));
 

@@ -132,11 +132,11 @@ inline GlobalRun run_global(const Scenario& sc, const CaptureResult* paper_run, 
     throw InputError(str("global run: ", e.what()));
   } catch (const NumericalError& e) {
     if (screen && screen->admitted() == 0) throw InputError(screen->shortfall());
-    throw NumericalError(str("global run: ", e.what(),
-                             screen ? str(" (", screen->admitted(), " of ", screen->evaluated(),
-                                          " candidate runs met the post-capture constraints ",
-                                          screen->constraints().flags(), ")")
-                                    : std::string()));
+    throw NumericalError(str(
+        "global run: ", e.what(),
+        screen ? str(" (", screen->admitted(), " of ", screen->evaluated(),
+                     " candidate runs met the post-capture constraints ", screen->constraints().flags(), ")")
+               : std::string()));
   }
   if (screen) add_post_capture(*screen, r);
   const CaptureSetup setup = prepare_capture(sc.problem, sc.task, opt);

@@ -10,7 +10,6 @@
 #include <nlohmann/json.hpp>
 #include <toml++/toml.h>
 
-
 namespace ffsr {
 namespace detail {
 
