@@ -26,8 +26,8 @@
 //
 // Start: first touch (delta = 0). The robot moves with zero total momentum and the velocity of its
 // contact point equal to `approach_speed` along u (joint rates from the pseudo-inverse of the linear
-// rows of J_f at that point; the base follows from momentum conservation); the target moves with its own velocity and
-// spin. delta_dot^- = u . (v_e - v_tp) of that state (Eq. 10-12) sets the damping (Eq. 22).
+// rows of J_f at that point; the base follows from momentum conservation); the target moves with its
+// own velocity and spin. delta_dot^- = u . (v_e - v_tp) of that state (Eq. 10-12) sets the damping (Eq. 22).
 // Integration: SUNDIALS CVODE (BDF, Newton, dense), tight tolerances, on displacements from the
 // initial state so that the ~0.1 mm deformation is resolved; separation (delta back to zero) and the
 // force peak (dF/dt = 0) are located by CVODE's root finding.

@@ -389,7 +389,8 @@ void print_table(std::ostream& out, const Scenario& sc, const ScenarioResult& r)
       << ", optimized " << (sc.task.kind == CaptureTask::Kind::Pose ? "pose" : "position")
       << "; F_max: Eq. 24 closed form; exact: peak of the single-body model (Eq. 16)\n";
   print_post_capture_note(out, sc, r);
-  // a failed run's CaptureResult is empty: no damped evaluations, and its smallest singular value (0) is not one
+  // a failed run's CaptureResult is empty: no damped evaluations, and its smallest singular value (0)
+  // is not one
   const long damped = r.plain.damped_steps + r.optimized.damped_steps;
   if (damped > 0)
     out << "note: near a singularity the pseudo-inverse was damped in " << damped
