@@ -225,7 +225,10 @@ def test_run_with_post_capture_constraints_equals_the_command(tmp_path):
     got = ffsr.Scenario.load(str(scenario), global_starts=2, joint_torque_limit=20,
                              max_peak_joint_torque=3).run().to_dict()
     assert differences(got, expected) == []
-    assert 0 < got["global"]["post_capture"]["peak_joint_torque"] <= 3
+    assert 0 < got["global"]["post_capture_constraints"]["peak_joint_torque"] <= 3
+    # the same capture's post-capture figures under the two names: the constraints' and the run's
+    assert (got["global"]["post_capture_constraints"]["peak_joint_torque"] ==
+            got["global"]["post_capture"]["peak_joint_torque"])
     with pytest.raises(ffsr.InputError, match="--max-peak-joint-torque: must be positive"):
         ffsr.Scenario.load(str(scenario), max_peak_joint_torque=-1)
 

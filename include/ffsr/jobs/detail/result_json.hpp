@@ -157,14 +157,15 @@ inline void add_global_json(nlohmann::json& j, const Scenario& sc, const GlobalR
   x["branches"] = branches_json(g.branches);
   if (g.post_capture) {  // the post-capture constraints: the figures at the capture reached
     const PostCaptureFigures& f = *g.post_capture;
-    x["post_capture"] = {{"time_to_rest", f.time_to_rest},
-                         {"peak_joint_torque", f.peak_joint_torque},
-                         {"peak_joint", f.peak_joint >= 0 ? sc.model->joint(f.peak_joint).name : ""},
-                         {"peak_gripper_force", f.peak_gripper_force},
-                         {"peak_gripper_moment", f.peak_gripper_moment},
-                         {"candidates", g.post_capture_candidates},
-                         {"candidates_meeting_constraints", g.post_capture_admitted},
-                         {"reached_goals_rejected", g.result.goals_not_admitted}};
+    x["post_capture_constraints"] = {
+        {"time_to_rest", f.time_to_rest},
+        {"peak_joint_torque", f.peak_joint_torque},
+        {"peak_joint", f.peak_joint >= 0 ? sc.model->joint(f.peak_joint).name : ""},
+        {"peak_gripper_force", f.peak_gripper_force},
+        {"peak_gripper_moment", f.peak_gripper_moment},
+        {"candidates", g.post_capture_candidates},
+        {"candidates_meeting_constraints", g.post_capture_admitted},
+        {"reached_goals_rejected", g.result.goals_not_admitted}};
   }
   j["global"] = x;
   add_reductions_json(j, "global_", base_run, &r.run);
