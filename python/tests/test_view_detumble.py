@@ -131,7 +131,7 @@ def test_the_target_rides_on_the_gripper_in_the_page(captured, tmp_path):
 def test_the_page_opens_at_the_capture_and_inline(captured, tmp_path):
     """Without a time in its address the page opens at the capture instant (badge 'capture'); its
     inline form (a notebook's iframe) draws with no console error."""
-    from test_view import NOTEBOOK
+    from test_view import NOTEBOOK, NOTEBOOK_BUDGET_MS
 
     result, series, post, post_series = captured
     j = json.loads(result.read_text())
@@ -139,7 +139,7 @@ def test_the_page_opens_at_the_capture_and_inline(captured, tmp_path):
                          frames=80)
     notebook = tmp_path / "notebook.html"
     notebook.write_text(NOTEBOOK.replace("@@FRAME@@", shown._repr_html_()), encoding="utf-8")
-    page = open_page(notebook, tmp_path / "notebook.png")
+    page = open_page(notebook, tmp_path / "notebook.png", budget_ms=NOTEBOOK_BUDGET_MS)
     assert page.console == [], page.console
     s = page.summary()
     assert s["ready"] is True and s["errors"] == [], s

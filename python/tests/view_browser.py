@@ -87,14 +87,29 @@ class Page:
         return json.loads(text)
 
 
-def open_page(html: Path, shot: Path, width: int = 1280, height: int = 800, fragment: str = "") -> Page:
-    """Opens `html` (a file) for a few seconds of virtual time; the DOM, a screenshot, the console lines."""
-    with tempfile.TemporaryDirectory(prefix="ffsr-chromium-") as profile:
-        cmd = [chromium(), *browser_flags(profile), "--enable-logging=stderr", "--v=0",
-               "--virtual-time-budget=8000", f"--window-size={width},{height}", f"--screenshot={shot}",
-               "--dump-dom", html.resolve().as_uri() + fragment]
-        p = subprocess.run(cmd, capture_output=True, text=True, timeout=180)
-    assert p.returncode == 0, f"chromium: exit {p.returncode}\n{p.stderr[-3000:]}"
+def _summary_pending(dom: str) -> bool:
+    """The page has a summary element its scripts have not filled yet."""
+    m = re.search(r'<pre id="ffsr-view-summary"[^>]*>(.*?)</pre>', dom, re.S)
+    return bool(m) and not m.group(1).strip()
+
+
+def open_page(html: Path, shot: Path, width: int = 1280, height: int = 800, fragment: str = "",
+              budget_ms: int = 8000) -> Page:
+    """Opens `html` (a file) for `budget_ms` of virtual time; the DOM, a screenshot, the console lines.
+
+    Headless Chromium's virtual time can run out while the page still compiles its three.js module on
+    a loaded machine (--dump-dom then shows the summary element empty: the scripts had not finished,
+    nothing failed). That case, and only that one, is opened again, up to three times, each with twice
+    the budget; a page whose scripts wrote a summary (errors included) is taken as it is."""
+    for attempt in range(3):
+        with tempfile.TemporaryDirectory(prefix="ffsr-chromium-") as profile:
+            cmd = [chromium(), *browser_flags(profile), "--enable-logging=stderr", "--v=0",
+                   f"--virtual-time-budget={budget_ms << attempt}", f"--window-size={width},{height}",
+                   f"--screenshot={shot}", "--dump-dom", html.resolve().as_uri() + fragment]
+            p = subprocess.run(cmd, capture_output=True, text=True, timeout=180)
+        assert p.returncode == 0, f"chromium: exit {p.returncode}\n{p.stderr[-3000:]}"
+        if not _summary_pending(p.stdout):
+            break
     console = [line for line in p.stderr.splitlines() if ":CONSOLE" in line]
     return Page(p.stdout, shot, console)
 
