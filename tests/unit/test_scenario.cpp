@@ -137,8 +137,7 @@ TEST_CASE("scenario: map, pareto and closed-loop through the library give the co
     o.vary = {2, 3};
     o.step_deg = {20};
     o.threads = 2;
-    const ffsr::Subject subject = ffsr::load_subject(sc.keys);
-    const ffsr::MapPlan plan = ffsr::plan_map(subject, o);
+    const ffsr::MapPlan plan = ffsr::plan_map(sc, o);
     REQUIRE(plan.count() == 18 * 18);
     double largest = 0;
     std::uint64_t seen = 0;
@@ -149,10 +148,10 @@ TEST_CASE("scenario: map, pareto and closed-loop through the library give the co
       seen += b.count;
       for (std::uint64_t i = 0; i < b.count; ++i) largest = std::max(largest, b.M_ie[i]);
     };
-    const ffsr::MapRun run = ffsr::evaluate_map(subject, plan, sink);
+    const ffsr::MapRun run = ffsr::evaluate_map(sc, plan, sink);
     CHECK(in_order);
     CHECK(seen == plan.count());
-    const json lib = library(ffsr::map_json(subject, run, "library"));
+    const json lib = library(ffsr::map_json(sc, run, "library"));
     check_same_numbers(lib, command_json({"map", "--vary", "2,3", "--step-deg", "20", "--threads", "2",
                                           "--csv", (tmp.path / "map.csv").string()}),
                        "map");
