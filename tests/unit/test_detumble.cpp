@@ -576,7 +576,7 @@ TEST_CASE("a Detumble key from the scenario file to the controller: one conversi
   const DetumbleJobResult d = detumble(sc);
   check_same(d.settings, s);
   CHECK(d.result.at_rest);
-  CHECK(d.result.ticks * s.run.tick < s.run.horizon);
+  CHECK(static_cast<double>(d.result.ticks) * s.run.tick < s.run.horizon);
   const Model stack = attach_body(*sc.model, sc.model->frame(sc.problem.frame).name, d.grasp.body);
   DetumbleController ctrl(stack, sc.problem.frame, s.limits, s.options);
   DetumbleCommand first = ctrl.make_command();
@@ -608,15 +608,15 @@ TEST_CASE("a Detumble key from the scenario file to the controller: one conversi
 
   // the actuator's bounds: each from its key
   const Scenario wheels = build_scenario(
-      detumble_scenario("base-actuator = \"reaction-wheels\"\nwheel-torque = 0.3\nwheel-momentum = 7\n"
-                        "stop-stack-spin = true\n"),
+      detumble_scenario("joint-torque-limit = 20\nbase-actuator = \"reaction-wheels\"\nwheel-torque = 0.3\n"
+                        "wheel-momentum = 7\nstop-stack-spin = true\n"),
       nullptr, ScenarioScope::Configuration);
   const DetumbleSettings w = detumble_settings(wheels.keys, *wheels.model);
   CHECK(w.limits.actuator == BaseActuator::ReactionWheels);
   CHECK(w.limits.wheel_torque == 0.3);
   CHECK(w.limits.wheel_momentum == 7);
   CHECK(w.options.stop_stack_spin);
-  for (int j = 0; j < 7; ++j) CHECK(w.limits.joint_torque(j) == wheels.model->joint(j).effort);  // the URDF's
+  CHECK(w.limits.joint_torque == Eigen::VectorXd::Constant(7, 20.0));  // one value for every joint
   CHECK(std::string(actuator_name(w.limits.actuator)) == wheels.keys.base_actuator);
 
   // one check: a bad limit is refused by the key table, with the controller's own test of a limit, in
