@@ -20,9 +20,8 @@ using namespace nb::literals;
 namespace {
 
 BaseActuator actuator_arg(const std::string& name) {
-  for (BaseActuator a : {BaseActuator::None, BaseActuator::ReactionWheels, BaseActuator::Thrusters})
-    if (name == actuator_name(a)) return a;
-  throw InputError(detail::str("detumble: unknown actuator '", name, "' (none, reaction-wheels, thrusters)"));
+  if (const std::optional<BaseActuator> a = find_base_actuator(name)) return *a;
+  throw InputError(detail::str("detumble: unknown actuator '", name, "' (", base_actuator_names(", "), ")"));
 }
 
 DetumbleLimits limits_arg(const Model& stack, nb::handle joint_torque, const std::string& actuator,
@@ -155,9 +154,9 @@ void bind_detumble_result(nb::module_& m) {
           "series_tau",
           [](const DetumbleRunResult& r) {
             Eigen::MatrixXd x(static_cast<Eigen::Index>(r.series.size()),
-                              r.series.empty() ? 0 : r.series[0].tau.size());
+                              r.series.empty() ? 0 : r.series[0].command.tau.size());
             for (size_t i = 0; i < r.series.size(); ++i)
-              x.row(static_cast<Eigen::Index>(i)) = r.series[i].tau.transpose();
+              x.row(static_cast<Eigen::Index>(i)) = r.series[i].command.tau.transpose();
             return out(x);
           },
           nb::rv_policy::automatic)
@@ -169,7 +168,7 @@ void bind_detumble_result(nb::module_& m) {
 
 /// The job `detumble` (ffsr/jobs/detumble.hpp): one result per start (the scenario's configuration, or
 /// each run of --run).
-/// With the series as the command's --csv writes it (made from the same subject).
+/// With the series as the command's --csv writes it (made from the same scenario).
 struct DetumbleJobRun : JobRun<std::vector<DetumbleJobResult>> {
   std::string series_csv;
 };
@@ -199,15 +198,14 @@ void bind_detumble_job(nb::module_& m) {
       "detumble",
       [](const Scenario& sc, std::optional<std::string> run) {
         return run_job<DetumbleJobRun>([&](DetumbleJobRun& r) {
-          const Subject s = scenario_subject(sc);
           if (run) {
-            r.result = detumble_runs(s, sc, *run);
-            r.json = detumble_runs_json(s, r.result, FFSR_VERSION).dump();
+            r.result = detumble_runs(sc, *run);
+            r.json = detumble_runs_json(sc, r.result, FFSR_VERSION).dump();
           } else {
-            r.result.push_back(detumble(s));
-            r.json = detumble_json(s, r.result.front(), FFSR_VERSION).dump();
+            r.result.push_back(detumble(sc));
+            r.json = detumble_json(sc, r.result.front(), FFSR_VERSION).dump();
           }
-          r.series_csv = detumble_series_csv(s, r.result);
+          r.series_csv = detumble_series_csv(sc, r.result);
         });
       },
       "run"_a = nb::none(),

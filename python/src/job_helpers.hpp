@@ -5,7 +5,6 @@
 
 #include "outputs.hpp"
 
-#include "ffsr/jobs/subject.hpp"
 #include "ffsr/scenario/scenario.hpp"
 
 #include <nanobind/stl/string.h>
@@ -63,13 +62,21 @@ void def_scenario_method(const char* name, Fn&& fn, const Extra&... extra) {
 /// (key, value) given to a job as the command's flags; no value: the scenario's.
 using KeyOverrides = std::vector<std::pair<const char*, std::optional<std::string>>>;
 
-/// The subject of a scenario: its keys as resolved, built again by the job layer (as the command builds
-/// the subject of --config FILE), with `overrides` (values a scenario refuses, as 'all').
-inline Subject scenario_subject(const Scenario& sc, const KeyOverrides& overrides = {}) {
+/// The scenario a one-configuration job evaluates: `sc` itself when no override is given; else the
+/// scenario of its keys with `overrides` (values the main job refuses, as 'all'), built by the library
+/// with scope Configuration into `variant` (as the command builds --config FILE with those flags).
+inline const Scenario& scenario_with(const Scenario& sc, const KeyOverrides& overrides,
+                                     std::optional<Scenario>& variant) {
   ScenarioKeys keys = sc.keys;
+  bool changed = false;
   for (const auto& [key, value] : overrides)
-    if (value) override_scenario_key(keys, key, *value);
-  return load_subject(std::move(keys));
+    if (value) {
+      override_scenario_key(keys, key, *value);
+      changed = true;
+    }
+  if (!changed) return sc;
+  variant.emplace(build_scenario(std::move(keys), nullptr, ScenarioScope::Configuration));
+  return *variant;
 }
 
 }  // namespace ffsr::python

@@ -17,10 +17,8 @@ namespace {
 
 using namespace nb::literals;
 
-/// inspect's result: the subject it evaluated (the result's Data is made from its model), the
-/// evaluation and the command's JSON, made together.
+/// inspect's result: the evaluation and the command's JSON, made together.
 struct InspectRun {
-  Subject subject;
   std::optional<InspectResult> result;
   std::string json;
 };
@@ -109,9 +107,8 @@ void bind_inspect(nb::module_& m) {
       "inspect",
       [](const Scenario& sc) {
         return run_job<InspectRun>([&sc](InspectRun& r) {
-          r.subject = scenario_subject(sc);
-          r.result.emplace(inspect(r.subject));
-          r.json = inspect_json(r.subject, *r.result, FFSR_VERSION).dump();
+          r.result.emplace(inspect(sc));
+          r.json = inspect_json(sc, *r.result, FFSR_VERSION).dump();
         });
       },
       "The job `inspect` (ffsr-optimize inspect --config FILE): the start configuration evaluated: H, J_f,\n"
@@ -166,7 +163,9 @@ void bind_contact_job(nb::module_& m) {
       [](const Scenario& sc, std::optional<std::string> model, std::optional<std::string> contact_joints,
          bool series) {
         return run_job<ContactRun>([&](ContactRun& r) {
-          const Subject s = scenario_subject(sc, {{"model", model}, {"contact-joints", contact_joints}});
+          std::optional<Scenario> variant;
+          const Scenario& s =
+              scenario_with(sc, {{"model", model}, {"contact-joints", contact_joints}}, variant);
           ContactJobOptions o;
           o.record_series = series;
           r.result = contact(s, o);

@@ -6,7 +6,7 @@
 #include "bindings.hpp"
 #include "job_helpers.hpp"
 
-#include "ffsr/jobs/scenario_run.hpp"
+#include "ffsr/jobs/whole_capture.hpp"
 
 #include <nanobind/stl/optional.h>
 #include <nanobind/stl/vector.h>
@@ -147,9 +147,8 @@ void bind_scenario(nb::module_& m) {
           [](const Scenario& sc) {
             return run_job<RunResult>([&sc](RunResult& r) {
               ScenarioRunOptions o;
-              o.keep_going = true;    // as the command: a failed plain or paper's-method row is reported
-              o.post_capture = true;  // with a Detumble key: each run's post-capture phase
-              r.result = run_scenario(sc, o);
+              o.keep_going = true;  // as the command: a failed plain or paper's-method row is reported
+              r.result = run_whole_capture(sc, o);  // with a Detumble key: each run's post-capture phase
               r.json = scenario_json(sc, r.result, FFSR_VERSION).dump();
             });
           },

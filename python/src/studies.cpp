@@ -32,8 +32,7 @@ using ParetoRun = JobRun<ParetoJobResult>;
 /// The map job into `r`: each block of points into its rows, on the thread that computed it (the rows
 /// are disjoint).
 void run_map(const Scenario& sc, const MapJobOptions& o, MapRunResult& r) {
-  const Subject s = scenario_subject(sc);
-  const MapPlan plan = plan_map(s, o);
+  const MapPlan plan = plan_map(sc, o);
   const auto rows = static_cast<Eigen::Index>(plan.count());
   const size_t k = plan.grid.axes.size();
   r.angles_deg.resize(rows, static_cast<Eigen::Index>(k));
@@ -49,8 +48,8 @@ void run_map(const Scenario& sc, const MapJobOptions& o, MapRunResult& r) {
       r.f_max(row) = b.f_max[i];
     }
   };
-  r.run.emplace(evaluate_map(s, plan, sink));
-  r.json = map_json(s, *r.run, FFSR_VERSION).dump();
+  r.run.emplace(evaluate_map(sc, plan, sink));
+  r.json = map_json(sc, *r.run, FFSR_VERSION).dump();
 }
 
 /// The robust job's options as the command checks its flags, before anything is planned.

@@ -10,11 +10,13 @@ if(NOT FFSR_SOURCE_DIR)
 endif()
 set(page "${FFSR_SOURCE_DIR}/docs/architecture.md")
 set(include_dir "${FFSR_SOURCE_DIR}/include/ffsr")
-file(STRINGS "${page}" lines)
+file(STRINGS "${page}" lines ENCODING UTF-8)
 
-# the table rows of the section whose title starts with `title`, without the header and rule rows
+# the rows of the first table of the section whose title starts with `title`, without the header and
+# rule rows
 function(section_rows title out)
   set(in FALSE)
+  set(started FALSE)
   set(rows "")
   foreach(line IN LISTS lines)
     if(line MATCHES "^## ${title}")
@@ -24,6 +26,9 @@ function(section_rows title out)
     elseif(in AND line MATCHES "^\\| " AND NOT line MATCHES "^\\|---")
       string(REPLACE ";" "," line "${line}")  # a CMake list of rows
       list(APPEND rows "${line}")
+      set(started TRUE)
+    elseif(in AND started AND NOT line MATCHES "^\\|")
+      break()  # the section's first table only
     endif()
   endforeach()
   if(rows)

@@ -70,9 +70,59 @@ foreach(h IN LISTS headers)
   endforeach()
 endforeach()
 
+# Within the floor jobs/: the order of its files, the lowest first (docs/architecture.md draws it). A
+# file includes only files of its own entry or of an entry below it: an entry is a header and the bodies
+# it includes at its end (which include it back), so that the jobs depend on each other one way (the
+# main job knows nothing of the detumble job, which plans the main job's runs; the whole capture
+# composes both). A jobs/ file missing from the table fails the check; an include of a file of a higher
+# entry is a cycle or on its way to one, and fails it too.
+set(FFSR_JOBS_ORDER
+  "detail/json_values"
+  "scenario_clearance"
+  "detail/detumble_result"
+  "detail/post_capture"
+  "detail/post_capture_front"
+  "scenario_run detail/scenario_run detail/base_disturbance_json detail/scenario_series detail/result_json"
+  "inspect map"
+  "contact"
+  "detumble"
+  "closed_loop pareto robust detail/robust"
+  "whole_capture"
+)
+set(rank 0)
+foreach(entry IN LISTS FFSR_JOBS_ORDER)
+  string(REPLACE " " ";" names "${entry}")
+  foreach(name IN LISTS names)
+    set(JOBS_${name} ${rank})
+  endforeach()
+  math(EXPR rank "${rank} + 1")
+endforeach()
+foreach(h IN LISTS headers)
+  if(NOT h MATCHES "^jobs/(.+)\\.(hpp|hxx)$")
+    continue()
+  endif()
+  set(own "${CMAKE_MATCH_1}")
+  if(NOT DEFINED JOBS_${own})
+    list(APPEND errors
+         "${h}: not in the order of the jobs/ files (FFSR_JOBS_ORDER in ${CMAKE_CURRENT_LIST_FILE})")
+    continue()
+  endif()
+  file(STRINGS "${FFSR_INCLUDE_DIR}/${h}" lines REGEX "^[ \t]*#[ \t]*include[ \t]*[<\"]ffsr/jobs/")
+  foreach(line IN LISTS lines)
+    string(REGEX MATCH "ffsr/jobs/([^\">]+)\\.(hpp|hxx)" _ "${line}")
+    set(dep "${CMAKE_MATCH_1}")
+    if(NOT DEFINED JOBS_${dep})
+      list(APPEND errors "${h}: includes ffsr/jobs/${dep}, which is not in the order of the jobs/ files")
+    elseif(JOBS_${dep} GREATER JOBS_${own})
+      list(APPEND errors "${h} includes ffsr/jobs/${dep}, a file above it in the order of the jobs/ files "
+                         "(FFSR_JOBS_ORDER): the two would depend on each other")
+    endif()
+  endforeach()
+endforeach()
+
 list(LENGTH headers count)
 if(errors)
   string(REPLACE ";" "\n  " text "${errors}")
   message(FATAL_ERROR "layers: ${count} headers, includes against the layers:\n  ${text}")
 endif()
-message(STATUS "layers: ${count} headers, every include at or below its folder's layer")
+message(STATUS "layers: ${count} headers, every include at or below its folder's layer, jobs/ in order")

@@ -1,6 +1,7 @@
 // The post-capture phase: the stack model (a body attached at a frame) against sums over bodies from
 // finite differences of forward kinematics; the grasp's plastic impulse (momentum conserved, relative
-// twist zero, the stack's momentum equal to the two bodies'); the detumbling controller and its run.
+// twist zero, the stack's momentum equal to the two bodies'); the detumbling controller and its run;
+// the way of the Detumble keys from a scenario file to the controller (jobs/detumble.hpp).
 
 #include <catch2/catch.hpp>
 
@@ -10,13 +11,17 @@
 #include "ffsr/algorithm/forward_dynamics.hpp"
 #include "ffsr/algorithm/grasp.hpp"
 #include "ffsr/control/detumble_run.hpp"
+#include "ffsr/jobs/detumble.hpp"
 #include "ffsr/model/attach.hpp"
 #include "ffsr/scenario/scenario.hpp"
 
 #include <cmath>
+#include <fstream>
 #include <limits>
 #include <optional>
+#include <sstream>
 #include <string>
+#include <type_traits>
 
 namespace test_detumble {
 
@@ -201,8 +206,9 @@ Eigen::VectorXd limits_7dof() {
 
 void check_torques_within_limits(const DetumbleRunResult& r, const Eigen::VectorXd& L) {
   for (const auto& s : r.series) {
-    for (int k = 0; k < L.size(); ++k) REQUIRE(std::abs(s.tau(k)) <= L(k) * (1 + 1e-12));
-    REQUIRE(s.theta_dot.cwiseAbs().maxCoeff() == s.joint_rate);  // the series' rates are the controller's
+    for (int k = 0; k < L.size(); ++k) REQUIRE(std::abs(s.command.tau(k)) <= L(k) * (1 + 1e-12));
+    // the series' rates are the controller's
+    REQUIRE(s.theta_dot.cwiseAbs().maxCoeff() == s.command.joint_rate);
   }
 }
 
@@ -228,8 +234,8 @@ TEST_CASE(
   CHECK(r.momentum_drift < 1e-8);
   CHECK(r.max_energy_balance < 1e-6);  // T(k+1) - T(k) = tau . (theta(k+1) - theta(k)) each tick
   CHECK(r.energy_end < r.energy_start);
-  CHECK(r.series.back().joint_rate < opt.rest_rate);
-  CHECK(r.series.back().relative_rate < opt.rest_rate);
+  CHECK(r.series.back().command.joint_rate < opt.rest_rate);
+  CHECK(r.series.back().command.relative_rate < opt.rest_rate);
   CHECK(r.peak_joint_torque > 0);
   check_torques_within_limits(r, lim.joint_torque);
   // the stack keeps its momentum: the total momentum after the grasp equals the run's
@@ -275,7 +281,7 @@ TEST_CASE("detumble, free-floating, torque limits that bind: the brake scaled, s
   CHECK(r.max_energy_balance < 1e-6);
   check_torques_within_limits(r, lim.joint_torque);
   long saturated = 0;
-  for (const auto& s : r.series) saturated += s.status == DetumbleStatus::Saturated;
+  for (const auto& s : r.series) saturated += s.command.status == DetumbleStatus::Saturated;
   CHECK(saturated > 10);
 }
 
@@ -294,7 +300,7 @@ TEST_CASE("detumble, free-floating, the passive law: kinetic energy never increa
   CHECK(r.momentum_drift < 1e-8);
   for (size_t k = 1; k < r.series.size(); ++k)
     REQUIRE(r.series[k].energy <= r.series[k - 1].energy * (1 + 1e-12));
-  for (const auto& s : r.series) REQUIRE(s.tau.dot(s.theta_dot) <= 0.0);
+  for (const auto& s : r.series) REQUIRE(s.command.tau.dot(s.theta_dot) <= 0.0);
   check_torques_within_limits(r, lim.joint_torque);
 }
 
@@ -314,13 +320,13 @@ TEST_CASE("detumble with reaction wheels: the stack's spin stopped, the wheels w
   const DetumbleRunResult r = run_detumble(g.stack, g.gripper, g.grasp.body, g.start, lim, opt, run);
   INFO("time to rest " << r.time_to_rest << " s, wheels " << r.peak_wheel_momentum << " N m s");
   CHECK(r.at_rest);
-  CHECK(r.series.back().stack_rate < opt.rest_rate);
+  CHECK(r.series.back().command.stack_rate < opt.rest_rate);
   CHECK(r.peak_wheel_momentum <= lim.wheel_momentum);
   CHECK(r.peak_wheel_momentum > 0.1);  // the wheels took the stack's spin
   CHECK(r.momentum_drift < 1e-8);      // stack + wheels
   check_torques_within_limits(r, lim.joint_torque);
   for (const auto& s : r.series)
-    REQUIRE((s.base_wrench.tail<3>().cwiseAbs().maxCoeff() <= std::sqrt(3.0) * lim.wheel_torque));
+    REQUIRE((s.command.base_wrench.tail<3>().cwiseAbs().maxCoeff() <= std::sqrt(3.0) * lim.wheel_torque));
 }
 
 TEST_CASE("detumble with thrusters: the stack's spin stopped", "[detumble]") {
@@ -338,7 +344,7 @@ TEST_CASE("detumble with thrusters: the stack's spin stopped", "[detumble]") {
   const DetumbleRunResult r = run_detumble(g.stack, g.gripper, g.grasp.body, g.start, lim, opt, run);
   INFO("time to rest " << r.time_to_rest << " s");
   CHECK(r.at_rest);
-  CHECK(r.series.back().stack_rate < opt.rest_rate);
+  CHECK(r.series.back().command.stack_rate < opt.rest_rate);
   check_torques_within_limits(r, lim.joint_torque);
 }
 
@@ -499,6 +505,131 @@ TEST_CASE("detumble refuses bad limits, a spin it cannot stop and an actuator to
   bad.horizon = 1e6;
   bad.tick = 0.01;
   run_refused(bad, "more than 1e7 ticks: horizon 1000000 s / tick 0.01 s = 100000000");
+}
+
+// --- the Detumble keys, from the scenario file to the controller -------------------------------------------
+
+namespace {
+
+// no field list is copied on the way: the sample holds the controller's command, the run's result and
+// the global search's figures share one summary, the job's result holds the settings as built
+static_assert(std::is_same_v<decltype(DetumbleSample::command), DetumbleCommand>);
+static_assert(std::is_base_of_v<DetumbleSummary, DetumbleRunResult>);
+static_assert(std::is_base_of_v<DetumbleSummary, PostCaptureFigures>);
+static_assert(std::is_same_v<decltype(DetumbleJobResult::settings), DetumbleSettings>);
+
+/// robots/paper_7dof_detumble.toml with its Detumble keys replaced by `detumble` (TOML lines).
+ScenarioKeys detumble_scenario(const std::string& detumble) {
+  const std::string file = source_path("robots/paper_7dof_detumble.toml");
+  std::ifstream in(file);
+  std::ostringstream text;
+  for (std::string line; std::getline(in, line);) {
+    const std::string key = line.substr(0, line.find(' '));
+    const ScenarioKey* k = find_scenario_key(key);
+    if (!k || k->group != KeyGroup::Detumble) text << line << "\n";
+  }
+  return read_scenario_text(text.str() + detumble, "scenario " + file, file);
+}
+
+void check_same(const DetumbleSettings& a, const DetumbleSettings& b) {
+  CHECK(a.limits.joint_torque == b.limits.joint_torque);
+  CHECK(a.limits.actuator == b.limits.actuator);
+  CHECK(a.limits.wheel_torque == b.limits.wheel_torque);
+  CHECK(a.limits.wheel_momentum == b.limits.wheel_momentum);
+  CHECK(a.limits.thruster_force == b.limits.thruster_force);
+  CHECK(a.limits.thruster_torque == b.limits.thruster_torque);
+  CHECK(a.options.joint_gain == b.options.joint_gain);
+  CHECK(a.options.base_gain == b.options.base_gain);
+  CHECK(a.options.rest_rate == b.options.rest_rate);
+  CHECK(a.options.stop_stack_spin == b.options.stop_stack_spin);
+  CHECK(a.options.hold == b.options.hold);
+  CHECK(a.run.tick == b.run.tick);
+  CHECK(a.run.horizon == b.run.horizon);
+  CHECK(a.run.record_every == b.run.record_every);
+  CHECK(a.run.rtol == b.run.rtol);
+  CHECK(a.run.atol == b.run.atol);
+}
+
+}  // namespace
+
+TEST_CASE("a Detumble key from the scenario file to the controller: one conversion, one check",
+          "[detumble][scenario]") {
+  const std::string keys = "joint-torque-limit = [60, 60, 60, 40, 20, 20, 20]\nrest-rate-deg = 0.1\n"
+                           "detumble-horizon = 110\ndetumble-tick = 0.02\n";
+  const Scenario sc = build_scenario(detumble_scenario(keys), nullptr, ScenarioScope::Configuration);
+  // the one conversion: each field as the keys give it, in the controller's units
+  const DetumbleSettings s = detumble_settings(sc.keys, *sc.model);
+  Eigen::VectorXd limit(7);
+  limit << 60, 60, 60, 40, 20, 20, 20;
+  CHECK(s.limits.joint_torque == limit);
+  CHECK(s.limits.actuator == BaseActuator::None);
+  CHECK(s.options.rest_rate == 0.1 * M_PI / 180.0);
+  CHECK_FALSE(s.options.stop_stack_spin);
+  CHECK(s.run.tick == 0.02);
+  CHECK(s.run.horizon == 110);
+  const DetumbleSettings defaults;  // the law's gains and the integrator's tolerances are not keys
+  CHECK(s.options.joint_gain == defaults.options.joint_gain);
+  CHECK(s.run.rtol == defaults.run.rtol);
+
+  // the job runs under them as built (the result holds the struct, no field copied on the way), and
+  // the controller takes them as they are: its first command at the grasp is the run's first sample's
+  const DetumbleJobResult d = detumble(sc);
+  check_same(d.settings, s);
+  CHECK(d.result.at_rest);
+  CHECK(static_cast<double>(d.result.ticks) * s.run.tick < s.run.horizon);
+  const Model stack = attach_body(*sc.model, sc.model->frame(sc.problem.frame).name, d.grasp.body);
+  DetumbleController ctrl(stack, sc.problem.frame, s.limits, s.options);
+  DetumbleCommand first = ctrl.make_command();
+  const detail::DetumbleSystem sys(stack);  // the run's state vector: the grasp's state as it packs it
+  const DetumbleState start{sc.problem.base, sc.problem.theta, d.grasp.v_after, Vector3::Zero()};
+  ctrl.step(sys.unpack(sys.pack(start)), first);
+  const DetumbleCommand& recorded = d.result.series.front().command;
+  CHECK(recorded.tau == first.tau);
+  CHECK(recorded.base_wrench == first.base_wrench);
+  CHECK(recorded.brake_scale == first.brake_scale);
+  CHECK(recorded.joint_rate == first.joint_rate);
+  CHECK(recorded.relative_rate == first.relative_rate);
+  CHECK(recorded.stack_rate == first.stack_rate);
+  CHECK(recorded.status == first.status);
+  CHECK(recorded.fault == first.fault);
+  CHECK(d.result.peak_joint_torque <= limit.maxCoeff());
+
+  // the global search's figures at the same configuration: the run's summary, whole
+  const PostCaptureFigures f = post_capture_figures(*sc.model, sc.problem.frame, s, sc.problem.base,
+                                                    sc.problem.theta, sc.problem.target,
+                                                    sc.problem.approach_speed);
+  CHECK(f.failure.empty());
+  CHECK(f.at_rest == d.result.at_rest);
+  CHECK(f.time_to_rest == d.result.time_to_rest);
+  CHECK(f.peak_joint_torque == d.result.peak_joint_torque);
+  CHECK(f.peak_joint == d.result.peak_joint);
+  CHECK(f.peak_gripper_force == d.result.peak_gripper_force);
+  CHECK(f.peak_gripper_moment == d.result.peak_gripper_moment);
+
+  // the actuator's bounds: each from its key
+  const Scenario wheels = build_scenario(
+      detumble_scenario("joint-torque-limit = 20\nbase-actuator = \"reaction-wheels\"\nwheel-torque = 0.3\n"
+                        "wheel-momentum = 7\nstop-stack-spin = true\n"),
+      nullptr, ScenarioScope::Configuration);
+  const DetumbleSettings w = detumble_settings(wheels.keys, *wheels.model);
+  CHECK(w.limits.actuator == BaseActuator::ReactionWheels);
+  CHECK(w.limits.wheel_torque == 0.3);
+  CHECK(w.limits.wheel_momentum == 7);
+  CHECK(w.options.stop_stack_spin);
+  CHECK(w.limits.joint_torque == Eigen::VectorXd::Constant(7, 20.0));  // one value for every joint
+  CHECK(std::string(actuator_name(w.limits.actuator)) == wheels.keys.base_actuator);
+
+  // one check: a bad limit is refused by the key table, with the controller's own test of a limit, in
+  // the file's words (its line), before the robot is loaded
+  CHECK_FALSE(detumble_bound_ok(-3));
+  try {
+    build_scenario(detumble_scenario("joint-torque-limit = [60, 60, 60, 40, 20, 20, -3]\n"), nullptr,
+                   ScenarioScope::Configuration);
+    FAIL("a negative joint torque limit was taken");
+  } catch (const InputError& e) {
+    CHECK_THAT(e.what(), Catch::Contains("joint-torque-limit: every limit must be positive, got -3"));
+    CHECK_THAT(e.what(), Catch::Contains("paper_7dof_detumble.toml:"));
+  }
 }
 
 }  // namespace test_detumble

@@ -14,6 +14,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -137,8 +138,7 @@ TEST_CASE("scenario: map, pareto and closed-loop through the library give the co
     o.vary = {2, 3};
     o.step_deg = {20};
     o.threads = 2;
-    const ffsr::Subject subject = ffsr::load_subject(sc.keys);
-    const ffsr::MapPlan plan = ffsr::plan_map(subject, o);
+    const ffsr::MapPlan plan = ffsr::plan_map(sc, o);
     REQUIRE(plan.count() == 18 * 18);
     double largest = 0;
     std::uint64_t seen = 0;
@@ -149,10 +149,10 @@ TEST_CASE("scenario: map, pareto and closed-loop through the library give the co
       seen += b.count;
       for (std::uint64_t i = 0; i < b.count; ++i) largest = std::max(largest, b.M_ie[i]);
     };
-    const ffsr::MapRun run = ffsr::evaluate_map(subject, plan, sink);
+    const ffsr::MapRun run = ffsr::evaluate_map(sc, plan, sink);
     CHECK(in_order);
     CHECK(seen == plan.count());
-    const json lib = library(ffsr::map_json(subject, run, "library"));
+    const json lib = library(ffsr::map_json(sc, run, "library"));
     check_same_numbers(lib, command_json({"map", "--vary", "2,3", "--step-deg", "20", "--threads", "2",
                                           "--csv", (tmp.path / "map.csv").string()}),
                        "map");
@@ -189,6 +189,62 @@ TEST_CASE("scenario: every robots/*.toml loads through the library", "[scenario]
   // the uncertain scenario's [uncertainty] table is read by the same reader
   const auto keys = ffsr::read_scenario_file(kSource + "/robots/paper_7dof_position_uncertain.toml");
   CHECK(ffsr::uncertainty_spec(keys).samples >= 1);
+}
+
+TEST_CASE("scenario: a Configuration scenario resolved for the main job is the Run one, the robot loaded once",
+          "[scenario]") {
+  for (const char* name : {"paper_7dof_position.toml", "paper_3dof_clearance.toml"}) {
+    const std::string file = kSource + "/robots/" + name;
+    INFO(file);
+#ifndef FFSR_HAVE_GEOMETRY  // a build without ffsr::geometry refuses scenarios with shapes
+    if (ffsr::scenario_uses_geometry(ffsr::read_scenario_file(file))) continue;
+#endif
+    const ffsr::Scenario run = ffsr::load_scenario(file);
+    ffsr::Scenario sc =
+        ffsr::build_scenario(ffsr::read_scenario_file(file), nullptr, ffsr::ScenarioScope::Configuration);
+    CHECK(sc.scope == ffsr::ScenarioScope::Configuration);
+    CHECK_FALSE(sc.geometry);
+    CHECK_THROWS_AS(ffsr::plan_plain_and_optimized(sc), std::invalid_argument);  // not the main job's yet
+    const ffsr::Model* model = sc.model.get();
+    ffsr::resolve_run(sc);
+    CHECK(sc.scope == ffsr::ScenarioScope::Run);
+    CHECK(sc.model.get() == model);  // not loaded again
+    CHECK(sc.problem.model == model);
+    CHECK(sc.keys.urdf == run.keys.urdf);
+    CHECK(sc.problem.theta == run.problem.theta);
+    CHECK(sc.problem.frame == run.problem.frame);
+    CHECK(sc.problem.law == run.problem.law);
+    CHECK(sc.problem.approach_speed == run.problem.approach_speed);
+    CHECK(sc.problem.joints.model == run.problem.joints.model);
+    CHECK(sc.task.rows() == run.task.rows());
+    CHECK(sc.baseline_task.rows() == run.baseline_task.rows());
+    CHECK(sc.capture.duration == run.capture.duration);
+    CHECK(sc.capture.step == run.capture.step);
+    CHECK(sc.capture.gain == run.capture.gain);
+    CHECK(sc.seed == run.seed);
+    CHECK(sc.hold_base_attitude == run.hold_base_attitude);
+    CHECK(static_cast<bool>(sc.geometry) == static_cast<bool>(run.geometry));
+  }
+  // the keys only the main job needs: a file without them loads for the one-configuration jobs, and
+  // resolve_run asks for them as build_scenario does
+  TempDir tmp;
+  std::string text = read_text(kSource + "/robots/paper_7dof_position.toml");
+  for (const char* key : {"urdf =", "duration ="}) {
+    const auto at = text.find(key);
+    text.erase(at, text.find('\n', at) - at);
+  }
+  const std::string file =
+      write_scenario(tmp, "s.toml", "urdf = \"" + kSource + "/robots/paper_7dof.urdf\"\n" + text);
+  ffsr::Scenario sc =
+      ffsr::build_scenario(ffsr::read_scenario_file(file), nullptr, ffsr::ScenarioScope::Configuration);
+  CHECK(sc.model->n() == 7);
+  try {
+    ffsr::resolve_run(sc);
+    FAIL("resolved without duration");
+  } catch (const ffsr::InputError& e) {
+    CHECK(std::string(e.what()) == "scenario " + file + ": missing key 'duration'");
+  }
+  CHECK_THROWS_WITH(ffsr::load_scenario(file), "scenario " + file + ": missing key 'duration'");
 }
 
 TEST_CASE("scenario: a variant built again from the resolved keys of a relative file finds the same URDF",

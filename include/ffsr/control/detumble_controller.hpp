@@ -9,9 +9,12 @@
 #include "ffsr/algorithm/rnea.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <string>
+#include <utility>
 
 namespace ffsr {
 
@@ -22,17 +25,37 @@ enum class BaseActuator {
   Thrusters,       ///< a force and a torque on the base per base axis, bounded
 };
 
+/// Each actuator and its name: the one spelling of the names, read by the key base-actuator (its check
+/// and its parsing, scenario/), the JSON's base_actuator, Python's `actuator` and the docs' key table.
+inline constexpr std::array<std::pair<BaseActuator, const char*>, 3> kBaseActuators{
+    {{BaseActuator::None, "none"},
+     {BaseActuator::ReactionWheels, "reaction-wheels"},
+     {BaseActuator::Thrusters, "thrusters"}}};
+
 inline const char* actuator_name(BaseActuator a) {
-  switch (a) {
-    case BaseActuator::None:
-      return "none";
-    case BaseActuator::ReactionWheels:
-      return "reaction-wheels";
-    case BaseActuator::Thrusters:
-      return "thrusters";
-  }
+  for (const auto& [x, name] : kBaseActuators)
+    if (x == a) return name;
   return "?";
 }
+
+/// The actuator named `name` (kBaseActuators), or none.
+inline std::optional<BaseActuator> find_base_actuator(const std::string& name) {
+  for (const auto& [x, n] : kBaseActuators)
+    if (name == n) return x;
+  return std::nullopt;
+}
+
+/// The names joined by ", ", the last by `last` ("none, reaction-wheels or thrusters").
+inline std::string base_actuator_names(const char* last = " or ") {
+  std::string out;
+  for (size_t i = 0; i < kBaseActuators.size(); ++i)
+    out += std::string(i == 0 ? "" : i + 1 == kBaseActuators.size() ? last : ", ") + kBaseActuators[i].second;
+  return out;
+}
+
+/// Whether `x` can be a bound of the hardware or a setting of the law: positive and finite. The one
+/// test of a limit: check_detumble's, and the Detumble keys' checks (scenario/detail/keys.hpp).
+inline bool detumble_bound_ok(double x) { return std::isfinite(x) && x > 0; }
 
 /// The hardware's bounds. Per base axis: a component in the base frame.
 struct DetumbleLimits {
@@ -131,12 +154,12 @@ namespace detail {
 inline void check_detumble(const Model& stack, const DetumbleLimits& l, const DetumbleOptions& o,
                            const char* where) {
   auto positive = [&](double x, const char* what) {
-    if (!std::isfinite(x) || !(x > 0))
+    if (!detumble_bound_ok(x))
       throw InputError(str(where, ": ", what, " must be positive and finite, got ", x));
   };
   require_size(l.joint_torque.size(), stack.n(), where, "joint torque limits");
   for (int k = 0; k < stack.n(); ++k)
-    if (!std::isfinite(l.joint_torque(k)) || !(l.joint_torque(k) > 0))
+    if (!detumble_bound_ok(l.joint_torque(k)))
       throw InputError(str(where, ": the torque limit of joint '", stack.joint(k).name,
                            "' must be positive and finite, got ", l.joint_torque(k)));
   if (l.actuator == BaseActuator::ReactionWheels) {

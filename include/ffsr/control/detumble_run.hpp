@@ -23,30 +23,45 @@ struct DetumbleRunOptions {
   double atol = 1e-15;   ///< CVODE, on positions, angles, rates and wheel momentum
 };
 
+/// Everything a post-capture run takes beside the stack and its start: the hardware's bounds, the law's
+/// settings and the run's. A scenario's Detumble keys build it in one place (detumble_settings,
+/// scenario/scenario.hpp); the detumble job, the global search's post-capture constraints and the
+/// results hold it as built.
+struct DetumbleSettings {
+  DetumbleLimits limits;
+  DetumbleOptions options;
+  DetumbleRunOptions run;
+};
+
 /// One recorded tick (inertial frame unless said).
 struct DetumbleSample {
   double t = 0;
   BasePose base;          ///< the base's pose
   Eigen::VectorXd theta;  ///< joint angles, rad
-  Eigen::VectorXd theta_dot, tau;
+  Eigen::VectorXd theta_dot;
+  /// the controller's command at the tick, held over it: the joint torques, the actuator's wrench
+  /// about the base origin, the rates it measured (joint, gripper relative to the base, stack), status
+  DetumbleCommand command;
   Vector3 gripper_force = Vector3::Zero();   ///< on the target by the gripper, N
   Vector3 gripper_moment = Vector3::Zero();  ///< the same, moment about the contact point, N m
-  Vector6 base_wrench = Vector6::Zero();     ///< the actuator's, about the base origin
   double base_attitude = 0;                  ///< rotation of the base since the grasp, rad
   Vector3 wheel_momentum = Vector3::Zero();  ///< stored in the wheels, base frame, N m s
-  double joint_rate = 0, relative_rate = 0, stack_rate = 0;
-  double energy = 0;                   ///< the stack's kinetic energy, J
-  Vector6 momentum = Vector6::Zero();  ///< stack + wheels [P; L about o]
-  DetumbleStatus status = DetumbleStatus::Braking;
+  double energy = 0;                         ///< the stack's kinetic energy, J
+  Vector6 momentum = Vector6::Zero();        ///< stack + wheels [P; L about o]
 };
 
-struct DetumbleRunResult {
+/// The figures of a post-capture run that a constraint or a table reads: the run's result holds them,
+/// the global search's post-capture figures (jobs/detail/post_capture.hpp) too.
+struct DetumbleSummary {
   bool at_rest = false;
-  double time_to_rest = 0;                       ///< first tick at rest (the horizon if never)
-  double peak_joint_torque = 0;                  ///< N m
-  int peak_joint = -1;                           ///< its joint (coordinate)
-  double peak_gripper_force = 0;                 ///< N
-  double peak_gripper_moment = 0;                ///< N m
+  double time_to_rest = 0;         ///< first tick at rest (the horizon if never)
+  double peak_joint_torque = 0;    ///< N m
+  int peak_joint = -1;             ///< its joint (coordinate)
+  double peak_gripper_force = 0;   ///< N
+  double peak_gripper_moment = 0;  ///< N m
+};
+
+struct DetumbleRunResult : DetumbleSummary {
   double base_attitude_excursion = 0;            ///< largest rotation of the base since the grasp, rad
   double peak_wheel_momentum = 0;                ///< largest stored component, N m s
   Vector3 wheel_momentum_end = Vector3::Zero();  ///< base frame
@@ -204,10 +219,16 @@ inline void check_detumble_feasible(const Model& stack, const DetumbleState& s, 
 /// The post-capture run from `start` (the grasp's state on the stack model; see the top of the file).
 /// `gripper` is the frame carrying `body` (the grasped target). The controller's command is computed
 /// at each tick and held until the next; the run stops at the first tick at rest or at the horizon.
-/// InputError for bad options; IntegrationError from CVODE.
+/// InputError for bad options; DetumbleInfeasibleError (check_detumble_feasible, run once) when the
+/// actuator cannot stop the stack's spin within the horizon; IntegrationError from CVODE.
 inline DetumbleRunResult run_detumble(const Model& stack, int gripper, const AttachedBody& body,
                                       const DetumbleState& start, const DetumbleLimits& limits,
                                       const DetumbleOptions& options, const DetumbleRunOptions& run);
+/// The same with the settings as one value.
+inline DetumbleRunResult run_detumble(const Model& stack, int gripper, const AttachedBody& body,
+                                      const DetumbleState& start, const DetumbleSettings& settings) {
+  return run_detumble(stack, gripper, body, start, settings.limits, settings.options, settings.run);
+}
 
 }  // namespace ffsr
 

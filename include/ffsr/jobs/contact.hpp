@@ -1,14 +1,14 @@
-// ffsr/jobs/contact.hpp -- the job `contact`: the maximum contact force of a subject (jobs/subject.hpp)
-// by the closed form (Eq. 24), the exact single-body peak (Eq. 16) and the multibody reference (CVODE:
-// robot + target, Figure 2), for one law of Table 1 or every law, under one joint model of the contact
-// or each; and that result as JSON (the keys and values of `ffsr-optimize contact --json`) and its
-// series as CSV (`--csv`). Component ffsr::scenario (and SUNDIALS: ffsr::cvode). Never prints.
+// ffsr/jobs/contact.hpp -- the job `contact`: the maximum contact force at a scenario's start
+// configuration (any scope, scenario/scenario.hpp) by the closed form (Eq. 24), the exact single-body
+// peak (Eq. 16) and the multibody reference (CVODE: robot + target, Figure 2), for one law of Table 1
+// or every law, under one joint model of the contact or each; and that result as JSON (the keys and
+// values of `ffsr-optimize contact --json`) and its series as CSV (`--csv`). Component ffsr::scenario
+// (and SUNDIALS: ffsr::cvode). Never prints.
 #pragma once
 
 #include "ffsr/algorithm/base_disturbance.hpp"
 #include "ffsr/jobs/detail/json_values.hpp"
 #include "ffsr/jobs/inspect.hpp"
-#include "ffsr/jobs/subject.hpp"
 #include "ffsr/optimize/objective.hpp"
 #include "ffsr/simulate/multibody.hpp"
 
@@ -49,17 +49,18 @@ struct ContactJobOptions {
 
 /// The laws to evaluate: every law of Table 1 for model 'all', else the one named. InputError naming
 /// --model (an unknown name lists the laws).
-std::vector<std::string> contact_laws(const Subject& s);
+std::vector<std::string> contact_laws(const Scenario& s);
 
-/// One law's row: the multibody run (the subject's joint-stiffness, joint-damping and armature), the
+/// One law's row: the multibody run (the scenario's joint-stiffness, joint-damping and armature), the
 /// closed form and exact peaks at its approach velocity under the joint model(s), the base's jump.
-ContactRow contact_row(const Subject& s, const std::string& law, const ContactJobOptions& options = {});
+ContactRow contact_row(const Scenario& s, const std::string& law, const ContactJobOptions& options = {});
 
 /// The job: a row for each law of contact_laws(s).
-std::vector<ContactRow> contact(const Subject& s, const ContactJobOptions& options = {});
+std::vector<ContactRow> contact(const Scenario& s, const ContactJobOptions& options = {});
 
 /// The rows as JSON: the keys and values of `ffsr-optimize contact --json` (`version` as given).
-nlohmann::json contact_json(const Subject& s, const std::vector<ContactRow>& rows, const std::string& version);
+nlohmann::json contact_json(const Scenario& s, const std::vector<ContactRow>& rows,
+                            const std::string& version);
 
 /// F(t), delta(t) of the multibody run(s) (record_series) as the CSV of `ffsr-optimize contact --csv`.
 std::string contact_series_csv(const std::vector<ContactRow>& rows);
@@ -68,17 +69,16 @@ namespace detail {
 
 /// The closed-form predictions under each joint model asked for (the chosen one, or all three): the
 /// capture objective's M_ie and peaks (CaptureEvaluator).
-inline std::vector<ContactRow::Prediction> joint_predictions(const Subject& s, const AnyContactLaw& law) {
-  const Robot& r = s.robot;
+inline std::vector<ContactRow::Prediction> joint_predictions(const Scenario& s, const AnyContactLaw& law) {
   ContactJoints joints = s.contact_joints();
   std::vector<JointModel> models{joints.model};
   if (s.all_joint_models()) models = {JointModel::Free, JointModel::Locked, JointModel::Armature};
   std::vector<ContactRow::Prediction> out;
-  Data data(r.model);
+  Data data(*s.model);
   for (JointModel m : models) {
     joints.model = m;
-    const CaptureEvaluator objective(r.model, r.end_effector, s.target, &law, joints);
-    const double M = objective.mass(data, r.base, r.theta);
+    const CaptureEvaluator objective(*s.model, s.problem.frame, s.problem.target, &law, joints);
+    const double M = objective.mass(data, s.problem.base, s.problem.theta);
     out.push_back({m, M, objective.f_max_closed_form(M), objective.f_max_exact(M)});
   }
   return out;
@@ -119,36 +119,36 @@ inline nlohmann::json contact_row_json(const ContactRow& r) {
 
 }  // namespace detail
 
-inline std::vector<std::string> contact_laws(const Subject& s) {
+inline std::vector<std::string> contact_laws(const Scenario& s) {
   std::vector<std::string> names;
-  if (s.law == "all") {
+  if (s.problem.law == "all") {
     for (auto n : contact_law_names()) names.emplace_back(n);
     return names;
   }
   try {
-    make_contact_law(s.law, s.params, 1.0);  // unknown name: lists the laws
+    make_contact_law(s.problem.law, s.problem.contact, 1.0);  // unknown name: lists the laws
   } catch (const InputError& e) {
     throw InputError(located_key_message(s.keys, std::string("--model: ") + e.what()));
   }
-  names.push_back(s.law);
+  names.push_back(s.problem.law);
   return names;
 }
 
-inline ContactRow contact_row(const Subject& s, const std::string& law_name, const ContactJobOptions& o) {
-  const Robot& r = s.robot;
-  const Target& target = s.target;
-  const ContactParams& p = s.params;
+inline ContactRow contact_row(const Scenario& s, const std::string& law_name, const ContactJobOptions& o) {
+  const Target& target = s.problem.target;
+  const ContactParams& p = s.problem.contact;
   MultibodyContactOptions mo;
   mo.record_series = o.record_series;
   try {  // located in the file when the file gave the key
-    mo.joint_stiffness = per_joint_values(s.keys.joint_stiffness, r.model, "--joint-stiffness");
-    mo.joint_damping = per_joint_values(s.keys.joint_damping, r.model, "--joint-damping");
-    mo.armature = per_joint_values(s.keys.armature, r.model, "--armature");
+    mo.joint_stiffness = per_joint_values(s.keys.joint_stiffness, *s.model, "--joint-stiffness");
+    mo.joint_damping = per_joint_values(s.keys.joint_damping, *s.model, "--joint-damping");
+    mo.armature = per_joint_values(s.keys.armature, *s.model, "--armature");
   } catch (const InputError& e) {
     throw InputError(located_key_message(s.keys, e.what()));
   }
   MultibodyContactResult mb =
-      simulate_contact(r.model, r.base, r.theta, r.end_effector, target, s.approach_speed, p, law_name, mo);
+      simulate_contact(*s.model, s.problem.base, s.problem.theta, s.problem.frame, target,
+                       s.problem.approach_speed, p, law_name, mo);
   const AnyContactLaw law = make_contact_law(law_name, p, mb.approach_velocity);
   auto predictions = detail::joint_predictions(s, law);
   const double M_ie = predictions.front().M_ie;  // the chosen model's (free for all)
@@ -172,29 +172,31 @@ inline ContactRow contact_row(const Subject& s, const std::string& law_name, con
   row.mb_delta_max = mb.delta_max;
   row.mb_delta_at_f_max = mb.delta_at_f_max;
   row.base_jump_multibody = mb.base_velocity_end - mb.base_velocity_start;
-  Data data(r.model);  // the target's position does not enter (only its attitude, inertia and offset)
+  Data data(*s.model);  // the target's position does not enter (only its attitude, inertia and offset)
   row.base_jump =
-      CaptureEvaluator(r.model, r.end_effector, target, &law, joints).disturbance(data, r.base, r.theta);
+      CaptureEvaluator(*s.model, s.problem.frame, target, &law, joints)
+          .disturbance(data, s.problem.base, s.problem.theta);
   return row;
 }
 
-inline std::vector<ContactRow> contact(const Subject& s, const ContactJobOptions& options) {
+inline std::vector<ContactRow> contact(const Scenario& s, const ContactJobOptions& options) {
   std::vector<ContactRow> rows;
   for (const auto& n : contact_laws(s)) rows.push_back(contact_row(s, n, options));
   return rows;
 }
 
-inline nlohmann::json contact_json(const Subject& s, const std::vector<ContactRow>& rows,
+inline nlohmann::json contact_json(const Scenario& s, const std::vector<ContactRow>& rows,
                                    const std::string& version) {
-  nlohmann::json j = s.law == "all" ? nlohmann::json::object() : detail::contact_row_json(rows.front());
-  if (s.law == "all") {
+  nlohmann::json j =
+      s.problem.law == "all" ? nlohmann::json::object() : detail::contact_row_json(rows.front());
+  if (s.problem.law == "all") {
     j["integrated_effective_mass"] = rows.front().M_ie;
     j["approach_velocity"] = rows.front().v_in;
     j["laws"] = nlohmann::json::array();
     for (const auto& row : rows) j["laws"].push_back(detail::contact_row_json(row));
   }
-  j["parameters"] = {{"stiffness", s.params.K},     {"exponent", s.params.alpha},
-                     {"restitution", s.params.c_r}, {"approach_speed", s.approach_speed},
+  j["parameters"] = {{"stiffness", s.problem.contact.K},     {"exponent", s.problem.contact.alpha},
+                     {"restitution", s.problem.contact.c_r}, {"approach_speed", s.problem.approach_speed},
                      {"urdf", s.keys.urdf},         {"joints_deg", s.keys.joints_deg}};
   j["version"] = version;
   return j;

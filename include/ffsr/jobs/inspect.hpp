@@ -1,13 +1,12 @@
-// ffsr/jobs/inspect.hpp -- the job `inspect`: one configuration of a subject (jobs/subject.hpp)
-// evaluated: H, J_bm, J_f, the effective mass m_e (Eq. 4), the integrated effective mass M_ie (Eq. 14)
-// and the base's jump at the impact under the subject's joint model, the distances between the shapes;
-// and that evaluation as JSON (the keys and values of `ffsr-optimize inspect --json`). Component
-// ffsr::scenario. Never prints.
+// ffsr/jobs/inspect.hpp -- the job `inspect`: the start configuration of a scenario (any scope,
+// scenario/scenario.hpp) evaluated: H, J_bm, J_f, the effective mass m_e (Eq. 4), the integrated
+// effective mass M_ie (Eq. 14) and the base's jump at the impact under the scenario's joint model, the
+// distances between the shapes; and that evaluation as JSON (the keys and values of `ffsr-optimize
+// inspect --json`). Component ffsr::scenario. Never prints.
 #pragma once
 
 #include "ffsr/algorithm/base_disturbance.hpp"
 #include "ffsr/jobs/scenario_run.hpp"
-#include "ffsr/jobs/subject.hpp"
 #include "ffsr/optimize/objective.hpp"
 
 #include <cmath>
@@ -17,7 +16,7 @@
 
 namespace ffsr {
 
-/// What inspect evaluates at the subject's configuration.
+/// What inspect evaluates at the scenario's start configuration.
 struct InspectResult {
   ContactJoints joints;  ///< the joint model of M_ie, m_e and the base's jump
   double M_ie = 0;       ///< Eq. 14, kg
@@ -33,14 +32,14 @@ struct InspectResult {
   explicit InspectResult(const Model& model) : data(model) {}
 };
 
-/// Evaluates the subject's configuration. `embedded`: the URDF of a built-in scenario (its collision
+/// Evaluates the scenario's start configuration. `embedded`: the URDF of a built-in scenario (its collision
 /// shapes). InputError naming the key (contact-joints 'all' is refused: one joint model at a time;
 /// --model when the law cannot be built at the approach velocity).
-InspectResult inspect(const Subject& s, const EmbeddedUrdf* embedded = nullptr);
+InspectResult inspect(const Scenario& s, const EmbeddedUrdf* embedded = nullptr);
 
 /// The evaluation as JSON: the keys and values of `ffsr-optimize inspect --json` (`version` recorded
 /// as given).
-nlohmann::json inspect_json(const Subject& s, const InspectResult& e, const std::string& version);
+nlohmann::json inspect_json(const Scenario& s, const InspectResult& e, const std::string& version);
 
 namespace detail {
 
@@ -57,14 +56,14 @@ inline nlohmann::json matrix_json(const Eigen::MatrixXd& m) {
 
 /// The contact law at the approach velocity of the configuration, or nothing when the end-effector
 /// moving at the approach speed along u does not approach the target's contact point.
-inline std::optional<AnyContactLaw> inspect_law(const Subject& s) {
-  const Target& target = s.target;
+inline std::optional<AnyContactLaw> inspect_law(const Scenario& s) {
+  const Target& target = s.problem.target;
   const Vector3 u = target.normal_world();
-  const double vin = approach_velocity(u, Vector3(s.approach_speed * u), target.velocity,
+  const double vin = approach_velocity(u, Vector3(s.problem.approach_speed * u), target.velocity,
                                        target.angular_velocity_world(), target.offset_world());
   if (!(vin > 0)) return std::nullopt;
   try {
-    return make_contact_law(s.law, s.params, vin);
+    return make_contact_law(s.problem.law, s.problem.contact, vin);
   } catch (const InputError& e) {
     throw InputError(std::string("--model: ") + e.what());
   }
@@ -72,13 +71,13 @@ inline std::optional<AnyContactLaw> inspect_law(const Subject& s) {
 
 /// The distances of the configuration to the target at t = 0 (and to the bus, between the links) when
 /// the scenario gives shapes (scenario/geometry.hpp), else nothing.
-inline std::optional<ClearanceReport> inspect_clearance(const Subject& s, const EmbeddedUrdf* embedded) {
+inline std::optional<ClearanceReport> inspect_clearance(const Scenario& s, const EmbeddedUrdf* embedded) {
   const std::shared_ptr<const SceneGeometry> g =
-      scene_geometry(s.keys, s.robot.model, s.target.contact_offset, embedded);
+      scene_geometry(s.keys, *s.model, s.problem.target.contact_offset, embedded);
 #ifdef FFSR_HAVE_GEOMETRY
   if (g)
-    return configuration_clearance(s.robot.model, *g->checker, s.robot.base, s.robot.theta,
-                                   target_pose(s.target));
+    return configuration_clearance(*s.model, *g->checker, s.problem.base, s.problem.theta,
+                                   target_pose(s.problem.target));
 #endif
   return std::nullopt;
 }
@@ -95,52 +94,51 @@ inline nlohmann::json inspect_disturbance_json(const std::optional<BaseDisturban
 
 }  // namespace detail
 
-inline InspectResult inspect(const Subject& s, const EmbeddedUrdf* embedded) {
+inline InspectResult inspect(const Scenario& s, const EmbeddedUrdf* embedded) {
   if (s.all_joint_models())
     throw InputError(
         "--contact-joints: inspect evaluates one joint model; 'all' is for the contact subcommand");
-  const Robot& r = s.robot;
-  InspectResult e(r.model);
+  InspectResult e(*s.model);
   e.joints = s.contact_joints();
-  e.u = s.target.normal_world();
+  e.u = s.problem.target.normal_world();
   const std::optional<AnyContactLaw> law = detail::inspect_law(s);
   // M_ie and the base's jump (single-body impulse) of the joint model: the capture objective's
-  const CaptureEvaluator objective(r.model, r.end_effector, s.target, law ? &*law : nullptr, e.joints);
-  if (law) e.disturbance = objective.disturbance(e.data, r.base, r.theta);
-  e.M_ie = objective.mass(e.data, r.base, r.theta);
-  e.m_e = 1.0 / inverse_effective_mass(r.model, e.data, r.end_effector, e.u, e.joints);
-  frame_jacobian(r.model, e.data, r.end_effector);
-  e.Jf = generalized_jacobian(r.model, e.data);
-  e.ee = frame_pose(r.model, e.data, r.end_effector);
+  const CaptureEvaluator objective(*s.model, s.problem.frame, s.problem.target, law ? &*law : nullptr,
+                                   e.joints);
+  if (law) e.disturbance = objective.disturbance(e.data, s.problem.base, s.problem.theta);
+  e.M_ie = objective.mass(e.data, s.problem.base, s.problem.theta);
+  e.m_e = 1.0 / inverse_effective_mass(*s.model, e.data, s.problem.frame, e.u, e.joints);
+  frame_jacobian(*s.model, e.data, s.problem.frame);
+  e.Jf = generalized_jacobian(*s.model, e.data);
+  e.ee = frame_pose(*s.model, e.data, s.problem.frame);
   e.clearance = detail::inspect_clearance(s, embedded);
   return e;
 }
 
-inline nlohmann::json inspect_json(const Subject& s, const InspectResult& e, const std::string& version) {
+inline nlohmann::json inspect_json(const Scenario& s, const InspectResult& e, const std::string& version) {
   using detail::matrix_json;
   using detail::vector_json;
-  const Robot& r = s.robot;
   nlohmann::json j;
   j["urdf"] = s.keys.urdf;
-  j["end_effector"] = r.model.frame(r.end_effector).name;
-  j["joint_names"] = r.model.joint_names();
-  j["joints_deg"] = vector_json(Eigen::VectorXd(r.theta * (180.0 / M_PI)));
-  j["base_position"] = vector_json(Eigen::VectorXd(r.base.position));
+  j["end_effector"] = s.model->frame(s.problem.frame).name;
+  j["joint_names"] = s.model->joint_names();
+  j["joints_deg"] = vector_json(Eigen::VectorXd(s.problem.theta * (180.0 / M_PI)));
+  j["base_position"] = vector_json(Eigen::VectorXd(s.problem.base.position));
   j["end_effector_position"] = vector_json(Eigen::VectorXd(e.ee.p));
   j["end_effector_rpy_deg"] = vector_json(Eigen::VectorXd(rpy_from_rotation(e.ee.R) * (180.0 / M_PI)));
   j["direction"] = vector_json(Eigen::VectorXd(e.u));
   j["H"] = matrix_json(e.data.H);
   j["J_bm"] = matrix_json(e.data.J);
   j["J_f"] = matrix_json(e.Jf);
-  j["total_mass"] = r.model.total_mass();
+  j["total_mass"] = s.model->total_mass();
   j["contact_joints"] = joint_model_name(e.joints.model);
   if (e.joints.model == JointModel::Armature) j["armature"] = vector_json(e.joints.armature);
   j["effective_mass"] = e.m_e;
   j["integrated_effective_mass"] = e.M_ie;
   j["base_disturbance"] = detail::inspect_disturbance_json(e.disturbance);
   j["clearance"] = e.clearance ? detail::clearance_json(*e.clearance) : nlohmann::json(nullptr);
-  j["model_repairs"] = repairs_json(r.report);
-  j["model_load"] = report_json(r.report);
+  j["model_repairs"] = repairs_json(s.report);
+  j["model_load"] = report_json(s.report);
   j["version"] = version;
   return j;
 }

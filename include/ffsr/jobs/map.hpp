@@ -1,12 +1,12 @@
-// ffsr/jobs/map.hpp -- the job `map`: the integrated effective mass M_ie (Eq. 14) under the subject's
+// ffsr/jobs/map.hpp -- the job `map`: the integrated effective mass M_ie (Eq. 14) under the scenario's
 // joint model and the closed-form maximum contact force F_max (Eq. 24) over a grid of joint angles
-// (the paper's Figures 8 and 9), the joints not varied held at the subject's configuration; and the
+// (the paper's Figures 8 and 9), the joints not varied held at the scenario's start configuration; and the
 // run's summary as JSON (the keys and values of `ffsr-optimize map --json`). Component
 // ffsr::scenario. Never prints.
 #pragma once
 
 #include "ffsr/detail/parallel.hpp"
-#include "ffsr/jobs/subject.hpp"
+#include "ffsr/scenario/scenario.hpp"
 #include "ffsr/optimize/objective.hpp"
 
 #include <nlohmann/json.hpp>
@@ -69,7 +69,7 @@ struct MapJobOptions {
 /// points [first, end) and the threads.
 struct MapPlan {
   explicit MapPlan(AnyContactLaw contact_law) : law(std::move(contact_law)) {}
-  AnyContactLaw law;  ///< at the subject's approach velocity
+  AnyContactLaw law;  ///< at the scenario's approach velocity
   MapGrid grid;
   ContactJoints joints;
   std::uint64_t first = 0, end = 0;
@@ -114,21 +114,21 @@ struct MapRun {
 /// InputError naming --vary, --range-deg, --step-deg or --max-points.
 MapGrid map_grid(const MapJobOptions& o, const std::string& urdf, int n_joints);
 
-/// The contact law at the subject's approach velocity (Eq. 10-12). InputError naming --model ('all'
+/// The contact law at the scenario's approach velocity (Eq. 10-12). InputError naming --model ('all'
 /// or an unknown law) or --approach-speed (the end-effector does not approach the target).
-AnyContactLaw map_law(const Subject& s);
+AnyContactLaw map_law(const Scenario& s);
 
 /// Everything checked, nothing evaluated. InputError naming the flag.
-MapPlan plan_map(const Subject& s, const MapJobOptions& o);
+MapPlan plan_map(const Scenario& s, const MapJobOptions& o);
 
 /// Evaluates the plan's points into `sink`. Exceptions of the sink or of a point propagate.
-MapRun evaluate_map(const Subject& s, const MapPlan& plan, const MapSink& sink);
+MapRun evaluate_map(const Scenario& s, const MapPlan& plan, const MapSink& sink);
 
 /// The summary of a run: the grid, the shard's points and the extremes of M_ie with their F_max.
-nlohmann::json map_json(const Subject& s, const MapRun& r, const std::string& version);
+nlohmann::json map_json(const Scenario& s, const MapRun& r, const std::string& version);
 
 /// The CSV's header line (with its newline): one column per varied joint, then M_ie and F_max.
-std::string map_csv_header(const Subject& s, const MapPlan& plan);
+std::string map_csv_header(const Scenario& s, const MapPlan& plan);
 
 // ---------------------------------------------------------------------------------------------------
 
@@ -162,8 +162,8 @@ struct MapWorker {
   std::uint64_t argmax = 0, argmin = 0;
   MapBlock block;
 
-  MapWorker(const Robot& r, size_t axes, size_t block_points)
-      : data(r.model), theta(r.theta), angles(axes * block_points), M(block_points), F(block_points) {}
+  MapWorker(const Scenario& s, size_t axes, size_t block_points)
+      : data(*s.model), theta(s.problem.theta), angles(axes * block_points), M(block_points), F(block_points) {}
 
   /// Evaluates points [first, last) into the buffers.
   void run(const MapGrid& grid, const CaptureEvaluator& objective, const BasePose& base, std::uint64_t first,
@@ -249,27 +249,27 @@ inline MapGrid map_grid(const MapJobOptions& o, const std::string& urdf, int n_j
   return g;
 }
 
-inline AnyContactLaw map_law(const Subject& s) {
+inline AnyContactLaw map_law(const Scenario& s) {
   using detail::str;
-  const Target& target = s.target;
-  if (s.law == "all") throw InputError("--model: map evaluates one law; 'all' is for the contact subcommand");
+  const Target& target = s.problem.target;
+  if (s.problem.law == "all") throw InputError("--model: map evaluates one law; 'all' is for the contact subcommand");
   const Vector3 u = target.normal_world();
-  const double v_in = approach_velocity(u, Vector3(s.approach_speed * u), target.velocity,
+  const double v_in = approach_velocity(u, Vector3(s.problem.approach_speed * u), target.velocity,
                                         target.angular_velocity_world(), target.offset_world());  // Eq. 10-12
   if (!(v_in > 0))
     throw InputError(str("--approach-speed: the end-effector does not approach the target (delta_dot^- = ", v_in,
                          " m/s); increase the approach speed"));
   try {
-    return make_contact_law(s.law, s.params, v_in);
+    return make_contact_law(s.problem.law, s.problem.contact, v_in);
   } catch (const InputError& e) {
     throw InputError(std::string("--model: ") + e.what());
   }
 }
 
-inline MapPlan plan_map(const Subject& s, const MapJobOptions& o) {
+inline MapPlan plan_map(const Scenario& s, const MapJobOptions& o) {
   using detail::str;
   MapPlan p(map_law(s));
-  p.grid = map_grid(o, s.keys.urdf, s.robot.model.n());
+  p.grid = map_grid(o, s.keys.urdf, s.model->n());
   if (o.shard_n < 1) throw InputError("--shard: N must be at least 1");
   if (o.shard_k >= o.shard_n)
     throw InputError(str("--shard: K must be less than N (K counts from 0), got ", o.shard_k, "/", o.shard_n));
@@ -292,12 +292,11 @@ inline MapPlan plan_map(const Subject& s, const MapJobOptions& o) {
   return p;
 }
 
-inline MapRun evaluate_map(const Subject& s, const MapPlan& plan, const MapSink& sink) {
-  const Robot& r = s.robot;
-  const CaptureEvaluator objective(r.model, r.end_effector, s.target, &plan.law, plan.joints);
+inline MapRun evaluate_map(const Scenario& s, const MapPlan& plan, const MapSink& sink) {
+  const CaptureEvaluator objective(*s.model, s.problem.frame, s.problem.target, &plan.law, plan.joints);
   std::vector<std::unique_ptr<detail::MapWorker>> workers;
   for (unsigned t = 0; t < plan.threads; ++t)
-    workers.push_back(std::make_unique<detail::MapWorker>(r, plan.grid.axes.size(), static_cast<size_t>(plan.block)));
+    workers.push_back(std::make_unique<detail::MapWorker>(s, plan.grid.axes.size(), static_cast<size_t>(plan.block)));
   const auto t0 = std::chrono::steady_clock::now();
   detail::ParallelOptions opt;
   opt.chunk = plan.block;
@@ -311,7 +310,7 @@ inline MapRun evaluate_map(const Subject& s, const MapPlan& plan, const MapSink&
   detail::parallel_chunks(
       plan.count(), plan.threads,
       [&](unsigned t, std::uint64_t lo, std::uint64_t hi) {
-        workers[t]->run(plan.grid, objective, r.base, plan.first + lo, plan.first + hi);
+        workers[t]->run(plan.grid, objective, s.problem.base, plan.first + lo, plan.first + hi);
         if (sink.evaluated) sink.evaluated(t, workers[t]->block);
       },
       opt);
@@ -330,9 +329,9 @@ inline MapRun evaluate_map(const Subject& s, const MapPlan& plan, const MapSink&
   return out;
 }
 
-inline nlohmann::json map_json(const Subject& s, const MapRun& r, const std::string& version) {
+inline nlohmann::json map_json(const Scenario& s, const MapRun& r, const std::string& version) {
   const MapPlan& p = r.plan;
-  const auto names = s.robot.model.joint_names();
+  const auto names = s.model->joint_names();
   nlohmann::json axes = nlohmann::json::array();
   for (const MapAxis& a : p.grid.axes)
     axes.push_back({{"joint", names[static_cast<size_t>(a.joint)]},
@@ -359,9 +358,9 @@ inline nlohmann::json map_json(const Subject& s, const MapRun& r, const std::str
   return j;
 }
 
-inline std::string map_csv_header(const Subject& s, const MapPlan& plan) {
+inline std::string map_csv_header(const Scenario& s, const MapPlan& plan) {
   std::string header;
-  const auto names = s.robot.model.joint_names();
+  const auto names = s.model->joint_names();
   for (const MapAxis& a : plan.grid.axes) header += names[static_cast<size_t>(a.joint)] + "_deg,";
   const JointModel jm = plan.joints.model;
   header += jm == JointModel::Free ? "M_ie_kg,F_max_N\n"

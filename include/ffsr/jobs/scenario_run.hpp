@@ -65,9 +65,10 @@ struct ScenarioResult {
   /// with shapes (scenario/geometry.hpp, jobs/scenario_clearance.hpp): each run's smallest
   /// distances along its path
   std::vector<std::pair<std::string, ClearanceReport>> clearances;  ///< baseline, optimized, global
-  /// With ScenarioRunOptions::post_capture and a Detumble key given (scenario_has_post_capture): the
-  /// post-capture phase of each run that holds a result, as the job `detumble --run all` runs it
-  /// (jobs/detumble.hpp), in the order baseline, optimized, global (DetumbleJobResult::run)
+  /// With a Detumble key given (scenario_has_post_capture), when the main job runs as the whole capture
+  /// (run_whole_capture, jobs/whole_capture.hpp): the post-capture phase of each run that holds a
+  /// result, as the job `detumble --run all` runs it (jobs/detumble.hpp), in the order baseline,
+  /// optimized, global (DetumbleJobResult::run); scenario_json writes each as the run's post_capture.
   std::vector<DetumbleJobResult> post_capture;
 };
 
@@ -81,11 +82,6 @@ struct ScenarioRunOptions {
   /// global run then has no paper's-method start; when it fails too, the error names both failures.
   /// Default: the first failure is thrown (plan_plain_and_optimized).
   bool keep_going = false;
-  /// Runs the post-capture phase of every run (ScenarioResult::post_capture) when the scenario gives a
-  /// key of the Detumble group (scenario_has_post_capture): the command's main job and Scenario.run.
-  /// An error of that phase (an actuator too small, not at rest by the horizon) is an InputError
-  /// naming the key and the run. Default: the runs stop at the impact.
-  bool post_capture = false;
 };
 
 /// Whether a scenario asks for the post-capture phase: it gives (file or override) a key of the
@@ -96,15 +92,8 @@ inline bool scenario_has_post_capture(const ScenarioKeys& keys) {
   return false;
 }
 
-/// The post-capture phase of each run of `r` that holds a result (jobs/detumble.hpp: the grasp at the
-/// run's capture, the target at T, the stack brought to rest under the Detumble keys). InputError
-/// naming the key and the run.
-inline std::vector<DetumbleJobResult> post_capture_runs(const Scenario& sc, const ScenarioResult& r);
-/// One run's `post_capture` object of the main job's JSON: the run's `detumble --json` (detumble_json)
-/// without `version` and `run`.
-inline nlohmann::json post_capture_json(const Scenario& sc, const DetumbleJobResult& d);
-
-/// The plain and the optimized run. A NumericalError names the run ("plain run: ...").
+/// The plain and the optimized run of a scenario of scope Run (std::invalid_argument for another). A
+/// NumericalError names the run ("plain run: ...").
 std::pair<CaptureResult, CaptureResult> plan_plain_and_optimized(const Scenario& sc,
                                                                  const ScenarioRunOptions& options = {});
 
@@ -127,7 +116,8 @@ GlobalRun run_global(const Scenario& sc, GlobalObjective objective,
                      std::shared_ptr<RobustForceObjective> robust = nullptr, bool tight_reaching = false);
 
 /// The main job: plain, optimized and (unless global = false) global runs; robust-force reads the
-/// scenario's [uncertainty] table.
+/// scenario's [uncertainty] table. The scenario's scope is Run (std::invalid_argument for another).
+/// The runs stop at the impact: run_whole_capture (jobs/whole_capture.hpp) adds the post-capture phase.
 ScenarioResult run_scenario(const Scenario& sc, const ScenarioRunOptions& options = {});
 
 /// The result as JSON: the resolved scenario, the model as loaded, each run, the reductions, the
@@ -154,4 +144,3 @@ inline double reduction_percent(double before, double after) { return 100.0 * (b
 #include "ffsr/jobs/detail/base_disturbance_json.hpp"
 #include "ffsr/jobs/detail/scenario_series.hpp"
 #include "ffsr/jobs/detail/result_json.hpp"
-#include "ffsr/jobs/detumble.hpp"  // post_capture_runs, post_capture_json

@@ -3,6 +3,7 @@
 // problem it describes. Component ffsr::scenario (urdfdom, SUNDIALS, NLopt, toml++, nlohmann/json).
 #pragma once
 
+#include "ffsr/control/detumble_run.hpp"
 #include "ffsr/errors.hpp"
 #include "ffsr/parsers/urdf.hpp"
 #include "ffsr/optimize/capture.hpp"
@@ -95,6 +96,14 @@ struct ScenarioKeys {
   // the global search's post-capture constraints (jobs/detail/post_capture.hpp); 0: not set
   double max_time_to_rest = 0, max_peak_joint_torque = 0, max_gripper_force = 0, max_gripper_moment = 0;
 };
+
+/// The post-capture run's settings of the Detumble keys (joint-torque-limit ... grasp-after) for `model`
+/// (the robot; the stack has the same joints), the one conversion of those keys: joint-torque-limit
+/// (one value or one per joint; when not given, the URDF's <limit effort> of every joint), the base
+/// actuator and its bounds (each needed by its actuator, refused where it does not act, from a file
+/// too), rest-rate-deg, stop-stack-spin, detumble-tick, detumble-horizon. Each key's value is checked
+/// once, by the key table (ScenarioKey::check, when the scenario is built). InputError naming the key.
+DetumbleSettings detumble_settings(const ScenarioKeys& keys, const Model& model);
 
 /// The kind of a key's value: one parser each, from a TOML node and from text.
 enum class KeyKind { Text, Texts, Number, Numbers, Integer, Boolean };
@@ -225,12 +234,28 @@ std::string located_key_message(const ScenarioKeys& keys, const std::string& mes
 
 struct SceneGeometry;  // scenario/geometry.hpp
 
+/// How much of the problem build_scenario resolves.
+enum class ScenarioScope {
+  /// The whole problem of the main job (jobs/scenario_run.hpp): a file names the required keys, the
+  /// contact law is one law at a positive approach speed, the tasks, options, shapes are built.
+  Run,
+  /// The robot at its start configuration, the target and the contact law, what the one-configuration
+  /// jobs evaluate (inspect, contact, map, detumble): every key's own check first, the keys only the main
+  /// job needs are not required, the law is kept as given (contact takes 'all'), the approach speed
+  /// only finite (its sign is the job's to judge). The rest of a Run scenario is left at its defaults.
+  Configuration,
+};
+
 /// A validated scenario: the robot, the capture problem, the tasks of the optimized and the plain
-/// run, the optimized run's options (the plain run uses gain 0) and the global run's settings.
+/// run, the optimized run's options (the plain run uses gain 0) and the global run's settings. With
+/// ScenarioScope::Configuration: the robot, its start state, the target and the contact law only
+/// (model, problem.frame, problem.base, problem.theta, problem.target, problem.contact, problem.law,
+/// problem.approach_speed, report, keys).
 struct Scenario {
   ScenarioKeys keys;  ///< as resolved (the URDF path relative to the scenario file)
   std::string where;  ///< "scenario FILE" or "built-in scenario"
   bool builtin = false;
+  ScenarioScope scope = ScenarioScope::Run;  ///< what is resolved (resolve_run completes a Configuration)
   std::unique_ptr<Model> model;
   CaptureProblem problem;  ///< problem.model points to *model
   CaptureTask task, baseline_task;
@@ -243,6 +268,12 @@ struct Scenario {
   /// Multibody reference: per-joint PD gains holding the pre-contact rates (N m/rad, N m s/rad; size n).
   Eigen::VectorXd joint_stiffness, joint_damping;
   std::shared_ptr<const SceneGeometry> geometry;  ///< shapes and clearance; null: none given
+  /// The joint models of the contact (contact-joints, armature; algorithm/joint_models.hpp); 'all'
+  /// (contact: each model in turn) gives free. InputError naming the key (located in the file when the
+  /// file gave it).
+  ContactJoints contact_joints() const;
+  /// contact-joints = all: the job contact evaluates each joint model in turn.
+  bool all_joint_models() const { return keys.contact_joints == "all"; }
 };
 
 /// A URDF given as text for a built-in scenario whose `urdf` key names it (not read from disk).
@@ -252,10 +283,20 @@ struct EmbeddedUrdf {
   std::string xml;
 };
 
-/// Checks the keys (a file must name required_scenario_keys()) and builds the problem; a URDF path
-/// of the file is relative to the file. InputError naming the file or the key; ModelError from the
-/// loader.
-Scenario build_scenario(ScenarioKeys keys, const EmbeddedUrdf* embedded = nullptr);
+/// Called with the loader's report as soon as the robot is loaded (a command warns about every repair).
+using UrdfReportCallback = std::function<void(const UrdfReport&)>;
+
+/// Checks the keys and builds the problem of `scope`; a URDF path of the file is relative to the file.
+/// Run: a file must name required_scenario_keys(). Configuration: every key's own check
+/// (ScenarioKey::check: a file's keys for other jobs too) before the robot is loaded. `on_load`: called
+/// with the loader's report (Configuration only). InputError naming the file or the key (located in the
+/// file when the file gave it); ModelError from the loader.
+Scenario build_scenario(ScenarioKeys keys, const EmbeddedUrdf* embedded = nullptr,
+                        ScenarioScope scope = ScenarioScope::Run, const UrdfReportCallback& on_load = {});
+/// Resolves the rest of a Configuration scenario for the main job (the required keys, the contact law
+/// and speed, tasks, options, shapes) without loading the robot again, as build_scenario(Run) would;
+/// nothing to do for a Run scenario. InputError naming the file or the key.
+void resolve_run(Scenario& sc, const EmbeddedUrdf* embedded = nullptr);
 /// read_scenario_file + build_scenario.
 Scenario load_scenario(const std::string& path);
 

@@ -86,12 +86,12 @@ void print_contact_table(std::ostream& out, const std::vector<ContactRow>& rows)
 int run_contact(const ContactOptions& o) {
   set_quiet(o.out.quiet);
   Outputs outputs = o.out.outputs();  // an output on standard output: the table goes to standard error
-  const Subject subject = load_subject(o.subject);
+  const Scenario subject = load_subject(o.subject);
   const plot::Format plot_format = plot::check_request(o.out.plot, o.out.plot_format);
   ContactJobOptions job;
   job.record_series = !o.out.csv.empty() || !o.out.plot.empty();
   const std::vector<ContactRow> rows = contact(subject, job);
-  if (!o.out.plot.empty()) plot_contact(rows, subject.params, o, plot_format);
+  if (!o.out.plot.empty()) plot_contact(rows, subject.problem.contact, o, plot_format);
   outputs.set("--json", contact_json(subject, rows, FFSR_VERSION).dump(2) + "\n");
   if (!o.out.csv.empty()) outputs.set("--csv", contact_series_csv(rows));
   outputs.write();

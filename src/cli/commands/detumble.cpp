@@ -42,8 +42,8 @@ void print_detumble_table(std::ostream& out, const DetumbleJobResult& d) {
       << g.base_velocity_jump.tail<3>().norm() * deg << " deg/s\n"
       << "kinetic energy           " << g.energy_before << " J before the grasp, " << g.energy_after
       << " J after\n"
-      << "base actuator            " << actuator_name(d.limits.actuator)
-      << (d.options.stop_stack_spin ? " (stops the stack's spin)" : "") << "\n"
+      << "base actuator            " << actuator_name(d.settings.limits.actuator)
+      << (d.settings.options.stop_stack_spin ? " (stops the stack's spin)" : "") << "\n"
       << "time to rest             " << r.time_to_rest << " s (" << r.ticks << " ticks)\n"
       << "peak joint torque        " << r.peak_joint_torque << " N m (joint " << d.peak_joint_name << ")\n"
       << "peak gripper load        " << r.peak_gripper_force << " N, " << r.peak_gripper_moment << " N m\n"
@@ -65,30 +65,32 @@ void refuse_law_flags_without_contact(const DetumbleCommandOptions& o, const Sce
 }
 
 /// The figure of the runs: their series as recorded, the limits and the rest threshold they ran under.
-plot::Figure detumble_figure(const Subject& subject, const std::vector<DetumbleJobResult>& results) {
+plot::Figure detumble_figure(const Scenario& sc, const std::vector<DetumbleJobResult>& results) {
   figures::DetumbleSeries f;
   const DetumbleJobResult& first = results.front();
-  f.joint_names = subject.robot.model.joint_names();
-  f.torque_limit.assign(first.limits.joint_torque.data(),
-                        first.limits.joint_torque.data() + first.limits.joint_torque.size());
-  f.rest_rate = first.options.rest_rate;
-  f.stack_rate = first.options.stop_stack_spin;
-  if (first.limits.actuator == BaseActuator::ReactionWheels) f.wheel_bound = first.limits.wheel_momentum;
+  f.joint_names = sc.model->joint_names();
+  const DetumbleSettings& settings = first.settings;
+  f.torque_limit.assign(settings.limits.joint_torque.data(),
+                        settings.limits.joint_torque.data() + settings.limits.joint_torque.size());
+  f.rest_rate = settings.options.rest_rate;
+  f.stack_rate = settings.options.stop_stack_spin;
+  if (settings.limits.actuator == BaseActuator::ReactionWheels)
+    f.wheel_bound = settings.limits.wheel_momentum;
   for (const DetumbleJobResult& d : results) {
     figures::DetumbleSeries::Run r;
     r.label = d.run == "baseline" ? "plain" : d.run.empty() ? "joints-deg" : d.run;
     r.color = d.run == "optimized" ? 1 : d.run == "global" ? 2 : 0;  // the runs' colours of the main job
     for (const DetumbleSample& x : d.result.series) {
       r.t.push_back(x.t);
-      r.joint_rate.push_back(x.joint_rate);
-      r.relative_rate.push_back(x.relative_rate);
-      r.stack_rate.push_back(x.stack_rate);
+      r.joint_rate.push_back(x.command.joint_rate);
+      r.relative_rate.push_back(x.command.relative_rate);
+      r.stack_rate.push_back(x.command.stack_rate);
       r.force.push_back(x.gripper_force.norm());
       r.moment.push_back(x.gripper_moment.norm());
       r.attitude.push_back(x.base_attitude);
       r.energy.push_back(x.energy);
       r.rate.push_back(x.theta_dot);
-      r.torque.push_back(x.tau);
+      r.torque.push_back(x.command.tau);
       r.wheel.push_back(x.wheel_momentum);
     }
     f.runs.push_back(std::move(r));
@@ -109,20 +111,21 @@ plot::Figure detumble_figure(const Subject& subject, const std::vector<DetumbleJ
 int run_detumble_command(const DetumbleCommandOptions& o) {
   set_quiet(o.out.quiet);
   Outputs outputs = o.out.outputs();  // an output on standard output: the table goes to standard error
-  const Subject subject = load_subject(o.subject);
-  refuse_law_flags_without_contact(o, subject.keys);
+  Scenario sc = load_subject(o.subject);  // the robot is loaded once: --run resolves the rest of it
+  refuse_law_flags_without_contact(o, sc.keys);
   const plot::Format plot_format = plot::check_request(o.out.plot, o.out.plot_format);  // before the run
   std::vector<DetumbleJobResult> results;
   if (o.run.empty()) {
-    results.push_back(detumble(subject));
-    outputs.set("--json", detumble_json(subject, results.front(), FFSR_VERSION).dump(2) + "\n");
+    results.push_back(detumble(sc));
+    outputs.set("--json", detumble_json(sc, results.front(), FFSR_VERSION).dump(2) + "\n");
   } else {
     const EmbeddedUrdf embedded = builtin_urdf();
-    results = detumble_runs(subject, build_scenario(subject.keys, &embedded), o.run);
-    outputs.set("--json", detumble_runs_json(subject, results, FFSR_VERSION).dump(2) + "\n");
+    resolve_run(sc, &embedded);
+    results = detumble_runs(sc, o.run);
+    outputs.set("--json", detumble_runs_json(sc, results, FFSR_VERSION).dump(2) + "\n");
   }
-  if (!o.out.plot.empty()) plot::render({detumble_figure(subject, results)}, o.out.plot, plot_format);
-  if (!o.out.csv.empty()) outputs.set("--csv", detumble_series_csv(subject, results));
+  if (!o.out.plot.empty()) plot::render({detumble_figure(sc, results)}, o.out.plot, plot_format);
+  if (!o.out.csv.empty()) outputs.set("--csv", detumble_series_csv(sc, results));
   outputs.write();
   for (size_t i = 0; i < results.size(); ++i) {
     if (i > 0) outputs.table() << "\n";

@@ -53,19 +53,18 @@ void print_load_report(std::ostream& out, const UrdfReport& rep) {
   line("inertia repairs  ", r);
 }
 
-void print_inspect(std::ostream& out, const Subject& s, const InspectResult& e) {
-  const Robot& r = s.robot;
+void print_inspect(std::ostream& out, const Scenario& s, const InspectResult& e) {
   out << std::setprecision(6);
-  out << "robot            " << s.keys.urdf << " (" << r.model.n() << " joints, " << r.model.total_mass()
+  out << "robot            " << s.keys.urdf << " (" << s.model->n() << " joints, " << s.model->total_mass()
       << " kg)\n";
-  out << "end-effector     " << r.model.frame(r.end_effector).name << " at ["
+  out << "end-effector     " << s.model->frame(s.problem.frame).name << " at ["
       << e.ee.p.transpose().format(Eigen::IOFormat(6, 0, ", ")) << "] m\n";
   out << "joints           ";
-  const auto names = r.model.joint_names();
+  const auto names = s.model->joint_names();
   for (size_t i = 0; i < names.size(); ++i)
-    out << names[i] << "=" << r.theta(static_cast<Eigen::Index>(i)) * 180.0 / M_PI
+    out << names[i] << "=" << s.problem.theta(static_cast<Eigen::Index>(i)) * 180.0 / M_PI
         << (i + 1 < names.size() ? ", " : " deg\n");
-  print_load_report(out, r.report);
+  print_load_report(out, s.report);
   out << "direction u      [" << e.u.transpose().format(Eigen::IOFormat(6, 0, ", ")) << "]\n";
   if (e.joints.model != JointModel::Free)
     out << "contact joints   " << joint_model_name(e.joints.model) << " (M_ie, m_e and the base jump)\n";
@@ -75,18 +74,18 @@ void print_inspect(std::ostream& out, const Subject& s, const InspectResult& e) 
     out << "base jump        |dw_0| = " << e.disturbance->angular_rate() * 180.0 / M_PI
         << " deg/s, |dv_0| = " << e.disturbance->linear.norm() << " m/s   (impulse " << e.disturbance->impulse
         << " N s, "
-        << s.law << ")\n";
+        << s.problem.law << ")\n";
   else
     out << "base jump        none: the end-effector does not approach the target at --approach-speed\n";
   if (e.clearance) print_clearance(out, *e.clearance);
-  out << "J_f (generalized Jacobian, 6x" << r.model.n() << ", linear rows first):\n"
+  out << "J_f (generalized Jacobian, 6x" << s.model->n() << ", linear rows first):\n"
       << e.Jf.format(Eigen::IOFormat(5, 0, "  ", "\n", "  ")) << "\n";
 }
 
 int run_inspect(const InspectOptions& o) {
   set_quiet(o.out.quiet);
   Outputs outputs = o.out.outputs();  // --json '-': the table goes to standard error
-  const Subject s = load_subject(o.subject);
+  const Scenario s = load_subject(o.subject);
   const EmbeddedUrdf embedded = builtin_urdf();
   const InspectResult e = inspect(s, &embedded);
   outputs.set("--json", inspect_json(s, e, FFSR_VERSION).dump(2) + "\n");

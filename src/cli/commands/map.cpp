@@ -192,9 +192,8 @@ int run_map(const MapOptions& o) {
   Outputs outputs;  // the JSON summary; the CSV is streamed (below)
   outputs.add("--json", o.out.json);
   if (is_stdout_name(o.out.csv)) outputs.claim_stdout("--csv " + o.out.csv);
-  const Subject subject = load_subject(o.subject);
-  const Robot& r = subject.robot;
-  const MapPlan plan = plan_map(subject, job_options(o, subject.keys.urdf, r.model.n()));
+  const Scenario subject = load_subject(o.subject);
+  const MapPlan plan = plan_map(subject, job_options(o, subject.keys.urdf, subject.model->n()));
   const bool plotting = !o.out.plot.empty();
   const plot::Format plot_format = plot::parse_format(o.out.plot_format, "--plot-format");
   const std::vector<double> slice_deg = check_map_plot(o, plan);
@@ -225,7 +224,7 @@ int run_map(const MapOptions& o) {
   std::vector<std::string> drawn;
   const auto t0 = std::chrono::steady_clock::now();
   if (plotting)
-    drawn = plot::render(map_figures(plan.grid, r.model.joint_names(), std::move(values), slice_deg), o.out.plot,
+    drawn = plot::render(map_figures(plan.grid, subject.model->joint_names(), std::move(values), slice_deg), o.out.plot,
                          plot_format);
   run.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   outputs.set("--json", map_json(subject, run, FFSR_VERSION).dump(2) + "\n");

@@ -12,7 +12,7 @@
 #include "figures/figures.hpp"
 #include "commands/subcommands.hpp"
 
-#include "ffsr/jobs/scenario_run.hpp"
+#include "ffsr/jobs/whole_capture.hpp"
 
 #include <algorithm>
 #include <iomanip>
@@ -97,13 +97,12 @@ ScenarioResult compute(Scenario& sc, const RunSettings& o) {
   sc.capture.record_series = !o.csv.empty() || !o.plot.empty();
   Progress p1{"plain"}, p2{"optimized"};
   ScenarioRunOptions run;
-  run.keep_going = true;    // a plain or paper's-method row that fails is reported; the global row decides
-  run.post_capture = true;  // with a Detumble key: each run's post-capture phase
+  run.keep_going = true;  // a plain or paper's-method row that fails is reported; the global row decides
   if (!o.quiet) {
     run.plain_progress = std::ref(p1);
     run.optimized_progress = std::ref(p2);
   }
-  return run_scenario(sc, run);
+  return run_whole_capture(sc, run);  // with a Detumble key: each run's post-capture phase
 }
 
 std::string deg_list(const Eigen::VectorXd& theta, int precision = 2) {
@@ -244,7 +243,7 @@ struct PostCaptureColumns {
           << x.peak_joint_torque << std::setw(joint) << d.peak_joint_name << std::setw(11)
           << x.peak_gripper_force << std::setw(14) << x.peak_gripper_moment << std::setprecision(3)
           << std::setw(16) << x.base_attitude_excursion * 180.0 / M_PI << std::setw(16)
-          << (d.limits.actuator == BaseActuator::ReactionWheels ? wheels.str() : "-");
+          << (d.settings.limits.actuator == BaseActuator::ReactionWheels ? wheels.str() : "-");
     }
   }
 };
@@ -253,8 +252,8 @@ struct PostCaptureColumns {
 void print_post_capture_note(std::ostream& out, const Scenario& sc, const ScenarioResult& r) {
   if (r.post_capture.empty()) return;
   const DetumbleJobResult& d = r.post_capture.front();
-  out << std::defaultfloat << "after the capture (base actuator " << actuator_name(d.limits.actuator)
-      << (d.options.stop_stack_spin ? ", stopping the stack's spin" : "") << ", at rest below "
+  out << std::defaultfloat << "after the capture (base actuator " << actuator_name(d.settings.limits.actuator)
+      << (d.settings.options.stop_stack_spin ? ", stopping the stack's spin" : "") << ", at rest below "
       << sc.keys.rest_rate_deg
       << " deg/s):\n  rest = time to rest, torque = peak joint torque (at joint), force and moment = peak "
          "gripper load,\n  attitude = base attitude excursion, wheels = peak momentum stored in the reaction "
@@ -438,7 +437,7 @@ void register_run(CLI::App& app, Action& action) {
   app.add_option("--config", o->config,
                  "Scenario file (TOML); every key is also a flag. Default: the built-in paper 3-DOF scenario")
       ->check(CLI::ExistingFile);
-  // every key: the Detumble keys add each run's post-capture phase (ScenarioRunOptions::post_capture)
+  // every key: the Detumble keys add each run's post-capture phase (run_whole_capture)
   o->flags.add_to(app);
   add_output_flags(
       app, o->settings,

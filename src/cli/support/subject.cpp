@@ -56,9 +56,10 @@ void SubjectOptions::add_to(CLI::App& app, const std::set<std::string>& also, co
   });
 }
 
-Subject load_subject(const SubjectOptions& o) {
+Scenario load_subject(const SubjectOptions& o) {
   const EmbeddedUrdf embedded = builtin_urdf();
-  return ffsr::load_subject(command_scenario_keys(o.config, o.flags), &embedded, warn_repairs);
+  return build_scenario(command_scenario_keys(o.config, o.flags), &embedded, ScenarioScope::Configuration,
+                        warn_repairs);
 }
 
 }  // namespace ffsr::cli

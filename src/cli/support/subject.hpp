@@ -7,7 +7,6 @@
 
 #include "ffsr/ffsr.hpp"
 #include "ffsr/scenario/scenario.hpp"
-#include "ffsr/jobs/subject.hpp"
 
 #include <CLI/CLI.hpp>
 
@@ -38,8 +37,9 @@ struct SubjectOptions {
   void add_to(CLI::App& app, const std::set<std::string>& also = {}, const std::set<std::string>& except = {});
 };
 
-/// Builds the subject (jobs/subject.hpp) of the options' keys; warns about every repair of the model.
-/// InputError naming the key or the file, ModelError from the loader.
-Subject load_subject(const SubjectOptions& options);
+/// Builds the scenario of the options' keys, scope Configuration (scenario/scenario.hpp: the robot at its
+/// start configuration, the target, the contact law); warns about every repair of the model as soon as
+/// it is loaded. InputError naming the key or the file, ModelError from the loader.
+Scenario load_subject(const SubjectOptions& options);
 
 }  // namespace ffsr::cli

@@ -45,12 +45,7 @@ inline DetumbleSample detumble_sample(DetumbleSystem& sys, const Eigen::VectorXd
   s.base = sys.base(y);
   s.theta = y.segment(7, n);
   s.theta_dot = y.segment(13 + n, n);
-  s.tau = cmd.tau;
-  s.base_wrench = cmd.base_wrench;
-  s.joint_rate = cmd.joint_rate;
-  s.relative_rate = cmd.relative_rate;
-  s.stack_rate = cmd.stack_rate;
-  s.status = cmd.status;
+  s.command = cmd;
   sys.gripper_load(y, cmd, gripper, body, s.gripper_force, s.gripper_moment);
   const Matrix3 R = sys.base(y).orientation.toRotationMatrix();
   s.base_attitude = Eigen::AngleAxisd(Matrix3(R_start.transpose() * R)).angle();
@@ -74,10 +69,10 @@ inline DetumbleRunResult run_detumble(const Model& stack, int gripper, const Att
                                       const DetumbleState& start, const DetumbleLimits& limits,
                                       const DetumbleOptions& options, const DetumbleRunOptions& run) {
   detail::check_detumble_run(stack, gripper, body, start, run);
-  if (limits.actuator == BaseActuator::None)
-    check_detumble_feasible(stack, start, limits, options, run.horizon);
+  const bool none = limits.actuator == BaseActuator::None;  // no actuator: say so before the limits' checks
+  if (none) check_detumble_feasible(stack, start, limits, options, run.horizon);
   detail::check_detumble(stack, limits, options, "run_detumble");
-  check_detumble_feasible(stack, start, limits, options, run.horizon);
+  if (!none) check_detumble_feasible(stack, start, limits, options, run.horizon);
   DetumbleController ctrl(stack, gripper, limits, options);
   DetumbleCommand cmd = ctrl.make_command();
   detail::DetumbleSystem sys(stack), probe(stack);

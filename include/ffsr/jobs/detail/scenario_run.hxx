@@ -4,6 +4,7 @@
 #include "ffsr/detail/parallel.hpp"
 
 #include <algorithm>
+#include <stdexcept>
 #include <thread>
 
 namespace ffsr {
@@ -27,6 +28,8 @@ inline CaptureOptions row_options(const Scenario& sc, const ScenarioRunOptions& 
 
 /// The plain or the optimized run; a NumericalError names it ("plain run: ...").
 inline CaptureResult plan_row(const Scenario& sc, const ScenarioRunOptions& options, bool plain) {
+  if (sc.scope != ScenarioScope::Run)  // a programming error: the caller resolves the rest (resolve_run)
+    throw std::invalid_argument("the main job's runs need a scenario of scope Run (resolve_run)");
   const CaptureOptions opt = row_options(sc, options, plain);
   try {
     return plan_capture(sc.problem, plain ? sc.baseline_task : sc.task, opt);
@@ -199,7 +202,7 @@ inline void add_robust_rows(const Scenario& sc, ScenarioResult& r) {
 
 namespace detail {
 
-/// The runs of the main job, up to the impact (run_scenario without the post-capture phase).
+/// The runs of the main job, up to the impact.
 inline ScenarioResult run_captures(const Scenario& sc, const ScenarioRunOptions& options) {
   ScenarioResult r;
   if (!options.keep_going || !sc.keys.global) {
@@ -236,9 +239,7 @@ inline ScenarioResult run_captures(const Scenario& sc, const ScenarioRunOptions&
 }  // namespace detail
 
 inline ScenarioResult run_scenario(const Scenario& sc, const ScenarioRunOptions& options) {
-  ScenarioResult r = detail::run_captures(sc, options);
-  if (options.post_capture && scenario_has_post_capture(sc.keys)) r.post_capture = post_capture_runs(sc, r);
-  return r;
+  return detail::run_captures(sc, options);
 }
 
 }  // namespace ffsr

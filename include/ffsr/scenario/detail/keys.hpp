@@ -450,24 +450,23 @@ inline void add_detumble_keys(std::vector<ScenarioKey>& keys) {
                "URDF's <limit effort>)")
           .in(G::Detumble)
           .checked([](const K& k) {
-            for (double v : k.joint_torque_limit)
-              if (!(finite(v, "joint-torque-limit") > 0))
+            for (double v : k.joint_torque_limit)  // the controller's own test of a limit
+              if (!detumble_bound_ok(finite(v, "joint-torque-limit")))
                 throw InputError(str("--joint-torque-limit: every limit must be positive, got ", v));
           })
           .echoed(echo_given("joint-torque-limit", &K::joint_torque_limit)));
-  keys.push_back(FFSR_KEY("base-actuator", base_actuator,
-                          "Detumble: the base's actuator: none, reaction-wheels or thrusters", "none")
+  const std::string actuators = "Detumble: the base's actuator: " + base_actuator_names();
+  keys.push_back(
+      FFSR_KEY("base-actuator", base_actuator, actuators.c_str(), actuator_name(BaseActuator::None))
                      .in(G::Detumble)
                      .checked([](const K& k) {
-                       if (k.base_actuator != "none" && k.base_actuator != "reaction-wheels" &&
-                           k.base_actuator != "thrusters")
-                         throw InputError(
-                             str("--base-actuator: expected none, reaction-wheels or thrusters, got '",
-                                 k.base_actuator, "'"));
+                       if (!find_base_actuator(k.base_actuator))
+                         throw InputError(str("--base-actuator: expected ", base_actuator_names(), ", got '",
+                                              k.base_actuator, "'"));
                      })
                      .echoed(echo_given("base-actuator", &K::base_actuator))
                      .acting([](const K& k) -> std::string {
-                       return k.stop_stack_spin || k.base_actuator == "none"
+                       return k.stop_stack_spin || k.base_actuator == actuator_name(BaseActuator::None)
                                   ? ""
                                   : "acts only when the run stops the stack's spin (stop-stack-spin = true)";
                      }));
@@ -479,14 +478,14 @@ inline void add_detumble_keys(std::vector<ScenarioKey>& keys) {
                        .acting(with_actuator(actuator)));
   };
   bound(FFSR_KEY("wheel-torque", wheel_torque, "Detumble: reaction wheels' torque per base axis, N m"),
-        "wheel-torque", &K::wheel_torque, "reaction-wheels");
+        "wheel-torque", &K::wheel_torque, actuator_name(BaseActuator::ReactionWheels));
   bound(FFSR_KEY("wheel-momentum", wheel_momentum,
                  "Detumble: reaction wheels' stored momentum per base axis, N m s"),
-        "wheel-momentum", &K::wheel_momentum, "reaction-wheels");
+        "wheel-momentum", &K::wheel_momentum, actuator_name(BaseActuator::ReactionWheels));
   bound(FFSR_KEY("thruster-force", thruster_force, "Detumble: thrusters' force per base axis, N"),
-        "thruster-force", &K::thruster_force, "thrusters");
+        "thruster-force", &K::thruster_force, actuator_name(BaseActuator::Thrusters));
   bound(FFSR_KEY("thruster-torque", thruster_torque, "Detumble: thrusters' torque per base axis, N m"),
-        "thruster-torque", &K::thruster_torque, "thrusters");
+        "thruster-torque", &K::thruster_torque, actuator_name(BaseActuator::Thrusters));
 }
 
 /// The post-capture run's settings (the detumble job): rest, horizon, tick, the stack's spin.

@@ -104,6 +104,53 @@ inline UrdfOptions ModelLoadKeys::build(const std::string& end_effector) const {
   return u;
 }
 
+// --- the post-capture run's settings ---------------------------------------------------------------------
+
+inline DetumbleSettings detumble_settings(const ScenarioKeys& k, const Model& model) {
+  using detail::str;
+  for (const ScenarioKey& key : scenario_keys()) {  // a Detumble key given where it does not act
+    if (key.group != KeyGroup::Detumble || !key.acts || !k.given.count(key.name)) continue;
+    const std::string why = key.acts(k);
+    if (!why.empty()) throw InputError(str("--", key.name, ": ", why));
+  }
+  DetumbleSettings s;
+  DetumbleLimits& l = s.limits;
+  if (k.joint_torque_limit.empty()) {
+    l.joint_torque.resize(model.n());
+    for (int j = 0; j < model.n(); ++j) {
+      l.joint_torque(j) = model.joint(j).effort;
+      if (!(l.joint_torque(j) > 0))
+        throw InputError(
+            str("--joint-torque-limit: not given, and the URDF gives no <limit effort> for joint '",
+                model.joint(j).name, "'"));
+    }
+  } else {
+    l.joint_torque = per_joint_values(k.joint_torque_limit, model, "--joint-torque-limit");
+  }
+  const auto needed = [&k](const char* name, double value) {
+    if (!k.given.count(name))
+      throw InputError(str("--", name, ": needed with base-actuator = ", k.base_actuator));
+    return value;
+  };
+  const std::optional<BaseActuator> actuator = find_base_actuator(k.base_actuator);  // its parsing
+  if (!actuator)  // keys the table has not checked
+    throw InputError(
+        str("--base-actuator: expected ", base_actuator_names(), ", got '", k.base_actuator, "'"));
+  l.actuator = *actuator;
+  if (l.actuator == BaseActuator::ReactionWheels) {
+    l.wheel_torque = needed("wheel-torque", k.wheel_torque);
+    l.wheel_momentum = needed("wheel-momentum", k.wheel_momentum);
+  } else if (l.actuator == BaseActuator::Thrusters) {
+    l.thruster_force = needed("thruster-force", k.thruster_force);
+    l.thruster_torque = needed("thruster-torque", k.thruster_torque);
+  }
+  s.options.rest_rate = k.rest_rate_deg * M_PI / 180.0;
+  s.options.stop_stack_spin = k.stop_stack_spin;
+  s.run.tick = k.detumble_tick;
+  s.run.horizon = k.detumble_horizon;
+  return s;
+}
+
 // --- validation ------------------------------------------------------------------------------------------
 
 namespace detail {
@@ -265,16 +312,24 @@ inline GlobalObjective global_objective_of(const std::string& name) {
 
 namespace detail {
 
-/// The problem of the keys: robot, start state, target, contact, tasks and options (build_scenario
-/// without the file's checks and the shapes). InputError naming the key.
-inline void build_problem(Scenario& sc, ScenarioKeys& k, const EmbeddedUrdf* embedded) {
+/// The robot, its start state and the target (both scopes).
+inline void build_robot(Scenario& sc, ScenarioKeys& k, const EmbeddedUrdf* embedded,
+                        const UrdfReportCallback& on_load) {
   sc.model = model_of(k, embedded, sc.report);
+  if (on_load) on_load(sc.report);
   const Model& model = *sc.model;
   CaptureProblem& pb = sc.problem;
   pb.model = sc.model.get();
   pb.frame = model.end_effector();
   start_of(k, model, pb);
   pb.target = target_of(k);
+}
+
+/// The rest of the main job's problem: contact, tasks and options (build_scenario without the file's
+/// checks and the shapes). InputError naming the key.
+inline void build_run(Scenario& sc, ScenarioKeys& k) {
+  const Model& model = *sc.model;
+  CaptureProblem& pb = sc.problem;
   contact_of(k, pb);
   sc.task = task_of(k.task, k, "task");
   sc.baseline_task = k.baseline_task.empty() ? sc.task : task_of(k.baseline_task, k, "baseline-task");
@@ -290,32 +345,88 @@ inline void build_problem(Scenario& sc, ScenarioKeys& k, const EmbeddedUrdf* emb
                          model.n(),
                          " joints: no null space to optimize in (set gain = 0 or constrain fewer axes)"));
   sc.hold_base_attitude = base_attitude_of(k, model, pb, sc.task, sc.capture.gain);
+  sc.scope = ScenarioScope::Run;
 }
 
-}  // namespace detail
-
-inline Scenario build_scenario(ScenarioKeys k, const EmbeddedUrdf* embedded) {
-  using namespace detail;
-  Scenario sc;
-  sc.builtin = k.file.empty();
-  sc.where =
-      k.where.empty() ? (sc.builtin ? std::string("built-in scenario") : "scenario " + k.file) : k.where;
-  if (!sc.builtin)
-    for (const std::string& key : required_scenario_keys())
-      if (!k.given.count(key)) throw InputError(str(sc.where, ": missing key '", key, "'"));
-  // an error of a key the file gave names the file and the key's line
+/// The contact law of a Configuration scenario: its parameters checked, the law's name as given (the
+/// job contact takes 'all'), the approach speed finite.
+inline void configuration_contact_of(const ScenarioKeys& k, CaptureProblem& pb) {
+  pb.contact = {k.stiffness, k.exponent, k.restitution};  // validate names a non-finite value
   try {
-    build_problem(sc, k, embedded);
+    validate(pb.contact, "contact");
   } catch (const InputError& e) {
-    throw InputError(located_key_message(k, e.what()));
+    throw InputError(std::string("--stiffness/--exponent/--restitution: ") + e.what());
   }
-  sc.keys = std::move(k);
+  pb.law = k.model;
+  pb.approach_speed = finite(k.approach_speed, "approach-speed");
+}
+
+/// A file must name the required keys (the main job's).
+inline void require_scenario_keys(const ScenarioKeys& k, const std::string& where) {
+  if (!k.file.empty())
+    for (const std::string& key : required_scenario_keys())
+      if (!k.given.count(key)) throw InputError(str(where, ": missing key '", key, "'"));
+}
+
+/// The shapes and the clearance of a Run scenario.
+inline void build_geometry(Scenario& sc, const EmbeddedUrdf* embedded) {
   try {
     sc.geometry = scenario_geometry(sc, embedded);
   } catch (const InputError& e) {
     throw InputError(located_key_message(sc.keys, e.what()));
   }
+}
+
+}  // namespace detail
+
+inline ContactJoints Scenario::contact_joints() const {
+  try {  // located in the file when the file gave the key
+    const JointModel m =
+        all_joint_models() ? JointModel::Free : parse_joint_model(keys.contact_joints, "--contact-joints");
+    return {m, per_joint_values(keys.armature, *model, "--armature")};
+  } catch (const InputError& e) {
+    throw InputError(located_key_message(keys, e.what()));
+  }
+}
+
+inline Scenario build_scenario(ScenarioKeys k, const EmbeddedUrdf* embedded, ScenarioScope scope,
+                               const UrdfReportCallback& on_load) {
+  using namespace detail;
+  Scenario sc;
+  sc.builtin = k.file.empty();
+  sc.where =
+      k.where.empty() ? (sc.builtin ? std::string("built-in scenario") : "scenario " + k.file) : k.where;
+  sc.scope = scope;
+  if (scope == ScenarioScope::Run) require_scenario_keys(k, sc.where);
+  // an error of a key the file gave names the file and the key's line
+  try {
+    if (scope == ScenarioScope::Configuration) {
+      for (const ScenarioKey& key : scenario_keys())  // every key read is checked, those of other jobs too
+        if (key.check) key.check(k);
+      build_robot(sc, k, embedded, on_load);
+      configuration_contact_of(k, sc.problem);
+    } else {
+      build_robot(sc, k, embedded, nullptr);
+      build_run(sc, k);
+    }
+  } catch (const InputError& e) {
+    throw InputError(located_key_message(k, e.what()));
+  }
+  sc.keys = std::move(k);
+  if (scope == ScenarioScope::Run) build_geometry(sc, embedded);
   return sc;
+}
+
+inline void resolve_run(Scenario& sc, const EmbeddedUrdf* embedded) {
+  using namespace detail;
+  if (sc.scope == ScenarioScope::Run) return;
+  require_scenario_keys(sc.keys, sc.where);
+  try {
+    build_run(sc, sc.keys);
+  } catch (const InputError& e) {
+    throw InputError(located_key_message(sc.keys, e.what()));
+  }
+  build_geometry(sc, embedded);
 }
 
 inline Scenario load_scenario(const std::string& path) { return build_scenario(read_scenario_file(path)); }
