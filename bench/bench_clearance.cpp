@@ -33,8 +33,8 @@ void time_global(const std::string& dir, const char* file) {
   }
   const ffsr::ClearanceReport c = ffsr::run_clearance(sc, g.result.run);
   std::printf("%-36s %7.3f s  M_ie %.4f kg  smallest distance %.4f m (%s)  evaluations %ld  reaching runs %d\n",
-              file, best, g.result.run.M_ie, c.overall.distance, c.overall.pair.c_str(), g.result.evaluations,
-              g.result.shooting_iterations);
+              file, best, g.result.run.M_ie, c.overall.distance, c.overall.pair.c_str(),
+              g.result.counters.evaluations, g.result.counters.shooting_iterations);
 }
 
 }  // namespace

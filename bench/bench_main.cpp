@@ -636,8 +636,8 @@ void bench_global(const Settings& s, const Robot& r3, const Robot& r7) {
     std::printf(
         "%-11s   M_ie = %.4f kg, gap %.3f %%, %d shooting iteration(s), %ld SLSQP evaluations, search %.3f "
         "s\n",
-        "", last.run.M_ie, last.optimality_gap_percent, last.shooting_iterations, last.evaluations,
-        last.search_seconds);
+        "", last.run.M_ie, last.optimality_gap_percent, last.counters.shooting_iterations,
+        last.counters.evaluations, last.counters.search_seconds);
     return pb;
   };
   run(r3, 180.0, position_task(true, true, false), "< 1 s", 1.0);

@@ -46,7 +46,7 @@ void time_plan(const char* name, const ffsr::Scenario& sc, const std::vector<Eig
   }
   std::printf("%-34s %8.3f s  M_ie %.4f kg  manifold optimum %.4f kg  reconfigured %s  reaching runs %d\n",
               name, best, r.run.M_ie, r.manifold_optimum, r.reconfigured ? "yes" : "no",
-              r.shooting_iterations);
+              r.counters.shooting_iterations);
 }
 
 }  // namespace

@@ -1,7 +1,8 @@
 // python/src/algorithms.cpp -- the dynamics of ffsr._ffsr: kinematics, crba (H), rnea, the Jacobians
-// J_bm and J_f, momentum, the effective mass m_e (Eq. 4), the integrated effective mass M_ie (Eq. 14)
-// and its gradient under each joint model. Every function is the C++ function of the same name; the
-// matrices it leaves in its Data come back as read-only views (outputs.hpp).
+// J_bm and J_f, momentum (about the base origin and the centre of mass), the effective mass m_e
+// (Eq. 4), the integrated effective mass M_ie (Eq. 14) and its gradient under each joint model. Every
+// function is the C++ function of the same name; the matrices it leaves in its Data come back as
+// read-only views (outputs.hpp).
 #include "arguments.hpp"
 #include "bindings.hpp"
 #include "outputs.hpp"
@@ -145,6 +146,21 @@ void bind_momentum(nb::module_& m) {
       "model"_a, "data"_a, "v"_a,
       "Total momentum [P; L], L about the base frame origin, inertial frame, summed body by body at the\n"
       "last kinematics; equals the first six rows of H v.");
+
+  m.def(
+      "centroidal_momentum",
+      [](const Model& model, const Data& data, nb::handle v) {
+        check_data(model, data, "centroidal_momentum");
+        const VecIn vv(v, "centroidal_momentum", "v");
+        vv.require(model.nv());
+        const CentroidalMomentum c = centroidal_momentum(model, data, vv.map());
+        Vector6 h;
+        h << c.linear, c.angular;
+        return std::make_pair(out(c.com), out(h));
+      },
+      "model"_a, "data"_a, "v"_a,
+      "The centroidal momentum from data.H of the last crba: (c, [P; L_c]), the system's centre of mass\n"
+      "and its momentum, L_c about c, inertial frame (Pinocchio's computeCentroidalMomentum).");
 
   m.def(
       "kinetic_energy",

@@ -237,11 +237,11 @@ void bind_controller(nb::module_& m) {
       .def_prop_ro("max_joint_rate", &Controller::max_joint_rate, "Joint-rate limit, rad/s (0: none).")
       .def_prop_ro("servo", &Controller::servo, "True for the servo to a goal, False for the paper's method.")
       .def_prop_ro(
-          "capture_point", [](const Controller& c) { return out(c.setup().x_cap); },
+          "capture_point", [](const Controller& c) { return out(c.setup().capture.x_cap); },
           "The current plan's capture point x_cap at T (moved by update_target), m.",
           nb::rv_policy::automatic)
       .def_prop_ro(
-          "normal", [](const Controller& c) { return out(c.setup().u_cap); },
+          "normal", [](const Controller& c) { return out(c.setup().capture.u_cap); },
           "The current plan's inertial contact normal at T.", nb::rv_policy::automatic)
       .def_prop_ro(
           "task_rows", [](const Controller& c) { return std::vector<int>(c.setup().rows); },

@@ -1,6 +1,6 @@
-"""H, J_bm, J_f, m_e and M_ie of ffsr against Pinocchio's own Python package (`pin`), on the paper's two
-robots and the real URDFs of ../shared/urdf-samples, at random base poses and joint angles (fixed
-seeds), 1e-10 relative to the largest entry of the reference.
+"""H, J_bm, J_f, m_e, M_ie and the centroidal momentum of ffsr against Pinocchio's own Python package
+(`pin`), on the paper's two robots and the real URDFs of ../shared/urdf-samples, at random base poses
+and joint angles (fixed seeds), 1e-10 relative to the largest entry of the reference.
 
 Pinocchio computes the same quantities in its own coordinates: a free-flyer whose velocity is the
 base frame's [v; w] in the base frame, joints in its own order, continuous joints as (cos, sin), mimic
@@ -8,6 +8,7 @@ joints as coordinates of their own. The map T from ffsr's generalized velocity [
 (v0 and w0 in the inertial frame, the base frame being the bus frame when the URDF is mounted on a bus)
 to Pinocchio's is written down here from the conventions alone; then H = T^T H_pin T and
 J_bm = J_pin T. J_f, m_e (Eq. 4) and M_ie (Eq. 14) follow from those matrices with numpy's solve.
+Pinocchio's centroidal momentum takes its velocity T v.
 """
 
 import numpy as np
@@ -152,6 +153,22 @@ def check_case(case, seed, configs=4):
         assert abs(M_dense - M_ref) < TOL * M_ref
 
 
+def check_centroidal(case, seed, configs=3):
+    """ffsr.centroidal_momentum (from the last crba's H) against pin.computeCentroidalMomentum: the centre
+    of mass and [P; L_c], L_c about it, both in the inertial frame (Pinocchio's velocity is T v)."""
+    rng = np.random.default_rng(seed)
+    data = ffsr.Data(case.fm)
+    for _ in range(configs):
+        base, theta = case.random_config(rng)
+        v = rng.uniform(-0.5, 0.5, case.fm.nv)
+        q, T = case.pin_state(base, theta)
+        hg = pin.computeCentroidalMomentum(case.pm, case.pd, q, T @ v)
+        ffsr.crba(case.fm, data, base, theta)
+        c, h = ffsr.centroidal_momentum(case.fm, data, v)
+        assert rel_err(c, case.pd.com[0]) < TOL
+        assert rel_err(h, np.concatenate([hg.linear, hg.angular])) < TOL
+
+
 def test_paper_3dof():
     check_case(Case(ROBOTS / "paper_3dof.urdf"), seed=1)
 
@@ -187,3 +204,13 @@ def test_ur5():
 def test_kinova_with_continuous_joints():
     d = samples_dir_or_skip()
     check_case(Case(d / "kinova.urdf", "j2s6s200_end_effector", None, sample_bus()), seed=6)
+
+
+def test_centroidal_momentum():
+    check_centroidal(Case(ROBOTS / "paper_3dof.urdf"), seed=7)
+    check_centroidal(Case(ROBOTS / "paper_7dof.urdf", bus=sample_bus()), seed=8)
+
+
+def test_centroidal_momentum_with_a_mimic_joint():
+    d = samples_dir_or_skip()
+    check_centroidal(Case(d / "panda.urdf", "panda_hand", [0, 0, 0.1034], sample_bus()), seed=9)

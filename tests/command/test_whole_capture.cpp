@@ -35,7 +35,7 @@ ffsr::DetumbleRunResult detumble_at(const ffsr::Scenario& sc, const ffsr::BasePo
                                     const Eigen::VectorXd& theta) {
   const ffsr::Model& m = *sc.model;
   const int ee = sc.problem.frame;
-  const ffsr::Target target = ffsr::prepare_capture(sc.problem, sc.task, sc.capture).capture_target;
+  const ffsr::Target target = ffsr::prepare_capture(sc.problem, sc.task, sc.capture).capture.target;
   const ffsr::GraspResult g = ffsr::grasp_at_capture(m, ee, base, theta, target, sc.problem.approach_speed);
   const ffsr::Model stack = ffsr::attach_body(m, m.frame(ee).name, g.body);
   ffsr::DetumbleLimits limits;
@@ -73,7 +73,7 @@ TEST_CASE("whole capture: the least M_ie among the captures whose post-capture r
   CHECK(g.post_capture->peak_joint_torque == Approx(at_chosen.peak_joint_torque).epsilon(1e-9));
   CHECK(g.post_capture->time_to_rest == Approx(at_chosen.time_to_rest));
   // no clearance here: a reached goal the constraints turn away is not counted as the clearance's
-  CHECK(g.result.goals_rejected == 0);
+  CHECK(g.result.counters.goals_rejected == 0);
   // another capture than the impact-best one, of no lower M_ie (on this planar arm the mirrored
   // posture has the same M_ie to 1e-4)
   CHECK(ffsr::detail::configuration_distance(*whole.model, g.result.run.theta, best.theta) > 0.5);

@@ -19,8 +19,13 @@ namespace ffsr_test {
 using Eigen::MatrixXd;
 using Eigen::VectorXd;
 using ffsr::BasePose;
+using ffsr::Data;
 using ffsr::Inertia;
+using ffsr::JointType;
 using ffsr::Matrix3;
+using ffsr::Model;
+using ffsr::ModelBuilder;
+using ffsr::Pose;
 using ffsr::Quaternion;
 using ffsr::Vector3;
 using ffsr::Vector6;
@@ -279,6 +284,188 @@ inline MatrixXd fd_frame_jacobian(const TestRobot& r, const Config& q, int frame
     J.block<3, 1>(3, k) = angular_velocity_fd(Xp.R, Xm.R, X0.R, h);
   }
   return J;
+}
+
+// -------------------------------------------------------------------------------------------------
+// The models of the algorithm tests (tests/unit/test_crba.cpp, test_rnea.cpp, test_aba.cpp,
+// test_kinematics.cpp, test_jacobian.cpp, test_momentum.cpp, test_effective_mass.cpp).
+
+/// The random branched tree: 9 moving joints on three branches (a, b, c; c hangs on a1), two
+/// prismatic joints, random non-unit axes, random full inertias and centre-of-mass offsets, a fixed
+/// child "tool" with mass on a3 and a joint "a4" hung on the fixed frame "tool", a massless fixed
+/// frame "tip" on a4 as the end-effector. Bodies are added interleaved (not depth-first).
+inline TestRobot random_tree(unsigned seed) {
+  Rng rng(seed);
+  auto inertia = [&](double m) { return Inertia{m, rng.vec3(0.3), rng.inertia(0.05 * m)}; };
+  auto pose = [&] { return Pose::from_xyz_rpy(rng.vec3(0.6), rng.vec3(M_PI)); };
+  auto axis = [&] { return Vector3(rng.unit() * rng.uniform(0.5, 2.0)); };  // normalized by the builder
+
+  const Inertia trunk = inertia(300);
+  ModelBuilder b("trunk", trunk);
+  TestRobot r;
+  r.name = "random tree";
+  r.links.push_back({"trunk", trunk});
+  auto add = [&](const char* joint, JointType type, const char* parent, const char* child, double m) {
+    const Inertia in = inertia(m);
+    b.add_joint(joint, type, parent, pose(), axis(), child, in);
+    r.links.push_back({child, in});
+  };
+  add("ja1", JointType::Revolute, "trunk", "a1", 12);
+  add("jb1", JointType::Revolute, "trunk", "b1", 9);
+  add("ja2", JointType::Prismatic, "a1", "a2", 7);
+  add("jc1", JointType::Revolute, "a1", "c1", 5);
+  add("jb2", JointType::Revolute, "b1", "b2", 8);
+  add("ja3", JointType::Revolute, "a2", "a3", 6);
+  const Inertia tool = inertia(2.5);
+  b.add_fixed("tool_mount", "a3", pose(), "tool", tool);
+  r.links.push_back({"tool", tool});
+  add("ja4", JointType::Revolute, "tool", "a4", 3);
+  add("jc2", JointType::Prismatic, "c1", "c2", 4);
+  add("jb3", JointType::Revolute, "b2", "b3", 4.5);
+  b.add_fixed("tip_mount", "a4", pose(), "tip", Inertia{});
+  b.set_end_effector("tip");
+  r.model = b.build();
+  r.ee = r.model.end_effector();
+  return r;
+}
+
+/// The paper's 3-DOF and 7-DOF robots and the random tree (seed 7), with their lists of masses.
+inline std::vector<TestRobot> robots_under_test() {
+  return {paper_robot("paper_3dof.urdf"), paper_robot("paper_7dof.urdf"), random_tree(7)};
+}
+
+/// The common loop of the identity checks: for every robot under test, `samples` random
+/// configurations drawn from one generator seeded with `seed`, each handed to
+/// body(robot, its Data, the generator, configuration, sample index); the body draws whatever else
+/// it needs from the same generator, so the sequence is fixed by the seed.
+template <class Body>
+void for_each_config(unsigned seed, int samples, Body body) {
+  Rng rng(seed);
+  for (const auto& r : robots_under_test()) {
+    Data d(r.model);
+    for (int k = 0; k < samples; ++k) {
+      const Config q = random_config(r.model, rng);
+      body(r, d, rng, q, k);
+    }
+  }
+}
+
+/// A generalized velocity: base ~ 0.4 m/s and 0.3 rad/s, joints ~ 1 rad/s (or m/s).
+inline VectorXd random_velocity(const Model& m, Rng& rng) {
+  VectorXd v(m.nv());
+  v << rng.vec3(0.4), rng.vec3(0.3), rng.vec(m.n(), 1.0);
+  return v;
+}
+
+/// The library's chart (advance_library), as a Chart.
+inline const Chart library_chart = advance_library;
+
+/// A serial chain of n revolute joints with random axes, offsets and inertias (the size tests of the
+/// articulated-body recursion).
+inline Model random_chain(int n, unsigned seed) {
+  Rng rng(seed);
+  ModelBuilder b("base", Inertia{400, rng.vec3(0.2), rng.inertia(100)});
+  std::string parent = "base";
+  for (int i = 0; i < n; ++i) {
+    const std::string child = "l" + std::to_string(i + 1);
+    b.add_joint("j" + std::to_string(i + 1), JointType::Revolute, parent,
+                Pose::from_xyz_rpy(rng.vec3(0.4), rng.vec3(M_PI)), Vector3(rng.unit()), child,
+                Inertia{rng.uniform(1, 10), rng.vec3(0.2), rng.inertia(0.5)});
+    parent = child;
+  }
+  b.add_fixed("tip_mount", parent, Pose::from_xyz_rpy(rng.vec3(0.3), Vector3::Zero()), "tip", Inertia{});
+  b.set_end_effector("tip");
+  return b.build();
+}
+
+/// A model with the name the tests print.
+struct NamedModel {
+  std::string name;
+  Model model;
+};
+
+/// A serial chain of n joints; `unit_axes`: axes +-x, +-y, +-z in turn and every third joint origin
+/// without rotation; else random axes and rotations. Inertias full, every other one diagonal.
+inline Model serial_chain(int n, unsigned seed, bool unit_axes,
+                          const Vector3& gravity = Vector3::Zero()) {
+  Rng rng(seed);
+  ModelBuilder b("base", Inertia{400, rng.vec3(0.2), rng.inertia(100)});
+  b.set_gravity(gravity);
+  std::string parent = "base";
+  const Vector3 axes[] = {Vector3::UnitX(), -Vector3::UnitY(), Vector3::UnitZ(),
+                          -Vector3::UnitX(), Vector3::UnitY(), -Vector3::UnitZ()};
+  for (int i = 0; i < n; ++i) {
+    const std::string child = "l" + std::to_string(i + 1);
+    const Vector3 rpy = unit_axes && i % 3 == 0 ? Vector3::Zero() : rng.vec3(M_PI);
+    const Vector3 axis = unit_axes ? axes[i % 6] : rng.unit();
+    const Matrix3 I = i % 2 ? Matrix3(Vector3(0.2, 0.3, 0.4).asDiagonal()) : rng.inertia(0.5);
+    b.add_joint("j" + std::to_string(i + 1), JointType::Revolute, parent,
+                Pose::from_xyz_rpy(rng.vec3(0.4), rpy), axis, child,
+                Inertia{rng.uniform(1, 10), rng.vec3(0.2), I});
+    parent = child;
+  }
+  b.add_fixed("tip_mount", parent, Pose::from_xyz_rpy(rng.vec3(0.3), Vector3::Zero()), "tip", Inertia{});
+  b.set_end_effector("tip");
+  return b.build();
+}
+
+/// A branched tree: trunk with branches a (a1 - a2 (prismatic) - a3, and c1 - c2 on a1) and b
+/// (b1 - b2), end-effector on a3. `depth_first`: bodies added so that every subtree is a contiguous
+/// range (a1 a2 a3 c1 c2 b1 b2); else interleaved (a1 b1 a2 c1 b2 a3 c2).
+inline Model branched_tree(unsigned seed, bool depth_first) {
+  Rng rng(seed);
+  ModelBuilder b("trunk", Inertia{300, rng.vec3(0.3), rng.inertia(20)});
+  struct J {
+    const char *joint, *parent, *child;
+    JointType type;
+  };
+  const JointType R = JointType::Revolute, P = JointType::Prismatic;
+  const std::vector<J> dfs = {{"ja1", "trunk", "a1", R}, {"ja2", "a1", "a2", P}, {"ja3", "a2", "a3", R},
+                              {"jc1", "a1", "c1", R},    {"jc2", "c1", "c2", P}, {"jb1", "trunk", "b1", R},
+                              {"jb2", "b1", "b2", R}};
+  const std::vector<int> interleaved = {0, 5, 1, 3, 6, 2, 4};
+  for (int k = 0; k < 7; ++k) {
+    const J& j = dfs[static_cast<size_t>(depth_first ? k : interleaved[static_cast<size_t>(k)])];
+    b.add_joint(j.joint, j.type, j.parent, Pose::from_xyz_rpy(rng.vec3(0.6), rng.vec3(M_PI)), rng.unit(),
+                j.child, Inertia{rng.uniform(2, 12), rng.vec3(0.3), rng.inertia(0.5)});
+  }
+  b.add_fixed("tip_mount", "a3", Pose::from_xyz_rpy(rng.vec3(0.3), Vector3::Zero()), "tip", Inertia{});
+  b.set_end_effector("tip");
+  return b.build();
+}
+
+/// A chain of 5 joints whose joint j4 mimics j2 (multiplier -0.7, offset 0.2).
+inline Model mimic_chain(unsigned seed) {
+  Rng rng(seed);
+  ModelBuilder b("base", Inertia{200, rng.vec3(0.2), rng.inertia(50)});
+  std::string parent = "base";
+  for (int i = 0; i < 5; ++i) {
+    const std::string child = "l" + std::to_string(i + 1);
+    b.add_joint("j" + std::to_string(i + 1), JointType::Revolute, parent,
+                Pose::from_xyz_rpy(rng.vec3(0.4), rng.vec3(M_PI)), rng.unit(), child,
+                Inertia{rng.uniform(1, 10), rng.vec3(0.2), rng.inertia(0.5)});
+    parent = child;
+  }
+  b.set_mimic("j4", "j2", -0.7, 0.2);
+  b.add_fixed("tip_mount", parent, Pose::from_xyz_rpy(rng.vec3(0.3), Vector3::Zero()), "tip", Inertia{});
+  b.set_end_effector("tip");
+  return b.build();
+}
+
+/// Every kind of tree the library builds: the paper's robots (URDF, unit joint axes), serial chains of
+/// 1 to 28 joints with random axes, a chain with axes along +-x, +-y, +-z, a branched tree numbered
+/// depth-first (as the URDF loader numbers it: the contiguous-subtree path of crba) and the same tree
+/// added out of depth-first order (the ancestor-walk path). In this order (tests index it).
+inline std::vector<NamedModel> models_of_every_kind() {
+  std::vector<NamedModel> m;
+  m.push_back({"paper 3-DOF", ffsr::model_from_urdf_file(source_path("robots/paper_3dof.urdf"))});
+  m.push_back({"paper 7-DOF", ffsr::model_from_urdf_file(source_path("robots/paper_7dof.urdf"))});
+  for (int n : {1, 3, 7, 14, 28})
+    m.push_back({"chain " + std::to_string(n), serial_chain(n, 100u + unsigned(n), false)});
+  m.push_back({"unit-axis chain 12", serial_chain(12, 7, true)});
+  m.push_back({"depth-first tree", branched_tree(5, true)});
+  m.push_back({"interleaved tree", branched_tree(5, false)});
+  return m;
 }
 
 }  // namespace ffsr_test

@@ -74,15 +74,16 @@ inline const Shared& shared_7dof_position() {
 inline void check_run(const Shared& s, double bound_M_ie) {
   const GlobalCaptureResult& g = s.global;
   INFO("global M_ie " << g.run.M_ie << " paper's method " << s.paper.M_ie << " optimum " << g.manifold_optimum
-                      << " gap " << g.optimality_gap_percent << " % iterations " << g.shooting_iterations);
+                      << " gap " << g.optimality_gap_percent << " % iterations "
+                      << g.counters.shooting_iterations);
   CHECK(g.run.M_ie <= bound_M_ie);
   CHECK(g.run.M_ie <= s.paper.M_ie);  // never worse than the paper's method
   CHECK(g.reached_manifold_optimum);
   CHECK(g.optimality_gap_percent <= 1.0);
   CHECK(g.optimality_gap_percent >=
         -1e-6);  // the optimum is the best the search knows, the reached point among the starts
-  CHECK(g.shooting_iterations >= 1);
-  CHECK(g.shooting_iterations <= 8 * g.goals_tried);
+  CHECK(g.counters.shooting_iterations >= 1);
+  CHECK(g.counters.shooting_iterations <= 8 * g.counters.goals_tried);
   CHECK(g.run.tracking_error <= s.opt.tolerance);
   CHECK(g.run.max_joint_rate <= kRate * (1 + 1e-9));  // the limit of the scenario
   // zero total momentum along the run (relative to the bodies' own momenta) and a still centre of mass
@@ -99,7 +100,7 @@ inline void check_run(const Shared& s, double bound_M_ie) {
       "gap %.3f %%, %d iterations, %ld SLSQP evaluations, search %.3f s\n",
       s.model.n(), g.run.M_ie, s.paper.M_ie, g.run.f_max_closed_form / 1e3, s.paper.f_max_closed_form / 1e3,
       g.run.max_joint_rate * 180 / M_PI, s.paper.max_joint_rate * 180 / M_PI, g.optimality_gap_percent,
-      g.shooting_iterations, g.evaluations, g.search_seconds);
+      g.counters.shooting_iterations, g.counters.evaluations, g.counters.search_seconds);
 }
 
 /// capture_residual's Jacobian against central differences (h = 1e-6) at `q`, column by column:

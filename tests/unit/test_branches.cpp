@@ -233,8 +233,8 @@ TEST_CASE("UR5 pose task: the branches equal an independent enumeration of the I
       const double u = static_cast<double>(rng() >> 11) * 0x1.0p-53;
       q(k) = m.joint(k).lower + (m.joint(k).upper - m.joint(k).lower) * u;
     }
-    if (!test_pose_projection(m, d, in.sc.problem.frame, in.base, in.setup.x_cap, in.setup.R_end, q))
-      continue;
+    const CaptureAtT& c = in.setup.capture;
+    if (!test_pose_projection(m, d, in.sc.problem.frame, in.base, c.x_cap, c.R_end, q)) continue;
     ++converged;
     bool known = false;
     for (const Eigen::VectorXd& k : mine) known = known || wrapped_distance(k, q) < 1e-6;
@@ -249,7 +249,7 @@ TEST_CASE("UR5 pose task: the branches equal an independent enumeration of the I
     for (const CaptureBranch& b : br) nearest = std::min(nearest, wrapped_distance(b.theta, q));
     CHECK(nearest < 1e-6);
     // ... and none has a lower M_ie than the best branch
-    CHECK(integrated_effective_mass(m, d, in.base, q, in.sc.problem.frame, in.setup.capture_target) >=
+    CHECK(integrated_effective_mass(m, d, in.base, q, in.sc.problem.frame, in.setup.capture.target) >=
           br.front().M_ie * (1 - 1e-9));
   }
   for (const CaptureBranch& b : br) {  // each branch is a solution of this test

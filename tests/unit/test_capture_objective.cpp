@@ -135,15 +135,15 @@ TEST_CASE("Capture objective: M_ie of each joint model against independent compu
     CaptureProblem pb = sc.problem;
     pb.joints = {JointModel::Locked, {}};
     CHECK(CaptureEvaluator(pb, s).mass(data, base, theta) ==
-          Approx(locked_M_ie(model, pb.frame, base, theta, s.capture_target)).epsilon(1e-10));
+          Approx(locked_M_ie(model, pb.frame, base, theta, s.capture.target)).epsilon(1e-10));
     pb.joints = {JointModel::Armature, Eigen::VectorXd::LinSpaced(model.n(), 0.1, 2.0)};
     CHECK(CaptureEvaluator(pb, s).mass(data, base, theta) ==
-          Approx(armature_M_ie(model, pb.frame, base, theta, pb.joints.armature, s.capture_target))
+          Approx(armature_M_ie(model, pb.frame, base, theta, pb.joints.armature, s.capture.target))
               .epsilon(1e-10));
     pb.joints = {};
     CHECK(CaptureEvaluator(pb, s).mass(data, base, theta) ==
           Approx(
-              armature_M_ie(model, pb.frame, base, theta, Eigen::VectorXd::Zero(model.n()), s.capture_target))
+              armature_M_ie(model, pb.frame, base, theta, Eigen::VectorXd::Zero(model.n()), s.capture.target))
               .epsilon(1e-10));
     // the map's fast path is the same M_ie
     CHECK(CaptureEvaluator(pb, s).mass_fast(data, base, theta) ==

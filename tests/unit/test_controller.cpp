@@ -149,7 +149,7 @@ TEST_CASE("controller: update_target re-anchors the line with a continuous refer
   CHECK((after.acceleration(tu) - before.acceleration(tu)).norm() <= 1e-12);  // acceleration too
   // the new capture point: the moved target propagated independently to T
   const Vector3 expected = propagate_target(moved, T - tu).contact_point();
-  CHECK((ctrl.setup().x_cap - expected).norm() <= 1e-12);
+  CHECK((ctrl.setup().capture.x_cap - expected).norm() <= 1e-12);
   after.at(T, x2, v2, R2, w2);
   CHECK((x2 - expected).norm() <= 1e-12);
   CHECK(v2.norm() <= 1e-12);
@@ -160,23 +160,23 @@ TEST_CASE("controller: update_target re-anchors the line with a continuous refer
   CHECK((v2 - v1).norm() <= 1e-5);
   // the exact target's estimate leaves the capture point where the plan put it (isotropic: closed form)
   auto exact = make_gradient_controller(sc.problem, sc.task, sc.capture);
-  const Vector3 planned = exact.setup().x_cap;
+  const Vector3 planned = exact.setup().capture.x_cap;
   const LineReference before_exact = exact.setup().line;
   REQUIRE(exact.update_target(tu, target_estimate(propagate_target(sc.problem.target, tu))) ==
           ControlFault::None);
-  CHECK((exact.setup().x_cap - planned).norm() <= 1e-12);
+  CHECK((exact.setup().capture.x_cap - planned).norm() <= 1e-12);
   // ... and the reference too: the quintic through the line's own position, velocity and
   // acceleration at tu that ends at the same point is the line itself
   for (double t : {tu, tu + 1.0, 100.0, 150.0, T}) same_reference(before_exact, exact.setup().line, t);
   CHECK((exact.setup().line.acceleration(tu) - before_exact.acceleration(tu)).norm() <= 1e-12);
   // bad inputs leave the plan as it was
-  const Vector3 kept = exact.setup().x_cap;
+  const Vector3 kept = exact.setup().capture.x_cap;
   TargetEstimate bad = target_estimate(sc.problem.target);
   bad.velocity(1) = std::numeric_limits<double>::quiet_NaN();
   CHECK(exact.update_target(tu, bad) == ControlFault::TargetVelocity);
   CHECK(exact.update_target(T, target_estimate(sc.problem.target)) == ControlFault::Time);
   CHECK(exact.update_target(-1, target_estimate(sc.problem.target)) == ControlFault::Time);
-  CHECK(exact.setup().x_cap == kept);
+  CHECK(exact.setup().capture.x_cap == kept);
 }
 
 TEST_CASE("controller: a prediction window averages the predicted capture points") {
@@ -184,7 +184,7 @@ TEST_CASE("controller: a prediction window averages the predicted capture points
   ControllerOptions copt;
   copt.prediction_window = 3;
   auto ctrl = make_gradient_controller(sc.problem, sc.task, sc.capture, copt);
-  const Vector3 planned = ctrl.setup().x_cap;  // the exact target's capture point
+  const Vector3 planned = ctrl.setup().capture.x_cap;  // the exact target's capture point
   const Vector3 d(0.01, -0.02, 0.005);
   // three estimates at 10, 20, 30 s: offsets +d, -d and 0 average to the exact point
   const double ts[] = {10.0, 20.0, 30.0};
@@ -193,14 +193,14 @@ TEST_CASE("controller: a prediction window averages the predicted capture points
     Target e = propagate_target(sc.problem.target, ts[i]);
     e.position += off[i];
     REQUIRE(ctrl.update_target(ts[i], target_estimate(e)) == ControlFault::None);
-    if (i == 0) CHECK((ctrl.setup().x_cap - planned - d).norm() <= 1e-12);  // one prediction: itself
+    if (i == 0) CHECK((ctrl.setup().capture.x_cap - planned - d).norm() <= 1e-12);  // one prediction: itself
   }
-  CHECK((ctrl.setup().x_cap - planned).norm() <= 1e-12);
+  CHECK((ctrl.setup().capture.x_cap - planned).norm() <= 1e-12);
   // a fourth replaces the first (+d): the mean of -d, 0, +2d is d/3
   Target e = propagate_target(sc.problem.target, 40.0);
   e.position += 2 * d;
   REQUIRE(ctrl.update_target(40.0, target_estimate(e)) == ControlFault::None);
-  CHECK((ctrl.setup().x_cap - planned - d / 3).norm() <= 1e-12);
+  CHECK((ctrl.setup().capture.x_cap - planned - d / 3).norm() <= 1e-12);
   copt.prediction_window = 0;
   CHECK_THROWS_WITH(make_gradient_controller(sc.problem, sc.task, sc.capture, copt),
                     Catch::Contains("prediction window"));

@@ -155,12 +155,15 @@ TEST_CASE("detumble controller: 1e5 ticks allocate nothing (7-DOF stack, wheels 
   body.inertia = Vector3(100, 80, 120).asDiagonal();
   body.pose.p = Vector3(0.3, -0.1, 0.2);
   const Model stack = attach_body(robot, "ee", body);
-  for (const BaseActuator a : {BaseActuator::None, BaseActuator::ReactionWheels}) {
+  for (const BaseActuator a : {BaseActuator::None, BaseActuator::ReactionWheels, BaseActuator::Thrusters}) {
+    CAPTURE(static_cast<int>(a));
     DetumbleLimits lim;
     lim.joint_torque = Eigen::VectorXd::Constant(7, 5.0);
     lim.actuator = a;
     lim.wheel_torque = 0.2;
     lim.wheel_momentum = 1;
+    lim.thruster_force = 2;
+    lim.thruster_torque = 0.2;
     DetumbleOptions opt;
     opt.stop_stack_spin = a != BaseActuator::None;
     DetumbleController ctrl(stack, stack.frame_index("ee"), lim, opt);
@@ -182,6 +185,16 @@ TEST_CASE("detumble controller: 1e5 ticks allocate nothing (7-DOF stack, wheels 
     CHECK(faults == 100);
     CHECK(saturated > 0);
   }
+  // the centroidal momentum the step's base wrench reads (from H): none either
+  Data d(stack);
+  crba(stack, d, BasePose{}, Eigen::VectorXd::Constant(7, 0.4));
+  const Eigen::VectorXd v = Eigen::VectorXd::Constant(13, 0.05);
+  double sum = 0;
+  const long n0 = g_news.load(), d0 = g_deletes.load();
+  for (long k = 0; k < 100000; ++k) sum += centroidal_momentum(stack, d, v).angular.norm();
+  CHECK(g_news.load() - n0 == 0);
+  CHECK(g_deletes.load() - d0 == 0);
+  CHECK(sum > 0);
 }
 
 TEST_CASE("controller: the counters see new and Eigen's allocations (control)") {

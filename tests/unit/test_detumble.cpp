@@ -249,7 +249,7 @@ TEST_CASE("detumble after the paper's approach on robots/paper_7dof_position.tom
   const CaptureResult plan = plan_capture(pb, sc.task, sc.capture);
   const CaptureSetup setup = prepare_capture(pb, sc.task, sc.capture);
   const GraspResult g =
-      grasp_at_capture(*pb.model, pb.frame, plan.base, plan.theta, setup.capture_target, pb.approach_speed);
+      grasp_at_capture(*pb.model, pb.frame, plan.base, plan.theta, setup.capture.target, pb.approach_speed);
   CHECK(g.relative_twist_after.cwiseAbs().maxCoeff() < 1e-12);
   CHECK(rel(g.momentum_after, g.momentum_before) < 1e-10);
   const Model stack = attach_body(*pb.model, pb.model->frame(pb.frame).name, g.body);

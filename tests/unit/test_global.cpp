@@ -95,11 +95,11 @@ TEST_CASE("Manifold search: deterministic for a seed, exact-force has the mass o
   so.objective = GlobalObjective::ExactForce;
   const ManifoldSearchResult f = search_capture_manifold(s.pb, s.task, setup, s.global.run.base, so);
   CHECK(f.best.theta == a.best.theta);  // a monotone function of M_ie has the same minimizer
-  CHECK(f.best.objective == Approx(max_force_exact(setup.law, a.best.M_ie)).epsilon(1e-12));
+  CHECK(f.best.objective == Approx(max_force_exact(setup.capture.law, a.best.M_ie)).epsilon(1e-12));
   // the optimum is on the manifold: the end-effector on the capture point in x and y
   Data d(s.model);
   crba(s.model, d, s.global.run.base, a.best.theta);
-  const Vector3 e = frame_pose(s.model, d, s.pb.frame).p - setup.x_cap;
+  const Vector3 e = frame_pose(s.model, d, s.pb.frame).p - setup.capture.x_cap;
   CHECK(e.head<2>().norm() < 1e-9);
 }
 

@@ -413,8 +413,9 @@ TEST_CASE("joint models on the paper's scenarios (measurement)", "[.measure]") {
         crba(model, data, run->base, run->theta);
         for (const char* m : names) {
           const ContactJoints j{parse_joint_model(m, "m"), sc.problem.joints.armature};
-          const double M = 1.0 / (inverse_effective_mass(model, data, sc.problem.frame, setup.u_cap, j) +
-                                  setup.target_inv_mass);
+          const double M =
+              1.0 / (inverse_effective_mass(model, data, sc.problem.frame, setup.capture.u_cap, j) +
+                     setup.capture.target_inv_mass);
           const AnyContactLaw law =
               make_contact_law(sc.problem.law, sc.problem.contact, run->approach_velocity);
           os << "  " << m << " M " << M << " kg F " << max_force_exact(law, M) << " N;";

@@ -53,7 +53,7 @@ TEST_CASE_METHOD(Paper7Position,
   CHECK(f.points.size() >= 20);
   Data d(m);
   Eigen::VectorXd r;
-  const AnyContactLaw law = make_contact_law(pb.law, pb.contact, s.v_in);
+  const AnyContactLaw law = make_contact_law(pb.law, pb.contact, s.capture.v_in);
   for (size_t i = 0; i < f.points.size(); ++i) {
     const ParetoPoint& p = f.points[i];
     if (i > 0) {  // M_ie increasing, rate decreasing: no point dominates another
@@ -63,7 +63,7 @@ TEST_CASE_METHOD(Paper7Position,
     capture_residual(m, d, pb, task, s, base, p.theta, r, nullptr);
     CHECK(r.norm() < 1e-9);
     // the rate again, through the whole-configuration function (target at T, the law at delta_dot^-)
-    const BaseDisturbance bd = base_disturbance(m, d, base, p.theta, pb.frame, s.capture_target, law);
+    const BaseDisturbance bd = base_disturbance(m, d, base, p.theta, pb.frame, s.capture.target, law);
     CHECK(bd.angular_rate() == Approx(p.base_rate).epsilon(1e-12));
     CHECK(bd.M_ie == Approx(p.M_ie).epsilon(1e-12));
   }
@@ -135,9 +135,9 @@ TEST_CASE_METHOD(Paper7Position,
   so.inequalities = base_rate_inequality(pb, s, mid.base_rate);
   const ManifoldSearchResult r = search_capture_manifold(pb, task, s, base, so);
   Data d(m);
-  const AnyContactLaw law = make_contact_law(pb.law, pb.contact, s.v_in);
+  const AnyContactLaw law = make_contact_law(pb.law, pb.contact, s.capture.v_in);
   for (const ManifoldPoint& p : r.local_optima)  // every optimum kept keeps the limit
-    CHECK(base_disturbance(m, d, base, p.theta, pb.frame, s.capture_target, law).angular_rate() <=
+    CHECK(base_disturbance(m, d, base, p.theta, pb.frame, s.capture.target, law).angular_rate() <=
           mid.base_rate * (1 + 1e-5));
   INFO("front point " << mid.M_ie << " kg at " << mid.base_rate << " rad/s, constrained search "
                       << r.best.M_ie << " kg");

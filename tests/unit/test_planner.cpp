@@ -73,8 +73,11 @@ Vector3 centre_of_mass(const Model& m, Data& d, const BasePose& b, const Eigen::
 
 /// A capture setup with nothing but what a policy reads filled in by the test.
 CaptureSetup bare_setup() {
-  return CaptureSetup{Target{}, {}, {}, 0, 0, make_contact_law("hunt-crossley", ContactParams{}, 1.0),
-                      {},       {}, {}, {}, {}};
+  return CaptureSetup{{Target{}, {}, {}, 0, 0, make_contact_law("hunt-crossley", ContactParams{}, 1.0), {}},
+                      {},
+                      {},
+                      {},
+                      {}};
 }
 
 }  // namespace
@@ -262,8 +265,8 @@ TEST_CASE("The null-space policies", "[planner]") {
     pb.model = &m;
     pb.frame = m.end_effector();
     CaptureSetup s = bare_setup();
-    s.u_cap = Vector3(1, 2, -1).normalized();
-    s.target_inv_mass = 1.0 / 200;
+    s.capture.u_cap = Vector3(1, 2, -1).normalized();
+    s.capture.target_inv_mass = 1.0 / 200;
     crba(m, d, base, theta);
     frame_jacobian(m, d, pb.frame);
     generalized_jacobian(m, d);
@@ -276,15 +279,15 @@ TEST_CASE("The null-space policies", "[planner]") {
     CHECK((solver.task_jacobian() * qd).norm() < 1e-12 * (1 + qd.norm()));
     // with N = E: rho times the central difference of M_ie (no joint limits on this robot)
     policy(m, d, pb, s, 0, base, theta, Eigen::MatrixXd::Identity(m.n(), m.n()), qd);
-    const double h = 1e-6;
+    const double h = 1e-6, b = s.capture.target_inv_mass;
     for (int k = 0; k < m.n(); ++k) {
       Eigen::VectorXd tp = theta, tm = theta;
       tp(k) += h;
       tm(k) -= h;
       crba(m, d, base, tp);
-      const double Mp = 1.0 / (inverse_effective_mass(m, d, pb.frame, s.u_cap) + s.target_inv_mass);
+      const double Mp = 1.0 / (inverse_effective_mass(m, d, pb.frame, s.capture.u_cap) + b);
       crba(m, d, base, tm);
-      const double Mm = 1.0 / (inverse_effective_mass(m, d, pb.frame, s.u_cap) + s.target_inv_mass);
+      const double Mm = 1.0 / (inverse_effective_mass(m, d, pb.frame, s.capture.u_cap) + b);
       CHECK(std::abs(qd(k) - policy.gain * (Mp - Mm) / (2 * h)) < 1e-5 * (1 + std::abs(qd(k))));
     }
   }

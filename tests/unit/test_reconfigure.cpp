@@ -68,7 +68,7 @@ Eigen::VectorXd oriented_optimum(const ffsr::Scenario& sc, const ffsr::CaptureSe
   for (const ffsr::ManifoldPoint& p : sr.local_optima) {
     ffsr::crba(model, d, sc.problem.base, p.theta);
     const ffsr::Matrix3 R = ffsr::frame_pose(model, d, sc.problem.frame).R;
-    if (Eigen::AngleAxisd(setup.R_end * R.transpose()).angle() < 1e-6) return p.theta;
+    if (Eigen::AngleAxisd(setup.capture.R_end * R.transpose()).angle() < 1e-6) return p.theta;
   }
   return {};
 }
@@ -203,7 +203,7 @@ TEST_CASE("reconfigure: a grasp orientation the task alone cannot reach, reached
   const ffsr::GlobalCaptureResult r =
       ffsr::plan_capture_global(sc.problem, sc.task, opt, options(sc, ffsr::ReconfigureMode::Auto));
   INFO("M_ie " << r.run.M_ie << " kg, manifold optimum " << r.manifold_optimum << " kg");
-  CHECK(r.task_alone_failure.find("cannot follow the line") != std::string::npos);
+  CHECK(r.counters.task_alone_failure.find("cannot follow the line") != std::string::npos);
   CHECK(r.reconfigured);
   CHECK(r.run.M_ie <= 1.31);
   CHECK(std::abs(r.run.M_ie - r.manifold_optimum) <= 0.01 * r.run.M_ie);

@@ -55,6 +55,36 @@ inline Vector6 momentum(const Model& model, const Data& data, const Eigen::Ref<c
   return h;
 }
 
+/// The system's momentum about its centre of mass (inertial frame): the centre of mass c, the linear
+/// momentum P = M v_c and the angular momentum about c,
+///   L_c = sum_i R_i I_i R_i^T w_i + m_i (c_i - c) x (v_i - v_c),
+/// which is conserved, as P is, when no external force acts. M is the total mass.
+struct CentroidalMomentum {
+  double mass = 0;
+  Vector3 com = Vector3::Zero();      ///< c
+  Vector3 linear = Vector3::Zero();   ///< P = M v_c
+  Vector3 angular = Vector3::Zero();  ///< L_c, about c
+};
+
+/// The centroidal momentum from the base rows of H: [P; L_0] = H(0:6, :) v, the momentum about the
+/// base frame origin p_0 (momentum()), M = H(0, 0), c - p_0 from the block M [c - p_0]x = H(3:6, 0:3),
+/// and L_c = L_0 - (c - p_0) x P. Reads data.H (crba) and data.p[0]; no allocation. InputError for
+/// a v of the wrong size.
+inline CentroidalMomentum centroidal_momentum(const Model& model, const Data& data,
+                                              const Eigen::Ref<const Eigen::VectorXd>& v) {
+  detail::require_size(v.size(), model.nv(), "centroidal_momentum", "v");
+  const Eigen::MatrixXd& H = data.H;
+  Vector6 h;
+  for (int k = 0; k < 6; ++k) h(k) = H.row(k).dot(v);
+  CentroidalMomentum c;
+  c.mass = H(0, 0);
+  const Vector3 r(H(5, 1) / c.mass, H(3, 2) / c.mass, H(4, 0) / c.mass);  // c - p_0
+  c.com = data.p[0] + r;
+  c.linear = h.head<3>();
+  c.angular = h.tail<3>() - r.cross(c.linear);
+  return c;
+}
+
 namespace detail {
 
 /// Total momentum [P; L] about the base frame origin (inertial axes) from what the articulated-body

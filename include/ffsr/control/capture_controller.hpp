@@ -290,16 +290,16 @@ class CaptureController {
       Matrix3 Rd;
       c.setup.line.at(t, xd, vd, Rd, wd);
       CaptureSetup& s = c.setup;
-      s.capture_target = at_T;
+      s.capture.target = at_T;
       c.remember(at_T.contact_point(), at_T.normal_world());
-      s.x_cap = c.mean_point();
-      s.u_cap = c.mean_normal();
+      s.capture.x_cap = c.mean_point();
+      s.capture.u_cap = c.mean_normal();
       const Vector3 ad = s.line.acceleration(t);
       s.line.x0 = xd;
       s.line.v0 = vd;
       s.line.a0 = ad;
       s.line.start = t;
-      s.line.x_cap = s.x_cap;
+      s.line.x_cap = s.capture.x_cap;
     } catch (...) {
       return ControlFault::Numerical;
     }

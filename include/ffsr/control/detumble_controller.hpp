@@ -6,6 +6,7 @@
 #pragma once
 
 #include "ffsr/algorithm/jacobian.hpp"
+#include "ffsr/algorithm/momentum.hpp"
 #include "ffsr/algorithm/rnea.hpp"
 
 #include <algorithm>
@@ -253,23 +254,19 @@ class DetumbleController {
     out.fault = f;
   }
 
-  /// The actuator's wrench from the stack's momentum [P; L about p_0] = H_b rows of H v: the moment
-  /// -k L_c with L_c = L - r x P about the stack's centre of mass (r = c - p_0, from M [r]x, the
-  /// block of H_b), and for thrusters the force -k P; each clamped per base axis, a wheel torque cut on
-  /// an axis whose stored momentum is at its bound and would grow. Reads data_.H. Writes out.base_wrench.
+  /// The actuator's wrench from the stack's centroidal momentum (centroidal_momentum, from the base rows
+  /// of H): the moment -k L_c, L_c the angular momentum about the stack's centre of mass, and for
+  /// thrusters the force -k P; each clamped per base axis, a wheel torque cut on an axis whose stored
+  /// momentum is at its bound and would grow. Reads data_.H. Writes out.base_wrench.
   void base_wrench(const DetumbleState& s, DetumbleCommand& out) const {
     out.base_wrench.setZero();
     if (!opt_.stop_stack_spin || limits_.actuator == BaseActuator::None) return;
-    const Eigen::MatrixXd& H = data_.H;
-    Vector6 h;
-    for (int r = 0; r < 6; ++r) h(r) = H.row(r).dot(s.v);
-    const double M = H(0, 0);
-    const Vector3 rc(H(5, 1) / M, H(3, 2) / M, H(4, 0) / M);  // M [r]x = H(3:6, 0:3)
-    const Vector3 Lc = h.tail<3>() - rc.cross(h.head<3>());
+    const CentroidalMomentum h = centroidal_momentum(*model_, data_, s.v);
+    const Vector3& Lc = h.angular;
     const Matrix3 R = s.base.orientation.normalized().toRotationMatrix();
     const double k = opt_.base_gain;
     if (limits_.actuator == BaseActuator::Thrusters) {
-      out.base_wrench.head<3>() = detail::clamp_in_base(R, -k * h.head<3>(), limits_.thruster_force);
+      out.base_wrench.head<3>() = detail::clamp_in_base(R, -k * h.linear, limits_.thruster_force);
       out.base_wrench.tail<3>() = detail::clamp_in_base(R, -k * Lc, limits_.thruster_torque);
       return;
     }

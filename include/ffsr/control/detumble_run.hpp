@@ -190,10 +190,7 @@ inline void check_detumble_feasible(const Model& stack, const DetumbleState& s, 
   if (!o.stop_stack_spin) return;
   Data d(stack);
   crba(stack, d, s.base, s.theta);
-  const Vector6 h = d.H.topRows<6>() * s.v;
-  const double M = d.H(0, 0);
-  const Vector3 rc(d.H(5, 1) / M, d.H(3, 2) / M, d.H(4, 0) / M);
-  const double L = (h.tail<3>() - rc.cross(h.head<3>())).norm();
+  const double L = centroidal_momentum(stack, d, s.v).angular.norm();
   if (l.actuator == BaseActuator::None)
     throw DetumbleInfeasibleError(
         DetumbleBound::Actuator,

@@ -120,7 +120,7 @@ namespace detail {
 /// InputError naming the run it started from.
 inline std::vector<DetumbleJobResult> detumble_each_run(
     const Scenario& sc, const std::vector<std::pair<std::string, const CaptureResult*>>& runs) {
-  const Target target = prepare_capture(sc.problem, sc.task, sc.capture).capture_target;
+  const Target target = prepare_capture(sc.problem, sc.task, sc.capture).capture.target;
   std::vector<DetumbleJobResult> out;
   for (const auto& [name, run] : runs) {
     try {

@@ -73,7 +73,7 @@ inline void check_pareto_post_capture_flags(const Scenario& sc, const std::strin
 /// The post-capture front of the job (r: the main job's runs; f: the base-rate sweep at `base`).
 inline PostCaptureFront pareto_post_capture(const Scenario& sc, const ScenarioResult& r, const ParetoFront& f,
                                             const CaptureSetup& setup, const std::string& axis, double e) {
-  const PostCaptureScreen screen(sc, setup.capture_target, "--axis");
+  const PostCaptureScreen screen(sc, setup.capture.target, "--axis");
   const CaptureResult& g = r.global->result.run;
   std::vector<Eigen::VectorXd> thetas{g.theta};
   for (const CaptureBranch& b : r.global->branches) thetas.push_back(b.theta);
@@ -105,7 +105,7 @@ inline ParetoJobResult pareto(const Scenario& sc, const ParetoJobOptions& o) {
   ParetoJobResult out;
   out.front = pareto_front(sc.problem, sc.task, setup, g.base, po, {r.optimized.theta, g.theta});
   Data data(*sc.model);
-  const double e = single_body_restitution(setup.law);
+  const double e = single_body_restitution(setup.capture.law);
   for (const CaptureResult* x : {&r.plain, &r.optimized, &g})
     out.runs.push_back(detail::pareto_point(*sc.model, data, sc.problem, setup, x->base, x->theta, e));
   out.base = g.base;

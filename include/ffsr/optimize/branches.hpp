@@ -106,10 +106,10 @@ inline std::vector<CaptureBranch> capture_branches(const CaptureProblem& pb, con
     crba(model, data, base, p.theta);
     const Pose ee = frame_pose(model, data, pb.frame);
     b.orientation_error =
-        task.kind == CaptureTask::Kind::Pose ? rotation_angle(setup.R_end * ee.R.transpose()) : 0.0;
+        task.kind == CaptureTask::Kind::Pose ? rotation_angle(setup.capture.R_end * ee.R.transpose()) : 0.0;
     double e2 = 0;  // the task's position rows only (a planar task leaves z free)
     for (int r : setup.rows)
-      if (r < 3) e2 += (ee.p(r) - setup.x_cap(r)) * (ee.p(r) - setup.x_cap(r));
+      if (r < 3) e2 += (ee.p(r) - setup.capture.x_cap(r)) * (ee.p(r) - setup.capture.x_cap(r));
     b.position_error = std::sqrt(e2);
     out.push_back(std::move(b));
   }

@@ -127,33 +127,29 @@ inline CaptureSetup prepare_capture(const CaptureProblem& pb, const CaptureTask&
   detail::check_capture_input(pb, task, opt, where);
   const Model& model = *pb.model;
   // The capture: the target's contact point, normal and attitude at T.
-  CaptureSetup s{propagate_target(pb.target, opt.duration),
-                 {},
-                 {},
-                 0,
-                 0,
-                 make_contact_law("hunt-crossley", ContactParams{}, 1.0),
-                 {},
+  CaptureSetup s{{propagate_target(pb.target, opt.duration), {}, {}, 0, 0,
+                  make_contact_law("hunt-crossley", ContactParams{}, 1.0), {}},
                  {},
                  {},
                  {},
                  {}};
-  s.x_cap = s.capture_target.contact_point();
-  s.u_cap = s.capture_target.normal_world();
-  s.target_inv_mass = s.capture_target.inverse_mass_along_normal();
-  s.v_in = approach_velocity(s.u_cap, Vector3(pb.approach_speed * s.u_cap), s.capture_target.velocity,
-                             s.capture_target.angular_velocity_world(), s.capture_target.offset_world());
-  if (!(s.v_in > 0))
+  CaptureAtT& c = s.capture;
+  c.x_cap = c.target.contact_point();
+  c.u_cap = c.target.normal_world();
+  c.target_inv_mass = c.target.inverse_mass_along_normal();
+  c.v_in = approach_velocity(c.u_cap, Vector3(pb.approach_speed * c.u_cap), c.target.velocity,
+                             c.target.angular_velocity_world(), c.target.offset_world());
+  if (!(c.v_in > 0))
     throw InputError(
-        str(where, ": at the capture the end-effector does not approach the target (delta_dot^- = ", s.v_in,
+        str(where, ": at the capture the end-effector does not approach the target (delta_dot^- = ", c.v_in,
             " m/s); increase the approach speed"));
-  s.law = make_contact_law(pb.law, pb.contact, s.v_in);
+  c.law = make_contact_law(pb.law, pb.contact, c.v_in);
 
   Data data(model);
   crba(model, data, pb.base, pb.theta);
   const Pose ee0 = frame_pose(model, data, pb.frame);
-  s.R_end = task.final_orientation ? *task.final_orientation : ee0.R;
-  s.line = {ee0.p, s.x_cap, ee0.R, detail::rotation_log(s.R_end * ee0.R.transpose()), opt.duration};
+  c.R_end = task.final_orientation ? *task.final_orientation : ee0.R;
+  s.line = {ee0.p, c.x_cap, ee0.R, detail::rotation_log(c.R_end * ee0.R.transpose()), opt.duration};
   if (task.kind == CaptureTask::Kind::Pose) {
     for (int r = 0; r < 6; ++r) s.rows.push_back(r);
   } else {
@@ -255,7 +251,7 @@ inline void finish_capture(const Model& model, Data& data, const CaptureProblem&
                            const Eigen::VectorXd& theta, CaptureResult& res, const char* where) {
   crba(model, data, base, theta);
   const Pose ee = frame_pose(model, data, pb.frame);
-  const Vector3& x_cap = setup.x_cap;
+  const Vector3& x_cap = setup.capture.x_cap;
   res.theta = theta;
   res.base = base;
   res.end_effector = ee.p;
@@ -265,13 +261,13 @@ inline void finish_capture(const Model& model, Data& data, const CaptureProblem&
   res.tracking_error = std::sqrt(e2);
   res.capture_distance = (ee.p - x_cap).norm();
   res.orientation_error =
-      task.kind == CaptureTask::Kind::Pose ? rotation_angle(setup.R_end * ee.R.transpose()) : 0.0;
+      task.kind == CaptureTask::Kind::Pose ? rotation_angle(setup.capture.R_end * ee.R.transpose()) : 0.0;
   res.base_position_drift = (base.position - pb.base.position).norm();
   res.base_attitude_drift = rotation_angle(base.orientation.toRotationMatrix() *
                                            pb.base.orientation.normalized().toRotationMatrix().transpose());
   const CaptureEvaluator objective(pb, setup);
   res.M_ie = objective.mass_at(data);
-  res.approach_velocity = setup.v_in;
+  res.approach_velocity = setup.capture.v_in;
   res.f_max_closed_form = objective.f_max_closed_form(res.M_ie);
   res.f_max_exact = objective.f_max_exact(res.M_ie);
   if (!std::isfinite(res.M_ie) || !std::isfinite(res.f_max_exact) || !std::isfinite(res.f_max_closed_form))
@@ -344,7 +340,7 @@ CaptureResult integrate_capture(const CaptureProblem& pb, const CaptureTask& tas
         "the point may be out of reach, or the gripper's turn to the final orientation cannot be followed "
         "along the line from this configuration";
   CaptureResult res;
-  res.capture_point = setup.x_cap;
+  res.capture_point = setup.capture.x_cap;
   BasePose base = pb.base;
   base.orientation.normalize();
   Eigen::VectorXd theta = pb.theta;
@@ -389,7 +385,7 @@ inline GradientPolicy gradient_policy(const CaptureProblem& pb, const CaptureOpt
   policy.objective = opt.objective;
   policy.alpha = pb.contact.alpha;
   if (opt.objective == CaptureObjective::ExactMaxForce)
-    policy.f_scale = max_force_exact(setup.law, 1.0) * (pb.contact.alpha / (pb.contact.alpha + 1));
+    policy.f_scale = max_force_exact(setup.capture.law, 1.0) * (pb.contact.alpha / (pb.contact.alpha + 1));
   return policy;
 }
 

@@ -67,8 +67,8 @@ inline void capture_residual(const Model& model, Data& data, const CaptureProble
   crba(model, data, base, theta);
   const Pose ee = frame_pose(model, data, pb.frame);
   Vector6 e;
-  e.head<3>() = ee.p - s.x_cap;
-  e.tail<3>() = detail::rotation_log(s.R_end * ee.R.transpose());
+  e.head<3>() = ee.p - s.capture.x_cap;
+  e.tail<3>() = detail::rotation_log(s.capture.R_end * ee.R.transpose());
   const int m = task.rows();
   r.resize(m);
   for (int i = 0; i < m; ++i) r(i) = e(s.rows[static_cast<size_t>(i)]);
@@ -180,7 +180,7 @@ inline double base_rate(const BaseRateContext& c, const Eigen::VectorXd& theta, 
   crba(*c.pb->model, *c.data, *c.base, theta);
   Vector6 b;
   M = CaptureEvaluator(*c.pb, *c.setup).mass_and_base_response_at(*c.data, b);
-  const double P = M * approach_velocity(c.setup->law) * (1.0 + c.restitution);
+  const double P = M * approach_velocity(c.setup->capture.law) * (1.0 + c.restitution);
   return P * b.tail<3>().norm();
 }
 
@@ -242,7 +242,7 @@ inline std::shared_ptr<const ManifoldInequalities> base_rate_inequality(const Ca
   c->ctx.pb = &c->pb;
   c->ctx.setup = &c->s;
   c->ctx.data = &c->data;
-  c->ctx.restitution = single_body_restitution(s.law);
+  c->ctx.restitution = single_body_restitution(s.capture.law);
   c->ctx.scale = max_rate;
   q->eval = [c](const BasePose& base, const Eigen::VectorXd& theta, double* g, double* grad) {
     c->ctx.base = &base;

@@ -121,19 +121,26 @@ struct CaptureResult {
   std::vector<CaptureSample> series;
 };
 
-/// Everything a capture run needs that follows from the problem: the target at T, the capture point
-/// and direction, the contact law at the capture's approach velocity, the line reference and the task
-/// rows. Made (and every input checked) by prepare_capture.
-struct CaptureSetup {
-  Target capture_target;             ///< the target at T
-  Vector3 x_cap = Vector3::Zero();   ///< capture point
-  Vector3 u_cap = Vector3::UnitX();  ///< inertial contact normal at T
-  double target_inv_mass = 0;        ///< the target's inverse mass along the normal (Eq. 14)
-  double v_in = 0;                   ///< delta_dot^- at the capture
-  AnyContactLaw law;
-  LineReference line;
+/// The capture at T, which follows from the target, the task and the contact, not from the robot's
+/// initial state: the target then, the capture point and normal, the contact law at the capture's
+/// approach velocity, the end-effector's orientation then. A run from another state towards the same
+/// capture (the approach after a reconfiguration, reconfigure.hpp) takes it whole.
+struct CaptureAtT {
+  Target target;                        ///< the target at T
+  Vector3 x_cap = Vector3::Zero();      ///< capture point
+  Vector3 u_cap = Vector3::UnitX();     ///< inertial contact normal at T
+  double target_inv_mass = 0;           ///< the target's inverse mass along the normal (Eq. 14)
+  double v_in = 0;                      ///< delta_dot^- at the capture
+  AnyContactLaw law;                    ///< the contact law at v_in
   Matrix3 R_end = Matrix3::Identity();  ///< pose task: the end-effector orientation at T
-  std::vector<int> rows;                ///< rows of J_f (and of the 6-D error) that the task constrains
+};
+
+/// Everything a capture run needs that follows from the problem: the capture at T, the line reference
+/// from the initial state and the task rows. Made (and every input checked) by prepare_capture.
+struct CaptureSetup {
+  CaptureAtT capture;     ///< the target, the capture point and normal, the law, the orientation at T
+  LineReference line;     ///< from the initial end-effector pose to the capture
+  std::vector<int> rows;  ///< rows of J_f (and of the 6-D error) that the task constrains
   /// hold_base_attitude: Q (3 x r), the base angular velocities held at zero (base_attitude.hpp); else empty
   Eigen::MatrixXd attitude_basis;
   /// hold_base_attitude: each joint's share of the freedom the task and the held rows leave at the

@@ -434,7 +434,7 @@ inline ManifoldSearchResult detail::search_manifold(const CaptureProblem& pb, co
   const std::vector<Eigen::VectorXd> starts = manifold_starts(model, so.seed, extra_starts, random_starts);
   res.starts = static_cast<int>(starts.size());
 
-  const CvodeMultibodyPeak peak(pb, s.capture_target, so.multibody);
+  const CvodeMultibodyPeak peak(pb, s.capture.target, so.multibody);
   const CaptureEvaluator objective(pb, s, so.objective, &peak, so.robust.get());
   ManifoldSlsqp local(pb, task, s, base, so.constraint_tolerance, so.max_local_evaluations,
                       so.inequalities.get());
@@ -462,12 +462,13 @@ inline ManifoldSearchResult detail::search_manifold(const CaptureProblem& pb, co
   if (found.empty() && so.inequalities && so.inequalities->count > 0)
     throw InfeasibleInequalitiesError(
         str("search_capture_manifold: no configuration that puts the end-effector on the capture point [",
-            s.x_cap.transpose(), "] from the base pose at T satisfies the search's inequality constraints (",
-            res.starts, " starts)"));
+            s.capture.x_cap.transpose(),
+            "] from the base pose at T satisfies the search's inequality constraints (", res.starts,
+            " starts)"));
   if (found.empty())
     throw InputError(
         str("search_capture_manifold: no configuration puts the end-effector on the capture point [",
-            s.x_cap.transpose(), "] from the base pose at T (", res.starts,
+            s.capture.x_cap.transpose(), "] from the base pose at T (", res.starts,
             " starts); the capture point is out of reach"));
   std::sort(found.begin(), found.end(),
             [](const ManifoldPoint& a, const ManifoldPoint& b) { return a.objective < b.objective; });

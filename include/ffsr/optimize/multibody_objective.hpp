@@ -36,7 +36,7 @@ inline ManifoldPoint evaluate_capture(const CaptureProblem& pb, const CaptureSet
                                       const MultibodyContactOptions& mo = {},
                                       RobustForceObjective* robust = nullptr) {
   Data data(*pb.model);
-  const CvodeMultibodyPeak peak(pb, s.capture_target, mo);
+  const CvodeMultibodyPeak peak(pb, s.capture.target, mo);
   return CaptureEvaluator(pb, s, objective, &peak, robust).evaluate(data, base, theta);
 }
 

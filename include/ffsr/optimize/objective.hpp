@@ -77,9 +77,9 @@ class CaptureEvaluator {
                    RobustForceObjective* robust = nullptr)
       : model_(pb.model),
         frame_(pb.frame),
-        u_(s.u_cap),
-        b_(s.target_inv_mass),
-        law_(&s.law),
+        u_(s.capture.u_cap),
+        b_(s.capture.target_inv_mass),
+        law_(&s.capture.law),
         joints_(&pb.joints),
         kind_(kind),
         peak_(peak),

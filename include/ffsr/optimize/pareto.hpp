@@ -184,7 +184,7 @@ inline ParetoFront pareto_front(const CaptureProblem& pb, const CaptureTask& tas
   ctx.rate.setup = &s;
   ctx.rate.base = &base;
   ctx.rate.data = &data;
-  ctx.rate.restitution = single_body_restitution(s.law);
+  ctx.rate.restitution = single_body_restitution(s.capture.law);
   const double e = ctx.rate.restitution;
   std::vector<ParetoPoint> all;
   for (const ManifoldPoint& m : mass.local_optima)

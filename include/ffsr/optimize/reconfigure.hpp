@@ -192,20 +192,14 @@ inline void integrate_reconfiguration(const CaptureProblem& pb, const CaptureOpt
 }
 
 /// The approach's setup from the state at t_r: prepare_capture on `pb2` (checks, line start, task
-/// rows), then the capture of the whole run (`setup`: target at T, capture point, normal, law,
+/// rows), then the capture of the whole run (`setup.capture`: target at T, capture point, normal, law,
 /// final orientation) so that the line ends at the same capture point and orientation.
 inline CaptureSetup approach_setup(const CaptureProblem& pb2, const CaptureTask& task,
                                    const CaptureOptions& opt2, const CaptureSetup& setup, const char* where) {
   CaptureSetup s = prepare_capture(pb2, task, opt2, where);
-  s.capture_target = setup.capture_target;
-  s.x_cap = setup.x_cap;
-  s.u_cap = setup.u_cap;
-  s.target_inv_mass = setup.target_inv_mass;
-  s.v_in = setup.v_in;
-  s.law = setup.law;
-  s.R_end = setup.R_end;
-  s.line.x_cap = setup.x_cap;
-  s.line.rot_total = rotation_log(s.R_end * s.line.R0.transpose());
+  s.capture = setup.capture;
+  s.line.x_cap = s.capture.x_cap;
+  s.line.rot_total = rotation_log(s.capture.R_end * s.line.R0.transpose());
   return s;
 }
 

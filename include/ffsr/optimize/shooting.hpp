@@ -44,6 +44,27 @@ struct NoAdmittedCandidateError : InputError {
   using InputError::InputError;
 };
 
+/// What plan_capture_global did over every goal it tried: its counters and the last messages of what
+/// failed. A result holds them as of its return, whichever goal's run it reports.
+struct GlobalSearchCounters {
+  int shooting_iterations = 0;     ///< reaching runs over every goal tried
+  int goals_tried = 0;
+  int goals_out_of_limits = 0;     ///< goals given up because the way to them crosses a joint limit
+  long evaluations = 0;            ///< over every search
+  long objective_evaluations = 0;  ///< multibody simulations over every search
+  double search_seconds = 0;       ///< over every search
+  int goals_rejected = 0;          ///< reached goals whose run check_run rejected
+  int goals_not_admitted = 0;      ///< reached goals whose configuration admit rejected
+  std::string rejection;           ///< the last rejection's message
+  /// Empty when the task alone (no null-space motion) followed the line and gave the first base pose
+  /// at T; otherwise its error (possible only with a reconfiguration allowed): the first search was at
+  /// the initial base pose.
+  std::string task_alone_failure;
+  /// The error of the last reaching run that failed and whose goal was given up for it (an approach
+  /// after a reconfiguration, or alone where a reconfiguration may follow); empty if none.
+  std::string run_failure;
+};
+
 struct GlobalCaptureResult {
   CaptureResult run;                  ///< the reaching run (its capture configuration and checks)
   ManifoldSearchResult search;        ///< the last search, at the reached base pose
@@ -53,29 +74,14 @@ struct GlobalCaptureResult {
   /// false: no better optimum than the one reached could be reached (it lies on another component
   /// of the self-motion manifold: the servo ended elsewhere); the gap then exceeds gap_percent
   bool reached_manifold_optimum = true;
-  int shooting_iterations = 0;  ///< reaching runs over every goal tried
-  int goals_tried = 0;
-  int goals_out_of_limits = 0;     ///< goals given up because the way to them crosses a joint limit
-  long evaluations = 0;            ///< over every search
-  long objective_evaluations = 0;  ///< multibody simulations over every search
-  double search_seconds = 0;       ///< over every search
   /// The phases of `run`: the approach alone, or the reconfiguration then the approach.
   std::vector<RunPhase> phases;
-  bool reconfigured = false;   ///< `run` begins with a reconfiguration
-  int goals_rejected = 0;      ///< reached goals whose run check_run rejected
-  int goals_not_admitted = 0;  ///< reached goals whose configuration admit rejected
-  std::string rejection;       ///< the last rejection's message
+  bool reconfigured = false;  ///< `run` begins with a reconfiguration
   /// With a clearance (scenario/geometry.hpp): the distance bound of the searches, m (the
   /// clearance plus the margin of the round that planned the run); manifold_optimum is the optimum
   /// under it. 0: no distance bound.
   double search_distance_bound = 0;
-  /// Empty when the task alone (no null-space motion) followed the line and gave the first base pose
-  /// at T; otherwise its error (possible only with a reconfiguration allowed): the first search was at
-  /// the initial base pose.
-  std::string task_alone_failure;
-  /// The error of the last reaching run that failed and whose goal was given up for it (an approach
-  /// after a reconfiguration, or alone where a reconfiguration may follow); empty if none.
-  std::string run_failure;
+  GlobalSearchCounters counters;  ///< over every goal tried, whichever goal's run `run` is
 };
 
 namespace detail {
@@ -87,10 +93,10 @@ inline void check_global_options(const GlobalCaptureOptions& g, const char* wher
 }
 
 /// Adds a search's evaluation counts and time to the planner's counters.
-inline void account(GlobalCaptureResult& res, const ManifoldSearchResult& sr) {
-  res.evaluations += sr.evaluations;
-  res.objective_evaluations += sr.objective_evaluations;
-  res.search_seconds += sr.seconds;
+inline void account(GlobalSearchCounters& c, const ManifoldSearchResult& sr) {
+  c.evaluations += sr.evaluations;
+  c.objective_evaluations += sr.objective_evaluations;
+  c.search_seconds += sr.seconds;
 }
 
 /// Pose task: the angle between the end-effector's orientation at (base, theta) and the final one
@@ -100,7 +106,7 @@ inline double goal_orientation_error(const CaptureProblem& pb, const CaptureTask
   if (task.kind != CaptureTask::Kind::Pose) return 0.0;
   Data data(*pb.model);
   crba(*pb.model, data, base, theta);
-  return rotation_angle(s.R_end * frame_pose(*pb.model, data, pb.frame).R.transpose());
+  return rotation_angle(s.capture.R_end * frame_pose(*pb.model, data, pb.frame).R.transpose());
 }
 
 /// Drops the local optima whose end-effector is not in the final orientation (a residual that
@@ -143,14 +149,14 @@ inline void best_admitted(const GlobalCaptureOptions& g, const BasePose& base, M
 /// The goals of plan_capture_global at the base pose of the task-only run: the best max_goals local
 /// optima of a search from `extra` and random starts (multibody-force: the ranked ones), and the
 /// local optima next to each extra start (on the component of the self-motion manifold the arm is
-/// on, so reachable when the better ones are not), sorted by objective. Counts into res.
+/// on, so reachable when the better ones are not), sorted by objective. Counts into `counters`.
 inline std::vector<ManifoldPoint> capture_goals(const CaptureProblem& pb, const CaptureTask& task,
                                                 const CaptureSetup& setup, const BasePose& base,
                                                 const GlobalCaptureOptions& g,
                                                 const std::vector<Eigen::VectorXd>& extra,
-                                                GlobalCaptureResult& res) {
+                                                GlobalSearchCounters& counters) {
   ManifoldSearchResult first = search_capture_manifold(pb, task, setup, base, g.search, extra);
-  account(res, first);
+  account(counters, first);
   drop_turned_optima(pb, task, setup, base, g, first);
   std::vector<ManifoldPoint> goals;
   for (const ManifoldPoint& p : first.local_optima)
@@ -165,7 +171,7 @@ inline std::vector<ManifoldPoint> capture_goals(const CaptureProblem& pb, const 
   for (const Eigen::VectorXd& x : extra) {
     try {
       const ManifoldSearchResult near = detail::search_manifold(pb, task, setup, base, g.search, {x}, 0);
-      account(res, near);
+      account(counters, near);
       near_goals.push_back(near.best);
     } catch (const InputError&) {
     }
@@ -181,22 +187,23 @@ inline std::vector<ManifoldPoint> capture_goals(const CaptureProblem& pb, const 
 
 /// The shooting loop for one goal: reaching runs with ServoPolicy, the goal re-optimized locally at
 /// each reached base pose, until the reached objective is within gap_percent of that local optimum;
-/// then a full search at the reached base pose gives the gap. Returns that result (counters as of
-/// then), or nothing when the goal is given up: a joint limit on the way (goals_out_of_limits), the
-/// goal off the manifold at the reached base pose, the run ending on another component (more than
-/// 0.5 rad from the goal on some joint), or max_iterations spent. Counts into res.
+/// then a full search at the reached base pose gives the gap. Returns that result (its counters left
+/// empty: with_counters gives them), or nothing when the goal is given up: a joint limit on the way
+/// (goals_out_of_limits), the goal off the manifold at the reached base pose, the run ending on
+/// another component (more than 0.5 rad from the goal on some joint), or max_iterations spent. Counts
+/// into `counters`.
 /// t_r > 0: each run reconfigures the arm to the goal in t_r seconds first (plan_reconfigured_capture),
 /// and a better optimum of the full search (on another component, which the reconfiguration can
 /// reach) becomes the next goal while iterations remain.
 inline std::optional<GlobalCaptureResult> reach_goal(const CaptureProblem& pb, const CaptureTask& task,
                                                      const CaptureOptions& run_opt, const CaptureSetup& setup,
                                                      const GlobalCaptureOptions& g, Eigen::VectorXd goal,
-                                                     GlobalCaptureResult& res, const char* where,
+                                                     GlobalSearchCounters& counters, const char* where,
                                                      double t_r = 0) {
   for (int it = 1; it <= g.max_iterations; ++it) {
     ServoPolicy servo;
     servo.theta_goal = goal;
-    ++res.shooting_iterations;
+    ++counters.shooting_iterations;
     CaptureResult run;
     std::vector<RunPhase> phases;
     try {
@@ -209,27 +216,27 @@ inline std::optional<GlobalCaptureResult> reach_goal(const CaptureProblem& pb, c
         phases = approach_only_phases(run, run_opt.duration);
       }
     } catch (const JointLimitError&) {
-      ++res.goals_out_of_limits;
+      ++counters.goals_out_of_limits;
       return std::nullopt;
     } catch (const NumericalError& e) {
       // the approach fails (after a reconfiguration, or alone where one may follow): give the goal
       // up; the approach alone without a reconfiguration to fall back on: the run's error
       if (t_r > 0 || g.reconfigure.mode != ReconfigureMode::Never) {
-        res.run_failure = e.what();
+        counters.run_failure = e.what();
         return std::nullopt;
       }
       throw;
     }
     const ManifoldPoint reached = evaluate_capture(pb, setup, run.base, run.theta, g.search.objective,
                                                    g.search.multibody, g.search.robust.get());
-    if (g.search.objective == GlobalObjective::MultibodyForce) ++res.objective_evaluations;
+    if (g.search.objective == GlobalObjective::MultibodyForce) ++counters.objective_evaluations;
     ManifoldSearchResult local;  // the goal re-optimized locally at the reached base pose
     try {
       local = detail::search_manifold(pb, task, setup, run.base, g.search, {goal}, 0);
     } catch (const InputError&) {
       return std::nullopt;
     }
-    account(res, local);
+    account(counters, local);
     // the servo leaves ~e^-10 of the error; the rest is the move of the manifold with the base pose,
     // small against the distance between components
     if (detail::configuration_distance(*pb.model, run.theta, local.best.theta) > 0.5) return std::nullopt;
@@ -247,7 +254,7 @@ inline std::optional<GlobalCaptureResult> reach_goal(const CaptureProblem& pb, c
     ex.push_back(goal);
     ex.push_back(run.theta);
     ManifoldSearchResult full = search_capture_manifold(pb, task, setup, run.base, g.search, ex);
-    account(res, full);
+    account(counters, full);
     drop_turned_optima(pb, task, setup, run.base, g, full);
     best_admitted(g, run.base, full);
     const double gap = 100.0 * (reached.objective - full.best.objective) / full.best.objective;
@@ -255,7 +262,7 @@ inline std::optional<GlobalCaptureResult> reach_goal(const CaptureProblem& pb, c
       goal = full.best.theta;  // reachable too: the reconfiguration moves to its component
       continue;
     }
-    GlobalCaptureResult r = res;
+    GlobalCaptureResult r;
     r.run = std::move(run);
     r.search = std::move(full);
     r.objective = reached.objective;
@@ -276,17 +283,9 @@ inline void check_reconfiguration_duration(double t_r, double duration, const ch
         str(where, ": the reconfiguration duration must lie in (0, ", duration, ") s, got ", t_r));
 }
 
-/// The best reached goal's result with the counters of every goal tried (`counts`).
-inline GlobalCaptureResult with_counters(GlobalCaptureResult best, const GlobalCaptureResult& counts) {
-  best.shooting_iterations = counts.shooting_iterations;
-  best.goals_tried = counts.goals_tried;
-  best.goals_out_of_limits = counts.goals_out_of_limits;
-  best.evaluations = counts.evaluations;
-  best.objective_evaluations = counts.objective_evaluations;
-  best.search_seconds = counts.search_seconds;
-  best.goals_rejected = counts.goals_rejected;
-  best.goals_not_admitted = counts.goals_not_admitted;
-  best.run_failure = counts.run_failure;
+/// A reached goal's result (reach_goal: without counters) with the counters of every goal tried.
+inline GlobalCaptureResult with_counters(GlobalCaptureResult best, const GlobalSearchCounters& counters) {
+  best.counters = counters;
   return best;
 }
 
@@ -298,12 +297,12 @@ namespace detail {
 /// `extra` and its base pose at T is returned (the first search's); a rate limit below what it needs
 /// is an InputError. With a reconfiguration allowed, a task the arm cannot follow from its start (a
 /// grasp orientation far from the initial one, an algorithmic singularity on the way) is no error:
-/// its failure goes into res.task_alone_failure and the initial base pose is returned, and the
+/// its failure goes into counters.task_alone_failure and the initial base pose is returned, and the
 /// reconfiguration moves the arm to where the approach works.
 inline BasePose task_alone_base(const CaptureProblem& pb, const CaptureTask& task,
                                 const CaptureOptions& quiet, const CaptureSetup& setup,
                                 const GlobalCaptureOptions& g, const char* where,
-                                std::vector<Eigen::VectorXd>& extra, GlobalCaptureResult& res) {
+                                std::vector<Eigen::VectorXd>& extra, GlobalSearchCounters& counters) {
   ServoPolicy none;
   try {
     const CaptureResult plain = integrate_capture(pb, task, quiet, setup, none, where);
@@ -315,7 +314,7 @@ inline BasePose task_alone_base(const CaptureProblem& pb, const CaptureTask& tas
     return plain.base;
   } catch (const NumericalError& e) {
     if (g.reconfigure.mode == ReconfigureMode::Never) throw;
-    res.task_alone_failure = e.what();
+    counters.task_alone_failure = e.what();
   }
   return pb.base;
 }
@@ -327,12 +326,12 @@ inline BasePose task_alone_base(const CaptureProblem& pb, const CaptureTask& tas
 inline std::optional<GlobalCaptureResult> reach_reconfigured(
     const CaptureProblem& pb, const CaptureTask& task, const CaptureOptions& run_opt,
     const CaptureSetup& setup, const GlobalCaptureOptions& g, const Eigen::VectorXd& goal,
-    GlobalCaptureResult& res, const char* where) {
+    GlobalSearchCounters& counters, const char* where) {
   const double t_r = g.reconfigure.duration > 0
                          ? g.reconfigure.duration
                          : default_reconfiguration_duration(*pb.model, pb.theta, goal, run_opt);
   try {
-    return reach_goal(pb, task, run_opt, setup, g, goal, res, where, t_r);
+    return reach_goal(pb, task, run_opt, setup, g, goal, counters, where, t_r);
   } catch (const ReconfigurationRateError&) {
     if (g.reconfigure.duration > 0) throw;
   }
@@ -340,32 +339,31 @@ inline std::optional<GlobalCaptureResult> reach_reconfigured(
 }
 
 /// Drops a reached goal's run that g.admit or g.check_run rejects (the clearance along the path), counted
-/// with its message in res.
-inline void check_reached(const GlobalCaptureOptions& g, GlobalCaptureResult& res,
+/// with its message in `counters`.
+inline void check_reached(const GlobalCaptureOptions& g, GlobalSearchCounters& counters,
                           std::optional<GlobalCaptureResult>& r) {
   if (r && g.admit && !g.admit(r->run.base, {r->run.theta}).at(0)) {
-    ++res.goals_not_admitted;
-    res.rejection = "the reached capture configuration does not meet the candidate constraint";
+    ++counters.goals_not_admitted;
+    counters.rejection = "the reached capture configuration does not meet the candidate constraint";
     r.reset();
   }
   if (!r || !g.check_run) return;
   if (std::optional<std::string> why = g.check_run(r->run, r->reconfigured ? r->phases.front().t_end : 0.0)) {
-    ++res.goals_rejected;
-    res.rejection = *why;
+    ++counters.goals_rejected;
+    counters.rejection = *why;
     r.reset();
   }
 }
 
 /// The error when no goal was reached, with what was tried and why the runs failed.
-inline NumericalError no_goal_reached(const GlobalCaptureResult& res, const char* where) {
+inline NumericalError no_goal_reached(const GlobalSearchCounters& c, const char* where) {
   return NumericalError(str(
-      where, ": no capture configuration chosen by the search was reached (", res.goals_tried, " goals, ",
-      res.goals_out_of_limits, " of them behind a joint limit, ", res.shooting_iterations, " reaching runs)",
-      res.goals_rejected + res.goals_not_admitted
-          ? str("; the last reached goal was rejected: ", res.rejection)
-          : "",
-      res.task_alone_failure.empty() ? "" : str("; the task alone failed: ", res.task_alone_failure),
-      res.run_failure.empty() ? "" : str("; the last reaching run that failed: ", res.run_failure)));
+      where, ": no capture configuration chosen by the search was reached (", c.goals_tried, " goals, ",
+      c.goals_out_of_limits, " of them behind a joint limit, ", c.shooting_iterations, " reaching runs)",
+      c.goals_rejected + c.goals_not_admitted ? str("; the last reached goal was rejected: ", c.rejection)
+                                              : "",
+      c.task_alone_failure.empty() ? "" : str("; the task alone failed: ", c.task_alone_failure),
+      c.run_failure.empty() ? "" : str("; the last reaching run that failed: ", c.run_failure)));
 }
 
 }  // namespace detail
@@ -401,15 +399,16 @@ inline GlobalCaptureResult plan_capture_global(const CaptureProblem& pb, const C
   CaptureOptions quiet = o;
   quiet.record_series = false;
 
-  GlobalCaptureResult res;
+  GlobalSearchCounters counters;
   std::vector<Eigen::VectorXd> extra = g.extra_starts;
-  const BasePose first_base = detail::task_alone_base(pb, task, quiet, setup, g, where, extra, res);
+  const BasePose first_base = detail::task_alone_base(pb, task, quiet, setup, g, where, extra, counters);
   std::vector<ManifoldPoint> goals;
   try {
-    goals = detail::capture_goals(pb, task, setup, first_base, g, extra, res);
+    goals = detail::capture_goals(pb, task, setup, first_base, g, extra, counters);
   } catch (const InputError& e) {  // e.g. a capture point out of reach: the task alone's error first
-    if (res.task_alone_failure.empty()) throw;
-    throw NumericalError(str(res.task_alone_failure, "; the search at the initial base pose: ", e.what()));
+    if (counters.task_alone_failure.empty()) throw;
+    throw NumericalError(
+        str(counters.task_alone_failure, "; the search at the initial base pose: ", e.what()));
   }
 
   CaptureOptions run_opt = quiet;
@@ -417,20 +416,20 @@ inline GlobalCaptureResult plan_capture_global(const CaptureProblem& pb, const C
   std::optional<GlobalCaptureResult> fallback;
   const ReconfigureMode mode = g.reconfigure.mode;
   for (const ManifoldPoint& goal : goals) {
-    ++res.goals_tried;
+    ++counters.goals_tried;
     // the approach alone first (not for always), then (not for never) with a reconfiguration
     for (const bool reconfigure : {false, true}) {
       if (reconfigure ? mode == ReconfigureMode::Never : mode == ReconfigureMode::Always) continue;
       std::optional<GlobalCaptureResult> r =
-          reconfigure ? detail::reach_reconfigured(pb, task, run_opt, setup, g, goal.theta, res, where)
-                      : detail::reach_goal(pb, task, run_opt, setup, g, goal.theta, res, where);
-      detail::check_reached(g, res, r);
-      if (r && r->reached_manifold_optimum) return std::move(*r);
+          reconfigure ? detail::reach_reconfigured(pb, task, run_opt, setup, g, goal.theta, counters, where)
+                      : detail::reach_goal(pb, task, run_opt, setup, g, goal.theta, counters, where);
+      detail::check_reached(g, counters, r);
+      if (r && r->reached_manifold_optimum) return detail::with_counters(std::move(*r), counters);
       if (r && (!fallback || r->objective < fallback->objective)) fallback = std::move(r);
     }
   }
-  if (fallback) return detail::with_counters(std::move(*fallback), res);
-  throw detail::no_goal_reached(res, where);
+  if (fallback) return detail::with_counters(std::move(*fallback), counters);
+  throw detail::no_goal_reached(counters, where);
 }
 
 }  // namespace ffsr

@@ -167,6 +167,7 @@ std::string metres4(double x) {
 void print_global_notes(std::ostream& out, const Scenario& sc, const GlobalRun& g,
                         const CaptureResult* opt_run) {
   const GlobalCaptureResult& r = g.result;
+  const GlobalSearchCounters& n = r.counters;
   const ScenarioKeys& o = sc.keys;
   const bool mb = o.objective == "multibody-force";
   const double unit = mb || o.objective == "exact-force" || o.objective == "robust-force" ? 1e3 : 1.0;
@@ -175,12 +176,12 @@ void print_global_notes(std::ostream& out, const Scenario& sc, const GlobalRun& 
       << "): reached " << r.objective / unit << u << ", manifold optimum at the reached base pose "
       << (r.search_distance_bound > 0 ? "with distances >= " + metres4(r.search_distance_bound) + " " : "")
       << r.manifold_optimum / unit << u << " (gap " << r.optimality_gap_percent << " %), "
-      << r.shooting_iterations << " reaching run(s), " << r.goals_tried << " goal(s) tried"
-      << (r.goals_out_of_limits > 0 ? " (" + std::to_string(r.goals_out_of_limits) + " behind a joint limit)"
+      << n.shooting_iterations << " reaching run(s), " << n.goals_tried << " goal(s) tried"
+      << (n.goals_out_of_limits > 0 ? " (" + std::to_string(n.goals_out_of_limits) + " behind a joint limit)"
                                     : "")
-      << "; search: " << r.search.method << ", " << r.search.starts << " starts, " << r.evaluations
-      << " evaluations" << (mb ? ", " + std::to_string(r.objective_evaluations) + " CVODE runs" : "") << ", "
-      << r.search_seconds << " s\n";
+      << "; search: " << r.search.method << ", " << r.search.starts << " starts, " << n.evaluations
+      << " evaluations" << (mb ? ", " + std::to_string(n.objective_evaluations) + " CVODE runs" : "") << ", "
+      << n.search_seconds << " s\n";
   for (const RunPhase& p : r.reconfigured ? r.phases : std::vector<RunPhase>{})
     out << "global " << p.name << " phase: t = " << std::setprecision(2) << p.t_begin << " to " << p.t_end
         << " s, base attitude change " << std::setprecision(3) << p.base_attitude_change * 180.0 / M_PI
@@ -360,9 +361,9 @@ void print_clearance(std::ostream& out, const Scenario& sc, const ScenarioResult
           << c.overall.pair << " " << c.overall.distance << " m at t = " << std::setprecision(1)
           << c.overall.time << " s\n"
           << std::setprecision(4);
-  if (r.global && r.global->result.goals_rejected > 0)
-    out << "clearance: " << r.global->result.goals_rejected
-        << " reached goal(s) rejected along the path; last: " << r.global->result.rejection << "\n";
+  if (r.global && r.global->result.counters.goals_rejected > 0)
+    out << "clearance: " << r.global->result.counters.goals_rejected
+        << " reached goal(s) rejected along the path; last: " << r.global->result.counters.rejection << "\n";
 }
 
 void print_table(std::ostream& out, const Scenario& sc, const ScenarioResult& r) {

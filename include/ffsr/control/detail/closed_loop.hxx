@@ -129,7 +129,7 @@ void finish_closed_loop(const CaptureController<Policy>& ctrl, ClosedLoopPlant& 
   res.end_effector = frame_pose(p.model, p.data, pb.frame).p;
   res.capture_point = truth.contact_point();
   res.capture_error = (res.end_effector - res.capture_point).norm();
-  const CaptureEvaluator objective(p.model, pb.frame, truth, &ctrl.setup().law, pb.joints);
+  const CaptureEvaluator objective(p.model, pb.frame, truth, &ctrl.setup().capture.law, pb.joints);
   res.M_ie = objective.mass_at(p.data);
   res.f_max_closed_form = objective.f_max_closed_form(res.M_ie);
   res.base_attitude_change = rotation_angle(res.base.orientation.toRotationMatrix() *

@@ -124,9 +124,9 @@ inline void add_global_json(nlohmann::json& j, const Scenario& sc, const GlobalR
   x["manifold_optimum"] = r.manifold_optimum;
   x["optimality_gap_percent"] = r.optimality_gap_percent;
   x["search_distance_bound"] = r.search_distance_bound;
-  x["shooting_iterations"] = r.shooting_iterations;
-  x["goals_tried"] = r.goals_tried;
-  x["goals_out_of_limits"] = r.goals_out_of_limits;
+  x["shooting_iterations"] = r.counters.shooting_iterations;
+  x["goals_tried"] = r.counters.goals_tried;
+  x["goals_out_of_limits"] = r.counters.goals_out_of_limits;
   x["reached_manifold_optimum"] = r.reached_manifold_optimum;
   x["reconfigured"] = r.reconfigured;
   nlohmann::json phases = nlohmann::json::array();
@@ -141,9 +141,9 @@ inline void add_global_json(nlohmann::json& j, const Scenario& sc, const GlobalR
   x["phases"] = phases;
   x["search"] = {{"method", r.search.method},
                  {"starts", r.search.starts},
-                 {"evaluations", r.evaluations},
-                 {"multibody_evaluations", r.objective_evaluations},
-                 {"seconds", r.search_seconds}};
+                 {"evaluations", r.counters.evaluations},
+                 {"multibody_evaluations", r.counters.objective_evaluations},
+                 {"seconds", r.counters.search_seconds}};
   if (sc.objective == GlobalObjective::MultibodyForce) {
     // the ranked local optima of M_ie at the reached base pose: how far the mass and force optima are apart
     nlohmann::json ranked = nlohmann::json::array();
@@ -165,7 +165,7 @@ inline void add_global_json(nlohmann::json& j, const Scenario& sc, const GlobalR
         {"peak_gripper_moment", f.peak_gripper_moment},
         {"candidates", g.post_capture_candidates},
         {"candidates_meeting_constraints", g.post_capture_admitted},
-        {"reached_goals_rejected", g.result.goals_not_admitted}};
+        {"reached_goals_rejected", g.result.counters.goals_not_admitted}};
   }
   j["global"] = x;
   add_reductions_json(j, "global_", base_run, &r.run);
@@ -191,7 +191,7 @@ inline nlohmann::json clearance_json(const ClearanceReport& c) {
 /// rejected by the path check.
 inline void add_clearance_json(nlohmann::json& j, const ScenarioResult& r) {
   for (const auto& [name, c] : r.clearances) j[name]["min_clearance"] = clearance_json(c);
-  if (r.global) j["global"]["goals_rejected_by_clearance"] = r.global->result.goals_rejected;
+  if (r.global) j["global"]["goals_rejected_by_clearance"] = r.global->result.counters.goals_rejected;
 }
 
 }  // namespace detail

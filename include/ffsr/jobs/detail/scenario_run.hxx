@@ -68,7 +68,7 @@ namespace detail {
 inline std::shared_ptr<PostCaptureScreen> post_capture_screen(const Scenario& sc, const CaptureOptions& opt,
                                                               GlobalCaptureOptions& g) {
   if (!post_capture_constraints(sc.keys).any()) return nullptr;
-  const Target at_capture = prepare_capture(sc.problem, sc.task, opt).capture_target;
+  const Target at_capture = prepare_capture(sc.problem, sc.task, opt).capture.target;
   auto screen = std::make_shared<PostCaptureScreen>(sc, at_capture);
   g.admit = [screen](const BasePose& b, const std::vector<Eigen::VectorXd>& t) { return (*screen)(b, t); };
   return screen;
