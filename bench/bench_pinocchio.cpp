@@ -113,7 +113,7 @@ Poses random_poses(int n, int count, unsigned seed) {
 struct Row {
   std::string name;
   int n = 0;
-  double t[15] = {};  // the routes' times, in the order of compare's loops
+  double t[18] = {};  // the routes' times, in the order of compare's loops
   double agree[6] = {};
 };
 
@@ -127,9 +127,9 @@ Row compare(const std::string& name, const std::string& urdf) {
   const int n = fm.n();
   constexpr int kPoses = 1000, kBlocks = 20, kPassPoses = 200, kPasses = 51;
   const Poses P = random_poses(n, kPoses, 1234u + static_cast<unsigned>(n));
-  const auto pin = ffsr_bench::make_pinocchio_inline(fm, fee, P.base, P.theta, P.u);
+  const auto pin = ffsr_bench::make_pinocchio_inline(urdf, "ee", P.base, P.theta, P.u);
 #ifdef FFSR_BENCH_PIN_LIBRARY
-  const auto lib = ffsr_bench::make_pinocchio_library(fm, fee, P.base, P.theta, P.u);
+  const auto lib = ffsr_bench::make_pinocchio_library(urdf, "ee", P.base, P.theta, P.u);
 #else  // no precompiled library in this build: its columns time the templates again
   const auto& lib = pin;
 #endif
@@ -144,25 +144,28 @@ Row compare(const std::string& name, const std::string& urdf) {
     const auto uk = static_cast<size_t>(k);
     return 1.0 / before::integrated_effective_mass(fm, bd, P.base[uk], P.theta[uk], fee, P.u[uk], 0.0);
   };
+  auto rel = [](double a, double b) { return std::abs(a - b) / std::abs(b); };
   Row row{name, n, {}, {}};
-  double* d = row.agree;  // H-before, H-pin, M-before, M-dense, M-Delassus, Delassus-dense
+  double* d = row.agree;  // H-before, H-Pinocchio, M-before, M-Pinocchio dense, M-Delassus, Delassus-dense
   for (int k = 0; k < kPoses; ++k) {
     const auto uk = static_cast<size_t>(k);
     const Eigen::MatrixXd& Hb = before::crba(fm, bd, P.base[uk], P.theta[uk]);
     const Eigen::MatrixXd& Hn = ffsr::crba(fm, fd, P.base[uk], P.theta[uk]);
     d[0] = std::max(d[0], (Hn - Hb).cwiseAbs().maxCoeff() / Hb.cwiseAbs().maxCoeff());
-    if (k < kBlocks) {
-      const Eigen::MatrixXd Hp = pin->joint_block(k);
-      const double dp = (Hn.bottomRightCorner(n, n) - Hp).cwiseAbs().maxCoeff();
-      d[1] = std::max(d[1], dp / Hp.cwiseAbs().maxCoeff());
-    }
+    if (k < kBlocks)
+      for (Kind c : {Kind::CrbaLocal, Kind::CrbaWorld}) {
+        const Eigen::MatrixXd Hp = pin->joint_block(c, k);
+        const double dp = (Hn.bottomRightCorner(n, n) - Hp).cwiseAbs().maxCoeff();
+        d[1] = std::max(d[1], dp / Hp.cwiseAbs().maxCoeff());
+      }
     const double a = mie_now(k), b = mie_before(k);
-    const double p = pin->inverse_effective_mass(Kind::Dense, k);
+    const double p = pin->inverse_effective_mass(Kind::DenseLocal, k);
     const double q = pin->inverse_effective_mass(Kind::Delassus, k);
-    d[2] = std::max(d[2], std::abs(a - b) / b);
-    d[3] = std::max(d[3], std::abs(a - p) / p);
-    d[4] = std::max(d[4], std::abs(a - q) / q);
-    d[5] = std::max(d[5], std::abs(q - p) / p);
+    d[2] = std::max(d[2], rel(a, b));
+    for (Kind c : {Kind::DenseLocal, Kind::DenseWorld, Kind::Minverse})
+      d[3] = std::max(d[3], rel(a, pin->inverse_effective_mass(c, k)));
+    d[4] = std::max(d[4], rel(a, q));
+    d[5] = std::max(d[5], rel(q, p));
   }
   auto ffsr_pass = [&](auto&& fn) {
     double acc = 0;
@@ -177,7 +180,7 @@ Row compare(const std::string& name, const std::string& urdf) {
   };
   for (double& x : row.t) x = 1e300;
   for (int r = -1; r < kPasses; ++r) {  // pass -1 warms up; the minimum over the others
-    const double a[15] = {ffsr_pass(crba_now),
+    const double a[18] = {ffsr_pass(crba_now),
                           ffsr_pass(crba_before),
                           pin_pass(*pin, Kind::CrbaLocal),
                           pin_pass(*pin, Kind::CrbaWorld),
@@ -186,17 +189,20 @@ Row compare(const std::string& name, const std::string& urdf) {
                           pin_pass(*lib, Kind::CrbaWorld),
                           ffsr_pass(mie_now),
                           ffsr_pass(mie_before),
-                          pin_pass(*pin, Kind::Dense),
+                          pin_pass(*pin, Kind::DenseLocal),
+                          pin_pass(*pin, Kind::DenseWorld),
+                          pin_pass(*pin, Kind::Minverse),
                           pin_pass(*pin, Kind::Delassus),
-                          pin_pass(*lib, Kind::Dense),
+                          pin_pass(*lib, Kind::DenseLocal),
+                          pin_pass(*lib, Kind::DenseWorld),
                           pin_pass(*lib, Kind::Delassus),
                           ffsr_pass(crba_now),
                           ffsr_pass(mie_now)};
     if (r >= 0)
-      for (int i = 0; i < 15; ++i) row.t[i] = std::min(row.t[i], a[i]);
+      for (int i = 0; i < 18; ++i) row.t[i] = std::min(row.t[i], a[i]);
   }
-  row.t[0] = std::min(row.t[0], row.t[13]);  // ffsr timed twice a pass, at both ends
-  row.t[7] = std::min(row.t[7], row.t[14]);
+  row.t[0] = std::min(row.t[0], row.t[16]);  // ffsr timed twice a pass, at both ends
+  row.t[7] = std::min(row.t[7], row.t[17]);
   return row;
 }
 
@@ -209,22 +215,22 @@ constexpr bool kLibraryTimed = false;
 void print_tables(const std::vector<Row>& rows) {
   std::printf(
       "ns per call, minimum over 51 interleaved passes of the mean over the same 200 random poses "
-      "(thread CPU time); Pinocchio's templates instantiated at the bench's flags, \"library\" its "
-      "precompiled libpinocchio_default%s\n\n",
+      "(thread CPU time); Pinocchio's templates instantiated in this executable at its flags, "
+      "\"library\" its precompiled libpinocchio_default%s\n\n",
       kLibraryTimed ? "" : " (not in this build: the library columns time the templates again)");
   std::printf(
       "| robot | n | CRBA ffsr / Pinocchio | before | Pinocchio LOCAL / WORLD | LOCAL + sym | library | "
-      "M_ie ffsr | before | Pinocchio dense | Pinocchio Delassus | ffsr / better | library dense / "
-      "Delassus |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+      "M_ie ffsr / Pinocchio | before | Pinocchio dense LOCAL / WORLD | Minverse | Delassus | "
+      "library dense / Delassus |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   for (const Row& w : rows) {
     const double* t = w.t;
-    const double pc = std::min(t[2], t[3]), pm = std::min(t[9], t[10]);
+    const double pc = std::min(t[2], t[3]), pm = std::min({t[9], t[10], t[11], t[12]});
     std::printf(
-        "| %s | %d | %.0f / %.0f ns = %.2fx | %.0f | %.0f / %.0f | %.0f | %.0f | %.0f ns | %.0f | %.0f | "
-        "%.0f | %.2fx | %.0f / %.0f |\n",
+        "| %s | %d | %.0f / %.0f ns = %.2fx | %.0f | %.0f / %.0f | %.0f | %.0f | %.0f / %.0f ns = %.2fx | "
+        "%.0f | %.0f / %.0f | %.0f | %.0f | %.0f / %.0f |\n",
         w.name.c_str(), w.n, t[0] * 1e9, pc * 1e9, t[0] / pc, t[1] * 1e9, t[2] * 1e9, t[3] * 1e9, t[4] * 1e9,
-        std::min(t[5], t[6]) * 1e9, t[7] * 1e9, t[8] * 1e9, t[9] * 1e9, t[10] * 1e9, t[7] / pm, t[11] * 1e9,
-        t[12] * 1e9);
+        std::min(t[5], t[6]) * 1e9, t[7] * 1e9, pm * 1e9, t[7] / pm, t[8] * 1e9, t[9] * 1e9, t[10] * 1e9,
+        t[11] * 1e9, t[12] * 1e9, std::min(t[13], t[14]) * 1e9, t[15] * 1e9);
   }
   std::printf(
       "\n| robot | H - before | H - Pinocchio | M_ie - before | M_ie - Pinocchio dense | M_ie - Delassus | "
