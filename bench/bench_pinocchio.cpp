@@ -6,28 +6,34 @@
 //
 // Built only with -DFFSR_BENCH_PINOCCHIO=ON (bench/CMakeLists.txt), against Pinocchio's C++ headers
 // and libraries, e.g. those of the PyPI package `pin` (pip install pin==4.1.0). Nothing else in the
-// project needs Pinocchio. Pinocchio's templates are instantiated in the bench's own unit at the
-// bench's compiler and flags (bench_pinocchio_side.cpp; its precompiled library is timed beside).
+// project needs Pinocchio. Pinocchio's templates are instantiated in this executable at the bench's
+// compiler and flags, linked statically (bench_pinocchio_side.cpp; its precompiled library is timed
+// beside, from a shared library of its own).
 //
 // Robots: the paper's 3-DOF and 7-DOF robots (joint axes along x or z) and serial chains of 3, 7, 14,
-// 28 and 56 revolute joints on a floating base (random axes, offsets and inertias from a fixed seed),
-// each loaded from the same URDF text by both libraries: ffsr's model from URDF, Pinocchio's built
-// from it joint by joint with a free-flyer root, RX/RY/RZ joints for axes along x, y, z and the
-// unaligned revolute joint otherwise. Poses: the same 1000 random configurations (fixed seed) and
-// unit directions u for all.
+// 28 and 56 continuous joints on a floating base (random axes, offsets and inertias from a fixed
+// seed), each loaded from the same URDF text by both libraries as their users load one: ffsr's
+// model_from_urdf_string and Pinocchio's urdf::buildModelFromXML with a free-flyer root (its RZ, RX
+// or unaligned unbounded revolute joints, whose configuration is the pair (cos q, sin q): Pinocchio
+// gets the sines and cosines precomputed, ffsr computes them from the angles). Poses: the same 1000
+// random configurations (fixed seed) and unit directions u for all.
 //
 // Routes: CRBA -- ffsr::crba (the full symmetric H), the frozen code before the rewrite
 // (bench_before.hpp), pinocchio::crba in its LOCAL and WORLD conventions (upper triangle; the ratio is
 // against the faster of the two) and LOCAL followed by the copy of its upper triangle into the lower
-// (the same output as ffsr's); M_ie -- ffsr::integrated_effective_mass (the O(n)
-// articulated-body route), the frozen function, Pinocchio's crba + computeJointJacobians +
-// getFrameJacobian + LLT solve ("dense") and its computeDelassusMatrix of a 3-D contact at the frame
-// ("Delassus", O(n)); the ratio is against the faster of the two. Each time is the minimum over 51
+// (the same output as ffsr's); M_ie -- ffsr::integrated_effective_mass (the O(n) articulated-body
+// route), the frozen function, and four Pinocchio routes (bench_pinocchio.hpp): crba +
+// computeFrameJacobian + its sparse cholesky::decompose ("dense LOCAL"), crba WORLD + getFrameJacobian
+// from the joint Jacobians it leaves + the same factorization ("dense WORLD"), computeMinverse +
+// computeFrameJacobian ("Minverse") and computeDelassusMatrix of a 3-D contact at the frame
+// ("Delassus", O(n)); the ratio is against the fastest of the four. Each time is the minimum over 51
 // passes of the mean time per call over 200 of the poses, in CPU time of the thread
 // (CLOCK_THREAD_CPUTIME_ID); every pass times all the loops back to back, so that a change of the
 // machine's load hits them alike. All 1000 poses serve the agreement checks: H against the frozen
-// code (largest entry difference over the largest entry), H's joint block against Pinocchio's, and
-// the inverse effective mass against the frozen code and both Pinocchio routes (relative).
+// code (largest entry difference over the largest entry), H's joint block against Pinocchio's (both
+// conventions), and the inverse effective mass against the frozen code and every Pinocchio route
+// (relative; the dense column is the largest over the three dense routes). They also check that the
+// two libraries read the URDF alike.
 // The output is the two Markdown tables of docs/performance.md.
 #include "ffsr/algorithm/effective_mass.hpp"
 #include "ffsr/parsers/urdf.hpp"
