@@ -43,6 +43,8 @@ class Routes final : public PinocchioRoutes {
       if (theta[k].size() != n_) throw std::runtime_error("pinocchio model: wrong number of joints");
       Eigen::VectorXd qk(pm_.nq);
       qk.head<7>() << base[k].position, base[k].orientation.coeffs();  // x y z, qx qy qz qw
+      // joint j's velocity index less the base's 6 is its coordinate: the URDF's joints in the same
+      // order as ffsr's on these serial robots (the agreement table checks it)
       for (pinocchio::JointIndex j = 2; j < static_cast<pinocchio::JointIndex>(pm_.njoints); ++j) {
         const auto& jm = pm_.joints[j];
         const double angle = theta[k](jm.idx_v() - 6);
