@@ -47,10 +47,9 @@ class PinocchioRoutes {
   virtual Eigen::MatrixXd joint_block(Kind kind, int k) = 0;
 };
 
-using PinocchioFactory = std::unique_ptr<PinocchioRoutes> (*)(const std::string& urdf, const std::string& frame,
-                                                              const std::vector<ffsr::BasePose>& base,
-                                                              const std::vector<Eigen::VectorXd>& theta,
-                                                              const std::vector<Eigen::Vector3d>& u);
+using PinocchioFactory = std::unique_ptr<PinocchioRoutes> (*)(
+    const std::string& urdf, const std::string& frame, const std::vector<ffsr::BasePose>& base,
+    const std::vector<Eigen::VectorXd>& theta, const std::vector<Eigen::Vector3d>& u);
 
 /// Pinocchio's templates instantiated in the bench's executable, at the bench's compiler and flags
 /// (an object library linked in statically; its symbols hidden, so that the precompiled library
