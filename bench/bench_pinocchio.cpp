@@ -6,28 +6,34 @@
 //
 // Built only with -DFFSR_BENCH_PINOCCHIO=ON (bench/CMakeLists.txt), against Pinocchio's C++ headers
 // and libraries, e.g. those of the PyPI package `pin` (pip install pin==4.1.0). Nothing else in the
-// project needs Pinocchio. Pinocchio's templates are instantiated in the bench's own unit at the
-// bench's compiler and flags (bench_pinocchio_side.cpp; its precompiled library is timed beside).
+// project needs Pinocchio. Pinocchio's templates are instantiated in this executable at the bench's
+// compiler and flags, linked statically (bench_pinocchio_side.cpp; its precompiled library is timed
+// beside, from a shared library of its own).
 //
 // Robots: the paper's 3-DOF and 7-DOF robots (joint axes along x or z) and serial chains of 3, 7, 14,
-// 28 and 56 revolute joints on a floating base (random axes, offsets and inertias from a fixed seed),
-// each loaded from the same URDF text by both libraries: ffsr's model from URDF, Pinocchio's built
-// from it joint by joint with a free-flyer root, RX/RY/RZ joints for axes along x, y, z and the
-// unaligned revolute joint otherwise. Poses: the same 1000 random configurations (fixed seed) and
-// unit directions u for all.
+// 28 and 56 continuous joints on a floating base (random axes, offsets and inertias from a fixed
+// seed), each loaded from the same URDF text by both libraries as their users load one: ffsr's
+// model_from_urdf_string and Pinocchio's urdf::buildModelFromXML with a free-flyer root (its RZ, RX
+// or unaligned unbounded revolute joints, whose configuration is the pair (cos q, sin q): Pinocchio
+// gets the sines and cosines precomputed, ffsr computes them from the angles). Poses: the same 1000
+// random configurations (fixed seed) and unit directions u for all.
 //
 // Routes: CRBA -- ffsr::crba (the full symmetric H), the frozen code before the rewrite
 // (bench_before.hpp), pinocchio::crba in its LOCAL and WORLD conventions (upper triangle; the ratio is
 // against the faster of the two) and LOCAL followed by the copy of its upper triangle into the lower
-// (the same output as ffsr's); M_ie -- ffsr::integrated_effective_mass (the O(n)
-// articulated-body route), the frozen function, Pinocchio's crba + computeJointJacobians +
-// getFrameJacobian + LLT solve ("dense") and its computeDelassusMatrix of a 3-D contact at the frame
-// ("Delassus", O(n)); the ratio is against the faster of the two. Each time is the minimum over 51
+// (the same output as ffsr's); M_ie -- ffsr::integrated_effective_mass (the O(n) articulated-body
+// route), the frozen function, and four Pinocchio routes (bench_pinocchio.hpp): crba +
+// computeFrameJacobian + its sparse cholesky::decompose ("dense LOCAL"), crba WORLD + getFrameJacobian
+// from the joint Jacobians it leaves + the same factorization ("dense WORLD"), computeMinverse +
+// computeFrameJacobian ("Minverse") and computeDelassusMatrix of a 3-D contact at the frame
+// ("Delassus", O(n)); the ratio is against the fastest of the four. Each time is the minimum over 51
 // passes of the mean time per call over 200 of the poses, in CPU time of the thread
 // (CLOCK_THREAD_CPUTIME_ID); every pass times all the loops back to back, so that a change of the
 // machine's load hits them alike. All 1000 poses serve the agreement checks: H against the frozen
-// code (largest entry difference over the largest entry), H's joint block against Pinocchio's, and
-// the inverse effective mass against the frozen code and both Pinocchio routes (relative).
+// code (largest entry difference over the largest entry), H's joint block against Pinocchio's (both
+// conventions), and the inverse effective mass against the frozen code and every Pinocchio route
+// (relative; the dense column is the largest over the three dense routes). They also check that the
+// two libraries read the URDF alike.
 // The output is the two Markdown tables of docs/performance.md.
 #include "ffsr/algorithm/effective_mass.hpp"
 #include "ffsr/parsers/urdf.hpp"
@@ -113,7 +119,7 @@ Poses random_poses(int n, int count, unsigned seed) {
 struct Row {
   std::string name;
   int n = 0;
-  double t[15] = {};  // the routes' times, in the order of compare's loops
+  double t[18] = {};  // the routes' times, in the order of compare's loops
   double agree[6] = {};
 };
 
@@ -127,9 +133,9 @@ Row compare(const std::string& name, const std::string& urdf) {
   const int n = fm.n();
   constexpr int kPoses = 1000, kBlocks = 20, kPassPoses = 200, kPasses = 51;
   const Poses P = random_poses(n, kPoses, 1234u + static_cast<unsigned>(n));
-  const auto pin = ffsr_bench::make_pinocchio_inline(fm, fee, P.base, P.theta, P.u);
+  const auto pin = ffsr_bench::make_pinocchio_inline(urdf, "ee", P.base, P.theta, P.u);
 #ifdef FFSR_BENCH_PIN_LIBRARY
-  const auto lib = ffsr_bench::make_pinocchio_library(fm, fee, P.base, P.theta, P.u);
+  const auto lib = ffsr_bench::make_pinocchio_library(urdf, "ee", P.base, P.theta, P.u);
 #else  // no precompiled library in this build: its columns time the templates again
   const auto& lib = pin;
 #endif
@@ -144,25 +150,28 @@ Row compare(const std::string& name, const std::string& urdf) {
     const auto uk = static_cast<size_t>(k);
     return 1.0 / before::integrated_effective_mass(fm, bd, P.base[uk], P.theta[uk], fee, P.u[uk], 0.0);
   };
+  auto rel = [](double a, double b) { return std::abs(a - b) / std::abs(b); };
   Row row{name, n, {}, {}};
-  double* d = row.agree;  // H-before, H-pin, M-before, M-dense, M-Delassus, Delassus-dense
+  double* d = row.agree;  // H-before, H-Pinocchio, M-before, M-Pinocchio dense, M-Delassus, Delassus-dense
   for (int k = 0; k < kPoses; ++k) {
     const auto uk = static_cast<size_t>(k);
     const Eigen::MatrixXd& Hb = before::crba(fm, bd, P.base[uk], P.theta[uk]);
     const Eigen::MatrixXd& Hn = ffsr::crba(fm, fd, P.base[uk], P.theta[uk]);
     d[0] = std::max(d[0], (Hn - Hb).cwiseAbs().maxCoeff() / Hb.cwiseAbs().maxCoeff());
-    if (k < kBlocks) {
-      const Eigen::MatrixXd Hp = pin->joint_block(k);
-      const double dp = (Hn.bottomRightCorner(n, n) - Hp).cwiseAbs().maxCoeff();
-      d[1] = std::max(d[1], dp / Hp.cwiseAbs().maxCoeff());
-    }
+    if (k < kBlocks)
+      for (Kind c : {Kind::CrbaLocal, Kind::CrbaWorld}) {
+        const Eigen::MatrixXd Hp = pin->joint_block(c, k);
+        const double dp = (Hn.bottomRightCorner(n, n) - Hp).cwiseAbs().maxCoeff();
+        d[1] = std::max(d[1], dp / Hp.cwiseAbs().maxCoeff());
+      }
     const double a = mie_now(k), b = mie_before(k);
-    const double p = pin->inverse_effective_mass(Kind::Dense, k);
+    const double p = pin->inverse_effective_mass(Kind::DenseLocal, k);
     const double q = pin->inverse_effective_mass(Kind::Delassus, k);
-    d[2] = std::max(d[2], std::abs(a - b) / b);
-    d[3] = std::max(d[3], std::abs(a - p) / p);
-    d[4] = std::max(d[4], std::abs(a - q) / q);
-    d[5] = std::max(d[5], std::abs(q - p) / p);
+    d[2] = std::max(d[2], rel(a, b));
+    for (Kind c : {Kind::DenseLocal, Kind::DenseWorld, Kind::Minverse})
+      d[3] = std::max(d[3], rel(a, pin->inverse_effective_mass(c, k)));
+    d[4] = std::max(d[4], rel(a, q));
+    d[5] = std::max(d[5], rel(q, p));
   }
   auto ffsr_pass = [&](auto&& fn) {
     double acc = 0;
@@ -177,7 +186,7 @@ Row compare(const std::string& name, const std::string& urdf) {
   };
   for (double& x : row.t) x = 1e300;
   for (int r = -1; r < kPasses; ++r) {  // pass -1 warms up; the minimum over the others
-    const double a[15] = {ffsr_pass(crba_now),
+    const double a[18] = {ffsr_pass(crba_now),
                           ffsr_pass(crba_before),
                           pin_pass(*pin, Kind::CrbaLocal),
                           pin_pass(*pin, Kind::CrbaWorld),
@@ -186,17 +195,20 @@ Row compare(const std::string& name, const std::string& urdf) {
                           pin_pass(*lib, Kind::CrbaWorld),
                           ffsr_pass(mie_now),
                           ffsr_pass(mie_before),
-                          pin_pass(*pin, Kind::Dense),
+                          pin_pass(*pin, Kind::DenseLocal),
+                          pin_pass(*pin, Kind::DenseWorld),
+                          pin_pass(*pin, Kind::Minverse),
                           pin_pass(*pin, Kind::Delassus),
-                          pin_pass(*lib, Kind::Dense),
+                          pin_pass(*lib, Kind::DenseLocal),
+                          pin_pass(*lib, Kind::DenseWorld),
                           pin_pass(*lib, Kind::Delassus),
                           ffsr_pass(crba_now),
                           ffsr_pass(mie_now)};
     if (r >= 0)
-      for (int i = 0; i < 15; ++i) row.t[i] = std::min(row.t[i], a[i]);
+      for (int i = 0; i < 18; ++i) row.t[i] = std::min(row.t[i], a[i]);
   }
-  row.t[0] = std::min(row.t[0], row.t[13]);  // ffsr timed twice a pass, at both ends
-  row.t[7] = std::min(row.t[7], row.t[14]);
+  row.t[0] = std::min(row.t[0], row.t[16]);  // ffsr timed twice a pass, at both ends
+  row.t[7] = std::min(row.t[7], row.t[17]);
   return row;
 }
 
@@ -209,22 +221,22 @@ constexpr bool kLibraryTimed = false;
 void print_tables(const std::vector<Row>& rows) {
   std::printf(
       "ns per call, minimum over 51 interleaved passes of the mean over the same 200 random poses "
-      "(thread CPU time); Pinocchio's templates instantiated at the bench's flags, \"library\" its "
-      "precompiled libpinocchio_default%s\n\n",
+      "(thread CPU time); Pinocchio's templates instantiated in this executable at its flags, "
+      "\"library\" its precompiled libpinocchio_default%s\n\n",
       kLibraryTimed ? "" : " (not in this build: the library columns time the templates again)");
   std::printf(
       "| robot | n | CRBA ffsr / Pinocchio | before | Pinocchio LOCAL / WORLD | LOCAL + sym | library | "
-      "M_ie ffsr | before | Pinocchio dense | Pinocchio Delassus | ffsr / better | library dense / "
-      "Delassus |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+      "M_ie ffsr / Pinocchio | before | Pinocchio dense LOCAL / WORLD | Minverse | Delassus | "
+      "library dense / Delassus |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   for (const Row& w : rows) {
     const double* t = w.t;
-    const double pc = std::min(t[2], t[3]), pm = std::min(t[9], t[10]);
+    const double pc = std::min(t[2], t[3]), pm = std::min({t[9], t[10], t[11], t[12]});
     std::printf(
-        "| %s | %d | %.0f / %.0f ns = %.2fx | %.0f | %.0f / %.0f | %.0f | %.0f | %.0f ns | %.0f | %.0f | "
-        "%.0f | %.2fx | %.0f / %.0f |\n",
+        "| %s | %d | %.0f / %.0f ns = %.2fx | %.0f | %.0f / %.0f | %.0f | %.0f | %.0f / %.0f ns = %.2fx | "
+        "%.0f | %.0f / %.0f | %.0f | %.0f | %.0f / %.0f |\n",
         w.name.c_str(), w.n, t[0] * 1e9, pc * 1e9, t[0] / pc, t[1] * 1e9, t[2] * 1e9, t[3] * 1e9, t[4] * 1e9,
-        std::min(t[5], t[6]) * 1e9, t[7] * 1e9, t[8] * 1e9, t[9] * 1e9, t[10] * 1e9, t[7] / pm, t[11] * 1e9,
-        t[12] * 1e9);
+        std::min(t[5], t[6]) * 1e9, t[7] * 1e9, pm * 1e9, t[7] / pm, t[8] * 1e9, t[9] * 1e9, t[10] * 1e9,
+        t[11] * 1e9, t[12] * 1e9, std::min(t[13], t[14]) * 1e9, t[15] * 1e9);
   }
   std::printf(
       "\n| robot | H - before | H - Pinocchio | M_ie - before | M_ie - Pinocchio dense | M_ie - Delassus | "

@@ -1,14 +1,17 @@
-// bench/bench_pinocchio_side.cpp -- Pinocchio's CRBA and three routes to u^T J_v M^-1 J_v^T u for
+// bench/bench_pinocchio_side.cpp -- Pinocchio's CRBA and four routes to u^T J_v M^-1 J_v^T u for
 // ffsr-bench-pinocchio. Compiled twice (bench/CMakeLists.txt): FFSR_BENCH_PIN_FACTORY names the
-// factory, make_pinocchio_inline (templates instantiated here) or make_pinocchio_library (the
-// precompiled libpinocchio_default's, PINOCCHIO_ENABLE_TEMPLATE_INSTANTIATION).
+// factory, make_pinocchio_inline (templates instantiated here, linked into the bench's executable) or
+// make_pinocchio_library (the precompiled libpinocchio_default's, PINOCCHIO_ENABLE_TEMPLATE_INSTANTIATION).
 #include "bench_pinocchio.hpp"
 
+#include <pinocchio/algorithm/aba.hpp>
+#include <pinocchio/algorithm/cholesky.hpp>
 #include <pinocchio/algorithm/crba.hpp>
 #include <pinocchio/algorithm/delassus.hpp>
 #include <pinocchio/algorithm/frames.hpp>
 #include <pinocchio/algorithm/jacobian.hpp>
 #include <pinocchio/multibody.hpp>
+#include <pinocchio/parsers/urdf.hpp>
 
 #include <stdexcept>
 
@@ -21,53 +24,38 @@ namespace {
 
 volatile double g_pin_sink = 0;
 
-pinocchio::JointIndex add_joint(pinocchio::Model& pm, pinocchio::JointIndex parent, const ffsr::Body& b) {
-  using pinocchio::SE3;
-  const SE3 placement(b.tree.R, b.tree.p);
-  const Eigen::Vector3d& a = b.joint.axis;
-  if (b.joint.type == ffsr::JointType::Prismatic)
-    return pm.addJoint(parent, pinocchio::JointModelPrismaticUnaligned(a), placement, b.joint.name);
-  if (a == Eigen::Vector3d::UnitX())
-    return pm.addJoint(parent, pinocchio::JointModelRX(), placement, b.joint.name);
-  if (a == Eigen::Vector3d::UnitY())
-    return pm.addJoint(parent, pinocchio::JointModelRY(), placement, b.joint.name);
-  if (a == Eigen::Vector3d::UnitZ())
-    return pm.addJoint(parent, pinocchio::JointModelRZ(), placement, b.joint.name);
-  return pm.addJoint(parent, pinocchio::JointModelRevoluteUnaligned(a), placement, b.joint.name);
-}
-
-pinocchio::Model build(const ffsr::Model& fm, int frame, pinocchio::FrameIndex& fid) {
-  using pinocchio::SE3;
-  if (fm.nb() != fm.n() + 1) throw std::runtime_error("pinocchio model: mimic joints are not mapped");
+/// The model as a Pinocchio user loads it: the URDF text, a free-flyer root joint.
+pinocchio::Model load(const std::string& urdf) {
   pinocchio::Model pm;
-  const int nb = fm.nb();
-  std::vector<pinocchio::JointIndex> jid(static_cast<size_t>(nb));
-  auto inertia = [](const ffsr::Inertia& in) { return pinocchio::Inertia(in.mass, in.com, in.I); };
-  jid[0] = pm.addJoint(0, pinocchio::JointModelFreeFlyer(), SE3::Identity(), "root");
-  pm.appendBodyToJoint(jid[0], inertia(fm.body(0).inertia), SE3::Identity());
-  for (int i = 1; i < nb; ++i) {
-    const ffsr::Body& b = fm.body(i);
-    jid[static_cast<size_t>(i)] = add_joint(pm, jid[static_cast<size_t>(b.parent)], b);
-    pm.appendBodyToJoint(jid[static_cast<size_t>(i)], inertia(b.inertia), SE3::Identity());
-  }
-  const ffsr::Frame& f = fm.frame(frame);
-  const pinocchio::JointIndex parent = jid[static_cast<size_t>(f.body)];
-  fid = pm.addFrame(pinocchio::Frame("ee_bench", parent, SE3(f.pose.R, f.pose.p), pinocchio::OP_FRAME));
-  if (pm.nv != 6 + fm.n()) throw std::runtime_error("pinocchio model: wrong size");
+  pinocchio::urdf::buildModelFromXML(urdf, pinocchio::JointModelFreeFlyer(), pm);
   return pm;
 }
 
 class Routes final : public PinocchioRoutes {
  public:
-  Routes(const ffsr::Model& fm, int frame, const std::vector<ffsr::BasePose>& base,
+  Routes(const std::string& urdf, const std::string& frame, const std::vector<ffsr::BasePose>& base,
          const std::vector<Eigen::VectorXd>& theta, const std::vector<Eigen::Vector3d>& dirs)
-      : pm_(build(fm, frame, fid_)), pd_(pm_), u_(dirs), J_(6, pm_.nv), llt_(pm_.nv), w_(pm_.nv), D_(3, 3),
-        n_(fm.n()) {
+      : pm_(load(urdf)), pd_(pm_), u_(dirs), J_(6, pm_.nv), w_(pm_.nv), D_(3, 3) {
+    if (!pm_.existFrame(frame)) throw std::runtime_error("pinocchio model: no frame " + frame);
+    fid_ = pm_.getFrameId(frame);
+    n_ = pm_.nv - 6;
     for (size_t k = 0; k < base.size(); ++k) {
+      if (theta[k].size() != n_) throw std::runtime_error("pinocchio model: wrong number of joints");
       Eigen::VectorXd qk(pm_.nq);
-      qk << base[k].position, base[k].orientation.coeffs(), theta[k];  // x y z, qx qy qz qw, joints
+      qk.head<7>() << base[k].position, base[k].orientation.coeffs();  // x y z, qx qy qz qw
+      // joint j's velocity index less the base's 6 is its coordinate: the URDF's joints in the same
+      // order as ffsr's on these serial robots (the agreement table checks it)
+      for (pinocchio::JointIndex j = 2; j < static_cast<pinocchio::JointIndex>(pm_.njoints); ++j) {
+        const auto& jm = pm_.joints[j];
+        const double angle = theta[k](jm.idx_v() - 6);
+        if (jm.nq() == 2)  // an unbounded revolute joint (URDF continuous): (cos q, sin q)
+          qk.segment<2>(jm.idx_q()) << std::cos(angle), std::sin(angle);
+        else
+          qk(jm.idx_q()) = angle;
+      }
       q_.push_back(qk);
     }
+    J_.setZero();
     // the 3-D contact at the frame, its quantities in the contact's axes (LOCAL)
     const pinocchio::Frame& f = pm_.frames[fid_];
     cm_.emplace_back(pinocchio::CONTACT_3D, pm_, f.parentJoint, f.placement, pinocchio::LOCAL);
@@ -75,26 +63,51 @@ class Routes final : public PinocchioRoutes {
   }
   double pass(Kind kind, int count) override;
   double inverse_effective_mass(Kind kind, int k) override {
-    return kind == Kind::Delassus ? delassus(k) : dense(k);
+    switch (kind) {
+      case Kind::DenseWorld:
+        return dense_world(k);
+      case Kind::Minverse:
+        return minverse(k);
+      case Kind::Delassus:
+        return delassus(k);
+      default:
+        return dense_local(k);
+    }
   }
-  Eigen::MatrixXd joint_block(int k) override {
-    pinocchio::crba(pm_, pd_, q_[static_cast<size_t>(k)]);
+  Eigen::MatrixXd joint_block(Kind kind, int k) override {
+    pinocchio::crba(pm_, pd_, q_[static_cast<size_t>(k)],
+                    kind == Kind::CrbaWorld ? pinocchio::Convention::WORLD : pinocchio::Convention::LOCAL);
     pd_.M.triangularView<Eigen::StrictlyLower>() = pd_.M.transpose().triangularView<Eigen::StrictlyLower>();
     return pd_.M.bottomRightCorner(n_, n_);
   }
 
  private:
-  double dense(int k) {
+  /// w^T M^-1 w = |D^-1/2 U^-1 w|^2 from the factorization M = U D U^T of data.M's upper triangle.
+  double factored_form() {
+    pinocchio::cholesky::decompose(pm_, pd_);
+    pinocchio::cholesky::Uiv(pm_, pd_, w_);
+    return w_.cwiseAbs2().dot(pd_.Dinv);
+  }
+  double dense_local(int k) {
     const auto uk = static_cast<size_t>(k);
-    pinocchio::crba(pm_, pd_, q_[uk]);
-    pd_.M.triangularView<Eigen::StrictlyLower>() = pd_.M.transpose().triangularView<Eigen::StrictlyLower>();
-    J_.setZero();
-    pinocchio::computeJointJacobians(pm_, pd_, q_[uk]);
-    pinocchio::updateFramePlacements(pm_, pd_);
+    pinocchio::crba(pm_, pd_, q_[uk], pinocchio::Convention::LOCAL);
+    pinocchio::computeFrameJacobian(pm_, pd_, q_[uk], fid_, pinocchio::LOCAL_WORLD_ALIGNED, J_);
+    w_.noalias() = J_.topRows<3>().transpose() * u_[uk];
+    return factored_form();
+  }
+  double dense_world(int k) {
+    const auto uk = static_cast<size_t>(k);
+    pinocchio::crba(pm_, pd_, q_[uk], pinocchio::Convention::WORLD);  // also data.J and data.oMi
     pinocchio::getFrameJacobian(pm_, pd_, fid_, pinocchio::LOCAL_WORLD_ALIGNED, J_);
     w_.noalias() = J_.topRows<3>().transpose() * u_[uk];
-    llt_.compute(pd_.M);
-    return w_.dot(llt_.solve(w_));
+    return factored_form();
+  }
+  double minverse(int k) {
+    const auto uk = static_cast<size_t>(k);
+    pinocchio::computeMinverse(pm_, pd_, q_[uk]);  // upper triangle
+    pinocchio::computeFrameJacobian(pm_, pd_, q_[uk], fid_, pinocchio::LOCAL_WORLD_ALIGNED, J_);
+    w_.noalias() = J_.topRows<3>().transpose() * u_[uk];
+    return w_.dot(pd_.Minv.selfadjointView<Eigen::Upper>() * w_);
   }
   double delassus(int k) {
     const auto uk = static_cast<size_t>(k);
@@ -106,18 +119,17 @@ class Routes final : public PinocchioRoutes {
     return uc.dot(D_ * uc);
   }
 
-  pinocchio::FrameIndex fid_ = 0;  // before pm_: build() writes it while pm_ is initialized
   pinocchio::Model pm_;
   pinocchio::Data pd_;
+  pinocchio::FrameIndex fid_ = 0;
+  Eigen::Index n_ = 0;
   std::vector<Eigen::VectorXd> q_;
   std::vector<Eigen::Vector3d> u_;
   pinocchio::Data::Matrix6x J_;
-  Eigen::LLT<Eigen::MatrixXd> llt_;
   Eigen::VectorXd w_;
   Eigen::MatrixXd D_;
   std::vector<pinocchio::RigidConstraintModel> cm_;
   std::vector<pinocchio::RigidConstraintData> cd_;
-  int n_ = 0;
 };
 
 double Routes::pass(Kind kind, int count) {
@@ -140,8 +152,14 @@ double Routes::pass(Kind kind, int count) {
       for (int k = 0; k < count; ++k)
         acc += pinocchio::crba(pm_, pd_, q_[static_cast<size_t>(k)], pinocchio::Convention::WORLD)(6, 6);
       break;
-    case Kind::Dense:
-      for (int k = 0; k < count; ++k) acc += dense(k);
+    case Kind::DenseLocal:
+      for (int k = 0; k < count; ++k) acc += dense_local(k);
+      break;
+    case Kind::DenseWorld:
+      for (int k = 0; k < count; ++k) acc += dense_world(k);
+      break;
+    case Kind::Minverse:
+      for (int k = 0; k < count; ++k) acc += minverse(k);
       break;
     case Kind::Delassus:
       for (int k = 0; k < count; ++k) acc += delassus(k);
@@ -155,9 +173,9 @@ double Routes::pass(Kind kind, int count) {
 }  // namespace
 
 __attribute__((visibility("default"))) std::unique_ptr<PinocchioRoutes> FFSR_BENCH_PIN_FACTORY(
-    const ffsr::Model& model, int frame, const std::vector<ffsr::BasePose>& base,
+    const std::string& urdf, const std::string& frame, const std::vector<ffsr::BasePose>& base,
     const std::vector<Eigen::VectorXd>& theta, const std::vector<Eigen::Vector3d>& u) {
-  return std::make_unique<Routes>(model, frame, base, theta, u);
+  return std::make_unique<Routes>(urdf, frame, base, theta, u);
 }
 
 }  // namespace ffsr_bench
