@@ -121,7 +121,8 @@ int run_detumble_command(const DetumbleCommandOptions& o) {
     results = detumble_runs(subject, build_scenario(subject.keys, &embedded), o.run);
     outputs.set("--json", detumble_runs_json(subject, results, FFSR_VERSION).dump(2) + "\n");
   }
-  if (!o.out.plot.empty()) plot::render({detumble_figure(subject, results)}, o.out.plot, plot_format);
+  if (!o.out.plot.empty())
+    outputs.stage(plot::draw({detumble_figure(subject, results)}, o.out.plot, plot_format));
   if (!o.out.csv.empty()) outputs.set("--csv", detumble_series_csv(subject, results));
   outputs.write();
   for (size_t i = 0; i < results.size(); ++i) {
