@@ -26,7 +26,8 @@ target carried by the gripper, the joints and the base following that series.
 From Python: ``ffsr.view.capture(result, "capture.html", series)`` where ``result`` is the job's
 result (an object with ``to_dict()``, or the dict of the command's ``--json``) and ``series`` the
 time series (a path to the ``--csv`` file, its text, or a mapping of its columns; by default
-``result.series``); it returns a :class:`CaptureView`, which Jupyter shows inline (the page in an
+``result.series``: an in-process run, ``ffsr.view.capture(ffsr.Scenario.load(path).run())``, carries
+its own, ``RunResult.series``); it returns a :class:`CaptureView`, which Jupyter shows inline (the page in an
 iframe), and writes the file when given a path. Bad input raises :class:`ViewInputError` naming
 the file (or argument); nothing is written then. This module needs the Python standard library only.
 """
@@ -565,7 +566,7 @@ def capture(result: Any, path: Optional[Union[str, os.PathLike]] = None, series:
     path: the HTML file to write (one self-contained file); None: nothing is written.
     result: the main job's result (an object with ``to_dict()``, or the dict of ``ffsr-optimize --json``).
     series: its time series: a path to the ``--csv`` file, the CSV text, or a mapping of its columns;
-        None: ``result.series`` (called when it is a method).
+        None: ``result.series`` (called when it is a method; ``Scenario.run()``'s RunResult has it).
     run: the run the page opens on (baseline, optimized, global; default: the last the result holds).
     frames: at most this many samples per run go into the page (evenly spread; the first, the last
         and the phase boundary always).

@@ -6,6 +6,8 @@
 
 #include <Python.h>
 
+#include <algorithm>
+#include <cmath>
 #include <vector>
 
 namespace ffsr::python {
@@ -58,6 +60,35 @@ AnyArray float64_array(nb::handle h, const char* where, const char* what) {
 }  // namespace
 
 std::string py_type_name(nb::handle h) { return nb::cast<std::string>(nb::str(h.type().attr("__name__"))); }
+
+double speed_arg(double x, const char* where, const char* what) {
+  if (!(std::isfinite(x) && x > 0))
+    throw InputError(str(where, ": ", what, " must be positive (m/s), got ", x));
+  return x;
+}
+
+std::string keyword_message(const std::string& message, const std::string& where,
+                            const std::vector<std::string>& keywords) {
+  if (message.rfind("--", 0) != 0) return message;
+  const size_t end = std::min(message.find_first_of(": "), message.size());
+  std::vector<std::string> names;  // the flags before the first ':' or ' ', "--a/--b", as keywords
+  for (size_t at = 0; at < end;) {
+    const size_t slash = std::min(message.find('/', at), end);
+    std::string n = message.substr(at, slash - at);
+    if (n.rfind("--", 0) != 0) return message;  // not a list of flags
+    n = n.substr(2);
+    for (char& c : n)
+      if (c == '-') c = '_';
+    names.push_back(n);
+    at = slash + 1;
+  }
+  bool keyword = false;
+  for (const std::string& n : names) keyword = keyword || std::count(keywords.begin(), keywords.end(), n) > 0;
+  if (!keyword) return message;
+  std::string text = where + ": ";
+  for (size_t i = 0; i < names.size(); ++i) text += (i == 0 ? "" : "/") + names[i];
+  return text + message.substr(end);
+}
 
 double number(nb::handle x, const char* where, const char* what) {
   if (!PyFloat_Check(x.ptr()) && !PyLong_Check(x.ptr()))

@@ -7,6 +7,8 @@
 #include "common.hpp"
 
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace ffsr::python {
 
@@ -58,6 +60,53 @@ Quaternion quat_xyzw(nb::handle h, const char* where, const char* what, Values v
 double number(nb::handle x, const char* where, const char* what);
 /// The name of a Python object's type, for messages.
 std::string py_type_name(nb::handle h);
+/// A speed argument (approach_speed): finite and positive, the main job's bound on the key
+/// approach-speed; else InputError "<where>: <what> must be positive (m/s), got <x>".
+double speed_arg(double x, const char* where, const char* what);
+
+/// A library message about flags ("--key: ..." or "--a/--b: ...") as the Python call's: when one of
+/// the flags is a keyword argument of the call (an underscore for a dash), "<where>: key: ..." with
+/// the keys as keywords; any other message unchanged.
+std::string keyword_message(const std::string& message, const std::string& where,
+                            const std::vector<std::string>& keywords);
+/// Calls `f()`; an InputError (a JointRateLimitError stays one) leaves with keyword_message's text.
+template <class F>
+decltype(auto) with_keyword_errors(const std::string& where, const std::vector<std::string>& keywords,
+                                   F&& f) {
+  try {
+    return std::forward<F>(f)();
+  } catch (const JointRateLimitError& e) {
+    throw JointRateLimitError(keyword_message(e.what(), where, keywords));
+  } catch (const InputError& e) {
+    throw InputError(keyword_message(e.what(), where, keywords));
+  }
+}
+
+namespace keyword_detail {
+template <class A>
+auto keyword_name(std::vector<std::string>& names, const A& a, int) -> decltype((void)a.name_, void()) {
+  if (a.name_) names.emplace_back(a.name_);
+}
+template <class A>
+void keyword_name(std::vector<std::string>&, const A&, long) {}
+
+template <class Fn, class R, class... A>
+auto with_keyword_errors_fn(std::string where, std::vector<std::string> keywords, Fn fn,
+                            R (Fn::*)(A...) const) {
+  return [where = std::move(where), keywords = std::move(keywords), fn = std::move(fn)](A... a) -> R {
+    return with_keyword_errors(where, keywords, [&]() -> R { return fn(std::forward<A>(a)...); });
+  };
+}
+}  // namespace keyword_detail
+
+/// `fn` (a lambda bound with the nanobind `extra`: its "name"_a arguments) whose InputError names
+/// the call's keyword arguments as keywords (keyword_message), not as the command's flags.
+template <class Fn, class... Extra>
+auto keyword_errors(const std::string& where, Fn fn, const Extra&... extra) {
+  std::vector<std::string> keywords;
+  (keyword_detail::keyword_name(keywords, extra, 0), ...);
+  return keyword_detail::with_keyword_errors_fn(where, std::move(keywords), std::move(fn), &Fn::operator());
+}
 
 /// The frame argument of the algorithms: None (the model's end-effector), an index or a frame name.
 int frame_arg(const Model& model, nb::handle frame, const char* where);

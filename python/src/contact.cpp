@@ -262,6 +262,7 @@ void bind_multibody_contact(nb::module_& m) {
          nb::handle armature, double rtol, double max_duration) {
         const char* w = "simulate_contact";
         const VecIn th(theta, w, "theta");
+        speed_arg(approach_speed, w, "approach_speed");
         MultibodyContactOptions o;
         o.record_series = record_series;
         o.rtol = rtol;

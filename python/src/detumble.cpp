@@ -273,6 +273,7 @@ void bind_contact_grasp(nb::module_& m) {
          double approach_speed, const ContactParams& params, const std::string& law) {
         const VecIn th(theta, "grasp_after_contact", "theta");
         th.require(model.n());
+        speed_arg(approach_speed, "grasp_after_contact", "approach_speed");
         const int f = frame_arg(model, frame, "grasp_after_contact");
         const Eigen::VectorXd q = th.map();
         nb::gil_scoped_release release;
@@ -320,7 +321,7 @@ void bind_detumble(nb::module_& m) {
         const VecIn th(theta, "grasp_at_capture", "theta");
         th.require(model.n());
         return grasp_at_capture(model, frame_arg(model, frame, "grasp_at_capture"), base, th.map(), target,
-                                approach_speed);
+                                speed_arg(approach_speed, "grasp_at_capture", "approach_speed"));
       },
       "model"_a, "frame"_a = nb::none(), "base"_a, "theta"_a, "target"_a, "approach_speed"_a,
       "The grasp at the end of the approach (contact point moving at approach_speed along the normal\n"

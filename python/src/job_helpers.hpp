@@ -3,6 +3,7 @@
 // to_dict() and to_json(), and the job is a method of ffsr.Scenario.
 #pragma once
 
+#include "arguments.hpp"
 #include "outputs.hpp"
 
 #include "ffsr/scenario/scenario.hpp"
@@ -51,12 +52,14 @@ nb::class_<Run> job_result_class(nb::module_& m, const char* name, const char* d
   return c;
 }
 
-/// Adds `fn` as the method `name` of ffsr.Scenario (bound before the jobs, by bind_scenario).
+/// Adds `fn` as the method `name` of ffsr.Scenario (bound before the jobs, by bind_scenario). An
+/// error about one of its keyword arguments names the keyword ("Scenario.detumble: run: ...").
 template <class Fn, class... Extra>
 void def_scenario_method(const char* name, Fn&& fn, const Extra&... extra) {
   nb::handle scenario = nb::type<Scenario>();
   scenario.attr(name) =
-      nb::cpp_function(std::forward<Fn>(fn), nb::is_method(), nb::name(name), nb::scope(scenario), extra...);
+      nb::cpp_function(keyword_errors(std::string("Scenario.") + name, std::forward<Fn>(fn), extra...),
+                       nb::is_method(), nb::name(name), nb::scope(scenario), extra...);
 }
 
 /// (key, value) given to a job as the command's flags; no value: the scenario's.

@@ -11,7 +11,9 @@
 #include <nanobind/stl/optional.h>
 #include <nanobind/stl/vector.h>
 
+#include <cstdlib>
 #include <sstream>
+#include <string>
 
 namespace ffsr::python {
 namespace {
@@ -42,8 +44,41 @@ std::string flag_text(nb::handle v, const std::string& key) {
   return number(v);
 }
 
-/// The main job's result and its JSON (the command's --json), made together.
-using RunResult = JobRun<ScenarioResult>;
+/// The main job's result and its JSON (the command's --json), made together, with its time series as
+/// the command's --csv writes it (made from the same result).
+struct RunResult : JobRun<ScenarioResult> {
+  std::string series_csv;
+};
+
+/// The columns of a CSV (the main job's series): {name: numpy array} for the numbers, {name: list of
+/// str} for the text columns `run` and `phase`; every value as the CSV writes it.
+nb::dict csv_columns(const std::string& text) {
+  std::vector<std::vector<std::string>> rows;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) {
+    if (line.empty()) continue;
+    std::vector<std::string>& row = rows.emplace_back();
+    std::istringstream fields(line);
+    for (std::string f; std::getline(fields, f, ',');) row.push_back(f);
+  }
+  nb::dict d;
+  if (rows.empty()) return d;
+  const std::vector<std::string>& header = rows.front();
+  const size_t n = rows.size() - 1;
+  for (size_t c = 0; c < header.size(); ++c) {
+    if (header[c] == "run" || header[c] == "phase") {
+      nb::list texts;
+      for (size_t i = 1; i <= n; ++i) texts.append(nb::str(rows[i].at(c).c_str()));
+      d[header[c].c_str()] = texts;
+    } else {
+      double* data = nullptr;
+      NewArray a = new_array(n, &data);
+      for (size_t i = 1; i <= n; ++i) data[i - 1] = std::strtod(rows[i].at(c).c_str(), nullptr);
+      d[header[c].c_str()] = a;
+    }
+  }
+  return d;
+}
 
 /// A run of the main job that holds a result, else None.
 std::optional<CaptureResult> run_or_none(bool ok, const CaptureResult& run) {
@@ -105,7 +140,15 @@ void bind_run_result(nb::module_& m) {
               d[x.run.c_str()] = nb::cast(x.result, nb::rv_policy::copy);
             return d;
           },
-          "Each run's post-capture phase with a Detumble key, {run: DetumbleResult}; else empty.");
+          "Each run's post-capture phase with a Detumble key, {run: DetumbleResult}; else empty.")
+      .def(
+          "series_csv", [](const RunResult& r) { return r.series_csv; },
+          "The time series of every run as the command's --csv writes it (run, t, joint angles, the base's,\n"
+          "the target's and every body's pose, M_ie, the F_max estimate, phase).")
+      .def_prop_ro(
+          "series", [](const RunResult& r) { return csv_columns(r.series_csv); },
+          "The columns of series_csv(): {name: numpy array}, the text columns run and phase as lists of\n"
+          "str. ffsr.view.capture(result) draws the run from them.");
 }
 
 void bind_scenario(nb::module_& m) {
@@ -117,14 +160,18 @@ void bind_scenario(nb::module_& m) {
           "load",
           [](const std::string& path, nb::kwargs overrides) {
             ScenarioKeys keys = read_scenario_file(path);
-            for (auto [k, v] : overrides) {
-              std::string key = nb::cast<std::string>(k);
-              for (char& c : key)
-                if (c == '_') c = '-';
-              if (!find_scenario_key(key)) throw InputError(str("--", key, ": not a scenario key"));
-              override_scenario_key(keys, key, flag_text(v, key));
-            }
-            return std::make_unique<Scenario>(build_scenario(std::move(keys)));
+            std::vector<std::string> keywords;  // an error about one names the keyword, not the flag
+            for (auto [k, v] : overrides) keywords.push_back(nb::cast<std::string>(k));
+            return with_keyword_errors("Scenario.load", keywords, [&] {
+              for (auto [k, v] : overrides) {
+                std::string key = nb::cast<std::string>(k);
+                for (char& c : key)
+                  if (c == '_') c = '-';
+                if (!find_scenario_key(key)) throw InputError(str("--", key, ": not a scenario key"));
+                override_scenario_key(keys, key, flag_text(v, key));
+              }
+              return std::make_unique<Scenario>(build_scenario(std::move(keys)));
+            });
           },
           "path"_a, "overrides"_a,
           "Reads and validates a scenario file. A keyword overrides the key of the same name, as the "
@@ -147,15 +194,18 @@ void bind_scenario(nb::module_& m) {
           [](const Scenario& sc) {
             return run_job<RunResult>([&sc](RunResult& r) {
               ScenarioRunOptions o;
-              o.keep_going = true;  // as the command: a failed plain or paper's-method row is reported
+              o.keep_going = true;     // as the command: a failed plain or paper's-method row is reported
+              o.record_series = true;  // the series of the command's --csv (RunResult.series)
               r.result = run_whole_capture(sc, o);  // with a Detumble key: each run's post-capture phase
               r.json = scenario_json(sc, r.result, FFSR_VERSION).dump();
+              r.series_csv = scenario_series_csv(sc, r.result);
             });
           },
           "The main job (ffsr-optimize --config FILE): the plain run, the paper's method (Eq. 29-31) and, "
           "unless\n"
           "global = false, the global run; M_ie (Eq. 14) and the peak force (Eq. 24, Eq. 16) of each;\n"
-          "with a Detumble key, each run's post-capture phase (RunResult.post_capture).");
+          "with a Detumble key, each run's post-capture phase (RunResult.post_capture); the time series\n"
+          "of the command's --csv (RunResult.series, series_csv()): ffsr.view.capture(scenario.run()).");
 }
 
 }  // namespace ffsr::python

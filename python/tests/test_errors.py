@@ -155,3 +155,46 @@ def test_overflow_from_finite_values_is_a_numerical_error():
     # finite values still answer: u . (v_e - omega_t x r) with (omega_t x r)_x = -omega_z r_y
     assert ffsr.approach_velocity([1, 0, 0], [0.2, 0, 0], [0, 0, 0], [0, 0, 0.03], [-0.25, 0.15, 0]) == \
         pytest.approx(0.2 + 0.03 * 0.15, rel=1e-15)
+
+
+def test_an_approach_speed_is_positive_in_every_call(robot):
+    """The main job's bound on approach-speed (positive, finite) in the calls that take a speed, each
+    naming itself and its argument."""
+    model, _ = robot
+    theta = np.radians([0.0, 90.0, -90.0])
+    target = ffsr.Target()
+    for bad, shown in ((0.0, "0"), (-0.2, "-0.2"), (float("nan"), "nan"), (float("inf"), "inf")):
+        with pytest.raises(ffsr.InputError, match=rf"^grasp_at_capture: approach_speed must be positive \(m/s\), "
+                                                  rf"got {shown}$"):
+            ffsr.grasp_at_capture(model, None, ffsr.BasePose(), theta, target, bad)
+        with pytest.raises(ffsr.InputError, match=rf"^grasp_after_contact: approach_speed must be positive"):
+            ffsr.grasp_after_contact(model, None, ffsr.BasePose(), theta, target, bad)
+        with pytest.raises(ffsr.InputError, match=rf"^simulate_contact: approach_speed must be positive"):
+            ffsr.simulate_contact(model, ffsr.BasePose(), theta, approach_speed=bad)
+    # as a scenario key: Scenario.load's keyword, named as the keyword
+    with pytest.raises(ffsr.InputError, match=r"^Scenario\.load: approach_speed: must be positive, got -0\.2$"):
+        ffsr.Scenario.load(str(ROBOTS / "paper_3dof.toml"), approach_speed=-0.2)
+    assert ffsr.grasp_at_capture(model, None, ffsr.BasePose(), theta, target, 0.2) is not None
+
+
+def test_an_error_names_the_python_argument():
+    """A job's or Scenario.load's keyword at fault is named as the keyword (an underscore for a dash),
+    after the call, not as the command's flag."""
+    scenario = str(ROBOTS / "paper_3dof.toml")
+    with pytest.raises(ffsr.InputError,
+                       match=r"^Scenario\.detumble: run: expected plain, optimized, global or all, got 'nope'$"):
+        ffsr.Scenario.load(scenario).detumble(run="nope")
+    with pytest.raises(ffsr.InputError, match=r"^Scenario\.load: stop_stack_spin: expected true or false, got 'yes'$"):
+        ffsr.Scenario.load(scenario, stop_stack_spin="yes")
+    with pytest.raises(ffsr.InputError, match=r"^Scenario\.load: stop_stack_spin: expected true or false, got '1'$"):
+        ffsr.Scenario.load(scenario, stop_stack_spin=1)
+    with pytest.raises(ffsr.InputError, match=r"^Scenario\.load: global: expected true or false, got 'on'$"):
+        ffsr.Scenario.load(scenario, **{"global": "on"})
+    # a keyword with a key of the file: both named as keywords, not located at the file's line of the other
+    with pytest.raises(ffsr.InputError, match=r"^Scenario\.load: target_mass/target_inertia: "):
+        ffsr.Scenario.load(scenario, target_inertia=[1, 1, 5])
+    with pytest.raises(ffsr.InputError, match=r"^Scenario\.load: joint_torque_limit: "):
+        ffsr.Scenario.load(scenario, joint_torque_limit="strong")
+    with pytest.raises(ffsr.InputError, match=r"^Scenario\.load: no_such_key: not a scenario key$"):
+        ffsr.Scenario.load(scenario, no_such_key=1)
+    assert ffsr.Scenario.load(scenario, stop_stack_spin=True) is not None  # the words themselves

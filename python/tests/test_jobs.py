@@ -6,6 +6,8 @@ wall-clock time.
 The command is the one of the C++ build: $FFSR_OPTIMIZE, else build-ci/ or build/ of the repository;
 the tests skip with a message when none is built."""
 
+import csv
+import io
 import json
 import math
 import os
@@ -77,6 +79,34 @@ def test_run_equals_the_command(tmp_path, name):
     assert result.optimized.M_ie == got["optimized"]["integrated_effective_mass"]
 
 
+def test_run_series_equals_the_command_csv(tmp_path):
+    """RunResult.series holds the columns of the command's --csv (the arrays the 3-D view draws), every
+    number to 1e-12; each run's last sample is that run's capture configuration."""
+    scenario = ROBOTS / "paper_3dof.toml"
+    out = tmp_path / "series.csv"
+    subprocess.run([command(), "--config", str(scenario), "--quiet", "--csv", str(out)], check=True, timeout=900)
+    lines = list(csv.reader(io.StringIO(out.read_text())))
+    header, rows = lines[0], lines[1:]
+    result = ffsr.Scenario.load(str(scenario)).run()
+    series = result.series
+    assert list(series) == header
+    for i, name in enumerate(header):
+        column = series[name]
+        assert len(column) == len(rows), name
+        if name in ("run", "phase"):
+            assert list(column) == [r[i] for r in rows], name
+        else:
+            assert isinstance(column, np.ndarray) and column.dtype == np.float64, name
+            np.testing.assert_allclose(column, [float(r[i]) for r in rows], rtol=1e-12, atol=1e-12, err_msg=name)
+    assert result.series_csv() == out.read_text()
+    joints = [h for h in header if h.endswith("_deg")]
+    runs = np.array(series["run"])
+    for label, run in (("baseline", result.plain), ("optimized", result.optimized), ("global", result.global_run)):
+        last = np.flatnonzero(runs == label)[-1]
+        np.testing.assert_allclose([series[j][last] for j in joints], np.degrees(run.theta), rtol=0, atol=1e-9)
+        assert series["t"][last] == pytest.approx(result.to_dict()["scene"]["capture_time"], rel=1e-12)
+
+
 def test_run_with_post_capture_equals_the_command_and_the_detumble_job(tmp_path):
     """The main job of a scenario with Detumble keys: each run's post_capture is the command's, and the
     figures of Scenario.detumble(run='all') (a separate run), to the bit."""
@@ -145,7 +175,7 @@ def test_contact_every_law_and_joint_model(tmp_path):
     assert differences(got, expected) == []
     assert [r.model for r in result.rows] == [law["model"] for law in got["laws"]]
     assert all(r.series.shape[0] > 10 and r.series.shape[1] == 3 for r in result.rows)
-    with pytest.raises(ffsr.InputError, match="--model"):
+    with pytest.raises(ffsr.InputError, match=r"^Scenario\.contact: model: "):
         ffsr.Scenario.load(str(scenario)).contact(model="hertz-nonsense")
 
 
@@ -169,9 +199,9 @@ def test_closed_loop_flags_equal_the_keywords(tmp_path):
                                                            spin_noise_deg=0.1, noise_seed=7, prediction_window=3,
                                                            control_rate=500)
     assert differences(result.to_dict(), expected) == []
-    with pytest.raises(ffsr.InputError, match="--control-rate: must be positive and finite"):
+    with pytest.raises(ffsr.InputError, match=r"^Scenario\.closed_loop: control_rate: must be positive and finite"):
         ffsr.Scenario.load(str(scenario)).closed_loop(control_rate=0.0)
-    with pytest.raises(ffsr.InputError, match="--plan: expected paper or global"):
+    with pytest.raises(ffsr.InputError, match=r"^Scenario\.closed_loop: plan: expected paper or global"):
         ffsr.Scenario.load(str(scenario)).closed_loop(plan="best")
 
 
@@ -200,7 +230,7 @@ def test_robust_given_configuration_equals_the_command(tmp_path):
     assert differences(got.to_dict(), expected) == []
     with pytest.raises(ffsr.InputError, match="no \\[uncertainty\\] table"):
         ffsr.Scenario.load(str(ROBOTS / "paper_3dof.toml")).robust()
-    with pytest.raises(ffsr.InputError, match="--force-model"):
+    with pytest.raises(ffsr.InputError, match=r"^Scenario\.robust: force_model: "):
         ffsr.Scenario.load(str(scenario)).robust(force_model="fast", capture_joints_deg=joints)
 
 
@@ -213,7 +243,7 @@ def test_pareto_equals_the_command(tmp_path, name):
     assert differences(got, expected) == []  # but the search's wall-clock time (seconds)
     assert result.knee.M_ie == got["knee"]["integrated_effective_mass"]
     assert len(result.front) == len(got["front"])
-    with pytest.raises(ffsr.InputError, match="--levels: must be >= 1"):
+    with pytest.raises(ffsr.InputError, match=r"^Scenario\.pareto: levels: must be >= 1"):
         ffsr.Scenario.load(str(scenario)).pareto(levels=0)
 
 
@@ -229,7 +259,7 @@ def test_run_with_post_capture_constraints_equals_the_command(tmp_path):
     # the same capture's post-capture figures under the two names: the constraints' and the run's
     assert (got["global"]["post_capture_constraints"]["peak_joint_torque"] ==
             got["global"]["post_capture"]["peak_joint_torque"])
-    with pytest.raises(ffsr.InputError, match="--max-peak-joint-torque: must be positive"):
+    with pytest.raises(ffsr.InputError, match=r"^Scenario\.load: max_peak_joint_torque: must be positive"):
         ffsr.Scenario.load(str(scenario), max_peak_joint_torque=-1)
 
 
@@ -249,7 +279,7 @@ def test_pareto_post_capture_axis_equals_the_command(tmp_path):
     assert all(a["integrated_effective_mass"] < b["integrated_effective_mass"] and a["value"] > b["value"]
                for a, b in zip(front, front[1:]))
     assert result.front_csv().splitlines()[0].startswith("index,M_ie_kg,time_to_rest_s,")
-    with pytest.raises(ffsr.InputError, match="--axis: expected"):
+    with pytest.raises(ffsr.InputError, match=r"^Scenario\.pareto: axis: expected"):
         ffsr.Scenario.load(str(scenario)).pareto(axis="torque")
 
 
@@ -300,17 +330,17 @@ def test_map_shard_joint_model_and_threads(tmp_path):
 
 def test_map_bad_input():
     sc = ffsr.Scenario.load(str(ROBOTS / "paper_3dof.toml"))
-    with pytest.raises(ffsr.InputError, match="--vary: joint 4 is not one of 1..3"):
+    with pytest.raises(ffsr.InputError, match=r"^Scenario\.map: vary: joint 4 is not one of 1\.\.3"):
         sc.map([4])
-    with pytest.raises(ffsr.InputError, match="--vary: joint 1 is given twice"):
+    with pytest.raises(ffsr.InputError, match=r"^Scenario\.map: vary: joint 1 is given twice"):
         sc.map([1, 1])
-    with pytest.raises(ffsr.InputError, match="--range-deg: the range of joint 1 is inverted"):
+    with pytest.raises(ffsr.InputError, match=r"^Scenario\.map: range_deg: the range of joint 1 is inverted"):
         sc.map([1], range_deg=[10, 5])
-    with pytest.raises(ffsr.InputError, match="--range-deg: expected 2 numbers, got 3"):
+    with pytest.raises(ffsr.InputError, match=r"^Scenario\.map: range_deg: expected 2 numbers, got 3"):
         sc.map([1], range_deg=[1, 2, 3])
-    with pytest.raises(ffsr.InputError, match="--step-deg: the step must be positive"):
+    with pytest.raises(ffsr.InputError, match=r"^Scenario\.map: step_deg: the step must be positive"):
         sc.map([1], step_deg=[float("nan")])
-    with pytest.raises(ffsr.InputError, match="--max-points: the grid has 27000 points"):
+    with pytest.raises(ffsr.InputError, match=r"^Scenario\.map: max_points: the grid has 27000 points"):
         sc.map([1, 2, 3], step_deg=[12], max_points=100)
     with pytest.raises(ffsr.InputError, match="--shard: K must be less than N"):
         sc.map([1], shard_k=3, shard_n=3)

@@ -294,6 +294,33 @@ def test_capture_from_a_result_object_with_its_series(paper_3dof, tmp_path):
     assert (tmp_path / "columns.html").stat().st_size > 600_000  # three.js is in the file
 
 
+def test_page_of_an_in_process_run(paper_3dof, tmp_path):
+    """ffsr.view.capture(Scenario.run()): the run's series comes with its result (RunResult.series), no
+    file of the command; the page draws the three runs as the one made from the command's files."""
+    ffsr = pytest.importorskip("ffsr")
+    if not hasattr(ffsr, "Scenario"):
+        pytest.skip("the extension ffsr._ffsr is not built")
+    result = ffsr.Scenario.load(str(ROBOTS / "paper_3dof.toml")).run()
+    html = tmp_path / "in_process.html"
+    assert view.capture(result, html).path == html
+    page = open_page(html, tmp_path / "in_process.png")
+    assert page.console == [], page.console
+    s = page.summary()
+    assert s["ready"] is True and s["errors"] == [], s
+    assert s["runs"] == ["baseline", "optimized", "global"] and s["run"] == "global"
+    assert s["time"] == pytest.approx(result.to_dict()["scene"]["capture_time"])
+    variance, colours = grey_statistics(page.png, (330, 200, 1000, 700))
+    assert variance > 30 and colours > 50, (variance, colours)
+    # the frames are the command's: the same samples of the same series
+    command_result, command_series = paper_3dof
+    mine = view.page_data(result, result.series, frames=50)
+    theirs = view.page_data(json.loads(command_result.read_text()), command_series, frames=50)
+    assert [r["name"] for r in mine["runs"]] == [r["name"] for r in theirs["runs"]]
+    for a, b in zip(mine["runs"], theirs["runs"]):
+        for key in ("t", "base", "bodies", "target", "ee"):
+            assert a[key] == b[key], (a["name"], key)
+
+
 # --- bad input: one line naming the file, exit 2, nothing written --------------------------------------
 
 

@@ -5,6 +5,7 @@
 #include "support/output.hpp"
 #include "support/parse.hpp"
 #include "support/progress.hpp"
+#include "support/scenario_flags.hpp"
 #include "support/subject.hpp"
 #include "commands/subcommands.hpp"
 
@@ -75,6 +76,7 @@ int main(int argc, char** argv) {
   register_closed_loop(app, action);
   register_detumble(app, action);
   register_run(app, action);
+  refuse_untaken_scenario_keys(app);  // a key's flag on a subcommand that does not take it: why
   app.require_subcommand(0, 1);
   try {
     app.parse(argc, argv);

@@ -752,3 +752,157 @@ TEST_CASE("conventions: a row of the main job says which keys of the scenario it
   CHECK(front.at("runs").at("optimized").at("keys_not_applied").get<V>() == global_keys);
   CHECK(front.at("runs").at("global").at("keys_not_applied").get<V>().empty());
 }
+
+namespace test_conventions {
+
+/// One error line (the command's prefix) that holds every string of `parts`; the refusal of `flag`.
+void check_refusal(const CommandResult& r, const std::vector<std::string>& parts) {
+  INFO("exit " << r.exit_code << "\nstdout: [" << r.out.substr(0, 200) << "]\nstderr: [" << r.err << "]");
+  CHECK(r.exit_code == 2);
+  CHECK(r.err.rfind("ffsr-optimize: error: ", 0) == 0);
+  CHECK(std::count(r.err.begin(), r.err.end(), '\n') == 1);
+  CHECK(r.out.empty());
+  for (const std::string& p : parts) {
+    INFO("the error must say: " << p);
+    CHECK(r.err.find(p) != std::string::npos);
+  }
+}
+
+/// The built-in 3-DOF scenario as a file in `dir` (its URDF by absolute path), with `extra` appended;
+/// `line`: the line number of the first appended line.
+std::string scenario_with(const ffsr::test::TempDir& dir, const std::string& extra, long* line = nullptr) {
+  std::string toml = ffsr::test::read_file(kSource + "/robots/paper_3dof.toml");
+  toml = std::regex_replace(toml, std::regex("urdf = \"paper_3dof.urdf\""), "urdf = \"" + kUrdf3 + "\"");
+  if (!toml.empty() && toml.back() != '\n') toml += "\n";
+  if (line) *line = std::count(toml.begin(), toml.end(), '\n') + 1;
+  const std::string file = dir.str() + "/s.toml";
+  std::ofstream(file) << toml << extra;
+  return file;
+}
+
+}  // namespace test_conventions
+
+TEST_CASE("conventions: a boolean is true or false, nothing else, as a flag or in a file",
+          "[cli][conventions]") {
+  ffsr::test::TempDir tmp;
+  for (const std::string bad : {"yes", "on", "y", "TRUE", "1", "t", "no", "0", "False"}) {
+    INFO(bad);
+    // the flags of boolean keys, on the subcommands that take them; nothing is written
+    const Args flag{"detumble", "--joint-torque-limit", "20", "--stop-stack-spin", bad, "--json", "d.json"};
+    check_refusal(cli(flag, tmp.str()),
+                  {"--stop-stack-spin: expected true or false, got '" + bad + "'"});
+    check_refusal(cli({"--global", bad, "--json", "r.json"}, tmp.str()),
+                  {"--global: expected true or false, got '" + bad + "'"});
+    check_refusal(cli({"inspect", "--quiet=" + bad, "--json", "i.json"}, tmp.str()),
+                  {"--quiet", "expected true or false, got '" + bad + "'"});
+    CHECK(tmp.entries().empty());
+  }
+  // the words themselves work: true and false, and --quiet alone
+  for (const std::string quiet : {"--quiet=true", "--quiet=false", "--quiet"}) {
+    const Args a{"inspect", quiet, "--json", "-"};
+    const CommandResult r = cli(a);
+    INFO(r.err);
+    CHECK(r.exit_code == 0);
+  }
+  // in a file: TOML's true and false only (not 1, not the text "yes" or "true")
+  for (const std::string bad : {"1", "\"yes\"", "\"true\"", "0"}) {
+    long line = 0;
+    const std::string file = scenario_with(tmp, "stop-stack-spin = " + bad + "\n", &line);
+    INFO(bad);
+    const std::string where = "scenario " + file + ":" + std::to_string(line);
+    check_refusal(cli({"detumble", "--config", file, "--joint-torque-limit", "20"}),
+                  {where + ": stop-stack-spin: expected true or false"});
+    if (bad == "\"true\"") continue;  // a command key of the file (quiet) is read as text, "true" is true
+    const std::string quiet = scenario_with(tmp, "quiet = " + bad + "\n", &line);
+    check_refusal(cli({"inspect", "--config", quiet}), {"quiet", "expected true or false"});
+  }
+  const std::string good = scenario_with(tmp, "stop-stack-spin = true\nglobal = false\n");
+  const CommandResult r =
+      cli({"detumble", "--config", good, "--joint-torque-limit", "20", "--json", "-", "--quiet"});
+  INFO(r.err);
+  CHECK(r.exit_code == 0);
+}
+
+TEST_CASE("conventions: a scenario key's flag on a subcommand that does not take it is refused saying why",
+          "[cli][conventions]") {
+  // every subcommand knows every key's flag: where it does not take one, one line names the flag, the
+  // subcommand and the jobs that take it (not the parser's "arguments were not expected")
+  int refusals = 0;
+  for (const Sub& sub : subcommands()) {
+    if (sub.name.empty()) continue;  // the main job takes every key
+    const std::set<std::string> accepted = accepted_flags(sub.name);
+    for (const ffsr::ScenarioKey& key : ffsr::scenario_keys()) {
+      const std::string flag = "--" + key.name;
+      if (accepted.count(flag)) continue;
+      if (key.name != "joint-torque-limit" && key.name != "base-position" && key.name != "stiffness" &&
+          key.name != "global" && key.name != "target-shape")
+        continue;  // a few keys of several groups (the walk above runs them all)
+      Args a{sub.name, flag, key.kind == ffsr::KeyKind::Boolean ? "true" : "1"};
+      const CommandResult r = cli(a);
+      INFO(sub.name << " " << flag);
+      check_refusal(r, {flag + ": ", "(the subcommand " + sub.name + " does not take it; ", "the main job"});
+      CHECK(r.err.find("not expected") == std::string::npos);
+      ++refusals;
+    }
+  }
+  CHECK(refusals >= 10);
+  // the reason of a key a subcommand leaves out of a group it takes
+  check_refusal(cli({"map", "--vary", "1", "--base-position", "1,0,0"}),
+                {"--base-position: M_ie and F_max do not depend on where the base is (the subcommand map"});
+  check_refusal(cli({"inspect", "--joint-torque-limit", "20"}),
+                {"--joint-torque-limit: a key of the post-capture phase, which inspect does not evaluate",
+                 "detumble"});
+}
+
+TEST_CASE("conventions: the approach speed is positive in every subcommand, named as the flag or the key",
+          "[cli][conventions]") {
+  ffsr::test::TempDir tmp;
+  for (const std::string bad : {"-0.2", "0"}) {
+    for (const Args& a : {Args{"detumble", "--joint-torque-limit", "20"},
+                          Args{"detumble", "--joint-torque-limit", "20", "--grasp-after", "contact"},
+                          Args{"inspect"}, Args{"contact"}, Args{"map", "--vary", "1", "--step-deg", "90"},
+                          Args{"--global", "false"}}) {
+      Args args = a;
+      args.insert(args.end(), {"--approach-speed=" + bad, "--json", "out.json"});
+      const CommandResult r = cli(args, tmp.str());
+      INFO(args[0] << " " << bad);
+      check_refusal(r, {"--approach-speed: must be positive, got " + (bad == "0" ? std::string("0") : bad)});
+      CHECK(r.err.find("--grasp-after") == std::string::npos);
+      CHECK(tmp.entries().empty());
+    }
+  }
+  std::string toml = ffsr::test::read_file(kSource + "/robots/paper_3dof.toml");
+  toml = std::regex_replace(toml, std::regex("urdf = \"paper_3dof.urdf\""), "urdf = \"" + kUrdf3 + "\"");
+  toml = std::regex_replace(toml, std::regex("approach-speed = 0.2"), "approach-speed = -0.2");
+  const std::string file = tmp.str() + "/neg.toml";
+  std::ofstream(file) << toml;
+  const long line = 23;  // approach-speed's line in robots/paper_3dof.toml
+  for (const Args& a :
+       {Args{"detumble", "--config", file, "--joint-torque-limit", "20", "--grasp-after", "contact"},
+        Args{"inspect", "--config", file}})
+    check_refusal(cli(a), {"scenario " + file + ":" + std::to_string(line) +
+                           ": approach-speed: must be positive"});
+}
+
+TEST_CASE("conventions: a flag at fault is named as the flag, not located at the line of another key",
+          "[cli][conventions]") {
+  // target-mass comes from the file, the flag gives a non-physical inertia (1 + 1 < 5): the error is
+  // the flag's, not "scenario FILE:10: target-mass"
+  ffsr::test::TempDir tmp;
+  const std::string file = scenario_with(tmp, "");
+  for (const Args& a : {Args{"--config", file, "--global", "false", "--target-inertia", "1,1,5"},
+                        Args{"inspect", "--config", file, "--target-inertia", "1,1,5"}}) {
+    const CommandResult r = cli(a);
+    check_refusal(r, {"error: --target-mass/--target-inertia: "});
+    CHECK(r.err.find(file + ":") == std::string::npos);
+  }
+  // the same inertia in the file: located at the file's line of target-mass (10), the keys named as
+  // written there
+  std::string toml = ffsr::test::read_file(file);
+  toml = std::regex_replace(toml, std::regex("target-inertia = \\[100, 100, 100\\]"),
+                            "target-inertia = [1, 1, 5]");
+  const std::string bad = tmp.str() + "/bad.toml";
+  std::ofstream(bad) << toml;
+  const CommandResult r = cli({"inspect", "--config", bad});
+  check_refusal(r, {"scenario " + bad + ":10: target-mass/target-inertia: "});
+}

@@ -356,7 +356,137 @@ TEST_CASE("a reader that closed the pipe: exit 2 with one line, not a crash", "[
 }
 
 // ------------------------------------------------------------------------------------------------
-// 4. regression runs: --expect BASELINE.json
+// 4. one transaction: the figures, the JSON and the CSV appear together or not at all
+// ------------------------------------------------------------------------------------------------
+
+namespace {
+
+/// The built-in 3-DOF scenario with an [uncertainty] table (robust's input), written into `dir`.
+std::string uncertain_scenario(const TempDir& dir) {
+  std::string toml = read_file(kSource + "/robots/paper_3dof.toml");
+  const std::string from = "urdf = \"paper_3dof.urdf\"";
+  const size_t at = toml.find(from);
+  REQUIRE(at != std::string::npos);
+  toml.replace(at, from.size(), "urdf = \"" + kUrdf3 + "\"");
+  const std::string path = dir / "uncertain.toml";
+  write_text(path, toml + "\n[uncertainty]\nsamples = 4\nseed = 3\n"
+                          "target-mass = { law = \"uniform\", relative = 0.1 }\n");
+  return path;
+}
+
+/// Every subcommand that draws (--plot), with a small run of it on the built-in 3-DOF scenario.
+std::vector<std::pair<std::string, Args>> drawing_runs(const TempDir& inputs) {
+  return {{"main job", {"--global", "false"}},
+          {"detumble", {"detumble", "--joint-torque-limit", "20"}},
+          {"xi", {"xi", "--points", "3"}},
+          {"contact", {"contact"}},
+          {"map", {"map", "--vary", "1", "--step-deg", "90"}},
+          {"robust", {"robust", "--config", uncertain_scenario(inputs), "--global", "false"}},
+          {"pareto", {"pareto", "--levels", "2", "--starts", "2", "--global-starts", "2"}},
+          {"closed-loop", {"closed-loop", "--control-rate", "5", "--estimate-rate", "1"}}};
+}
+
+Args with(Args a, const Args& more) {
+  a.insert(a.end(), more.begin(), more.end());
+  return a;
+}
+
+}  // namespace
+
+TEST_CASE("a JSON that cannot be written leaves no figure of --plot behind, in every subcommand",
+          "[output][transaction]") {
+  TempDir inputs;
+  for (const auto& [name, run] : drawing_runs(inputs)) {
+    // a missing folder for the JSON, then a full disk (/dev/full: every write fails)
+    std::vector<std::pair<std::string, std::string>> failures{{"/nonexistent-ffsr-dir/x.json", "x.json"}};
+    if (is_char_device("/dev/full")) failures.emplace_back("/dev/full", "No space left on device");
+    for (const auto& [json_path, says] : failures) {
+      TempDir tmp;
+      fs::create_directory(tmp.path() / "figures");
+      const auto r =
+          ffsr::test::cli(with(run, {"--quiet", "--plot", "figures", "--json", json_path}), tmp.str());
+      INFO(name << " --json " << json_path);
+      CHECK(r.exit_code == 2);
+      check_one_error_line(r, {json_path, "--json", says});
+      CHECK(r.out.empty());
+      CHECK(tmp.entries() == std::vector<std::string>{"figures"});
+      CHECK(fs::is_empty(tmp.path() / "figures"));  // no figure, no scratch folder
+    }
+  }
+}
+
+TEST_CASE("the figures appear with the JSON when every output is written", "[output][transaction]") {
+  // the control of the case above: the same runs draw when the JSON can be written
+  for (const Args& run : {Args{"--global", "false"}, Args{"detumble", "--joint-torque-limit", "20"}}) {
+    TempDir tmp;
+    fs::create_directory(tmp.path() / "figures");
+    const auto r =
+        ffsr::test::cli(with(run, {"--quiet", "--plot", "figures", "--json", "r.json"}), tmp.str());
+    INFO(r.err);
+    REQUIRE(r.exit_code == 0);
+    CHECK(tmp.entries() == std::vector<std::string>{"figures", "r.json"});
+    std::vector<std::string> drawn;
+    for (const auto& e : fs::directory_iterator(tmp.path() / "figures"))
+      drawn.push_back(e.path().filename().string());
+    CHECK_FALSE(drawn.empty());
+    for (const auto& f : drawn) CHECK((f.size() > 4 && f.substr(f.size() - 4) == ".png"));  // no scratch left
+  }
+}
+
+TEST_CASE("map: a JSON that cannot be written leaves neither the streamed CSV nor a figure",
+          "[output][transaction]") {
+  TempDir tmp;
+  fs::create_directory(tmp.path() / "figures");
+  write_text(tmp / "map.csv", "earlier\n");
+  const auto r = ffsr::test::cli({"map", "--vary", "1", "--step-deg", "90", "--quiet", "--csv", "map.csv",
+                                  "--plot", "figures", "--json", "/nonexistent-ffsr-dir/m.json"},
+                                 tmp.str());
+  CHECK(r.exit_code == 2);
+  check_one_error_line(r, {"/nonexistent-ffsr-dir/m.json", "--json"});
+  CHECK(tmp.entries() == std::vector<std::string>{"figures", "map.csv"});  // no temporary file
+  CHECK(read_file(tmp / "map.csv") == "earlier\n");                        // the earlier map stays
+  CHECK(fs::is_empty(tmp.path() / "figures"));
+}
+
+TEST_CASE("two outputs to one file: an error naming both flags, nothing written", "[output][transaction]") {
+  TempDir tmp;
+  write_text(tmp / "r.json", "earlier\n");
+  fs::create_symlink("r.json", tmp.path() / "link.json");
+  fs::create_directory(tmp.path() / "sub");
+  struct Case {
+    Args args;
+    std::vector<std::string> names;
+  };
+  const std::vector<Case> cases{
+      {{"--global", "false", "--json", "r.json", "--csv", "r.json"}, {"--json r.json", "--csv r.json"}},
+      {{"--global", "false", "--json", "./r.json", "--csv", "r.json"}, {"--json ./r.json", "--csv r.json"}},
+      {{"--global", "false", "--json", "sub/../r.json", "--csv", tmp / "r.json"},
+       {"--json sub/../r.json", "--csv " + (tmp / "r.json")}},
+      {{"--global", "false", "--json", "link.json", "--csv", "r.json"}, {"--json link.json", "--csv r.json"}},
+      {{"contact", "--json", "r.json", "--series", "./r.json"}, {"--json r.json", "--series ./r.json"}},
+      {{"map", "--vary", "1", "--step-deg", "90", "--json", "r.json", "--csv", "./r.json"},
+       {"--json r.json", "--csv ./r.json"}},
+  };
+  for (const auto& c : cases) {
+    const auto r = ffsr::test::cli(with(c.args, {"--quiet"}), tmp.str());
+    INFO(r.err);
+    CHECK(r.exit_code == 2);
+    check_one_error_line(r, with(c.names, {"two outputs to one file"}));
+    CHECK(r.out.empty());
+    CHECK(tmp.entries() == std::vector<std::string>{"link.json", "r.json", "sub"});
+    CHECK(read_file(tmp / "r.json") == "earlier\n");
+  }
+  // a figure's file named by another output: refused before anything is written
+  const Args drawn_over{"detumble", "--joint-torque-limit", "20", "--quiet",
+                        "--plot",   ".",                    "--json", "detumble.png"};
+  const auto f = ffsr::test::cli(drawn_over, tmp.str());
+  CHECK(f.exit_code == 2);
+  check_one_error_line(f, {"--plot .", "detumble.png", "--json", "two outputs to one file"});
+  CHECK(tmp.entries() == std::vector<std::string>{"link.json", "r.json", "sub"});
+}
+
+// ------------------------------------------------------------------------------------------------
+// 5. regression runs: --expect BASELINE.json
 // ------------------------------------------------------------------------------------------------
 
 namespace {

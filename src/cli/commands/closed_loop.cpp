@@ -108,7 +108,8 @@ int run_closed_loop(ClosedLoopCliOptions o, const CLI::App& app) {
   o.record_plan_series = !o.plot.empty();  // the plan's joint angles beside the closed loop's
   const ClosedLoopJobResult job = closed_loop(sc, o);  // checks --prediction-window, plans, runs the loop
   const ClosedLoopResult& r = job.result;
-  if (!o.plot.empty()) plot::render({closed_loop_figure(sc, job.plan, job.loop, r)}, o.plot, plot_format);
+  if (!o.plot.empty())
+    outputs.stage(plot::draw({closed_loop_figure(sc, job.plan, job.loop, r)}, o.plot, plot_format));
   outputs.set("--json", closed_loop_json(sc, job, FFSR_VERSION).dump(2) + "\n");
   outputs.set("--csv", closed_loop_series_csv(r));
   outputs.write();

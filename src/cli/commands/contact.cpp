@@ -23,8 +23,8 @@ struct ContactOptions {
 };
 
 /// Figure 3 from the same rows; the marked points from the multibody run.
-void plot_contact(const std::vector<ContactRow>& rows, const ContactParams& params, const ContactOptions& o,
-                  plot::Format plot_format) {
+StagedFiles plot_contact(const std::vector<ContactRow>& rows, const ContactParams& params,
+                         const ContactOptions& o, plot::Format plot_format) {
   std::vector<figures::ContactCurve> curves;
   for (const auto& row : rows) {
     figures::ContactCurve c;
@@ -41,7 +41,8 @@ void plot_contact(const std::vector<ContactRow>& rows, const ContactParams& para
     c.f_max = row.f_multibody;
     curves.push_back(std::move(c));
   }
-  plot::render({figures::contact(curves, rows.front().M_ie, rows.front().v_in)}, o.out.plot, plot_format);
+  return plot::draw({figures::contact(curves, rows.front().M_ie, rows.front().v_in)}, o.out.plot,
+                    plot_format);
 }
 
 /// The closed-form predictions under the joint models beside the multibody run (when not only free).
@@ -91,7 +92,7 @@ int run_contact(const ContactOptions& o) {
   ContactJobOptions job;
   job.record_series = !o.out.csv.empty() || !o.out.plot.empty();
   const std::vector<ContactRow> rows = contact(subject, job);
-  if (!o.out.plot.empty()) plot_contact(rows, subject.problem.contact, o, plot_format);
+  if (!o.out.plot.empty()) outputs.stage(plot_contact(rows, subject.problem.contact, o, plot_format));
   outputs.set("--json", contact_json(subject, rows, FFSR_VERSION).dump(2) + "\n");
   if (!o.out.csv.empty()) outputs.set("--csv", contact_series_csv(rows));
   outputs.write();

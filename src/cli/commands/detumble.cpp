@@ -124,7 +124,8 @@ int run_detumble_command(const DetumbleCommandOptions& o) {
     results = detumble_runs(sc, o.run);
     outputs.set("--json", detumble_runs_json(sc, results, FFSR_VERSION).dump(2) + "\n");
   }
-  if (!o.out.plot.empty()) plot::render({detumble_figure(sc, results)}, o.out.plot, plot_format);
+  if (!o.out.plot.empty())
+    outputs.stage(plot::draw({detumble_figure(sc, results)}, o.out.plot, plot_format));
   if (!o.out.csv.empty()) outputs.set("--csv", detumble_series_csv(sc, results));
   outputs.write();
   for (size_t i = 0; i < results.size(); ++i) {

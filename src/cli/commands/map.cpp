@@ -17,7 +17,6 @@
 #include <iostream>
 #include <limits>
 #include <memory>
-#include <optional>
 #include <sstream>
 #include <thread>
 
@@ -25,8 +24,8 @@
 // the N shard files in the order k = 0..N-1 is, byte for byte, the CSV of the whole grid. Each block
 // of points is formatted with std::to_chars (the shortest text that reads back as the same double) on
 // the thread that evaluated it and appended to the output in point order, so the output never has
-// to fit in memory. The file is written like every output of the command (StreamingOutput: a
-// temporary next to the destination, renamed at the end: all or nothing).
+// to fit in memory. The file is written like every output of the command (Outputs::stream: a
+// temporary next to the destination, renamed with the other outputs at the end: all or nothing).
 //
 // Pictures (--plot DIR): one varied joint gives M_ie against the angle; two a heat map with contour
 // lines and a colour bar (Figure 9); three the orthogonal slices through --slice-deg (Figure 9's
@@ -191,7 +190,6 @@ int run_map(const MapOptions& o) {
   set_quiet(o.out.quiet);
   Outputs outputs;  // the JSON summary; the CSV is streamed (below)
   outputs.add("--json", o.out.json);
-  if (is_stdout_name(o.out.csv)) outputs.claim_stdout("--csv " + o.out.csv);
   const Scenario subject = load_subject(o.subject);
   const MapPlan plan = plan_map(subject, job_options(o, subject.keys.urdf, subject.model->n()));
   const bool plotting = !o.out.plot.empty();
@@ -199,8 +197,8 @@ int run_map(const MapOptions& o) {
   const std::vector<double> slice_deg = check_map_plot(o, plan);
   std::vector<double> values(plotting ? plan.count() : 0);
 
-  std::optional<StreamingOutput> out;  // the map; without --csv, the summary (--json, the table) only
-  if (!o.out.csv.empty()) out.emplace("--csv", o.out.csv);  // checked before any point is evaluated
+  // the map; without --csv, the summary (--json, the table) only; checked before any point is evaluated
+  StreamingOutput* out = o.out.csv.empty() ? nullptr : &outputs.stream("--csv", o.out.csv);
   if (out && plan.shard_k == 0) {
     const std::string header = map_csv_header(subject, plan);
     out->write(header.data(), header.size());
@@ -220,16 +218,15 @@ int run_map(const MapOptions& o) {
   };
   sink.progress = [&](std::uint64_t done, std::uint64_t total) { progress(done, total); };
   MapRun run = evaluate_map(subject, plan, sink);
-  // the pictures before the CSV is committed: a failed drawing leaves no CSV behind
+  // the pictures, the summary and the CSV are put in place together: a failed one leaves none behind
   std::vector<std::string> drawn;
   const auto t0 = std::chrono::steady_clock::now();
   if (plotting)
-    drawn = plot::render(map_figures(plan.grid, subject.model->joint_names(), std::move(values), slice_deg), o.out.plot,
-                         plot_format);
+    drawn = outputs.stage(plot::draw(map_figures(plan.grid, subject.model->joint_names(), std::move(values), slice_deg),
+                                     o.out.plot, plot_format));
   run.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   outputs.set("--json", map_json(subject, run, FFSR_VERSION).dump(2) + "\n");
-  outputs.write();  // the summary first: a failed JSON leaves no CSV behind
-  if (out) out->commit();
+  outputs.write();
   std::ostream& os = outputs.table();  // standard error when the CSV or the JSON goes to standard output
   print_map_summary(os, o, run);
   for (const std::string& f : drawn) os << "wrote " << f << "\n";

@@ -133,8 +133,8 @@ int run_pareto(const ParetoCliOptions& o) {
   outputs.set("--csv", pc ? post_capture_front_csv(*pc) : pareto_csv(f));
   std::vector<std::string> drawn;
   if (!o.out.plot.empty())
-    drawn = plot::render({pc ? post_capture_figure(sc, *pc) : pareto_figure(sc, f, runs)}, o.out.plot,
-                         plot_format);
+    drawn = outputs.stage(plot::draw({pc ? post_capture_figure(sc, *pc) : pareto_figure(sc, f, runs)},
+                                     o.out.plot, plot_format));
   outputs.write();
   std::ostream& out = outputs.table();
   if (pc)

@@ -162,7 +162,8 @@ int run_merge(const RobustOptions& o) {
   const nlohmann::json j = m.to_json();
   outputs.set("--json", j.dump(1) + "\n");
   std::vector<std::string> drawn;
-  if (!o.plot.empty()) drawn = plot::render({figures::robust(robust_series(m))}, o.plot, plot_format);
+  if (!o.plot.empty())
+    drawn = outputs.stage(plot::draw({figures::robust(robust_series(m))}, o.plot, plot_format));
   outputs.write();
   std::ostream& out = outputs.table();
   out << "ffsr-optimize " << FFSR_VERSION << " robust: merged " << count << " shard summaries, " << m.end
@@ -225,7 +226,7 @@ std::string robust_csv(const RobustRun& run) {
   return c.str();
 }
 
-/// JSON, CSV and the figure (the picture first: a failed drawing leaves no output file), then the table.
+/// JSON, CSV and the figure, written all or nothing, then the table.
 int report_robust(const Scenario& sc, const RobustRun& run, const RobustOptions& o, Outputs& outputs,
                   plot::Format plot_format) {
   const RobustSummary summary = robust_summary(sc, run, o.config, FFSR_VERSION);
@@ -233,7 +234,8 @@ int report_robust(const Scenario& sc, const RobustRun& run, const RobustOptions&
   if (!o.json.empty()) outputs.set("--json", j.dump(1) + "\n");
   if (!o.csv.empty()) outputs.set("--csv", robust_csv(run));
   std::vector<std::string> drawn;
-  if (!o.plot.empty()) drawn = plot::render({figures::robust(robust_series(summary))}, o.plot, plot_format);
+  if (!o.plot.empty())
+    drawn = outputs.stage(plot::draw({figures::robust(robust_series(summary))}, o.plot, plot_format));
   outputs.write();
   std::ostream& out = outputs.table();
   out << "ffsr-optimize " << FFSR_VERSION << " robust: " << sc.where << " (" << sc.model->n() << " joints, "

@@ -145,9 +145,9 @@ void write_outputs(const Scenario& sc, const ScenarioResult& r, const RunSetting
     for (figures::CaptureRun& run : runs)  // the plain run's clearance is called "baseline"
       for (const auto& [name, c] : r.clearances)
         if (name == (run.label == "plain" ? "baseline" : run.label)) run.clearance = &c;
-    plot::render(figures::capture(*sc.model, sc.problem.frame, sc.problem.target, sc.capture.duration, runs,
-                                  shapes ? &*shapes : nullptr),
-                 o.plot, q.plot_format);
+    q.outputs.stage(plot::draw(figures::capture(*sc.model, sc.problem.frame, sc.problem.target,
+                                                sc.capture.duration, runs, shapes ? &*shapes : nullptr),
+                               o.plot, q.plot_format));
   }
   q.outputs.set("--json", j.dump(2) + "\n");
   q.outputs.set("--csv", o.csv.empty() ? std::string() : scenario_series_csv(sc, r));

@@ -152,7 +152,7 @@ int report(const XiOptions& o, const XiSetup& s) {
   if (!o.out.plot.empty()) {
     std::vector<plot::Figure> figs;
     for (const auto& st : s.studies) figs.push_back(figures::xi(st));
-    plot::render(figs, o.out.plot, s.plot_format);
+    outputs.stage(plot::draw(figs, o.out.plot, s.plot_format));
   }
   const std::string csv = xi_csv(s);
   outputs.set("--json", xi_json(s).dump(2) + "\n");

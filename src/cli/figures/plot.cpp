@@ -540,27 +540,6 @@ std::string read_text(const std::string& path) {
   return s.str();
 }
 
-/// A fresh folder inside `dir` for the drawing process's files, removed with everything in it when
-/// this object goes (the finished figures are moved out first).
-class ScratchFolder {
- public:
-  explicit ScratchFolder(const std::string& dir) {
-    std::string tmpl = (std::filesystem::path(dir) / ".ffsr-plot-XXXXXX").string();
-    if (!::mkdtemp(tmpl.data())) throw InputError(str("--plot: cannot write into folder '", dir, "'"));
-    path_ = tmpl;
-  }
-  ~ScratchFolder() {
-    std::error_code ec;
-    std::filesystem::remove_all(path_, ec);
-  }
-  ScratchFolder(const ScratchFolder&) = delete;
-  ScratchFolder& operator=(const ScratchFolder&) = delete;
-  const std::filesystem::path& path() const { return path_; }
-
- private:
-  std::filesystem::path path_;
-};
-
 /// The drawing process: PLplot's chatter goes to `log`, never to our stdout (exit() from PLplot is
 /// fine here); before each figure "@@figure NAME", on an error of ours "@@error WHY". Never returns.
 [[noreturn]] void draw_in_child(const std::vector<Figure>& figures, const std::vector<std::string>& names,
@@ -642,46 +621,46 @@ void check_drawn(int status, const ChildReport& r, const std::string& dir) {
   throw InputError(str("--plot: cannot draw ", file, ": ", why));
 }
 
-/// Moves the figures from the scratch folder into `dir` once every one of them exists.
-std::vector<std::string> move_into(const std::string& dir, const std::filesystem::path& tmp,
-                                   const std::vector<std::string>& names) {
+/// Checks that every figure exists in the scratch folder (PLplot may exit 0 without a file).
+void check_written(const StagedFiles& staged) {
   namespace fs = std::filesystem;
-  for (const auto& n : names) {
+  for (const auto& n : staged.names()) {
     std::error_code ec;
-    const fs::path from = tmp / n;
+    const fs::path from = staged.scratch() / n;
     if (!fs::is_regular_file(from, ec) || fs::file_size(from, ec) == 0)
-      throw InputError(str("--plot: cannot draw ", (fs::path(dir) / n).string(), ": PLplot wrote no file"));
+      throw InputError(
+          str("--plot: cannot draw ", (fs::path(staged.dir()) / n).string(), ": PLplot wrote no file"));
   }
-  std::vector<std::string> written;
-  for (const auto& n : names) {
-    std::error_code ec;
-    const fs::path to = fs::path(dir) / n;
-    fs::rename(tmp / n, to, ec);
-    if (ec) throw InputError(str("--plot: cannot write ", to.string(), ": ", ec.message()));
-    written.push_back(to.string());
-  }
-  return written;
 }
 
 }  // namespace
 
-std::vector<std::string> render(const std::vector<Figure>& figures, const std::string& dir, Format format) {
-  const ScratchFolder tmp(dir);
-  const std::string log = (tmp.path() / "plplot.log").string();
+StagedFiles draw(const std::vector<Figure>& figures, const std::string& dir, Format format) {
+  StagedFiles staged(dir, "--plot");
+  const std::string log = (staged.scratch() / "plplot.log").string();
   std::vector<std::string> names;
   for (const auto& f : figures) names.push_back(f.name + "." + extension(format));
-  const int status = draw_in_process(figures, names, tmp.path(), log, format);
+  const int status = draw_in_process(figures, names, staged.scratch(), log, format);
   check_drawn(status, read_report(log), dir);
-  return move_into(dir, tmp.path(), names);
+  for (const auto& n : names) staged.add(n);
+  check_written(staged);
+  return staged;
 }
 
 #else  // built without PLplot
 
-std::vector<std::string> render(const std::vector<Figure>&, const std::string&, Format) {
+StagedFiles draw(const std::vector<Figure>&, const std::string&, Format) {
   require_available("--plot");
   return {};
 }
 
 #endif
+
+std::vector<std::string> render(const std::vector<Figure>& figures, const std::string& dir, Format format) {
+  StagedFiles staged = draw(figures, dir, format);
+  std::vector<std::string> written = staged.targets();
+  staged.commit();
+  return written;
+}
 
 }  // namespace ffsr::cli::plot

@@ -2,6 +2,8 @@
 // heat maps, 3-D point clouds) and a renderer that hands it to PLplot.
 #pragma once
 
+#include "support/staging.hpp"
+
 #include <array>
 #include <string>
 #include <variant>
@@ -12,7 +14,9 @@
 // legends and colour bars. Rendering runs in a forked child process: PLplot may print to stdout or
 // stderr and calls exit() on some errors; the child's stdout goes to /dev/null, its stderr is
 // captured, and a failure becomes one InputError naming the file. All figures of a call are drawn
-// into a temporary folder inside DIR first and moved into DIR only when every one succeeded.
+// into a scratch folder inside DIR first (StagedFiles, support/staging.hpp); the subcommands hand it
+// to their Outputs, which moves the figures into DIR together with the JSON and the CSV, only when
+// every output of the run was produced.
 //
 // Built without PLplot (FFSR_WITH_PLOT=OFF), available() is false and require_available() throws
 // the one-line error every --plot gives.
@@ -110,8 +114,11 @@ struct Figure {
   std::vector<AnyPanel> panels;
 };
 
-/// Draws every figure into `dir` as <name>.<ext>, all or nothing. Returns the paths written.
-/// InputError naming the folder or the file when something fails (the folder is left as it was).
+/// Draws every figure as <name>.<ext> into a scratch folder inside `dir`, staged to be moved into
+/// `dir` by Outputs::stage and Outputs::write (or by StagedFiles::commit). InputError naming the
+/// folder or the file when something fails (the folder is left as it was).
+StagedFiles draw(const std::vector<Figure>& figures, const std::string& dir, Format format);
+/// draw, then the figures moved into `dir` at once: all or nothing. Returns the paths written.
 std::vector<std::string> render(const std::vector<Figure>& figures, const std::string& dir, Format format);
 
 }  // namespace ffsr::cli::plot

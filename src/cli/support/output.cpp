@@ -198,17 +198,68 @@ void write_outputs(const std::vector<OutputSpec>& outputs) {
   rename_temporaries(plan);
 }
 
+/// The file `path` names, for telling whether two outputs go to one file: the absolute path with
+/// "." and ".." resolved and the symbolic links of its existing part followed. Empty for standard
+/// output and character devices (/dev/null takes any number of outputs).
+std::string file_identity(const std::string& path) {
+  namespace fs = std::filesystem;
+  if (is_stdout_name(path)) return {};
+  struct stat st {};
+  if (::stat(path.c_str(), &st) == 0 && S_ISCHR(st.st_mode)) return {};
+  std::error_code ec;
+  fs::path p = fs::absolute(path, ec);
+  if (ec) return path;
+  const fs::path canonical = fs::weakly_canonical(p, ec);
+  return (ec ? p.lexically_normal() : canonical).string();
+}
+
+std::string two_outputs_error(const std::string& a, const std::string& b) {
+  return str(a, " and ", b, ": two outputs to one file");
+}
+
 }  // namespace
 
 bool is_stdout_name(const std::string& path) {
   return path == "-" || path == "/dev/stdout" || path == "/dev/fd/1" || path == "/proc/self/fd/1";
 }
 
+Outputs::Outputs() = default;
+Outputs::~Outputs() = default;  // the staged files and the streams' temporary files are removed
+Outputs::Outputs(Outputs&&) noexcept = default;
+Outputs& Outputs::operator=(Outputs&&) noexcept = default;
+
+void Outputs::check_distinct(const std::string& shown, const std::string& path) const {
+  const std::string id = file_identity(path);
+  if (id.empty()) return;
+  for (const auto& it : items_)
+    if (file_identity(it.path) == id)
+      throw InputError(two_outputs_error(it.given_as + " " + it.path, shown));
+  for (const auto& s : streams_)
+    if (file_identity(s->path()) == id)
+      throw InputError(two_outputs_error(s->flag() + " " + s->path(), shown));
+}
+
 void Outputs::add(const std::string& flag, const std::string& path, const std::string& given_as) {
   if (path.empty()) return;
   const std::string name = given_as.empty() ? flag : given_as;
   if (is_stdout_name(path)) claim_stdout(name + " " + path);
+  check_distinct(name + " " + path, path);
   items_.push_back({flag, name, path, {}, false});
+}
+
+std::vector<std::string> Outputs::stage(StagedFiles files) {
+  std::vector<std::string> targets = files.targets();
+  for (const std::string& target : targets)
+    check_distinct(str(files.flag(), " ", files.dir(), " (", target, ")"), target);
+  staged_.push_back(std::move(files));
+  return targets;
+}
+
+StreamingOutput& Outputs::stream(const std::string& flag, const std::string& path) {
+  if (is_stdout_name(path)) claim_stdout(flag + " " + path);
+  check_distinct(flag + " " + path, path);
+  streams_.push_back(std::make_unique<StreamingOutput>(flag, path));
+  return *streams_.back();
 }
 
 void Outputs::claim_stdout(const std::string& flag) {
@@ -237,15 +288,23 @@ void Outputs::set(const std::string& flag, std::string content) {
     }
 }
 
-void Outputs::write() const {
+void Outputs::write() {
   std::vector<OutputSpec> specs;
   for (const auto& it : items_)
     if (it.has_content) specs.push_back({it.given_as, it.path, &it.content});
-  write_outputs(specs);
+  OutputPlan plan(specs);
+  resolve_outputs(plan);
+  write_temporaries(plan);
+  for (auto& s : streams_) s->finish();
+  write_direct(plan);
+  // every output is produced: the renames
+  rename_temporaries(plan);
+  for (auto& s : streams_) s->commit();
+  for (auto& f : staged_) f.commit();
 }
 
 StreamingOutput::StreamingOutput(const std::string& flag, const std::string& path)
-    : name_(output_name({flag, path, nullptr})) {
+    : flag_(flag), path_(path), name_(output_name({flag, path, nullptr})) {
   const OutputKind kind = resolve_output(path, name_, final_);
   fd_ = kind == OutputKind::Regular ? open_temporary(final_, tmp_) : open_direct(kind, final_);
   if (fd_ < 0) throw_write_error(name_, errno);
@@ -268,11 +327,18 @@ void StreamingOutput::flush_buffer() {
   buffer_.clear();
 }
 
-void StreamingOutput::commit() {
-  flush_buffer();
-  if (fd_ > 1 && ::close(fd_) != 0 && err_ == 0) err_ = errno;
-  fd_ = -1;
+void StreamingOutput::finish() {
+  if (!finished_) {
+    flush_buffer();
+    if (fd_ > 1 && ::close(fd_) != 0 && err_ == 0) err_ = errno;
+    fd_ = -1;
+    finished_ = true;
+  }
   if (err_ != 0) throw_write_error(name_, err_);
+}
+
+void StreamingOutput::commit() {
+  finish();
   if (tmp_.empty()) return;  // written in place: standard output, a FIFO, a device
   if (::rename(tmp_.c_str(), final_.c_str()) != 0)
     throw_write_error(name_, errno, "cannot write the output file (rename failed)");
@@ -326,7 +392,14 @@ void add_output_flags(CLI::App& app, OutputKeys& keys, const OutputHelp& help) {
     app.add_option("--plot", keys.plot, str(help.plot, " into this (existing) folder"))->option_text("DIR");
     app.add_option("--plot-format", keys.plot_format, "Figure format: png, svg or pdf")->capture_default_str();
   }
-  app.add_flag("--quiet", keys.quiet, "Nothing on standard error but an error: no progress line, no warning");
+  // --quiet alone is true; --quiet=VALUE takes true or false only, like every boolean key
+  const CLI::Validator true_or_false(
+      [](std::string& v) {
+        return v == "true" || v == "false" ? std::string() : str("expected true or false, got '", v, "'");
+      },
+      "true|false");
+  app.add_flag("--quiet", keys.quiet, "Nothing on standard error but an error: no progress line, no warning")
+      ->check(true_or_false);
 }
 
 }  // namespace ffsr::cli

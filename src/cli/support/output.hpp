@@ -3,11 +3,13 @@
 #pragma once
 
 #include "ffsr/scenario/scenario.hpp"
+#include "support/staging.hpp"
 
 #include <nlohmann/json.hpp>
 
 #include <CLI/CLI.hpp>
 
+#include <memory>
 #include <ostream>
 #include <string>
 #include <utility>
@@ -24,10 +26,17 @@ namespace ffsr::cli {
 ///  - a symbolic link is followed and its final target is replaced atomically (a temporary file in
 ///    the target's directory, then rename), so the link stays a link;
 ///  - a regular file (or a new path) is written to a temporary file next to it and renamed into place
-///    when every output of the run is written: all or nothing.
+///    when every output of the run is written: all or nothing;
+///  - the figures of --plot are drawn into a scratch folder inside their folder (StagedFiles, given
+///    to stage()) and the streamed CSV of map into a temporary file (stream()); write() moves them
+///    into place with the others, after every output was produced;
+///  - two outputs to one file (the same path, ./F and F, a link and its target) are refused naming
+///    both flags, like two outputs to standard output (a character device such as /dev/null excepted).
 /// Every failure (missing directory, a directory in the way, full disk, I/O error, a reader that
 /// closed the pipe: SIGPIPE is ignored by main) throws InputError naming the flag and the file and
-/// leaves no partial regular file and no temporary file behind.
+/// leaves no partial regular file, no temporary file and no figure behind: an Outputs destroyed
+/// before write() succeeded removes what it staged.
+class StreamingOutput;
 class Outputs {
  public:
   /// Registers the output of `flag` (for example "--json") at `path`; an empty path: not requested.
@@ -45,16 +54,34 @@ class Outputs {
   std::ostream& table() const;
   /// Sets the content of the output registered by `flag` (ignored when the flag was not requested).
   void set(const std::string& flag, std::string content);
-  /// Writes every registered output that has content: regular files to temporary files first, then
-  /// the direct outputs (standard output, FIFOs, devices), then the renames.
-  void write() const;
+  /// Files produced before the write (the figures of --plot), moved into their folder by write().
+  /// Throws InputError naming both flags when one of them is the file of another output. Returns
+  /// the files' final paths.
+  std::vector<std::string> stage(StagedFiles files);
+  /// Opens the output of `flag` at `path` written as it is produced (see StreamingOutput), committed
+  /// by write(); same checks as add. The reference stays valid as long as this object.
+  StreamingOutput& stream(const std::string& flag, const std::string& path);
+  /// Writes every registered output that has content: regular files to temporary files first (and
+  /// the streamed outputs closed), then the direct outputs (standard output, FIFOs, devices), then
+  /// the renames of the temporary files, of the streamed outputs and of the staged files.
+  void write();
+
+  Outputs();
+  ~Outputs();
+  Outputs(Outputs&&) noexcept;
+  Outputs& operator=(Outputs&&) noexcept;
 
  private:
   struct Item {
     std::string flag, given_as, path, content;
     bool has_content = false;
   };
+  /// Refuses the output `shown` (its flag and path, for the message) at `path` when an output
+  /// registered before goes to the same file.
+  void check_distinct(const std::string& shown, const std::string& path) const;
   std::vector<Item> items_;
+  std::vector<std::unique_ptr<StreamingOutput>> streams_;
+  std::vector<StagedFiles> staged_;
   std::string stdout_flag_;
 };
 
@@ -78,17 +105,24 @@ class StreamingOutput {
   ~StreamingOutput();
   StreamingOutput(const StreamingOutput&) = delete;
   StreamingOutput& operator=(const StreamingOutput&) = delete;
-  /// Appends `n` bytes (buffered; a write error is reported by commit()).
+  /// Appends `n` bytes (buffered; a write error is reported by finish() or commit()).
   void write(const char* data, size_t n);
-  /// Flushes, closes and renames the temporary file into place.
+  /// Flushes and closes the file; InputError naming the flag and the file when a write failed.
+  void finish();
+  /// finish(), then renames the temporary file into place.
   void commit();
+  /// The file written, after symbolic links (empty for standard output).
+  const std::string& final_path() const { return final_; }
+  const std::string& flag() const { return flag_; }
+  const std::string& path() const { return path_; }
 
  private:
   static constexpr size_t kBuffer = 1 << 16;
   void flush_buffer();
-  std::string name_, final_, tmp_, buffer_;
+  std::string flag_, path_, name_, final_, tmp_, buffer_;
   int fd_ = -1;
   int err_ = 0;
+  bool finished_ = false;
 };
 /// Flushes standard output and throws InputError ("standard output: cannot write ...") when a write to
 /// it failed (a closed pipe, a full disk). main calls it after every successful action.

@@ -44,6 +44,74 @@ void ScenarioFlags::apply(ScenarioKeys& keys) const {
   }
 }
 
+namespace {
+
+/// What a key of `group` describes, and what a subcommand that does not take it does not do.
+const char* group_reason(KeyGroup group) {
+  switch (group) {
+    case KeyGroup::Robot: return "a key of the robot, which";
+    case KeyGroup::Start: return "a key of the start state, which";
+    case KeyGroup::Target: return "a key of the target, which";
+    case KeyGroup::TargetPlace: return "a key of where the target is (the capture point, distances), which";
+    case KeyGroup::Contact: return "a key of the contact law, which";
+    case KeyGroup::Planner: return "a key of the capture planner's runs (plain and optimized), which";
+    case KeyGroup::Global: return "a key of the global capture optimization, which";
+    case KeyGroup::JointModels: return "a key of the joints' model during the contact, which";
+    case KeyGroup::Shapes: return "a key of the collision shapes, which";
+    case KeyGroup::Detumble: return "a key of the post-capture phase, which";
+    case KeyGroup::PostCapture: return "a key of the global search's post-capture constraints, which";
+  }
+  return "a key which";
+}
+
+/// Why `sub` does not take `key`, where its own reason is more than its group's (the subcommands'
+/// registrations say so where they leave a key of a group they take out).
+std::string untaken_reason(const std::string& sub, const ScenarioKey& key) {
+  const std::string& k = key.name;
+  if (sub == "map" && k == "base-position") return "M_ie and F_max do not depend on where the base is";
+  if (sub == "closed-loop" && k == "global") return "the controller flies the plan that --plan names";
+  if (sub == "closed-loop" && (k == "baseline-task" || k == "base-attitude"))
+    return "the controller flies the plan as planned: the planner's tasks are not the controller's";
+  if ((sub == "inspect" || sub == "pareto") && (k == "stiffness" || k == "exponent"))
+    return str("the law's stiffness and exponent change neither M_ie nor the base's jump at the impact that ",
+               sub, " reports");
+  if (sub == "inspect" && (k == "clearance" || k == "contact-exemption"))
+    return "inspect reports the distances between whole bodies; the clearance constrains plans only";
+  if (sub == "robust" && (k == "joint-stiffness" || k == "joint-damping"))
+    return "robust's multibody force model runs with the library's default servo";
+  if (sub == "xi" && (k == "stiffness" || k == "approach-speed"))
+    return "xi depends on the exponent and the restitution only; its studies vary the stiffness and the "
+           "approach speed";
+  return str(group_reason(key.group), " ", sub, " does not evaluate");
+}
+
+}  // namespace
+
+void refuse_untaken_scenario_keys(CLI::App& app) {
+  const std::vector<CLI::App*> subs = app.get_subcommands([](CLI::App*) { return true; });
+  for (const ScenarioKey& key : scenario_keys()) {
+    const std::string flag = "--" + key.name;
+    std::vector<std::string> takers;
+    if (app.get_option_no_throw(flag)) takers.push_back("the main job");
+    for (const CLI::App* sub : subs)
+      if (sub->get_option_no_throw(flag)) takers.push_back(sub->get_name());
+    std::string who;
+    for (size_t i = 0; i < takers.size(); ++i)
+      who += (i == 0 ? "" : i + 1 == takers.size() ? " and " : ", ") + takers[i];
+    for (CLI::App* sub : subs) {
+      if (sub->get_option_no_throw(flag)) continue;
+      const std::string others = who.empty() ? "" : "; " + who + (takers.size() > 1 ? " do" : " does");
+      const std::string why = str(flag, ": ", untaken_reason(sub->get_name(), key), " (the subcommand ",
+                                  sub->get_name(), " does not take it", others, ")");
+      // one value, as the flag takes where it is taken, refused whatever it is (InputError: one line,
+      // exit 2; a hidden option has no name for the parser's own messages)
+      sub->add_option(flag)->group("")->allow_extra_args(false)->each([why](const std::string&) {
+        throw InputError(why);
+      });
+    }
+  }
+}
+
 void refuse_shapes_without_clearance(const ScenarioKeys& keys, const std::string& job) {
   if (keys.clearance > 0) return;
   for (const ScenarioKey& key : scenario_keys())

@@ -34,6 +34,14 @@ class ScenarioFlags {
   std::vector<std::pair<const ScenarioKey*, const CLI::Option*>> options_;
 };
 
+/// Makes every scenario key's flag known to every subcommand of `app`: where a subcommand does not
+/// take a key, its flag (hidden from the help) is refused with one line saying why and which jobs
+/// take it ("--joint-torque-limit: a key of the post-capture phase, which inspect does not run (the
+/// subcommand inspect does not take it; the main job, pareto and detumble do)"), as the main job
+/// refuses a key where its run does not act, instead of the parser's "arguments were not expected".
+/// Call after every subcommand registered its flags.
+void refuse_untaken_scenario_keys(CLI::App& app);
+
 /// Refuses a shape key given as a flag (the Shapes group but the clearance) for a job that uses the
 /// shapes through the clearance only, when the clearance is 0: InputError naming the key.
 void refuse_shapes_without_clearance(const ScenarioKeys& keys, const std::string& job);

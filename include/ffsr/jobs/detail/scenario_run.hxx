@@ -81,9 +81,11 @@ inline void add_post_capture(const PostCaptureScreen& screen, GlobalRun& r) {
   r.post_capture_admitted = screen.admitted();
 }
 
-/// run_global with the paper's-method run, or without it (null).
+/// run_global with the paper's-method run, or without it (null); `record_series`: keep the time
+/// series (ScenarioRunOptions::record_series) beside the scenario's own setting.
 inline GlobalRun run_global(const Scenario& sc, const CaptureResult* paper_run, GlobalObjective objective,
-                            std::shared_ptr<RobustForceObjective> robust, bool tight_reaching) {
+                            std::shared_ptr<RobustForceObjective> robust, bool tight_reaching,
+                            bool record_series = false) {
   CaptureOptions opt = sc.capture;
   opt.gain = 0.0;
   opt.max_joint_rate = sc.keys.max_joint_rate_deg * M_PI / 180.0;
@@ -112,7 +114,7 @@ inline GlobalRun run_global(const Scenario& sc, const CaptureResult* paper_run, 
   const std::shared_ptr<PostCaptureScreen> screen = post_capture_screen(sc, opt, g);
   g.reconfigure.mode = reconfigure_mode_of(sc.keys.reconfigure, "--reconfigure");
   g.reconfigure.duration = sc.keys.reconfigure_duration;
-  opt.record_series = opt.record_series || sc.geometry;
+  opt.record_series = opt.record_series || record_series || sc.geometry;
   GlobalRun r;
   try {
     r.result = plan_global_with_clearance(sc, opt, g);  // as plan_capture_global without a clearance
@@ -225,7 +227,8 @@ inline ScenarioResult run_captures(const Scenario& sc, const ScenarioRunOptions&
   }
   try {
     r.global =
-        detail::run_global(sc, r.optimized_ok() ? &r.optimized : nullptr, sc.objective, r.robust, false);
+        detail::run_global(sc, r.optimized_ok() ? &r.optimized : nullptr, sc.objective, r.robust, false,
+                           options.record_series);
   } catch (const NumericalError& e) {
     if (r.plain_ok() && r.optimized_ok()) throw;
     throw NumericalError(detail::str(r.plain_ok() ? r.optimized_failure : r.plain_failure,

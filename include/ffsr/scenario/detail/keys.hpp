@@ -214,6 +214,7 @@ inline void add_robot_keys(std::vector<ScenarioKey>& keys) {
 /// The robot's start state, the target and the contact law.
 inline void add_state_and_contact_keys(std::vector<ScenarioKey>& keys) {
   using G = KeyGroup;
+  using K = ScenarioKeys;
   keys.push_back(FFSR_KEY("joints-deg", joints_deg, "Initial joint angles, deg").in(G::Start).needed());
   keys.push_back(FFSR_KEY("base-position", base_position, "Initial base position, m").in(G::Start));
   keys.push_back(
@@ -241,10 +242,12 @@ inline void add_state_and_contact_keys(std::vector<ScenarioKey>& keys) {
   keys.push_back(FFSR_KEY("stiffness", stiffness, "K, N/m^alpha").in(G::Contact).needed());
   keys.push_back(FFSR_KEY("exponent", exponent, "alpha").in(G::Contact).needed());
   keys.push_back(FFSR_KEY("restitution", restitution, "c_r, 0 < c_r <= 1").in(G::Contact).needed());
+  // positive for every job that reads it (the main job's bound, also inspect's, detumble's, ...)
   keys.push_back(
       FFSR_KEY("approach-speed", approach_speed, "End-effector speed along the normal at the capture, m/s")
           .in(G::Contact)
-          .needed());
+          .needed()
+          .checked([](const K& k) { check_positive_if_given(k, "approach-speed", k.approach_speed); }));
 }
 
 /// The robot, its start state, the target and the contact law: what inspect, contact and map evaluate.

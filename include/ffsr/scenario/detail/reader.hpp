@@ -63,8 +63,8 @@ inline long scenario_key_line(const ScenarioKeys& k, const std::string& name) {
 
 /// A message about the keys ("--key: ..." or "--a/--b: ...", the flags of the keys it is about)
 /// located in the file that gave the first key, the keys the file gave named as written there:
-/// "scenario FILE:LINE: key: ...". Unchanged when the first key came from a flag or the built-in
-/// scenario.
+/// "scenario FILE:LINE: key: ...". Unchanged when one of the keys came from a flag (an override: the
+/// flag is named as the flag, not located at the line of another key) or the built-in scenario.
 inline std::string located_key_message(const ScenarioKeys& k, const std::string& message) {
   if (k.file.empty() || message.rfind("--", 0) != 0) return message;
   const size_t end = std::min(message.find_first_of(": "), message.size());
@@ -74,8 +74,10 @@ inline std::string located_key_message(const ScenarioKeys& k, const std::string&
     names.push_back(message.substr(at, slash - at));
     at = slash + 1;
   }
-  for (const std::string& n : names)
+  for (const std::string& n : names) {
     if (n.rfind("--", 0) != 0) return message;  // not a list of flags ("--a/b" is a path)
+    if (k.overridden.count(n.substr(2))) return message;  // a flag at fault: named as the flag
+  }
   const long line = scenario_key_line(k, names.front().substr(2));
   if (line <= 0) return message;
   std::string keys;

@@ -71,13 +71,10 @@ inline long long integer_from_text(const std::string& text, const std::string& k
   return x;
 }
 
+/// A boolean as text (a flag's value): exactly "true" or "false", nothing else (no yes, on, 1, TRUE).
 inline bool boolean_from_text(const std::string& text, const std::string& key) {
-  std::string t = trimmed(text);
-  std::transform(t.begin(), t.end(), t.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-  for (const char* yes : {"true", "1", "on", "yes", "y", "t", "enable", "+"})
-    if (t == yes) return true;
-  for (const char* no : {"false", "0", "off", "no", "n", "f", "disable", "-"})
-    if (t == no) return false;
+  if (text == "true") return true;
+  if (text == "false") return false;
   throw InputError(str(key, ": expected true or false, got '", text, "'"));
 }
 
@@ -153,7 +150,11 @@ T value_from_toml(const toml::node& n, const std::string& key) {
       return static_cast<int>(*i);
     }
   } else if constexpr (std::is_same_v<T, bool>) {
+    // a file's boolean is TOML's true or false: not 1, not "yes", not the text "true"
     if (auto b = n.value_exact<bool>()) return *b;
+    const auto t = text_of(n);
+    throw InputError(str(key, ": expected true or false, got ",
+                         n.is_string() ? "'" + t.value_or("") + "'" : t.value_or("a list")));
   }
   const auto t = text_of(n);
   if (!t) throw InputError(str(key, ": expected a single value"));
