@@ -355,9 +355,9 @@ def test_override_equals_the_flag(tmp_path):
 
 
 def test_bad_scenario_input(tmp_path):
-    with pytest.raises(ffsr.InputError, match="--gian: not a scenario key"):
+    with pytest.raises(ffsr.InputError, match=r"^Scenario\.load: gian: not a scenario key$"):
         ffsr.Scenario.load(str(ROBOTS / "paper_3dof.toml"), gian=1.0)
-    with pytest.raises(ffsr.InputError, match="--duration"):
+    with pytest.raises(ffsr.InputError, match=r"^Scenario\.load: duration: must be positive"):
         ffsr.Scenario.load(str(ROBOTS / "paper_3dof.toml"), duration=-1.0)
     bad = tmp_path / "bad.toml"
     bad.write_text("urdf = [\n")

@@ -814,9 +814,11 @@ TEST_CASE("conventions: a boolean is true or false, nothing else, as a flag or i
                   {where + ": stop-stack-spin: expected true or false"});
     if (bad == "\"true\"") continue;  // a command key of the file (quiet) is read as text, "true" is true
     const std::string quiet = scenario_with(tmp, "quiet = " + bad + "\n", &line);
-    check_refusal(cli({"inspect", "--config", quiet}), {"quiet", "expected true or false"});
+    // quiet is a key of the main job's file (a command key, read as text)
+    check_refusal(cli({"--config", quiet, "--global", "false"}), {"quiet", "expected true or false"});
   }
-  const std::string good = scenario_with(tmp, "stop-stack-spin = true\nglobal = false\n");
+  // the word itself (true needs a base actuator: false runs without one)
+  const std::string good = scenario_with(tmp, "stop-stack-spin = false\nglobal = false\n");
   const CommandResult r =
       cli({"detumble", "--config", good, "--joint-torque-limit", "20", "--json", "-", "--quiet"});
   INFO(r.err);
