@@ -63,7 +63,7 @@ int main(int argc, char** argv) {
       state.base.orientation = ffsr::Quaternion(ffsr::rotation_from_vector(dt * w)) * state.base.orientation;
       state.base.orientation.normalize();
     }
-    const double miss = (cmd.end_effector - controller.setup().x_cap).norm();
+    const double miss = (cmd.end_effector - controller.setup().capture.x_cap).norm();
     std::printf("capture point reached within %.2e m\n", miss);
     return miss < 1e-2 ? 0 : 1;
   } catch (const std::exception& e) {

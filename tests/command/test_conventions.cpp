@@ -406,7 +406,13 @@ TEST_CASE("each key a subcommand accepts changes its result, or the subcommand r
         const Args context = k.accepted ? only_accepted(c.context, accepted) : Args{};
         k.before = command_line(sub, context);
         Args changed = context;
-        changed.insert(changed.end(), c.alt.begin(), c.alt.end());
+        // a key the subcommand does not take: its flag alone (the other flags of its case, which the
+        // subcommand may refuse first, would hide whether this one is refused)
+        const auto own_end = k.accepted ? c.alt.end()
+                                        : std::find_if(c.alt.begin() + 1, c.alt.end(), [](const std::string& a) {
+                                            return a.rfind("--", 0) == 0;
+                                          });
+        changed.insert(changed.end(), c.alt.begin(), own_end);
         k.after = command_line(sub, changed);
         if (k.accepted) results[k.before];
         results[k.after];

@@ -303,12 +303,10 @@ TEST_CASE("scenario: bad keys and values name the file or the key", "[scenario]"
   const std::string lock = with("base-attitude = \"lock\"");
   CHECK(error_of([&] { ffsr::load_scenario(lock); }) ==
         "scenario " + lock + ":2: base-attitude: unknown mode 'lock'; expected 'free' or 'hold'");
-  // several keys, one of them a flag's: the file's named as written, the flag's as a flag
+  // several keys, one of them a flag's: named as flags, not located at the line of another key
   keys = ffsr::read_scenario_file(with(""));
   ffsr::override_scenario_key(keys, "restitution", "0");
-  CHECK(error_of([&] {
-          ffsr::build_scenario(keys);
-        }).rfind("scenario " + tmp.path.string() + "/s.toml:22: stiffness/exponent/--restitution: ", 0) == 0);
+  CHECK(error_of([&] { ffsr::build_scenario(keys); }).rfind("--stiffness/--exponent/--restitution: ", 0) == 0);
 }
 
 TEST_CASE("scenario: the keys a row of the main job does not take", "[scenario]") {
