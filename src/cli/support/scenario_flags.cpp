@@ -64,24 +64,45 @@ const char* group_reason(KeyGroup group) {
   return "a key which";
 }
 
-/// Why `sub` does not take `key`, where its own reason is more than its group's (the subcommands'
-/// registrations say so where they leave a key of a group they take out).
+/// A subcommand's own reason for leaving out keys of a group it takes.
+struct UntakenReason {
+  const char* sub;
+  std::vector<std::string> keys;
+  std::string why;
+};
+
+/// The subcommands' own reasons (their registrations leave these keys out of groups they take).
+const std::vector<UntakenReason>& untaken_reasons() {
+  static const std::vector<UntakenReason> reasons = {
+      {"map", {"base-position"}, "M_ie and F_max do not depend on where the base is"},
+      {"closed-loop", {"global"}, "the controller flies the plan that --plan names"},
+      {"closed-loop",
+       {"baseline-task", "base-attitude"},
+       "the controller flies the plan as planned: the planner's tasks are not the controller's"},
+      {"inspect",
+       {"stiffness", "exponent"},
+       "the law's stiffness and exponent change neither M_ie nor the base's jump at the impact that inspect "
+       "reports"},
+      {"pareto",
+       {"stiffness", "exponent"},
+       "the law's stiffness and exponent change neither M_ie nor the base's jump at the impact that pareto "
+       "reports"},
+      {"inspect",
+       {"clearance", "contact-exemption"},
+       "inspect reports the distances between whole bodies; the clearance constrains plans only"},
+      {"robust", {"joint-stiffness", "joint-damping"}, "robust's multibody force model runs with the library's default servo"},
+      {"xi",
+       {"stiffness", "approach-speed"},
+       "xi depends on the exponent and the restitution only; its studies vary the stiffness and the "
+       "approach speed"},
+  };
+  return reasons;
+}
+
+/// Why `sub` does not take `key`: its own reason where it has one (untaken_reasons), else its group's.
 std::string untaken_reason(const std::string& sub, const ScenarioKey& key) {
-  const std::string& k = key.name;
-  if (sub == "map" && k == "base-position") return "M_ie and F_max do not depend on where the base is";
-  if (sub == "closed-loop" && k == "global") return "the controller flies the plan that --plan names";
-  if (sub == "closed-loop" && (k == "baseline-task" || k == "base-attitude"))
-    return "the controller flies the plan as planned: the planner's tasks are not the controller's";
-  if ((sub == "inspect" || sub == "pareto") && (k == "stiffness" || k == "exponent"))
-    return str("the law's stiffness and exponent change neither M_ie nor the base's jump at the impact that ",
-               sub, " reports");
-  if (sub == "inspect" && (k == "clearance" || k == "contact-exemption"))
-    return "inspect reports the distances between whole bodies; the clearance constrains plans only";
-  if (sub == "robust" && (k == "joint-stiffness" || k == "joint-damping"))
-    return "robust's multibody force model runs with the library's default servo";
-  if (sub == "xi" && (k == "stiffness" || k == "approach-speed"))
-    return "xi depends on the exponent and the restitution only; its studies vary the stiffness and the "
-           "approach speed";
+  for (const UntakenReason& r : untaken_reasons())
+    if (sub == r.sub && std::find(r.keys.begin(), r.keys.end(), key.name) != r.keys.end()) return r.why;
   return str(group_reason(key.group), " ", sub, " does not evaluate");
 }
 

@@ -81,15 +81,12 @@ inline void add_post_capture(const PostCaptureScreen& screen, GlobalRun& r) {
   r.post_capture_admitted = screen.admitted();
 }
 
-/// run_global with the paper's-method run, or without it (null); `record_series`: keep the time
-/// series (ScenarioRunOptions::record_series) beside the scenario's own setting.
-inline GlobalRun run_global(const Scenario& sc, const CaptureResult* paper_run, GlobalObjective objective,
-                            std::shared_ptr<RobustForceObjective> robust, bool tight_reaching,
-                            bool record_series = false) {
-  CaptureOptions opt = sc.capture;
-  opt.gain = 0.0;
-  opt.max_joint_rate = sc.keys.max_joint_rate_deg * M_PI / 180.0;
-  opt.progress = nullptr;
+/// The global search's options of the scenario (run_global): its seed, starts, objective, joint models,
+/// the reaching tolerance, the paper's run as an extra start, the base-rate constraint.
+inline GlobalCaptureOptions global_search_options(const Scenario& sc, const CaptureOptions& opt,
+                                                  const CaptureResult* paper_run, GlobalObjective objective,
+                                                  const std::shared_ptr<RobustForceObjective>& robust,
+                                                  bool tight_reaching) {
   GlobalCaptureOptions g;
   g.search.seed = sc.seed;
   g.search.starts = sc.keys.global_starts;
@@ -111,6 +108,19 @@ inline GlobalRun run_global(const Scenario& sc, const CaptureResult* paper_run, 
   if (sc.keys.max_base_rate_deg > 0)  // the impact's base-rate jump as a constraint of every search
     g.search.inequalities = base_rate_inequality(sc.problem, prepare_capture(sc.problem, sc.task, opt),
                                                  sc.keys.max_base_rate_deg * M_PI / 180.0);
+  return g;
+}
+
+/// run_global with the paper's-method run, or without it (null); `record_series`: keep the time
+/// series (ScenarioRunOptions::record_series) beside the scenario's own setting.
+inline GlobalRun run_global(const Scenario& sc, const CaptureResult* paper_run, GlobalObjective objective,
+                            std::shared_ptr<RobustForceObjective> robust, bool tight_reaching,
+                            bool record_series = false) {
+  CaptureOptions opt = sc.capture;
+  opt.gain = 0.0;
+  opt.max_joint_rate = sc.keys.max_joint_rate_deg * M_PI / 180.0;
+  opt.progress = nullptr;
+  GlobalCaptureOptions g = global_search_options(sc, opt, paper_run, objective, robust, tight_reaching);
   const std::shared_ptr<PostCaptureScreen> screen = post_capture_screen(sc, opt, g);
   g.reconfigure.mode = reconfigure_mode_of(sc.keys.reconfigure, "--reconfigure");
   g.reconfigure.duration = sc.keys.reconfigure_duration;
