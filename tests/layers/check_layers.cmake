@@ -27,14 +27,20 @@ if(NOT FFSR_INCLUDE_DIR)
   message(FATAL_ERROR "check_layers: pass -DFFSR_INCLUDE_DIR=<include/ffsr>")
 endif()
 
-set(rank 0)
-foreach(entry IN LISTS FFSR_LAYERS)
-  string(REPLACE " " ";" names "${entry}")
-  foreach(name IN LISTS names)
-    set(LAYER_${name} ${rank})
+# sets <prefix>_<name> to the rank of its entry in the list `table` (entries lowest first, the names
+# of one entry separated by spaces share its rank)
+macro(rank_entries table prefix)
+  set(rank 0)
+  foreach(entry IN LISTS ${table})
+    string(REPLACE " " ";" names "${entry}")
+    foreach(name IN LISTS names)
+      set(${prefix}_${name} ${rank})
+    endforeach()
+    math(EXPR rank "${rank} + 1")
   endforeach()
-  math(EXPR rank "${rank} + 1")
-endforeach()
+endmacro()
+
+rank_entries(FFSR_LAYERS LAYER)
 
 # the layer name of a path relative to include/ffsr: its first component, or the file's name without
 # .hpp at the top
@@ -89,14 +95,7 @@ set(FFSR_JOBS_ORDER
   "closed_loop pareto robust detail/robust"
   "whole_capture"
 )
-set(rank 0)
-foreach(entry IN LISTS FFSR_JOBS_ORDER)
-  string(REPLACE " " ";" names "${entry}")
-  foreach(name IN LISTS names)
-    set(JOBS_${name} ${rank})
-  endforeach()
-  math(EXPR rank "${rank} + 1")
-endforeach()
+rank_entries(FFSR_JOBS_ORDER JOBS)
 foreach(h IN LISTS headers)
   if(NOT h MATCHES "^jobs/(.+)\\.(hpp|hxx)$")
     continue()
