@@ -1,8 +1,10 @@
 // Timings of the capture controller (control/capture_controller.hpp): step() per tick, median and
-// 99.9th percentile over 1e5 calls, and update_target() median, on the paper's 3-DOF and 7-DOF robots.
+// 99.9th percentile over 1e5 calls, and update_target() median, on the paper's 3-DOF and 7-DOF robots;
+// and of the detumbling controller (control/detumble_controller.hpp) on the 7-DOF stack, each law.
 // Exit status 1 when a step exceeds its budget (details after the includes).
 
 #include "ffsr/control/capture_controller.hpp"
+#include "ffsr/control/detumble_run.hpp"
 #include "ffsr/scenario/scenario.hpp"
 
 #include <sched.h>
@@ -91,6 +93,61 @@ Timing time_reference(long calls) {
   return {percentile(us, 0.5), percentile(us, 0.999), 0.0};
 }
 
+/// DetumbleController::step on the 7-DOF stack of robots/paper_7dof_detumble.toml (the grasp at its
+/// configuration): the states of a run, replayed; `mode` 0 the law with the joint limits, 1 with the
+/// gripper's limits too, 2 the passive law, 3 thrusters stopping the stack's spin.
+Timing time_detumble(const Scenario& sc, int mode, long calls) {
+  const Model& m = *sc.model;
+  const int ee = sc.problem.frame;
+  const GraspResult g = grasp_at_capture(m, ee, sc.problem.base, sc.problem.theta, sc.problem.target, 0.2);
+  const Model stack = attach_body(m, m.frame(ee).name, g.body);
+  DetumbleLimits lim;
+  lim.joint_torque.resize(7);
+  lim.joint_torque << 60, 60, 60, 40, 20, 20, 20;
+  DetumbleOptions opt;
+  if (mode == 1) {
+    lim.gripper_force = 20;
+    lim.gripper_moment = 10;
+  }
+  opt.hold = mode != 2;
+  if (mode == 3) {
+    lim.actuator = BaseActuator::Thrusters;
+    lim.thruster_force = 2;
+    lim.thruster_torque = 2.5;
+    opt.stop_stack_spin = true;
+  }
+  DetumbleRunOptions run;
+  run.horizon = 2;
+  run.dwell = 0;
+  run.rtol = 1e-8;
+  run.atol = 1e-10;
+  const DetumbleRunResult r =
+      run_detumble(stack, ee, g.body, {sc.problem.base, sc.problem.theta, g.v_after, {}}, lim, opt, run);
+  std::vector<DetumbleState> states;
+  for (const DetumbleSample& x : r.series) {
+    // the run's configurations and joint rates (the series keeps no base twist: zero here; the work of
+    // a step does not depend on it)
+    Eigen::VectorXd v(stack.nv());
+    v << Vector6::Zero(), x.theta_dot;
+    states.push_back({x.base, x.theta, v, x.wheel_momentum});
+  }
+  DetumbleController ctrl(stack, ee, g.body, lim, opt, run.tick);
+  DetumbleCommand cmd = ctrl.make_command();
+  std::vector<double> us(static_cast<size_t>(calls));
+  for (long k = 0; k < calls; ++k) {
+    const DetumbleState& st = states[static_cast<size_t>(k) % states.size()];
+    const auto a = Clock::now();
+    ctrl.step(st, cmd);
+    const auto b = Clock::now();
+    if (cmd.status == DetumbleStatus::Fault) {
+      std::fprintf(stderr, "bench_controller: unexpected detumble fault (%s)\n", fault_name(cmd.fault));
+      std::exit(2);
+    }
+    us[static_cast<size_t>(k)] = std::chrono::duration<double, std::micro>(b - a).count();
+  }
+  return {percentile(us, 0.5), percentile(us, 0.999), 0.0};
+}
+
 bool report(const char* name, const Timing& t, double budget_us) {
   const bool ok = t.median_us <= budget_us && t.p999_us <= 3 * t.median_us;
   std::printf(
@@ -150,6 +207,12 @@ int main(int argc, char** argv) {
     pb.target.inertia = Vector3(80, 100, 120).asDiagonal();
     auto paper = make_gradient_controller(pb, sc.task, sc.capture);
     ok = report("paper_7dof_position anisotropic", time_controller(paper, pb, calls / 10), 20.0) && ok;
+  }
+  {  // the detumbling controller on the 7-DOF stack
+    const Scenario sc = load_scenario(robots + "paper_7dof_detumble.toml");
+    const char* names[] = {"detumble 7-DOF joint limits", "detumble 7-DOF + gripper limits",
+                           "detumble 7-DOF passive law", "detumble 7-DOF thrusters"};
+    for (int mode = 0; mode < 4; ++mode) ok = report(names[mode], time_detumble(sc, mode, calls), 20.0) && ok;
   }
   return ok ? 0 : 1;
 }

@@ -19,6 +19,8 @@ using namespace nb::literals;
 
 namespace {
 
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
 BaseActuator actuator_arg(const std::string& name) {
   if (const std::optional<BaseActuator> a = find_base_actuator(name)) return *a;
   throw InputError(detail::str("detumble: unknown actuator '", name, "' (", base_actuator_names(", "), ")"));
@@ -26,7 +28,7 @@ BaseActuator actuator_arg(const std::string& name) {
 
 DetumbleLimits limits_arg(const Model& stack, nb::handle joint_torque, const std::string& actuator,
                           double wheel_torque, double wheel_momentum, double thruster_force,
-                          double thruster_torque) {
+                          double thruster_torque, double gripper_force, double gripper_moment) {
   DetumbleLimits l;
   const VecIn t(joint_torque, "detumble", "joint_torque");
   t.require(stack.n());
@@ -36,14 +38,16 @@ DetumbleLimits limits_arg(const Model& stack, nb::handle joint_torque, const std
   l.wheel_momentum = wheel_momentum;
   l.thruster_force = thruster_force;
   l.thruster_torque = thruster_torque;
+  l.gripper_force = gripper_force;
+  l.gripper_moment = gripper_moment;
   return l;
 }
 
-DetumbleOptions options_arg(double joint_gain, double base_gain, double rest_rate, bool stop_stack_spin,
+DetumbleOptions options_arg(double max_decay, double max_base_decay, double rest_rate, bool stop_stack_spin,
                             bool hold) {
   DetumbleOptions o;
-  o.joint_gain = joint_gain;
-  o.base_gain = base_gain;
+  o.max_decay = max_decay;
+  o.max_base_decay = max_base_decay;
   o.rest_rate = rest_rate;
   o.stop_stack_spin = stop_stack_spin;
   o.hold = hold;
@@ -82,6 +86,16 @@ void bind_grasp_result(nb::module_& m) {
       m, "AttachedBody",
       "A rigid body attached at a frame: mass (kg), inertia about its centre of mass (its\n"
       "axes, kg m^2), pose of its centre-of-mass frame in the frame, the name of that frame.")
+      .def(
+          "__init__",
+          [](AttachedBody* self, double mass, nb::handle inertia, const Pose& pose, const std::string& name) {
+            AttachedBody b{mass, mat3(inertia, "AttachedBody", "inertia"), pose, name};
+            detail::check_attached_body(b);
+            new (self) AttachedBody(std::move(b));
+          },
+          "mass"_a, "inertia"_a, "pose"_a = Pose{}, "name"_a = "target",
+          "InputError for a mass that is not positive and finite, an inertia that is not symmetric\n"
+          "positive definite or breaks the triangle inequality, a pose that is not a rotation.")
       .def_ro("mass", &AttachedBody::mass)
       .def_prop_ro(
           "inertia", [](const AttachedBody& b) { return out(b.inertia); }, nb::rv_policy::automatic)
@@ -141,6 +155,8 @@ void bind_detumble_result(nb::module_& m) {
       .def_ro("energy_start", &DetumbleRunResult::energy_start)
       .def_ro("energy_end", &DetumbleRunResult::energy_end)
       .def_ro("joint_work", &DetumbleRunResult::joint_work)
+      .def_ro("dwell_peak_rate", &DetumbleRunResult::dwell_peak_rate)
+      .def_ro("dwell_at_rest", &DetumbleRunResult::dwell_at_rest)
       .def_ro("ticks", &DetumbleRunResult::ticks)
       .def_prop_ro(
           "series_t",
@@ -222,20 +238,25 @@ void bind_detumble_controller(nb::module_& m) {
       "The detumbling controller on the stack model: one step per tick, no allocation.")
       .def(
           "__init__",
-          [](DetumbleController* self, const Model& stack, nb::handle gripper, nb::handle joint_torque,
-             const std::string& actuator, double wheel_torque, double wheel_momentum, double thruster_force,
-             double thruster_torque, double joint_gain, double base_gain, double rest_rate,
-             bool stop_stack_spin, bool hold) {
-            new (self)
-                DetumbleController(stack, frame_arg(stack, gripper, "DetumbleController"),
-                                   limits_arg(stack, joint_torque, actuator, wheel_torque, wheel_momentum,
-                                              thruster_force, thruster_torque),
-                                   options_arg(joint_gain, base_gain, rest_rate, stop_stack_spin, hold));
+          [](DetumbleController* self, const Model& stack, nb::handle gripper, const AttachedBody& body,
+             nb::handle joint_torque, const std::string& actuator, double wheel_torque, double wheel_momentum,
+             double thruster_force, double thruster_torque, double gripper_force, double gripper_moment,
+             double max_decay, double max_base_decay, double rest_rate, bool stop_stack_spin, bool hold,
+             double tick) {
+            new (self) DetumbleController(
+                stack, frame_arg(stack, gripper, "DetumbleController"), body,
+                limits_arg(stack, joint_torque, actuator, wheel_torque, wheel_momentum, thruster_force,
+                           thruster_torque, gripper_force, gripper_moment),
+                options_arg(max_decay, max_base_decay, rest_rate, stop_stack_spin, hold), tick);
           },
-          "stack"_a, "gripper"_a, "joint_torque"_a, "actuator"_a = "none", "wheel_torque"_a = 0.0,
-          "wheel_momentum"_a = 0.0, "thruster_force"_a = 0.0, "thruster_torque"_a = 0.0, "joint_gain"_a = 1.0,
-          "base_gain"_a = 0.1, "rest_rate"_a = 1e-3, "stop_stack_spin"_a = false, "hold"_a = true,
+          "stack"_a, "gripper"_a, "body"_a, "joint_torque"_a, "actuator"_a = "none", "wheel_torque"_a = 0.0,
+          "wheel_momentum"_a = 0.0, "thruster_force"_a = 0.0, "thruster_torque"_a = 0.0,
+          "gripper_force"_a = kInf, "gripper_moment"_a = kInf, "max_decay"_a = DetumbleOptions{}.max_decay,
+          "max_base_decay"_a = DetumbleOptions{}.max_base_decay, "rest_rate"_a = 1e-3,
+          "stop_stack_spin"_a = false, "hold"_a = true, "tick"_a = DetumbleRunOptions{}.tick,
           nb::keep_alive<1, 2>())
+      .def_prop_ro("decay_cap", &DetumbleController::decay_cap,
+                   "The largest decay rate the law asks: max_decay, at most half the tick's inverse (1/s).")
       .def(
           "step",
           [](DetumbleController& c, const Model& stack, const BasePose& base, nb::handle theta, nb::handle v,
@@ -251,6 +272,9 @@ void bind_detumble_controller(nb::module_& m) {
             d["relative_rate"] = cmd.relative_rate;
             d["stack_rate"] = cmd.stack_rate;
             d["brake_scale"] = cmd.brake_scale;
+            d["decay"] = cmd.decay;
+            d["base_decay"] = cmd.base_decay;
+            d["passive"] = cmd.passive;
             return d;
           },
           "stack"_a, "base"_a, "theta"_a, "v"_a, "wheel_momentum"_a = nb::none(),
@@ -331,21 +355,24 @@ void bind_detumble(nb::module_& m) {
       [](const Model& stack, nb::handle gripper, const AttachedBody& body, const BasePose& base,
          nb::handle theta, nb::handle v, nb::handle joint_torque, const std::string& actuator,
          double wheel_torque, double wheel_momentum, double thruster_force, double thruster_torque,
-         double joint_gain, double base_gain, double rest_rate, bool stop_stack_spin, bool hold, double tick,
-         double horizon) {
+         double gripper_force, double gripper_moment, double max_decay, double max_base_decay, double rest_rate,
+         bool stop_stack_spin, bool hold, double tick, double horizon, double dwell) {
         const DetumbleLimits l = limits_arg(stack, joint_torque, actuator, wheel_torque, wheel_momentum,
-                                            thruster_force, thruster_torque);
+                                            thruster_force, thruster_torque, gripper_force, gripper_moment);
         DetumbleRunOptions r;
         r.tick = tick;
         r.horizon = horizon;
+        r.dwell = dwell;
         return run_detumble(stack, frame_arg(stack, gripper, "run_detumble"), body,
                             state_arg(stack, base, theta, v, nb::none()), l,
-                            options_arg(joint_gain, base_gain, rest_rate, stop_stack_spin, hold), r);
+                            options_arg(max_decay, max_base_decay, rest_rate, stop_stack_spin, hold), r);
       },
       "stack"_a, "gripper"_a, "body"_a, "base"_a, "theta"_a, "v"_a, "joint_torque"_a, "actuator"_a = "none",
       "wheel_torque"_a = 0.0, "wheel_momentum"_a = 0.0, "thruster_force"_a = 0.0, "thruster_torque"_a = 0.0,
-      "joint_gain"_a = 1.0, "base_gain"_a = 0.1, "rest_rate"_a = 1e-3, "stop_stack_spin"_a = false,
-      "hold"_a = true, "tick"_a = 0.01, "horizon"_a = 120.0,
+      "gripper_force"_a = kInf, "gripper_moment"_a = kInf, "max_decay"_a = DetumbleOptions{}.max_decay,
+      "max_base_decay"_a = DetumbleOptions{}.max_base_decay, "rest_rate"_a = 1e-3, "stop_stack_spin"_a = false,
+      "hold"_a = true, "tick"_a = DetumbleRunOptions{}.tick, "horizon"_a = DetumbleRunOptions{}.horizon,
+      "dwell"_a = DetumbleRunOptions{}.dwell,
       "The post-capture run on the stack (ABA, CVODE) with the DetumbleController in the loop.");
 }
 

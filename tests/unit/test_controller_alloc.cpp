@@ -148,16 +148,23 @@ TEST_CASE("controller: 1e5 ticks allocate nothing (3-DOF and 7-DOF, gradient and
   }
 }
 
-TEST_CASE("detumble controller: 1e5 ticks allocate nothing (7-DOF stack, wheels and free-floating)") {
+TEST_CASE("detumble controller: 1e5 ticks allocate nothing (7-DOF stack, each actuator, each law)") {
   const Model robot = model_from_urdf_file(kRobots + "paper_7dof.urdf");
   AttachedBody body;
   body.mass = 200;
   body.inertia = Vector3(100, 80, 120).asDiagonal();
   body.pose.p = Vector3(0.3, -0.1, 0.2);
   const Model stack = attach_body(robot, "ee", body);
+  // the modes: the exact law with the joint limits, with the gripper's limits too, the passive law
+  for (int mode = 0; mode < 3; ++mode)
   for (const BaseActuator a : {BaseActuator::None, BaseActuator::ReactionWheels, BaseActuator::Thrusters}) {
+    CAPTURE(mode);
     CAPTURE(static_cast<int>(a));
     DetumbleLimits lim;
+    if (mode == 1) {
+      lim.gripper_force = 20;
+      lim.gripper_moment = 10;
+    }
     lim.joint_torque = Eigen::VectorXd::Constant(7, 5.0);
     lim.actuator = a;
     lim.wheel_torque = 0.2;
@@ -166,11 +173,12 @@ TEST_CASE("detumble controller: 1e5 ticks allocate nothing (7-DOF stack, wheels 
     lim.thruster_torque = 0.2;
     DetumbleOptions opt;
     opt.stop_stack_spin = a != BaseActuator::None;
-    DetumbleController ctrl(stack, stack.frame_index("ee"), lim, opt);
+    opt.hold = mode != 2;
+    DetumbleController ctrl(stack, stack.frame_index("ee"), body, lim, opt);
     DetumbleCommand cmd = ctrl.make_command();
     DetumbleState st{BasePose{}, Eigen::VectorXd::Constant(7, 0.4), Eigen::VectorXd::Constant(13, 0.05),
                      Vector3(0.5, -2.0, 0.1)};
-    long faults = 0, saturated = 0;
+    long faults = 0, saturated = 0, passive = 0;
     const long n0 = g_news.load(), d0 = g_deletes.load();
     for (long k = 0; k < 100000; ++k) {
       for (Eigen::Index j = 0; j < 7; ++j)
@@ -179,11 +187,13 @@ TEST_CASE("detumble controller: 1e5 ticks allocate nothing (7-DOF stack, wheels 
       ctrl.step(st, cmd);
       faults += cmd.status == DetumbleStatus::Fault;
       saturated += cmd.status == DetumbleStatus::Saturated;
+      passive += cmd.passive;
     }
     CHECK(g_news.load() - n0 == 0);
     CHECK(g_deletes.load() - d0 == 0);
     CHECK(faults == 100);
     CHECK(saturated > 0);
+    if (mode == 2) CHECK(passive == 100000 - faults);
   }
   // the centroidal momentum the step's base wrench reads (from H): none either
   Data d(stack);

@@ -304,6 +304,144 @@ TEST_CASE("detumble, free-floating, the passive law: kinetic energy never increa
   check_torques_within_limits(r, lim.joint_torque);
 }
 
+TEST_CASE("detumble at the limits: each command the largest decay that fits, checked by forward dynamics",
+          "[detumble]") {
+  // along a run: every command within the joint and gripper limits (the gripper's load from the run's
+  // ABA, not the controller's RNEA), and where the decay is below the cap some bound active; at the
+  // grasp, ABA under the command (the controller computes it by CRBA and RNEA) gives qdd = -decay qd
+  const Grasped g = grasped_7dof();
+  DetumbleLimits lim;
+  lim.joint_torque = limits_7dof();
+  lim.gripper_force = 20;
+  lim.gripper_moment = 10;
+  DetumbleController ctrl(g.stack, g.gripper, g.grasp.body, lim);
+  DetumbleRunOptions run;
+  run.horizon = 60;
+  run.dwell = 0;
+  const DetumbleRunResult r = run_detumble(g.stack, g.gripper, g.grasp.body, g.start, lim, {}, run);
+  REQUIRE(r.series.size() > 5);
+  long bound = 0;
+  for (const DetumbleSample& x : r.series) {
+    const DetumbleCommand& cmd = x.command;
+    REQUIRE_FALSE(cmd.passive);
+    REQUIRE(cmd.decay > 0);
+    REQUIRE(cmd.decay <= ctrl.decay_cap());
+    double worst = 0;
+    for (int k = 0; k < 7; ++k) worst = std::max(worst, std::abs(cmd.tau(k)) / lim.joint_torque(k));
+    worst = std::max({worst, x.gripper_force.norm() / lim.gripper_force, x.gripper_moment.norm() / lim.gripper_moment});
+    REQUIRE(worst <= 1 + 1e-9);
+    if (cmd.decay < ctrl.decay_cap()) {
+      REQUIRE(worst > 1 - 1e-9);  // the largest that fits: some bound is active
+      ++bound;
+    }
+  }
+  CHECK(bound > 3);
+  Data d(g.stack);
+  // the exact law at the grasp: forward dynamics under the first command
+  DetumbleCommand c = ctrl.make_command();
+  ctrl.step(g.start, c);
+  Eigen::VectorXd tau(g.stack.nv()), a(g.stack.nv());
+  tau << c.base_wrench, c.tau;
+  aba(g.stack, d, g.start.base, g.start.theta, g.start.v, tau, a);
+  const Eigen::VectorXd want = -c.decay * g.start.v.tail(7);
+  CHECK((a.tail(7) - want).cwiseAbs().maxCoeff() < 1e-9 * want.cwiseAbs().maxCoeff());
+}
+
+TEST_CASE("detumble on robots/paper_7dof_detumble.toml's stack: the limits used, held at rest for 10 s",
+          "[detumble]") {
+  // the previous law (lambda = 1 1/s, what max_decay = 1 asks while no limit binds) rested in 5.05 s
+  const Grasped g = grasped_7dof();
+  DetumbleLimits lim;
+  lim.joint_torque = limits_7dof();
+  DetumbleOptions opt;
+  opt.rest_rate = 0.05 * M_PI / 180;  // the scenario's rest-rate-deg
+  DetumbleRunOptions run;
+  run.horizon = 60;
+  run.dwell = 10;
+  DetumbleOptions slow = opt;
+  slow.max_decay = 1;
+  const DetumbleRunResult before = run_detumble(g.stack, g.gripper, g.grasp.body, g.start, lim, slow, run);
+  const DetumbleRunResult r = run_detumble(g.stack, g.gripper, g.grasp.body, g.start, lim, opt, run);
+  INFO("time to rest " << r.time_to_rest << " s (lambda = 1: " << before.time_to_rest << " s), peak torque "
+                       << r.peak_joint_torque << " N m, dwell peak rate " << r.dwell_peak_rate);
+  CHECK(std::abs(before.time_to_rest - 5.05) < 0.015);
+  CHECK(r.at_rest);
+  CHECK(r.time_to_rest <= 0.6 * 5.05);
+  CHECK(r.dwell_at_rest);
+  CHECK(r.dwell_peak_rate < opt.rest_rate);
+  CHECK(r.series.back().t >= r.time_to_rest + 10 - 1e-9);
+  CHECK(r.momentum_drift < 1e-8);
+  CHECK(r.peak_joint_torque > 0.9 * 20);  // it brakes with what it has, not with 5-23 % of it
+  check_torques_within_limits(r, lim.joint_torque);
+  // with the gripper's limits every sample's load (ABA's Newton-Euler, not the controller's) within them
+  DetumbleLimits grip = lim;
+  grip.gripper_force = 20;
+  grip.gripper_moment = 10;
+  const DetumbleRunResult rg = run_detumble(g.stack, g.gripper, g.grasp.body, g.start, grip, opt, run);
+  CHECK(rg.at_rest);
+  CHECK(rg.time_to_rest <= 0.6 * 5.05);
+  CHECK(rg.dwell_at_rest);
+  for (const DetumbleSample& x : rg.series) {
+    REQUIRE(x.gripper_force.norm() <= 20 * (1 + 1e-9));
+    REQUIRE(x.gripper_moment.norm() <= 10 * (1 + 1e-9));
+  }
+  CHECK(rg.peak_gripper_moment > 10 * (1 - 1e-6));  // the bound binds
+  CHECK(r.peak_gripper_moment > 10);                 // and without it the load goes past it
+}
+
+TEST_CASE("detumble ticks: energy never rises on a passive tick up to the longest tick, a longer one refused",
+          "[detumble]") {
+  const Grasped g = grasped_7dof();
+  DetumbleLimits lim;
+  lim.joint_torque = limits_7dof();
+  const double longest = detumble_longest_tick(g.stack, g.gripper, g.start);
+  INFO("longest tick " << longest << " s");
+  CHECK(std::abs(longest - 0.15 / g.start.v.tail(7).cwiseAbs().maxCoeff()) < 1e-12);
+  for (const double tick : {0.01, 0.1, 1.0, longest * (1 - 1e-9)}) {
+    CAPTURE(tick);
+    for (const bool hold : {false, true}) {
+      CAPTURE(hold);
+      DetumbleOptions opt;
+      opt.hold = hold;
+      DetumbleRunOptions run;
+      run.tick = tick;
+      run.horizon = std::max(8.0, 20 * tick);
+      run.dwell = 0;
+      const DetumbleRunResult r = run_detumble(g.stack, g.gripper, g.grasp.body, g.start, lim, opt, run);
+      long passive = 0;
+      for (size_t k = 1; k < r.series.size(); ++k)
+        if (r.series[k - 1].command.passive) {
+          ++passive;
+          REQUIRE(r.series[k].energy <= r.series[k - 1].energy + 1e-12 * r.energy_start);
+        }
+      CHECK(r.energy_end < r.energy_start);
+      CHECK(r.momentum_drift < 1e-8);
+      if (!hold) CHECK(passive == static_cast<long>(r.series.size()) - 1);
+      check_torques_within_limits(r, lim.joint_torque);
+    }
+  }
+  DetumbleRunOptions run;
+  run.tick = longest * 1.001;
+  try {
+    run_detumble(g.stack, g.gripper, g.grasp.body, g.start, lim, {}, run);
+    FAIL("a tick past the longest was taken");
+  } catch (const DetumbleInfeasibleError& e) {
+    CHECK(e.bound == DetumbleBound::Tick);
+    CHECK_THAT(e.what(), Catch::Matchers::Contains("joint 'joint6'"));
+  }
+  // an extreme spin (the target at 1e4 deg/s): refused at once, not run for minutes
+  Target t;
+  t.angular_velocity = Vector3(1e4, -0.5, 2) * M_PI / 180;
+  t.contact_offset = Vector3(-0.25, 0.15, 0.1);
+  const GraspResult fast = grasp_at_capture(g.robot, g.gripper, BasePose{}, g.start.theta, t, 0.2);
+  const Model stack = attach_body(g.robot, g.robot.frame(g.gripper).name, fast.body);
+  const DetumbleState start{BasePose{}, g.start.theta, fast.v_after, Vector3::Zero()};
+  CHECK_THROWS_AS(run_detumble(stack, g.gripper, fast.body, start, lim, {}, DetumbleRunOptions{}),
+                  DetumbleInfeasibleError);
+  CHECK(detumble_longest_tick(stack, g.gripper, start) < 1e-3);
+}
+
+
 TEST_CASE("detumble with reaction wheels: the stack's spin stopped, the wheels within their bounds",
           "[detumble]") {
   const Grasped g = grasped_7dof();
@@ -352,10 +490,10 @@ TEST_CASE("detumble: the gripper load is the rate of the target's momentum", "[d
   const Grasped g = grasped_7dof();
   DetumbleLimits lim;
   lim.joint_torque = limits_7dof();
-  DetumbleController ctrl(g.stack, g.gripper, lim);
+  DetumbleController ctrl(g.stack, g.gripper, g.grasp.body, lim);
   DetumbleCommand cmd = ctrl.make_command();
   ctrl.step(g.start, cmd);
-  REQUIRE(cmd.status == DetumbleStatus::Braking);
+  REQUIRE(cmd.status != DetumbleStatus::Fault);
   detail::DetumbleSystem sys(g.stack);
   const Eigen::VectorXd y = sys.pack(g.start);
   Vector3 f, n_p;
@@ -538,13 +676,16 @@ void check_same(const DetumbleSettings& a, const DetumbleSettings& b) {
   CHECK(a.limits.wheel_momentum == b.limits.wheel_momentum);
   CHECK(a.limits.thruster_force == b.limits.thruster_force);
   CHECK(a.limits.thruster_torque == b.limits.thruster_torque);
-  CHECK(a.options.joint_gain == b.options.joint_gain);
-  CHECK(a.options.base_gain == b.options.base_gain);
+  CHECK(a.limits.gripper_force == b.limits.gripper_force);
+  CHECK(a.limits.gripper_moment == b.limits.gripper_moment);
+  CHECK(a.options.max_decay == b.options.max_decay);
+  CHECK(a.options.max_base_decay == b.options.max_base_decay);
   CHECK(a.options.rest_rate == b.options.rest_rate);
   CHECK(a.options.stop_stack_spin == b.options.stop_stack_spin);
   CHECK(a.options.hold == b.options.hold);
   CHECK(a.run.tick == b.run.tick);
   CHECK(a.run.horizon == b.run.horizon);
+  CHECK(a.run.dwell == b.run.dwell);
   CHECK(a.run.record_every == b.run.record_every);
   CHECK(a.run.rtol == b.run.rtol);
   CHECK(a.run.atol == b.run.atol);
@@ -568,7 +709,7 @@ TEST_CASE("a Detumble key from the scenario file to the controller: one conversi
   CHECK(s.run.tick == 0.02);
   CHECK(s.run.horizon == 110);
   const DetumbleSettings defaults;  // the law's gains and the integrator's tolerances are not keys
-  CHECK(s.options.joint_gain == defaults.options.joint_gain);
+  CHECK(s.options.max_decay == defaults.options.max_decay);
   CHECK(s.run.rtol == defaults.run.rtol);
 
   // the job runs under them as built (the result holds the struct, no field copied on the way), and
@@ -578,7 +719,7 @@ TEST_CASE("a Detumble key from the scenario file to the controller: one conversi
   CHECK(d.result.at_rest);
   CHECK(static_cast<double>(d.result.ticks) * s.run.tick < s.run.horizon);
   const Model stack = attach_body(*sc.model, sc.model->frame(sc.problem.frame).name, d.grasp.body);
-  DetumbleController ctrl(stack, sc.problem.frame, s.limits, s.options);
+  DetumbleController ctrl(stack, sc.problem.frame, d.grasp.body, s.limits, s.options, s.run.tick);
   DetumbleCommand first = ctrl.make_command();
   const detail::DetumbleSystem sys(stack);  // the run's state vector: the grasp's state as it packs it
   const DetumbleState start{sc.problem.base, sc.problem.theta, d.grasp.v_after, Vector3::Zero()};
@@ -587,6 +728,9 @@ TEST_CASE("a Detumble key from the scenario file to the controller: one conversi
   CHECK(recorded.tau == first.tau);
   CHECK(recorded.base_wrench == first.base_wrench);
   CHECK(recorded.brake_scale == first.brake_scale);
+  CHECK(recorded.decay == first.decay);
+  CHECK(recorded.base_decay == first.base_decay);
+  CHECK(recorded.passive == first.passive);
   CHECK(recorded.joint_rate == first.joint_rate);
   CHECK(recorded.relative_rate == first.relative_rate);
   CHECK(recorded.stack_rate == first.stack_rate);
@@ -630,6 +774,15 @@ TEST_CASE("a Detumble key from the scenario file to the controller: one conversi
     CHECK_THAT(e.what(), Catch::Contains("joint-torque-limit: every limit must be positive, got -3"));
     CHECK_THAT(e.what(), Catch::Contains("paper_7dof_detumble.toml:"));
   }
+}
+
+TEST_CASE("detumble job: a tick past the longest refused naming detumble-tick", "[detumble]") {
+  const Scenario sc = build_scenario(detumble_scenario("joint-torque-limit = [60, 60, 60, 40, 20, 20, 20]\n"
+                                                       "detumble-tick = 1.2\n"),
+                                     nullptr, ScenarioScope::Configuration);
+  CHECK_THROWS_WITH(detumble(sc), Catch::Matchers::Contains("detumble-tick: detumble: the tick, 1.2 s") &&
+                                      Catch::Matchers::Contains("1.08") &&
+                                      Catch::Matchers::Contains("joint 'joint6'"));
 }
 
 }  // namespace test_detumble

@@ -1,13 +1,16 @@
 // ffsr/control/detumble_controller.hpp -- the post-capture phase as an onboard controller: one call per
 // control tick on the stack (robot + grasped target, model/attach.hpp), no heap allocation, no exception.
-// Joint torques brake the joint rates within per-joint limits; a base actuator (reaction wheels or
-// thrusters), where there is one, removes the stack's momentum within its bounds. The law and its cost
-// are in docs/detumble.md.
+// Each tick the joint torques brake the joint rates as hard as the joint torque limits and the gripper's
+// force and moment limits allow (the largest uniform decay that fits, a passive fallback when none does),
+// and hold the stack at rest once there; a base actuator (reaction wheels or thrusters), where there is
+// one, removes the stack's momentum as fast as its bounds allow. The law and its cost are in
+// docs/detumble.md.
 #pragma once
 
 #include "ffsr/algorithm/jacobian.hpp"
 #include "ffsr/algorithm/momentum.hpp"
 #include "ffsr/algorithm/rnea.hpp"
+#include "ffsr/model/attach.hpp"
 
 #include <algorithm>
 #include <array>
@@ -66,16 +69,29 @@ struct DetumbleLimits {
   double wheel_momentum = 0;   ///< reaction wheels: N m s stored per base axis
   double thruster_force = 0;   ///< thrusters: N per base axis
   double thruster_torque = 0;  ///< thrusters: N m per base axis
+  /// the gripper's load on the target: the force (N) and the moment about the contact point (N m),
+  /// each bounded in norm; infinity: not limited
+  double gripper_force = std::numeric_limits<double>::infinity();
+  double gripper_moment = std::numeric_limits<double>::infinity();
 };
+
+/// A decay rate times the tick stays at or below this: the command is held over the tick, and a joint
+/// asked to lose at most this fraction of its rate in one tick neither overshoots nor reverses.
+inline constexpr double kDetumbleTickFraction = 0.5;
 
 /// The law's settings.
 struct DetumbleOptions {
-  double joint_gain = 1.0;       ///< lambda (1/s): the joint rates asked to decay as qdd = -lambda qd
-  double base_gain = 0.1;        ///< k (1/s): the actuator asks dL/dt = -k L (and dP/dt = -k P, thrusters)
+  /// lambda_max (1/s): the fastest decay the joint rates are asked (qdd = -lambda qd, lambda the largest
+  /// that fits the limits, at most this and kDetumbleTickFraction / tick): the law's bandwidth
+  double max_decay = 20;
+  /// k_max (1/s): the fastest decay of the stack's momentum the actuator is asked (dL/dt = -k L, and
+  /// dP/dt = -k P with thrusters; k the largest within the actuator's bounds, at most this and
+  /// kDetumbleTickFraction / tick)
+  double max_base_decay = 2;
   double rest_rate = 1e-3;       ///< rad/s (m/s prismatic): at rest below it
   bool stop_stack_spin = false;  ///< also stop the stack's spin (needs an actuator)
-  /// true: the exact law (qdd = -lambda qd, holding against the velocity terms) where the limits allow
-  /// it, else the passive one; false: the passive law always (tau . qd <= 0)
+  /// true: the exact law (qdd = -lambda qd, holding against the velocity terms) with the largest lambda
+  /// the limits allow, else the passive one; false: the passive law always (tau . qd <= 0)
   bool hold = true;
 };
 
@@ -141,7 +157,10 @@ inline const char* fault_name(DetumbleFault f) {
 struct DetumbleCommand {
   Eigen::VectorXd tau;                    ///< joint torques (zero on a fault)
   Vector6 base_wrench = Vector6::Zero();  ///< force and moment on the base about its origin, inertial
-  double brake_scale = 1;                 ///< the passive law's scale into the limits (1: none cut)
+  double decay = 0;        ///< lambda of the tick (1/s): the exact law's, or the passive law's times its scale
+  double base_decay = 0;   ///< k of the tick (1/s): the actuator's (0 without one)
+  bool passive = false;    ///< the passive law acted (no decay of the exact law fitted the limits)
+  double brake_scale = 1;  ///< the passive law's scale into the limits (1: none cut)
   double joint_rate = 0;                  ///< largest |qd_k|
   double relative_rate = 0;               ///< |angular velocity of the gripper relative to the base|
   double stack_rate = 0;                  ///< |angular velocity of the base|
@@ -170,8 +189,14 @@ inline void check_detumble(const Model& stack, const DetumbleLimits& l, const De
     positive(l.thruster_force, "the thrusters' force");
     positive(l.thruster_torque, "the thrusters' torque");
   }
-  positive(o.joint_gain, "the joint gain");
-  positive(o.base_gain, "the base gain");
+  auto gripper = [&](double x, const char* what) {
+    if (std::isnan(x) || !(x > 0))
+      throw InputError(str(where, ": ", what, " must be positive (infinity: not limited), got ", x));
+  };
+  gripper(l.gripper_force, "the gripper's force limit");
+  gripper(l.gripper_moment, "the gripper's moment limit");
+  positive(o.max_decay, "the largest decay rate");
+  positive(o.max_base_decay, "the largest decay rate of the stack's momentum");
   positive(o.rest_rate, "the rest rate");
   if (o.stop_stack_spin && l.actuator == BaseActuator::None)
     throw InputError(str(where,
@@ -179,10 +204,33 @@ inline void check_detumble(const Model& stack, const DetumbleLimits& l, const De
                          "angular momentum is conserved (name reaction wheels or thrusters)"));
 }
 
-/// x clamped to [-L, L] per base axis: the components of x in the base frame (R) clamped, rotated back.
-inline Vector3 clamp_in_base(const Matrix3& R, const Vector3& x, double L) {
-  const Vector3 b = (R.transpose() * x).cwiseMax(-L).cwiseMin(L);
-  return R * b;
+/// Narrows [lo, hi] to the lambdas with |a + lambda b| <= L (lo > hi: none).
+inline void fit_bound(double a, double b, double L, double& lo, double& hi) noexcept {
+  if (b == 0) {
+    if (std::abs(a) > L) lo = std::numeric_limits<double>::infinity();
+    return;
+  }
+  const double r1 = (-L - a) / b, r2 = (L - a) / b;
+  lo = std::max(lo, std::min(r1, r2));
+  hi = std::min(hi, std::max(r1, r2));
+}
+
+/// Narrows [lo, hi] to the lambdas with |a + lambda b| <= L for 3-vectors (an infinite L: no bound).
+inline void fit_norm(const Vector3& a, const Vector3& b, double L, double& lo, double& hi) noexcept {
+  if (std::isinf(L)) return;
+  const double bb = b.squaredNorm(), ab = a.dot(b), c = a.squaredNorm() - L * L;
+  if (bb == 0) {
+    if (c > 0) lo = std::numeric_limits<double>::infinity();
+    return;
+  }
+  const double disc = ab * ab - bb * c;
+  if (disc < 0) {
+    lo = std::numeric_limits<double>::infinity();
+    return;
+  }
+  const double sq = std::sqrt(disc);
+  lo = std::max(lo, (-ab - sq) / bb);
+  hi = std::min(hi, (-ab + sq) / bb);
 }
 
 }  // namespace detail
@@ -190,27 +238,56 @@ inline Vector3 clamp_in_base(const Matrix3& R, const Vector3& x, double L) {
 /// The detumbling controller on the stack model (see the top of the file and docs/detumble.md).
 class DetumbleController {
  public:
-  /// `stack` (the robot with the target attached, attach_body) must outlive the controller;
-  /// `gripper` is the frame whose body carries the target. Allocates; step() then does not.
-  /// InputError for bad limits or options (detail::check_detumble) or a bad frame.
-  DetumbleController(const Model& stack, int gripper, const DetumbleLimits& limits,
-                     const DetumbleOptions& options = {})
+  /// `stack` (the robot with `body` attached at `gripper`'s frame, attach_body) must outlive the
+  /// controller; `gripper` is the frame whose body carries the target, `body` the target as attached
+  /// (its load on the gripper is what the gripper limits bound), `tick` the control period (s) over
+  /// which each command is held. Allocates; step() then does not. InputError for bad limits or options
+  /// (detail::check_detumble), a bad frame, body or tick.
+  DetumbleController(const Model& stack, int gripper, const AttachedBody& body, const DetumbleLimits& limits,
+                     const DetumbleOptions& options = {}, double tick = 0.01)
       : model_(&stack),
         gripper_(gripper),
         limits_(limits),
         opt_(options),
+        tick_(tick),
         data_(stack),
-        qdd_(stack.n()),
-        hold_(stack.n()) {
+        c_(stack.nv()),
+        vd0_(stack.nv()),
+        vd1_(stack.nv()),
+        vdt_(stack.nv()),
+        t0_(stack.n()),
+        t1_(stack.n()),
+        hold_(stack.n()),
+        qdd0_(stack.n()),
+        qdd1_(stack.n()),
+        hb_(6, stack.n()),
+        hstar_(stack.n(), stack.n()),
+        inv_(stack.n(), stack.n()),
+        llt_m_(stack.n()) {
     detail::check_detumble(stack, limits, options, "DetumbleController");
+    if (!std::isfinite(tick) || !(tick > 0))
+      throw InputError(detail::str("DetumbleController: the tick must be positive and finite, got ", tick));
     if (gripper < 0 || gripper >= static_cast<int>(stack.frames().size()))
       throw InputError(detail::str("DetumbleController: frame index ", gripper, " out of range"));
     if (stack.nb() - 1 != stack.n()) throw InputError("DetumbleController: the model has mimic joints");
+    detail::check_attached_body(body);
+    const Frame& f = stack.frame(gripper);
+    body_index_ = f.body;
+    r_gripper_ = f.pose.p;
+    const Matrix3 R = f.pose.R * body.pose.R;
+    target_ = SpatialInertia::from_com(body.mass, f.pose.p + f.pose.R * body.pose.p,
+                                       R * body.inertia * R.transpose());
+    decay_cap_ = std::min(opt_.max_decay, kDetumbleTickFraction / tick_);
+    base_cap_ = std::min(opt_.max_base_decay, kDetumbleTickFraction / tick_);
   }
 
   int joints() const noexcept { return model_->n(); }
   const DetumbleLimits& limits() const noexcept { return limits_; }
   const DetumbleOptions& options() const noexcept { return opt_; }
+  double tick() const noexcept { return tick_; }
+  /// The largest decay rate the law asks of the joint rates: max_decay, at most
+  /// kDetumbleTickFraction / tick.
+  double decay_cap() const noexcept { return decay_cap_; }
 
   /// A command sized for this controller (allocates: make it once).
   DetumbleCommand make_command() const {
@@ -250,74 +327,153 @@ class DetumbleController {
   static void fault(DetumbleCommand& out, DetumbleFault f) noexcept {
     out.tau.setZero();
     out.base_wrench.setZero();
+    out.decay = 0;
+    out.base_decay = 0;
     out.status = DetumbleStatus::Fault;
     out.fault = f;
   }
 
+  /// The largest k <= base_cap_ with |k x_i| <= L on every base axis i (x in the base frame).
+  double base_fit(const Vector3& x, double L) const {
+    double k = base_cap_;
+    for (int i = 0; i < 3; ++i)
+      if (std::abs(x(i)) * k > L) k = L / std::abs(x(i));
+    return k;
+  }
+
   /// The actuator's wrench from the stack's centroidal momentum (centroidal_momentum, from the base rows
   /// of H): the moment -k L_c, L_c the angular momentum about the stack's centre of mass, and for
-  /// thrusters the force -k P; each clamped per base axis, a wheel torque cut on an axis whose stored
-  /// momentum is at its bound and would grow. Reads data_.H. Writes out.base_wrench.
+  /// thrusters the force -k_f P, with the largest k (k_f) up to base_cap_ that keeps every base-axis
+  /// component within the actuator's bound (the direction kept); a wheel's torque is cut so that its
+  /// stored momentum stays within its bound over the tick. Reads data_.H. Writes out.base_wrench,
+  /// out.base_decay.
   void base_wrench(const DetumbleState& s, DetumbleCommand& out) const {
     out.base_wrench.setZero();
+    out.base_decay = 0;
     if (!opt_.stop_stack_spin || limits_.actuator == BaseActuator::None) return;
     const CentroidalMomentum h = centroidal_momentum(*model_, data_, s.v);
-    const Vector3& Lc = h.angular;
     const Matrix3 R = s.base.orientation.normalized().toRotationMatrix();
-    const double k = opt_.base_gain;
+    const Vector3 Lb = R.transpose() * h.angular;
     if (limits_.actuator == BaseActuator::Thrusters) {
-      out.base_wrench.head<3>() = detail::clamp_in_base(R, -k * h.linear, limits_.thruster_force);
-      out.base_wrench.tail<3>() = detail::clamp_in_base(R, -k * Lc, limits_.thruster_torque);
+      const Vector3 Pb = R.transpose() * h.linear;
+      out.base_wrench.head<3>() = R * (-base_fit(Pb, limits_.thruster_force) * Pb);
+      out.base_decay = base_fit(Lb, limits_.thruster_torque);
+      out.base_wrench.tail<3>() = R * (-out.base_decay * Lb);
       return;
     }
-    Vector3 tb = (R.transpose() * (-k * Lc)).cwiseMax(-limits_.wheel_torque).cwiseMin(limits_.wheel_torque);
+    out.base_decay = base_fit(Lb, limits_.wheel_torque);
+    Vector3 tb = -out.base_decay * Lb;
     const Vector3 hw = R.transpose() * s.wheel_momentum;  // the wheels take -torque: dh_w/dt = -t
     for (int i = 0; i < 3; ++i)
-      if (std::abs(hw(i)) >= limits_.wheel_momentum && hw(i) * tb(i) < 0) tb(i) = 0;
+      if (hw(i) * tb(i) < 0)  // the stored momentum grows on this axis: at most up to the bound
+        tb(i) = std::copysign(std::min(std::abs(tb(i)), std::max(0.0, limits_.wheel_momentum - std::abs(hw(i))) / tick_),
+                              tb(i));
     out.base_wrench.tail<3>() = R * tb;
   }
 
-  /// The joint torques. The exact law: the torques that give qdd = -lambda qd on the floating stack
-  /// with the base wrench w_b (C = bias_forces):
-  ///   a_b = H_b^-1 (w_b - C_b - H_bm qdd),  tau = H_mb a_b + H_mm qdd + C_m,
-  /// used when every joint stays within its limit. Otherwise (and always with hold = false) the passive
-  /// law tau_k = -s lambda H*_kk qd_k, H*_kk = H_kk - H_kb H_b^-1 H_bk the joint's inertia on the
-  /// floating stack, with the largest s <= 1 that keeps every joint within its limit: tau . qd <= 0, so
-  /// the joints only take energy out. Reads data_.H (crba). Writes data_.tau (bias_forces), qdd_,
-  /// hold_, out.tau, out.brake_scale; returns whether the passive law was used because of the limits.
+  /// Narrows [lo, hi] to the parameters x for which the gripper's load at the accelerations
+  /// a0 + x a1 stays within its limits (two RNEA passes: the load is affine in the accelerations).
+  /// Writes data_ (rnea), vdt_.
+  void gripper_fit(const DetumbleState& s, const Eigen::VectorXd& a0, const Eigen::VectorXd& a1, double& lo,
+                   double& hi) {
+    if (std::isinf(limits_.gripper_force) && std::isinf(limits_.gripper_moment)) return;
+    const auto e = static_cast<size_t>(body_index_);
+    rnea(*model_, data_, s.base, s.theta, s.v, a0);
+    const Vector6 A0 = data_.A[e], V = data_.V[e];
+    const Vector6 w0 = target_ * A0 + cross_force(V, target_ * V);
+    vdt_ = a0 + a1;
+    rnea(*model_, data_, s.base, s.theta, s.v, vdt_);
+    const Vector6 w1 = target_ * Vector6(data_.A[e] - A0);
+    const Vector3 f0 = w0.head<3>(), f1 = w1.head<3>();
+    detail::fit_norm(f0, f1, limits_.gripper_force, lo, hi);
+    detail::fit_norm(w0.tail<3>() - r_gripper_.cross(f0), w1.tail<3>() - r_gripper_.cross(f1),
+                     limits_.gripper_moment, lo, hi);
+  }
+
+  /// The joint torques. The exact law: on the floating stack with the base wrench w_b, the
+  /// accelerations that give qdd = -lambda qd are vd0 + lambda vd1,
+  ///   vd0 = [H_b^-1 (w_b - C_b); 0],  vd1 = [H_b^-1 H_bm qd; -qd]   (C = bias_forces),
+  /// and the torques tau(lambda) = t0 + lambda t1 (t0 = H_m vd0 + C_m holds the arm against the
+  /// velocity terms, t1 = -H* qd brakes, H* = H_mm - H_mb H_b^-1 H_bm): affine in lambda, as the
+  /// gripper's load is. lambda is the largest in [0, decay_cap_] with every joint torque and the
+  /// gripper's force and moment within their limits (an intersection of intervals). When no lambda
+  /// fits (and always with hold = false) the passive law tau_k = -s lambda_p H*_kk qd_k with
+  /// lambda_p = min(max_decay, kDetumbleTickFraction / (tick rho)), rho Gershgorin's bound on the largest eigenvalue of
+  /// D^1/2 H*^-1 D^1/2, D = diag(H*) (1 for uncoupled joints: the held torque's second-order work over
+  /// a tick stays below half its first-order one), and the
+  /// largest s <= 1 that keeps every joint and, where it can, the gripper within the limits:
+  /// tau . qd <= 0. Returns whether a limit bound the law or the passive law acted.
   bool joint_torques(const DetumbleState& s, DetumbleCommand& out) {
     const int n = model_->n();
     const Eigen::MatrixXd& H = data_.H;
     llt_.compute(H.topLeftCorner<6, 6>());
+    c_ = bias_forces(*model_, data_, s.base, s.theta, s.v);
     const auto qd = s.v.tail(n);
+    const auto Hbm = H.topRightCorner(6, n);
+    const auto Hm = H.bottomRows(n);
+    vd0_.head<6>() = llt_.solve(Vector6(out.base_wrench - c_.head<6>()));
+    vd0_.tail(n).setZero();
+    b6_.noalias() = Hbm * qd;
+    vd1_.head<6>() = llt_.solve(b6_);
+    vd1_.tail(n) = -qd;
+    t0_.noalias() = Hm * vd0_;
+    t0_ += c_.tail(n);
+    t1_.noalias() = Hm * vd1_;
     out.brake_scale = 1.0;
+    out.passive = false;
     if (opt_.hold) {
-      const Eigen::VectorXd& C = bias_forces(*model_, data_, s.base, s.theta, s.v);
-      qdd_ = -opt_.joint_gain * qd;
-      Vector6 rhs = out.base_wrench - C.head<6>();
-      for (int r = 0; r < 6; ++r) rhs(r) -= H.row(r).tail(n).dot(qdd_);
-      const Vector6 ab = llt_.solve(rhs);
-      bool within = true;
-      for (int k = 0; k < n; ++k) {
-        hold_(k) = H.row(6 + k).head<6>().dot(ab) + H.row(6 + k).tail(n).dot(qdd_) + C(6 + k);
-        within = within && std::abs(hold_(k)) <= limits_.joint_torque(k);
-      }
-      if (within) {
-        out.tau = hold_;
-        return false;
+      double lo = 0, hi = decay_cap_;
+      for (int k = 0; k < n && lo <= hi; ++k) detail::fit_bound(t0_(k), t1_(k), limits_.joint_torque(k), lo, hi);
+      if (lo <= hi) gripper_fit(s, vd0_, vd1_, lo, hi);
+      if (lo <= hi) {
+        out.decay = hi;
+        out.tau = t0_ + hi * t1_;
+        return hi < decay_cap_;
       }
     }
+    passive(s, out);
+    return true;
+  }
+
+  /// The passive law of joint_torques. Writes hb_, hstar_, inv_, hold_, qdd0_, qdd1_, vd0_, vd1_.
+  void passive(const DetumbleState& s, DetumbleCommand& out) {
+    const int n = model_->n();
+    const Eigen::MatrixXd& H = data_.H;
+    const auto qd = s.v.tail(n);
+    hb_ = H.topRightCorner(6, n);
+    llt_.solveInPlace(hb_);  // H_b^-1 H_bm
+    hstar_ = H.bottomRightCorner(n, n);
+    hstar_.noalias() -= H.bottomLeftCorner(n, 6) * hb_;
+    llt_m_.compute(hstar_);
+    inv_.setIdentity();
+    llt_m_.solveInPlace(inv_);
+    double rho = 0;  // Gershgorin: the largest row sum of |D^1/2 H*^-1 D^1/2|, D = diag(H*)
+    for (int i = 0; i < n; ++i) {
+      double row = 0;
+      for (int j = 0; j < n; ++j) row += std::sqrt(hstar_(i, i) * hstar_(j, j)) * std::abs(inv_(i, j));
+      rho = std::max(rho, row);
+    }
+    const double lambda = std::min(opt_.max_decay, kDetumbleTickFraction / (tick_ * std::max(rho, 1.0)));
     double scale = 1.0;
     for (int k = 0; k < n; ++k) {
-      const Vector6 Hbk = H.col(6 + k).head<6>();
-      const double Hkk = H(6 + k, 6 + k) - Hbk.dot(llt_.solve(Hbk));
-      hold_(k) = -opt_.joint_gain * Hkk * qd(k);
+      hold_(k) = -lambda * hstar_(k, k) * qd(k);
       if (std::abs(hold_(k)) > limits_.joint_torque(k))
         scale = std::min(scale, limits_.joint_torque(k) / std::abs(hold_(k)));
     }
+    // the gripper: the accelerations under s hold_ are vd0 + s vd1 with qdd(s) = H*^-1 (s hold_ - t0)
+    double lo = 0, hi = scale;
+    qdd0_.noalias() = -inv_ * t0_;
+    qdd1_.noalias() = inv_ * hold_;
+    vd1_.head<6>().noalias() = -hb_ * qdd1_;
+    vd1_.tail(n) = qdd1_;
+    vd0_.head<6>().noalias() -= hb_ * qdd0_;
+    vd0_.tail(n) = qdd0_;
+    gripper_fit(s, vd0_, vd1_, lo, hi);
+    if (lo <= hi) scale = hi;  // else no scale keeps the gripper's load within its limits
     out.tau = scale * hold_;
     out.brake_scale = scale;
-    return opt_.hold || scale < 1.0;
+    out.decay = scale * lambda;
+    out.passive = true;
   }
 
   /// The rates that decide rest: joints, the gripper relative to the base, the base. Writes data_.J.
@@ -342,9 +498,18 @@ class DetumbleController {
   int gripper_;
   DetumbleLimits limits_;
   DetumbleOptions opt_;
+  double tick_;
+  double decay_cap_ = 0, base_cap_ = 0;
+  int body_index_ = 0;
+  Vector3 r_gripper_ = Vector3::Zero();  ///< the gripper frame's origin in its body
+  SpatialInertia target_;                ///< the attached body, about its body's origin, body axes
   Data data_;
   Eigen::LLT<Matrix6> llt_;
-  Eigen::VectorXd qdd_, hold_;
+  Eigen::VectorXd c_, vd0_, vd1_, vdt_, t0_, t1_, hold_, qdd0_, qdd1_;
+  Vector6 b6_ = Vector6::Zero();
+  Eigen::Matrix<double, 6, Eigen::Dynamic> hb_;
+  Eigen::MatrixXd hstar_, inv_;
+  Eigen::LLT<Eigen::MatrixXd> llt_m_;
 };
 
 }  // namespace ffsr

@@ -17,7 +17,8 @@ namespace ffsr {
 /// The run's settings.
 struct DetumbleRunOptions {
   double tick = 0.01;    ///< control period, s
-  double horizon = 120;  ///< longest run, s
+  double horizon = 120;  ///< longest time to rest, s
+  double dwell = 5;      ///< after the first tick at rest, the run goes on (holding) this long, s (>= 0)
   int record_every = 1;  ///< keep every k-th tick in the series (0: none)
   double rtol = 1e-12;   ///< CVODE
   double atol = 1e-15;   ///< CVODE, on positions, angles, rates and wheel momentum
@@ -62,6 +63,10 @@ struct DetumbleSummary {
 };
 
 struct DetumbleRunResult : DetumbleSummary {
+  /// the hold after rest: the largest rate (joint, gripper relative to the base and, with
+  /// stop_stack_spin, the stack's) over the dwell's ticks, and whether every one was at rest
+  double dwell_peak_rate = 0;
+  bool dwell_at_rest = false;
   double base_attitude_excursion = 0;            ///< largest rotation of the base since the grasp, rad
   double peak_wheel_momentum = 0;                ///< largest stored component, N m s
   Vector3 wheel_momentum_end = Vector3::Zero();  ///< base frame
@@ -171,6 +176,7 @@ enum class DetumbleBound {
   Actuator,        ///< no base actuator (the stack's angular momentum is conserved)
   WheelMomentum,   ///< the reaction wheels cannot store the stack's angular momentum
   ActuatorTorque,  ///< the actuator's torque (wheels or thrusters) needs longer than the horizon
+  Tick,            ///< the tick is longer than the stack's fastest rate allows (detumble_longest_tick)
 };
 
 /// check_detumble_feasible's refusal: an InputError that says which bound is too small, so that a
@@ -180,6 +186,49 @@ class DetumbleInfeasibleError : public InputError {
   DetumbleInfeasibleError(DetumbleBound b, const std::string& what) : InputError(what), bound(b) {}
   DetumbleBound bound;
 };
+
+/// The largest angle (rad) the stack may turn in one tick at its fastest rate: the command is held over
+/// the tick, computed from the state at its start (the velocity terms, the hold, the gripper's load).
+inline constexpr double kDetumbleTickAngle = 0.15;
+
+/// The stack's fastest rate at `s` (rad/s): the largest joint rate, the gripper's angular rate relative
+/// to the base, the base's angular rate; and which (`what`: "joint 'name'", "the gripper relative to
+/// the base", "the base").
+inline double detumble_fastest_rate(const Model& stack, int gripper, const DetumbleState& s, std::string* what) {
+  const int n = stack.n();
+  Data d(stack);
+  forward_kinematics(stack, d, s.base, s.theta);
+  frame_jacobian(stack, d, gripper);
+  const Vector3 wrel = d.J.bottomRows<3>().rightCols(n) * s.v.tail(n);
+  Eigen::Index k = 0;
+  const double joint = n > 0 ? s.v.tail(n).cwiseAbs().maxCoeff(&k) : 0.0;
+  const double rel = wrel.norm(), base = s.v.segment<3>(3).norm();
+  const double fastest = std::max({joint, rel, base});
+  if (what)
+    *what = fastest == joint  ? detail::str("joint '", stack.joint(static_cast<int>(k)).name, "'")
+            : fastest == rel ? std::string("the gripper relative to the base")
+                             : std::string("the base");
+  return fastest;
+}
+
+/// The longest tick the law supports from `s`: kDetumbleTickAngle over the stack's fastest rate
+/// (infinity at rest). Under the law the rates fall from the start.
+inline double detumble_longest_tick(const Model& stack, int gripper, const DetumbleState& s) {
+  const double w = detumble_fastest_rate(stack, gripper, s, nullptr);
+  return w > 0 ? kDetumbleTickAngle / w : std::numeric_limits<double>::infinity();
+}
+
+/// Refuses a tick longer than detumble_longest_tick with DetumbleInfeasibleError (DetumbleBound::Tick).
+inline void check_detumble_tick(const Model& stack, int gripper, const DetumbleState& s, double tick) {
+  std::string what;
+  const double w = detumble_fastest_rate(stack, gripper, s, &what);
+  if (tick * w <= kDetumbleTickAngle) return;
+  throw DetumbleInfeasibleError(
+      DetumbleBound::Tick,
+      detail::str("detumble: the tick, ", tick, " s, is longer than the ", kDetumbleTickAngle / w,
+                  " s this stack supports: the command is held over a tick, and at its fastest rate (",
+                  what, ", ", w, " rad/s) the stack would turn more than ", kDetumbleTickAngle, " rad in one"));
+}
 
 /// Refuses a run that cannot stop the stack's spin, with DetumbleInfeasibleError naming L_c, the stack's
 /// angular momentum about its centre of mass: without an actuator (L_c is conserved), with wheels that
@@ -215,7 +264,8 @@ inline void check_detumble_feasible(const Model& stack, const DetumbleState& s, 
 
 /// The post-capture run from `start` (the grasp's state on the stack model; see the top of the file).
 /// `gripper` is the frame carrying `body` (the grasped target). The controller's command is computed
-/// at each tick and held until the next; the run stops at the first tick at rest or at the horizon.
+/// at each tick and held until the next; the run goes on for `run.dwell` after the first tick at rest
+/// (the controller holding the stack), or stops at the horizon.
 /// InputError for bad options; DetumbleInfeasibleError (check_detumble_feasible, run once) when the
 /// actuator cannot stop the stack's spin within the horizon; IntegrationError from CVODE.
 inline DetumbleRunResult run_detumble(const Model& stack, int gripper, const AttachedBody& body,

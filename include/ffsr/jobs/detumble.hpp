@@ -87,6 +87,7 @@ inline DetumbleJobResult detumble(const Scenario& s, const BasePose& base, const
   } catch (const DetumbleInfeasibleError& e) {
     const bool wheels = settings.limits.actuator == BaseActuator::ReactionWheels;
     const char* key = e.bound == DetumbleBound::Actuator        ? "stop-stack-spin"
+                      : e.bound == DetumbleBound::Tick          ? "detumble-tick"
                       : e.bound == DetumbleBound::WheelMomentum ? "wheel-momentum"
                       : wheels                                  ? "wheel-torque"
                                                                 : "thruster-torque";
@@ -182,8 +183,9 @@ inline nlohmann::json detumble_runs_json(const Scenario& s, const std::vector<De
 }
 
 /// The series as the CSV of `ffsr-optimize detumble --csv`: (with runs: the run's name first) time,
-/// the rates, the gripper load, the base's rotation, the wheels' momentum, the energy, each joint's
-/// rate and torque; then each joint's angle (rad), the base's pose, the target's (the gripper frame's
+/// the rates, the gripper load (norms), the base's rotation, the wheels' momentum (norm), the energy,
+/// the law's decay rate and whether it was the passive one, the base wrench (force and moment about the
+/// base origin, inertial), the wheels' momentum per base axis, each joint's rate and torque; then each joint's angle (rad), the base's pose, the target's (the gripper frame's
 /// pose composed with the grasp's attachment) and every moving body's (its joint frame, numbered as the
 /// main job's body<i> columns). Poses: x, y, z, qw, qx, qy, qz in the inertial frame.
 inline std::string detumble_series_csv(const Scenario& s, const std::vector<DetumbleJobResult>& results) {
@@ -196,7 +198,8 @@ inline std::string detumble_series_csv(const Scenario& s, const std::vector<Detu
   const int n = model.n();
   o << (runs ? "run," : "")
     << "t,joint_rate,relative_rate,stack_rate,gripper_force,gripper_moment,base_attitude,wheel_momentum,"
-       "energy";
+       "energy,decay,passive,base_force_x,base_force_y,base_force_z,base_moment_x,base_moment_y,base_moment_z,"
+       "wheel_momentum_x,wheel_momentum_y,wheel_momentum_z";
   for (int k = 0; k < n; ++k) o << ",theta_dot_" << k + 1;
   for (int k = 0; k < n; ++k) o << ",tau_" << k + 1;
   for (int k = 0; k < n; ++k) o << ",theta_" << k + 1;
@@ -210,7 +213,9 @@ inline std::string detumble_series_csv(const Scenario& s, const std::vector<Detu
       const DetumbleCommand& c = x.command;
       o << x.t << ',' << c.joint_rate << ',' << c.relative_rate << ',' << c.stack_rate << ','
         << x.gripper_force.norm() << ',' << x.gripper_moment.norm() << ',' << x.base_attitude << ','
-        << x.wheel_momentum.norm() << ',' << x.energy;
+        << x.wheel_momentum.norm() << ',' << x.energy << ',' << c.decay << ',' << (c.passive ? 1 : 0);
+      for (int k = 0; k < 6; ++k) o << ',' << c.base_wrench(k);
+      for (int k = 0; k < 3; ++k) o << ',' << x.wheel_momentum(k);
       for (int k = 0; k < n; ++k) o << ',' << x.theta_dot(k);
       for (int k = 0; k < n; ++k) o << ',' << c.tau(k);
       for (int k = 0; k < n; ++k) o << ',' << x.theta(k);

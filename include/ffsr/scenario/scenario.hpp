@@ -90,7 +90,9 @@ struct ScenarioKeys {
   std::vector<double> joint_torque_limit;  ///< N m per joint (one for all); empty: the URDF's effort
   std::string base_actuator = "none";      ///< none, reaction-wheels or thrusters
   double wheel_torque = 0, wheel_momentum = 0, thruster_force = 0, thruster_torque = 0;
-  double rest_rate_deg = 0.05, detumble_horizon = 120, detumble_tick = 0.01;
+  double gripper_force_limit = 0, gripper_moment_limit = 0;  ///< N, N m; 0: not given (not limited)
+  double rest_rate_deg = 0.05, detumble_horizon = 120, detumble_tick = 0.01, detumble_dwell = 5;
+  double detumble_max_decay = 20, detumble_max_base_decay = 2;  ///< 1/s (DetumbleOptions)
   bool stop_stack_spin = false;
   std::string grasp_after = "approach";  ///< the grasp's start: approach, or contact (the Hertz run first)
   // the global search's post-capture constraints (jobs/detail/post_capture.hpp); 0: not set

@@ -44,7 +44,10 @@ void print_detumble_table(std::ostream& out, const DetumbleJobResult& d) {
       << " J after\n"
       << "base actuator            " << actuator_name(d.settings.limits.actuator)
       << (d.settings.options.stop_stack_spin ? " (stops the stack's spin)" : "") << "\n"
-      << "time to rest             " << r.time_to_rest << " s (" << r.ticks << " ticks)\n"
+      << "time to rest             " << r.time_to_rest << " s ("
+      << std::lround(r.time_to_rest / d.settings.run.tick) << " ticks)\n"
+      << "held at rest             " << d.settings.run.dwell << " s: largest rate " << r.dwell_peak_rate * deg
+      << " deg/s" << (r.dwell_at_rest ? " (at rest throughout)" : " (NOT at rest throughout)") << "\n"
       << "peak joint torque        " << r.peak_joint_torque << " N m (joint " << d.peak_joint_name << ")\n"
       << "peak gripper load        " << r.peak_gripper_force << " N, " << r.peak_gripper_moment << " N m\n"
       << "base attitude excursion  " << r.base_attitude_excursion * deg << " deg\n"

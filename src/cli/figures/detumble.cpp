@@ -4,6 +4,7 @@
 #include "figures/figures.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 #include <utility>
@@ -67,6 +68,10 @@ Curve level(double y, double t0, double t1, std::string label, int style = 2) {
   return l;
 }
 
+/// The joints' colours: the palette without its black (the runs' line-style keys are drawn in black)
+/// and with the two blues far apart in the order (joint 1 blue, joint 7 sky blue).
+constexpr std::array<int, 7> kJointColours{0, 1, 2, 3, 4, 7, 5};
+
 /// Joint k of every run (colour by joint, line style by run), value scaled.
 void add_joints(Panel& p, const DetumbleSeries& s, bool rates, bool labels) {
   const size_t n = s.joint_names.size();
@@ -74,7 +79,7 @@ void add_joints(Panel& p, const DetumbleSeries& s, bool rates, bool labels) {
     for (size_t r = 0; r < s.runs.size(); ++r) {
       const auto& run = s.runs[r];
       Curve c;
-      c.color = static_cast<int>(j % plot::kPaletteSize);
+      c.color = kJointColours[j % kJointColours.size()];
       c.line_style = static_cast<int>(r % 8) + 1;
       c.width = 1.5;
       c.x = run.t;
@@ -162,7 +167,8 @@ plot::Figure detumble(const DetumbleSeries& s) {
                                             "|h| per base axis (N m s)")
                                  : labelled("kinetic energy of robot and target", time, "energy (J)");
   add_joints(rates, s, true, true);
-  rates.legend_outside = true;  // one entry per joint (and run): inside, it would hide the curves
+  // the legend inside, at the corner the curves leave freest (the rates fall to zero and stay there): an
+  // outside legend took a third of the panel's width
   add_joints(torque, s, false, false);
   add_limits(torque, s, t0, t1);
   std::vector<std::vector<Quantity>> rest_q, load_q, attitude_q, last_q;

@@ -171,7 +171,7 @@ class Renderer {
     const double px = 1.0 / fig_.width, py = 1.0 / fig_.height;
     vx0 = c.x0 + 96 * px;  // room for the y label and PLplot's "(x10^k)" scale label
     vx1 = c.x1 - (18 + right_extra) * px;
-    vy0 = c.y0 + (c.bottom ? 62 : 50) * py;  // the page edge clips descenders of the last row's x label
+    vy0 = c.y0 + (c.bottom ? 84 : 50) * py;  // the last row's x label, descenders included, above the edge
     vy1 = c.y1 - 30 * py;
   }
 

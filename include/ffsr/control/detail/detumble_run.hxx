@@ -17,9 +17,11 @@ inline void check_detumble_run(const Model& stack, int gripper, const AttachedBo
   if (!(r.tick < r.horizon))
     throw InputError(
         str(w, ": the tick (", r.tick, " s) must be shorter than the horizon (", r.horizon, " s)"));
-  if (r.horizon / r.tick > 1e7)
-    throw InputError(str(w, ": more than 1e7 ticks: horizon ", r.horizon, " s / tick ", r.tick,
-                         " s = ", r.horizon / r.tick));
+  if (!std::isfinite(r.dwell) || !(r.dwell >= 0))
+    throw InputError(str(w, ": the dwell must be >= 0 and finite, got ", r.dwell));
+  if ((r.horizon + r.dwell) / r.tick > 1e7)
+    throw InputError(str(w, ": more than 1e7 ticks: (horizon ", r.horizon, " s + dwell ", r.dwell,
+                         " s) / tick ", r.tick, " s = ", (r.horizon + r.dwell) / r.tick));
   if (r.record_every < 0) throw InputError(str(w, ": record_every must be >= 0, got ", r.record_every));
   if (!(r.rtol > 0) || !(r.atol > 0) || !std::isfinite(r.rtol) || !std::isfinite(r.atol))
     throw InputError(str(w, ": the tolerances must be positive and finite"));
@@ -73,7 +75,8 @@ inline DetumbleRunResult run_detumble(const Model& stack, int gripper, const Att
   if (none) check_detumble_feasible(stack, start, limits, options, run.horizon);
   detail::check_detumble(stack, limits, options, "run_detumble");
   if (!none) check_detumble_feasible(stack, start, limits, options, run.horizon);
-  DetumbleController ctrl(stack, gripper, limits, options);
+  check_detumble_tick(stack, gripper, start, run.tick);
+  DetumbleController ctrl(stack, gripper, body, limits, options, run.tick);
   DetumbleCommand cmd = ctrl.make_command();
   detail::DetumbleSystem sys(stack), probe(stack);
   const bool wheels = limits.actuator == BaseActuator::ReactionWheels && options.stop_stack_spin;
@@ -92,6 +95,8 @@ inline DetumbleRunResult run_detumble(const Model& stack, int gripper, const Att
   probe.energy_momentum(y, res.energy_start, h0);
   const int n = stack.n();
   const auto ticks = static_cast<long>(std::ceil(run.horizon / run.tick - 1e-9));
+  const auto dwell_ticks = static_cast<long>(std::ceil(run.dwell / run.tick - 1e-9));
+  long last_tick = ticks;  // the horizon, until the first tick at rest sets the end of the dwell
   double T_prev = res.energy_start;
   for (long k = 0;; ++k) {
     const double t = static_cast<double>(k) * run.tick;
@@ -103,14 +108,22 @@ inline DetumbleRunResult run_detumble(const Model& stack, int gripper, const Att
     res.momentum_drift = std::max(res.momentum_drift, (s.momentum - h0).norm() / std::max(h0.norm(), 1e-300));
     res.energy_end = s.energy;
     res.ticks = k;
-    res.time_to_rest = t;
     res.wheel_momentum_end = s.wheel_momentum;
-    const bool last = cmd.status == DetumbleStatus::AtRest || k == ticks;
-    if (run.record_every > 0 && (k % run.record_every == 0 || last)) res.series.push_back(std::move(s));
-    if (last) {
-      res.at_rest = cmd.status == DetumbleStatus::AtRest;
-      break;
+    const bool rest = cmd.status == DetumbleStatus::AtRest;
+    if (!res.at_rest) {
+      res.time_to_rest = t;
+      if (rest) {
+        res.at_rest = res.dwell_at_rest = true;
+        last_tick = k + dwell_ticks;
+      }
+    } else {  // the dwell
+      const double rate = std::max({cmd.joint_rate, cmd.relative_rate, options.stop_stack_spin ? cmd.stack_rate : 0.0});
+      res.dwell_peak_rate = std::max(res.dwell_peak_rate, rate);
+      res.dwell_at_rest = res.dwell_at_rest && rest;
     }
+    const bool last = k == last_tick;
+    if (run.record_every > 0 && (k % run.record_every == 0 || last)) res.series.push_back(std::move(s));
+    if (last) break;
     const Eigen::VectorXd theta_before = y.segment(7, n);
     if (k > 0) integ.reinit(t, y);  // the command jumps at the tick: a fresh start of the BDF history
     integ.advance(static_cast<double>(k + 1) * run.tick);

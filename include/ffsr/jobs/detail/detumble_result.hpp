@@ -85,7 +85,13 @@ inline nlohmann::json detumble_json(const Model& model, int gripper,
                      {"stop_stack_spin", s.options.stop_stack_spin},
                      {"rest_rate", s.options.rest_rate},
                      {"tick", s.run.tick},
-                     {"horizon", s.run.horizon}};
+                     {"horizon", s.run.horizon},
+                     {"dwell", s.run.dwell},
+                     {"max_decay", s.options.max_decay},
+                     {"max_base_decay", s.options.max_base_decay}};
+  const auto limit = [](double x) { return std::isinf(x) ? nlohmann::json() : nlohmann::json(x); };  // null: none
+  j["parameters"]["gripper_force_limit"] = limit(s.limits.gripper_force);
+  j["parameters"]["gripper_moment_limit"] = limit(s.limits.gripper_moment);
   j["status"] = status_name(e.command.status);
   j["at_rest"] = r.at_rest;
   j["time_to_rest"] = r.time_to_rest;
@@ -101,6 +107,8 @@ inline nlohmann::json detumble_json(const Model& model, int gripper,
   j["final_joint_rate"] = e.command.joint_rate;
   j["final_relative_rate"] = e.command.relative_rate;
   j["final_stack_rate"] = e.command.stack_rate;
+  j["dwell_peak_rate"] = r.dwell_peak_rate;
+  j["dwell_at_rest"] = r.dwell_at_rest;
   j["ticks"] = r.ticks;
   return j;
 }

@@ -489,6 +489,19 @@ inline void add_detumble_keys(std::vector<ScenarioKey>& keys) {
         "thruster-force", &K::thruster_force, actuator_name(BaseActuator::Thrusters));
   bound(FFSR_KEY("thruster-torque", thruster_torque, "Detumble: thrusters' torque per base axis, N m"),
         "thruster-torque", &K::thruster_torque, actuator_name(BaseActuator::Thrusters));
+  const auto limit = [&](ScenarioKey key, const char* name, double K::*member) {
+    keys.push_back(key.in(G::Detumble)
+                       .checked([name, member](const K& k) { check_positive_if_given(k, name, k.*member); })
+                       .echoed(echo_given(name, member)));
+  };
+  limit(FFSR_KEY("gripper-force-limit", gripper_force_limit,
+                 "Detumble: the gripper's force on the target, N (the controller keeps the load within it; "
+                 "> 0; default: not limited)"),
+        "gripper-force-limit", &K::gripper_force_limit);
+  limit(FFSR_KEY("gripper-moment-limit", gripper_moment_limit,
+                 "Detumble: the gripper's moment on the target about the contact point, N m (the controller "
+                 "keeps the load within it; > 0; default: not limited)"),
+        "gripper-moment-limit", &K::gripper_moment_limit);
 }
 
 /// The post-capture run's settings (the detumble job): rest, horizon, tick, the stack's spin.
@@ -516,12 +529,43 @@ inline void add_detumble_run_keys(std::vector<ScenarioKey>& keys) {
                        if (!(k.detumble_tick < k.detumble_horizon))
                          throw InputError(str("--detumble-tick: must be shorter than detumble-horizon (",
                                               k.detumble_horizon, " s), got ", k.detumble_tick));
-                       if (k.detumble_horizon / k.detumble_tick > 1e7)  // run_detumble's bound
-                         throw InputError(str("--detumble-tick: at most 1e7 ticks in detumble-horizon (",
-                                              k.detumble_horizon, " s), got ", k.detumble_tick, " s (",
-                                              k.detumble_horizon / k.detumble_tick, " ticks)"));
+                       const double span = k.detumble_horizon + k.detumble_dwell;
+                       if (span / k.detumble_tick > 1e7)  // run_detumble's bound
+                         throw InputError(str("--detumble-tick: at most 1e7 ticks in detumble-horizon + "
+                                              "detumble-dwell (", span, " s), got ", k.detumble_tick, " s (",
+                                              span / k.detumble_tick, " ticks)"));
                      })
                      .echoed(echo_given("detumble-tick", &K::detumble_tick)));
+  keys.push_back(
+      FFSR_KEY("detumble-dwell", detumble_dwell,
+               "Detumble: after the first tick at rest the controller holds the stack this long, s (>= 0)", "5")
+          .in(G::Detumble)
+          .checked([](const K& k) {
+            if (!std::isfinite(k.detumble_dwell) || k.detumble_dwell < 0)
+              throw InputError(str("--detumble-dwell: must be >= 0 and finite, got ", k.detumble_dwell));
+          })
+          .echoed(echo_given("detumble-dwell", &K::detumble_dwell)));
+  keys.push_back(
+      FFSR_KEY("detumble-max-decay", detumble_max_decay,
+               "Detumble: the fastest decay the law asks of the joint rates, 1/s (its bandwidth; at most half "
+               "the tick's inverse is used)",
+               "20")
+          .in(G::Detumble)
+          .checked([](const K& k) { check_positive_if_given(k, "detumble-max-decay", k.detumble_max_decay); })
+          .echoed(echo_given("detumble-max-decay", &K::detumble_max_decay)));
+  keys.push_back(
+      FFSR_KEY("detumble-max-base-decay", detumble_max_base_decay,
+               "Detumble: the fastest decay of the stack's momentum the base actuator is asked, 1/s (at most "
+               "half the tick's inverse is used)",
+               "2")
+          .in(G::Detumble)
+          .checked([](const K& k) {
+            check_positive_if_given(k, "detumble-max-base-decay", k.detumble_max_base_decay);
+          })
+          .echoed(echo_given("detumble-max-base-decay", &K::detumble_max_base_decay))
+          .acting([](const K& k) -> std::string {
+            return k.stop_stack_spin ? "" : "acts only when the run stops the stack's spin (stop-stack-spin = true)";
+          }));
   keys.push_back(
       FFSR_KEY("grasp-after", grasp_after,
                "Detumble: the grasp locks at the end of the approach, or after the Hertz contact run (the "

@@ -144,10 +144,15 @@ inline DetumbleSettings detumble_settings(const ScenarioKeys& k, const Model& mo
     l.thruster_force = needed("thruster-force", k.thruster_force);
     l.thruster_torque = needed("thruster-torque", k.thruster_torque);
   }
+  if (k.given.count("gripper-force-limit")) l.gripper_force = k.gripper_force_limit;
+  if (k.given.count("gripper-moment-limit")) l.gripper_moment = k.gripper_moment_limit;
   s.options.rest_rate = k.rest_rate_deg * M_PI / 180.0;
   s.options.stop_stack_spin = k.stop_stack_spin;
+  s.options.max_decay = k.detumble_max_decay;
+  s.options.max_base_decay = k.detumble_max_base_decay;
   s.run.tick = k.detumble_tick;
   s.run.horizon = k.detumble_horizon;
+  s.run.dwell = k.detumble_dwell;
   return s;
 }
 
