@@ -43,7 +43,9 @@ cp "$tmp/robust/robust.png" "$out/7dof_robust.png"
 # beyond the paper: M_ie against the base's angular rate jump at the impact, the three runs marked
 "$cli" pareto --config "$root/robots/paper_7dof_position.toml" --plot "$tmp/pareto" > /dev/null
 cp "$tmp/pareto/pareto.png" "$out/7dof_pareto.png"
-# beyond the paper: the post-capture runs after the three captures (docs/detumble.md)
-"$cli" detumble --config "$root/robots/paper_7dof_detumble.toml" --run all --plot "$tmp/detumble" --quiet > /dev/null
+# beyond the paper: the post-capture runs after the three captures (docs/detumble.md), half a second of
+# the hold after rest drawn
+"$cli" detumble --config "$root/robots/paper_7dof_detumble.toml" --run all --detumble-dwell 0.5 --plot "$tmp/detumble" \
+  --quiet > /dev/null
 cp "$tmp/detumble/detumble.png" "$out/7dof_detumble.png"
 ls -l "$out"

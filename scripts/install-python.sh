@@ -8,7 +8,9 @@
 # build-python/cmake-* (kept between runs: a rebuild compiles only what changed).
 # Nothing is downloaded at test time: this script is the only step that reaches PyPI.
 # FFSR_PYTHON_CXX_FLAGS, when set, replaces the build's optimization flags (python/pyproject.toml:
-# -O2 -DNDEBUG); .ci/run sets -O1 -DNDEBUG, as in its Release stage, to compile in less time.
+# -O2 -DNDEBUG). FFSR_PYTHON_WHEEL, when set to a wheel file (scripts/build-wheel.sh's), installs that
+# wheel instead of building the package: .ci/run compiles the package once, as the wheel its users get,
+# and tests that.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 venv=${1:-build-python/venv}
@@ -45,5 +47,9 @@ settings=()
 if [ -n "${FFSR_PYTHON_CXX_FLAGS:-}" ]; then
   settings+=("--config-settings=cmake.define.CMAKE_CXX_FLAGS_RELEASE=$FFSR_PYTHON_CXX_FLAGS")
 fi
-"$py" -m pip install --quiet --disable-pip-version-check --no-build-isolation --no-deps "${settings[@]}" ./python
+if [ -n "${FFSR_PYTHON_WHEEL:-}" ]; then  # a wheel built already (scripts/build-wheel.sh): no compile here
+  "$py" -m pip install --quiet --disable-pip-version-check --no-deps --force-reinstall "$FFSR_PYTHON_WHEEL"
+else
+  "$py" -m pip install --quiet --disable-pip-version-check --no-build-isolation --no-deps "${settings[@]}" ./python
+fi
 "$py" -c 'import ffsr; print("ffsr: installed the Python package", ffsr.__version__, "in", __import__("sys").prefix)'

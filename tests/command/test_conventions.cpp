@@ -235,8 +235,14 @@ const std::map<std::string, KeyCase>& key_cases() {
       {"thruster-force", {{"--thruster-force", "0.001"}, thrusters}},
       {"thruster-torque", {{"--thruster-torque", "0.5"}, thrusters}},
       {"rest-rate-deg", {{"--rest-rate-deg", "0.1"}, torque}},
-      {"detumble-horizon", {{"--detumble-horizon", "2"}, torque, false, true}},
+      {"detumble-horizon", {{"--detumble-horizon", "0.1"}, torque, false, true}},
       {"detumble-tick", {{"--detumble-tick", "0.02"}, torque}},
+      // the gripper's load bound by the controller (about 20 N and 30 N m at the 20 N m joints' braking)
+      {"gripper-force-limit", {{"--gripper-force-limit", "5"}, torque}},
+      {"gripper-moment-limit", {{"--gripper-moment-limit", "5"}, torque}},
+      {"detumble-dwell", {{"--detumble-dwell", "1"}, torque}},
+      {"detumble-max-decay", {{"--detumble-max-decay", "2"}, torque}},
+      {"detumble-max-base-decay", {{"--detumble-max-base-decay", "0.5"}, thrusters}},
       {"stop-stack-spin", {{"--stop-stack-spin", "true"}, wheels_kept}},
       // the grasp after the Hertz contact run: another lock impulse and start state
       {"grasp-after", {{"--grasp-after", "contact"}, torque}},
@@ -368,7 +374,7 @@ TEST_CASE("the main job takes every key of the post-capture phase (the walk belo
     CHECK(flags.count("--" + key.name) == 1);
     ++keys;
   }
-  CHECK(keys == 11);  // grasp-after with the ten of the limits, the actuator and the run
+  CHECK(keys == 16);  // grasp-after with the fifteen of the limits, the actuator, the law and the run
 }
 
 TEST_CASE("each key a subcommand accepts changes its result, or the subcommand refuses it",

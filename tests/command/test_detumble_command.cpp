@@ -64,7 +64,12 @@ TEST_CASE("detumble on the 7-DOF scenario: at rest, every torque within its limi
   const auto cols = read_csv(ffsr::test::read_file(dir.str() + "/series.csv"));
   const std::vector<double>& t = cols.at("t");
   REQUIRE(t.size() == size_t(j.at("ticks").get<long>()) + 1);
-  CHECK(t.back() == Approx(j.at("time_to_rest").get<double>()).margin(1e-12));
+  // the series goes on for the dwell after the first tick at rest (held there: every rate below it)
+  CHECK(t.back() == Approx(j.at("time_to_rest").get<double>() + 5).margin(1e-9));
+  CHECK(j.at("dwell_at_rest").get<bool>());
+  CHECK(j.at("dwell_peak_rate").get<double>() < rest);
+  CHECK(j.at("parameters").at("dwell").get<double>() == 5);
+  CHECK(j.at("parameters").at("gripper_force_limit").is_null());
   double peak = 0;
   for (size_t k = 0; k < limits.size(); ++k)
     for (double tau : cols.at("tau_" + std::to_string(k + 1))) {
@@ -326,8 +331,8 @@ TEST_CASE("main job: an error of the post-capture phase names the key and the ru
     std::vector<std::string> says;
   };
   const std::vector<Case> cases = {
-      {{"--joint-torque-limit", "20", "--detumble-horizon", "2"},
-       {"--detumble-horizon", "not at rest after 2 s", "baseline run"}},
+      {{"--joint-torque-limit", "20", "--detumble-horizon", "0.1"},
+       {"--detumble-horizon", "not at rest after 0.1 s", "baseline run"}},
       {{"--joint-torque-limit", "20", "--stop-stack-spin", "true"}, {"--stop-stack-spin", "baseline run"}},
       {{"--joint-torque-limit", "20", "--base-actuator", "reaction-wheels", "--wheel-torque", "0.2",
         "--wheel-momentum", "1", "--stop-stack-spin", "true"},

@@ -329,6 +329,7 @@ class DetumbleController {
     out.base_wrench.setZero();
     out.decay = 0;
     out.base_decay = 0;
+    out.passive = false;
     out.status = DetumbleStatus::Fault;
     out.fault = f;
   }
