@@ -129,8 +129,8 @@ def test_run_with_post_capture_equals_the_command_and_the_detumble_job(tmp_path)
 
 def test_run_with_post_capture_error_names_the_key_and_the_run():
     scenario = ROBOTS / "paper_7dof_detumble.toml"
-    with pytest.raises(ffsr.InputError, match=r"--detumble-horizon: .*not at rest after 2 s.*baseline run"):
-        ffsr.Scenario.load(str(scenario), detumble_horizon=2, **{"global": False}).run()
+    with pytest.raises(ffsr.InputError, match=r"--detumble-horizon: .*not at rest after 0\.1 s.*baseline run"):
+        ffsr.Scenario.load(str(scenario), detumble_horizon=0.1, **{"global": False}).run()
 
 
 @pytest.mark.parametrize("name", SCENARIOS)
@@ -248,17 +248,18 @@ def test_pareto_equals_the_command(tmp_path, name):
 
 
 def test_run_with_post_capture_constraints_equals_the_command(tmp_path):
-    # the global search keeps the captures whose post-capture run holds every joint within 3 N m
+    # the global search keeps the captures whose post-capture run, braking at 2 N m per joint, rests
+    # within 1.5 s
     scenario = ROBOTS / "paper_3dof.toml"
-    expected = command_json(tmp_path, scenario, "--global-starts", "2", "--joint-torque-limit", "20",
-                            "--max-peak-joint-torque", "3")
-    got = ffsr.Scenario.load(str(scenario), global_starts=2, joint_torque_limit=20,
-                             max_peak_joint_torque=3).run().to_dict()
+    expected = command_json(tmp_path, scenario, "--global-starts", "2", "--joint-torque-limit", "2",
+                            "--max-time-to-rest", "1.5")
+    got = ffsr.Scenario.load(str(scenario), global_starts=2, joint_torque_limit=2,
+                             max_time_to_rest=1.5).run().to_dict()
     assert differences(got, expected) == []
-    assert 0 < got["global"]["post_capture_constraints"]["peak_joint_torque"] <= 3
+    assert 0 < got["global"]["post_capture_constraints"]["time_to_rest"] <= 1.5
     # the same capture's post-capture figures under the two names: the constraints' and the run's
-    assert (got["global"]["post_capture_constraints"]["peak_joint_torque"] ==
-            got["global"]["post_capture"]["peak_joint_torque"])
+    assert (got["global"]["post_capture_constraints"]["time_to_rest"] ==
+            got["global"]["post_capture"]["time_to_rest"])
     with pytest.raises(ffsr.InputError, match=r"^Scenario\.load: max_peak_joint_torque: must be positive"):
         ffsr.Scenario.load(str(scenario), max_peak_joint_torque=-1)
 

@@ -28,7 +28,7 @@ except ImportError:  # the package not installed: the module from the source tre
     from ffsr import view
 
 SCENARIO = ROOT / "robots" / "paper_3dof.toml"
-DETUMBLE_FLAGS = ("--joint-torque-limit", "50")
+DETUMBLE_FLAGS = ("--joint-torque-limit", "50", "--detumble-dwell", "1")  # a short hold: every sample a frame
 
 
 @pytest.fixture(scope="module")
@@ -95,8 +95,9 @@ def test_the_target_rides_on_the_gripper_in_the_page(captured, tmp_path):
         by_time = {round(T + float(r["t"]), 6): r for r in samples}
         c = run["capture_index"]
         assert run["t"][c] == pytest.approx(T) and len(run["t"]) - c - 1 == 59  # 60 samples, the first is T
-        assert run["t"][-1] == pytest.approx(T + d["runs"][[r["run"] for r in d["runs"]].index(run["name"])]
-                                             ["time_to_rest"])
+        post_run = d["runs"][[r["run"] for r in d["runs"]].index(run["name"])]
+        # the series ends after the hold at rest (detumble-dwell)
+        assert run["t"][-1] == pytest.approx(T + post_run["time_to_rest"] + post_run["parameters"]["dwell"])
         for k in range(c + 1, len(run["t"])):
             p, R = kin.target(run["name"], by_time[run["t"][k]])
             pose = run["target"][7 * k:7 * k + 7]
@@ -211,7 +212,7 @@ def test_the_python_job_result_continues_the_view(captured, tmp_path):
     urdf = ROOT / "robots" / "paper_3dof.urdf"
     scenario = tmp_path / "paper_3dof_detumble.toml"
     scenario.write_text(SCENARIO.read_text().replace('urdf = "paper_3dof.urdf"', f'urdf = "{urdf}"')
-                        + "\njoint-torque-limit = 50\n")
+                        + "\njoint-torque-limit = 50\ndetumble-dwell = 1\n")  # the flags of DETUMBLE_FLAGS
     job = ffsr.Scenario.load(str(scenario)).detumble(run="all")
     j = json.loads(result.read_text())
     from_object = view.page_data(j, series, detumble=job, frames=100)

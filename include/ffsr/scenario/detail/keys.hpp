@@ -434,6 +434,15 @@ inline void add_joint_and_shape_keys(std::vector<ScenarioKey>& keys) {
           .echoed(echo_shape("contact-exemption", &K::contact_exemption)));
 }
 
+/// A Detumble key of a positive number, checked and echoed when given; returns it for more settings.
+inline ScenarioKey& add_positive_detumble_key(std::vector<ScenarioKey>& keys, ScenarioKey key, const char* name,
+                                              double ScenarioKeys::*member) {
+  keys.push_back(key.in(KeyGroup::Detumble)
+                     .checked([name, member](const ScenarioKeys& k) { check_positive_if_given(k, name, k.*member); })
+                     .echoed(echo_given(name, member)));
+  return keys.back();
+}
+
 /// The post-capture phase (the detumble job): the hardware's bounds and the run's settings.
 inline void add_detumble_keys(std::vector<ScenarioKey>& keys) {
   using G = KeyGroup;
@@ -475,10 +484,7 @@ inline void add_detumble_keys(std::vector<ScenarioKey>& keys) {
                      }));
   // a bound of the base actuator: positive, acting with its actuator only
   const auto bound = [&](ScenarioKey key, const char* name, double K::*member, const char* actuator) {
-    keys.push_back(key.in(G::Detumble)
-                       .checked([name, member](const K& k) { check_positive_if_given(k, name, k.*member); })
-                       .echoed(echo_given(name, member))
-                       .acting(with_actuator(actuator)));
+    add_positive_detumble_key(keys, std::move(key), name, member).acting(with_actuator(actuator));
   };
   bound(FFSR_KEY("wheel-torque", wheel_torque, "Detumble: reaction wheels' torque per base axis, N m"),
         "wheel-torque", &K::wheel_torque, actuator_name(BaseActuator::ReactionWheels));
@@ -489,16 +495,11 @@ inline void add_detumble_keys(std::vector<ScenarioKey>& keys) {
         "thruster-force", &K::thruster_force, actuator_name(BaseActuator::Thrusters));
   bound(FFSR_KEY("thruster-torque", thruster_torque, "Detumble: thrusters' torque per base axis, N m"),
         "thruster-torque", &K::thruster_torque, actuator_name(BaseActuator::Thrusters));
-  const auto limit = [&](ScenarioKey key, const char* name, double K::*member) {
-    keys.push_back(key.in(G::Detumble)
-                       .checked([name, member](const K& k) { check_positive_if_given(k, name, k.*member); })
-                       .echoed(echo_given(name, member)));
-  };
-  limit(FFSR_KEY("gripper-force-limit", gripper_force_limit,
+  add_positive_detumble_key(keys, FFSR_KEY("gripper-force-limit", gripper_force_limit,
                  "Detumble: the gripper's force on the target, N (the controller keeps the load within it; "
                  "> 0; default: not limited)"),
         "gripper-force-limit", &K::gripper_force_limit);
-  limit(FFSR_KEY("gripper-moment-limit", gripper_moment_limit,
+  add_positive_detumble_key(keys, FFSR_KEY("gripper-moment-limit", gripper_moment_limit,
                  "Detumble: the gripper's moment on the target about the contact point, N m (the controller "
                  "keeps the load within it; > 0; default: not limited)"),
         "gripper-moment-limit", &K::gripper_moment_limit);
@@ -508,19 +509,13 @@ inline void add_detumble_keys(std::vector<ScenarioKey>& keys) {
 inline void add_detumble_run_keys(std::vector<ScenarioKey>& keys) {
   using G = KeyGroup;
   using K = ScenarioKeys;
-  keys.push_back(
-      FFSR_KEY("rest-rate-deg", rest_rate_deg,
-               "Detumble: at rest when every joint rate and the gripper's rate relative to the base "
-               "(and the stack's, with stop-stack-spin) are below this, deg/s",
-               "0.05")
-          .in(G::Detumble)
-          .checked([](const K& k) { check_positive_if_given(k, "rest-rate-deg", k.rest_rate_deg); })
-          .echoed(echo_given("rest-rate-deg", &K::rest_rate_deg)));
-  keys.push_back(
-      FFSR_KEY("detumble-horizon", detumble_horizon, "Detumble: longest post-capture run, s", "120")
-          .in(G::Detumble)
-          .checked([](const K& k) { check_positive_if_given(k, "detumble-horizon", k.detumble_horizon); })
-          .echoed(echo_given("detumble-horizon", &K::detumble_horizon)));
+  add_positive_detumble_key(keys, FFSR_KEY("rest-rate-deg", rest_rate_deg,
+                 "Detumble: at rest when every joint rate and the gripper's rate relative to the base "
+                 "(and the stack's, with stop-stack-spin) are below this, deg/s", "0.05"),
+        "rest-rate-deg", &K::rest_rate_deg);
+  add_positive_detumble_key(keys, FFSR_KEY("detumble-horizon", detumble_horizon,
+                 "Detumble: longest time to rest, s", "120"),
+        "detumble-horizon", &K::detumble_horizon);
   keys.push_back(FFSR_KEY("detumble-tick", detumble_tick,
                           "Detumble: the controller's period, s (< detumble-horizon)", "0.01")
                      .in(G::Detumble)
@@ -545,27 +540,17 @@ inline void add_detumble_run_keys(std::vector<ScenarioKey>& keys) {
               throw InputError(str("--detumble-dwell: must be >= 0 and finite, got ", k.detumble_dwell));
           })
           .echoed(echo_given("detumble-dwell", &K::detumble_dwell)));
-  keys.push_back(
-      FFSR_KEY("detumble-max-decay", detumble_max_decay,
-               "Detumble: the fastest decay the law asks of the joint rates, 1/s (its bandwidth; at most half "
-               "the tick's inverse is used)",
-               "20")
-          .in(G::Detumble)
-          .checked([](const K& k) { check_positive_if_given(k, "detumble-max-decay", k.detumble_max_decay); })
-          .echoed(echo_given("detumble-max-decay", &K::detumble_max_decay)));
-  keys.push_back(
-      FFSR_KEY("detumble-max-base-decay", detumble_max_base_decay,
-               "Detumble: the fastest decay of the stack's momentum the base actuator is asked, 1/s (at most "
-               "half the tick's inverse is used)",
-               "2")
-          .in(G::Detumble)
-          .checked([](const K& k) {
-            check_positive_if_given(k, "detumble-max-base-decay", k.detumble_max_base_decay);
-          })
-          .echoed(echo_given("detumble-max-base-decay", &K::detumble_max_base_decay))
-          .acting([](const K& k) -> std::string {
-            return k.stop_stack_spin ? "" : "acts only when the run stops the stack's spin (stop-stack-spin = true)";
-          }));
+  add_positive_detumble_key(keys, FFSR_KEY("detumble-max-decay", detumble_max_decay,
+                 "Detumble: the fastest decay the law asks of the joint rates, 1/s (its bandwidth; at most half "
+                 "the tick's inverse is used)", "20"),
+        "detumble-max-decay", &K::detumble_max_decay);
+  add_positive_detumble_key(keys, FFSR_KEY("detumble-max-base-decay", detumble_max_base_decay,
+                 "Detumble: the fastest decay of the stack's momentum the base actuator is asked, 1/s (at "
+                 "most half the tick's inverse is used)", "2"),
+        "detumble-max-base-decay", &K::detumble_max_base_decay)
+      .acting([](const K& k) -> std::string {
+        return k.stop_stack_spin ? "" : "acts only when the run stops the stack's spin (stop-stack-spin = true)";
+      });
   keys.push_back(
       FFSR_KEY("grasp-after", grasp_after,
                "Detumble: the grasp locks at the end of the approach, or after the Hertz contact run (the "
