@@ -138,13 +138,20 @@ def test_grasp_after_contact_against_pinocchio(name):
     assert np.linalg.norm(total - a.impulse) < 1e-3 * np.linalg.norm(a.impulse)
 
 
-def test_detumble_run_and_controller():
+def grasped_7dof():
+    """The 7-DOF robot at the detumble scenario's configuration, the grasp at the end of the approach of
+    its target (1, -0.5, 2 deg/s) and the stack: (model, theta, target, base, grasp, stack)."""
     fm = ffsr.Model.from_urdf(str(ROBOTS / "paper_7dof.urdf"), end_effector="ee")
     theta = np.radians([0, 90, 90, -90, 90, 90, 0])
     target = ffsr.Target(angular_velocity=np.radians([1, -0.5, 2]), contact_offset=[-0.25, 0.15, 0.1])
     base = ffsr.BasePose()
     g = ffsr.grasp_at_capture(fm, None, base, theta, target, 0.2)
     stack = ffsr.attach_body(fm, "ee", g.body.mass, g.body.inertia, g.body.pose)
+    return fm, theta, target, base, g, stack
+
+
+def test_detumble_run_and_controller():
+    fm, theta, target, base, g, stack = grasped_7dof()
     limits = [60, 60, 60, 40, 20, 20, 20]
     r = ffsr.run_detumble(stack, "ee", g.body, base, theta, g.v_after, limits, horizon=60.0)
     assert r.at_rest and r.momentum_drift < 1e-8
@@ -168,12 +175,7 @@ def test_detumble_law_against_pinocchio_forward_dynamics():
     URDF plus the target as a fixed body) under the command's torques and base wrench gives
     qdd = -decay qd, and a joint or the gripper bound is active when the decay is below the cap."""
     pin = pytest.importorskip("pinocchio")
-    fm = ffsr.Model.from_urdf(str(ROBOTS / "paper_7dof.urdf"), end_effector="ee")
-    theta = np.radians([0, 90, 90, -90, 90, 90, 0])
-    target = ffsr.Target(angular_velocity=np.radians([1, -0.5, 2]), contact_offset=[-0.25, 0.15, 0.1])
-    base = ffsr.BasePose()
-    g = ffsr.grasp_at_capture(fm, None, base, theta, target, 0.2)
-    stack = ffsr.attach_body(fm, "ee", g.body.mass, g.body.inertia, g.body.pose)
+    fm, theta, target, base, g, stack = grasped_7dof()
     limits = np.array([60, 60, 60, 40, 20, 20, 20.0])
     c = ffsr.DetumbleController(stack, "ee", g.body, limits)
     cmd = c.step(stack, base, theta, g.v_after)
@@ -270,12 +272,7 @@ def test_detumble_keys_from_python_name_the_bound_too_small():
 
 
 def test_detumble_controller_and_attach_refuse_bad_input():
-    fm = ffsr.Model.from_urdf(str(ROBOTS / "paper_7dof.urdf"), end_effector="ee")
-    theta = np.radians([0, 90, 90, -90, 90, 90, 0])
-    target = ffsr.Target(angular_velocity=np.radians([1, -0.5, 2]), contact_offset=[-0.25, 0.15, 0.1])
-    base = ffsr.BasePose()
-    g = ffsr.grasp_at_capture(fm, None, base, theta, target, 0.2)
-    stack = ffsr.attach_body(fm, "ee", g.body.mass, g.body.inertia, g.body.pose)
+    fm, theta, target, base, g, stack = grasped_7dof()
     limits = [60, 60, 60, 40, 20, 20, 20]
     bad = [
         (dict(joint_torque=limits[:3]), r"joint_torque"),
