@@ -1,0 +1,198 @@
+// ffsr/optimize/detail/detumble_planner.hxx -- body of ffsr/optimize/detumble_planner.hpp.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+
+namespace ffsr {
+
+namespace detail {
+
+inline void check_detumble_plan_options(const DetumblePlanOptions& po, double horizon) {
+  constexpr const char* w = "plan_detumble";
+  if (po.intervals < 2 || po.intervals > 2000)
+    throw InputError(str(w, ": the intervals must be in [2, 2000], got ", po.intervals));
+  if (po.substeps < 1 || po.substeps > 50)
+    throw InputError(str(w, ": the substeps must be in [1, 50], got ", po.substeps));
+  if (!std::isfinite(po.effort_weight) || po.effort_weight < 0)
+    throw InputError(str(w, ": the effort weight must be >= 0 and finite, got ", po.effort_weight));
+  if (!std::isfinite(po.tolerance) || !(po.tolerance > 0))
+    throw InputError(str(w, ": the tolerance must be positive and finite, got ", po.tolerance));
+  if (!std::isfinite(po.optimality) || !(po.optimality > 0))
+    throw InputError(str(w, ": the optimality tolerance must be positive and finite, got ", po.optimality));
+  if (po.max_iterations < 1) throw InputError(str(w, ": max_iterations must be >= 1, got ", po.max_iterations));
+  if (!std::isfinite(horizon) || !(horizon > 0))
+    throw InputError(str(w, ": the horizon must be positive and finite, got ", horizon));
+}
+
+/// The initial guess from the detumbling law's run on the planner's own integrator (RK4 over each
+/// tick, the command held in the inertial frame as the onboard law holds it), sampled at the nodes:
+/// the states interpolated, each interval's controls the mean of the law's commands over it (base frame,
+/// scaled by the bounds, within [-1, 1]). Returns the law's time to rest (the horizon if never).
+inline double detumble_law_guess(DetumblePlanNlp& nlp, const Model& stack, int gripper, const AttachedBody& body,
+                                 const DetumbleState& start, const DetumbleLimits& limits,
+                                 const DetumbleOptions& options, double horizon, int N, Eigen::VectorXd& x) {
+  const int n = stack.n(), ny = nlp.ny(), nu = nlp.nu();
+  const double tick = std::min(0.01, 0.5 * detumble_longest_tick(stack, gripper, start));
+  DetumbleController ctrl(stack, gripper, body, limits, options, tick);
+  DetumbleCommand cmd = ctrl.make_command();
+  auto& w = nlp.work0();
+  w.y = nlp.start();
+  std::vector<Eigen::VectorXd> ys{w.y}, us;
+  const bool thrusters = limits.actuator == BaseActuator::Thrusters;
+  const bool wheels = limits.actuator == BaseActuator::ReactionWheels;
+  const auto ticks = static_cast<long>(std::ceil(horizon / tick));
+  double T = horizon;
+  for (long k = 0; k < ticks; ++k) {
+    ctrl.step(w.sys.unpack(w.y), cmd);
+    if (cmd.status == DetumbleStatus::Fault) break;
+    const bool slow = !(thrusters && options.stop_stack_spin) || w.y.segment<3>(7 + n).norm() < options.rest_rate;
+    if (cmd.status == DetumbleStatus::AtRest && slow) {
+      T = std::max(static_cast<double>(k) * tick, 2 * tick);
+      break;
+    }
+    const Matrix3 R = Quaternion(w.y(6), w.y(3), w.y(4), w.y(5)).normalized().toRotationMatrix();
+    Eigen::VectorXd u(nu);
+    u.head(n) = cmd.tau;
+    if (thrusters) u.tail(6) << R.transpose() * cmd.base_wrench.head<3>(), R.transpose() * cmd.base_wrench.tail<3>();
+    if (wheels) u.tail(3) = R.transpose() * cmd.base_wrench.tail<3>();
+    us.push_back(u.cwiseQuotient(nlp.scale()).cwiseMax(-1.0).cwiseMin(1.0));
+    nlp.step_held(w, cmd, tick, 2);
+    ys.push_back(w.y);
+  }
+  if (us.empty()) us.push_back(Eigen::VectorXd::Zero(nu));
+  x.resize(nlp.num_vars());
+  x(0) = T;
+  const double h = T / N;
+  const auto at = [&](double t) {  // the state at t, linear between ticks
+    const double s = std::min(t / tick, static_cast<double>(ys.size() - 1));
+    const auto i = static_cast<size_t>(std::floor(s));
+    const size_t j = std::min(i + 1, ys.size() - 1);
+    Eigen::VectorXd y = ys[i] + (s - static_cast<double>(i)) * (ys[j] - ys[i]);
+    y.segment<4>(3).normalize();
+    return y;
+  };
+  for (int k = 0; k <= N; ++k) x.segment(nlp.oy(k), ny) = k == 0 ? nlp.start() : at(k * h);
+  for (int k = 0; k < N; ++k) {
+    Eigen::VectorXd u = Eigen::VectorXd::Zero(nu);
+    int c = 0;
+    for (auto i = static_cast<size_t>(k * h / tick); i < us.size() && static_cast<double>(i) * tick < (k + 1) * h; ++i, ++c)
+      u += us[i];
+    if (c == 0) u = us[std::min(static_cast<size_t>(k * h / tick), us.size() - 1)];
+    else u /= c;
+    x.segment(nlp.ou(k), nu) = u;
+  }
+  return T;
+}
+
+/// The initial guess from a previous plan: T, and the nodes and controls resampled to N intervals.
+inline void detumble_plan_guess(DetumblePlanNlp& nlp, const DetumblePlan& p, int N, Eigen::VectorXd& x) {
+  x.resize(nlp.num_vars());
+  x(0) = p.duration;
+  const DetumbleSystem& sys = nlp.work0().sys;
+  const int M = p.intervals();
+  for (int k = 0; k <= N; ++k) {
+    const double s = static_cast<double>(k) * M / N;
+    const int i = std::min(static_cast<int>(std::floor(s)), M);
+    const int j = std::min(i + 1, M);
+    Eigen::VectorXd y = sys.pack(p.nodes[static_cast<size_t>(i)]);
+    y += (s - i) * (sys.pack(p.nodes[static_cast<size_t>(j)]) - y);
+    y.segment<4>(3).normalize();
+    x.segment(nlp.oy(k), nlp.ny()) = k == 0 ? nlp.start() : y;
+  }
+  const int n = static_cast<int>(p.tau.front().size()), nu = nlp.nu();
+  for (int k = 0; k < N; ++k) {
+    const auto i = static_cast<size_t>(std::min(M - 1, static_cast<int>((k + 0.5) * M / N)));
+    Eigen::VectorXd u(nu);
+    u.head(n) = p.tau[i];
+    if (nu - n == 6) u.tail(6) = p.base_wrench[i];
+    if (nu - n == 3) u.tail(3) = p.base_wrench[i].tail<3>();
+    x.segment(nlp.ou(k), nu) = u.cwiseQuotient(nlp.scale()).cwiseMax(-1.0).cwiseMin(1.0);
+  }
+}
+
+}  // namespace detail
+
+inline DetumblePlan plan_detumble(const Model& stack, int gripper, const AttachedBody& body,
+                                  const DetumbleState& start, const DetumbleLimits& limits,
+                                  const DetumbleOptions& options, double horizon, const DetumblePlanOptions& po,
+                                  const DetumblePlan* warm) {
+  const auto t_start = std::chrono::steady_clock::now();
+  constexpr const char* w = "plan_detumble";
+  detail::check_detumble_plan_options(po, horizon);
+  DetumbleRunOptions check;
+  check.horizon = horizon;
+  check.tick = horizon / 2;
+  detail::check_detumble_run(stack, gripper, body, start, check);
+  if (stack.nb() - 1 != stack.n()) throw InputError(detail::str(w, ": the model has mimic joints"));
+  const bool none = limits.actuator == BaseActuator::None;
+  if (none) check_detumble_feasible(stack, start, limits, options, horizon);
+  detail::check_detumble(stack, limits, options, w);
+  if (!none) check_detumble_feasible(stack, start, limits, options, horizon);
+  if (warm) detail::check_detumble_plan(stack, *warm, w);
+
+  const int N = po.intervals;
+  Ipopt::SmartPtr<detail::DetumblePlanNlp> nlp =
+      new detail::DetumblePlanNlp(stack, gripper, body, start, limits, options, horizon, po);
+  Eigen::VectorXd x0;
+  DetumblePlan plan;
+  if (warm) {
+    detail::detumble_plan_guess(*nlp, *warm, N, x0);
+    plan.warm_start_duration = warm->duration;
+  } else {
+    plan.warm_start_duration =
+        detail::detumble_law_guess(*nlp, stack, gripper, body, start, limits, options, horizon, N, x0);
+  }
+  nlp->set_guess(x0);
+
+  Ipopt::SmartPtr<Ipopt::IpoptApplication> app = IpoptApplicationFactory();
+  auto& opt = *app->Options();
+  opt.SetStringValue("sb", "yes");
+  opt.SetIntegerValue("print_level", po.print_level);
+  opt.SetStringValue("hessian_approximation", "limited-memory");
+  opt.SetNumericValue("tol", po.optimality);
+  opt.SetNumericValue("constr_viol_tol", po.tolerance);
+  opt.SetNumericValue("acceptable_constr_viol_tol", po.tolerance);
+  opt.SetNumericValue("bound_relax_factor", 0);
+  opt.SetIntegerValue("max_iter", po.max_iterations);
+  opt.SetStringValue("mu_strategy", po.adaptive_mu ? "adaptive" : "monotone");
+  opt.SetIntegerValue("limited_memory_max_history", po.history);
+  opt.SetStringValue("limited_memory_update_type", po.sr1 ? "sr1" : "bfgs");
+  opt.SetNumericValue("acceptable_tol", 100 * po.optimality);
+  opt.SetIntegerValue("acceptable_iter", 10);
+  if (warm) {  // near the solution: a small barrier, and the start kept near its bounds
+    opt.SetNumericValue("mu_init", 1e-5);
+    opt.SetNumericValue("bound_push", 1e-6);
+    opt.SetNumericValue("bound_frac", 1e-6);
+  }
+  if (app->Initialize() != Ipopt::Solve_Succeeded)
+    throw NumericalError(detail::str(w, ": IPOPT could not be initialised"));
+  const Ipopt::ApplicationReturnStatus st = app->OptimizeTNLP(Ipopt::SmartPtr<Ipopt::TNLP>(GetRawPtr(nlp)));
+  plan.status = detail::ipopt_status_name(st);
+  plan.iterations = IsValid(app->Statistics()) ? app->Statistics()->IterationCount() : 0;
+  const Eigen::VectorXd& x = nlp->solution();
+  const double viol = x.size() == nlp->num_vars() ? nlp->violation(x) : std::numeric_limits<double>::infinity();
+  plan.constraint_violation = viol;
+  const bool ok = (st == Ipopt::Solve_Succeeded || st == Ipopt::Solved_To_Acceptable_Level) && viol <= po.tolerance;
+  if (!ok)
+    throw DetumblePlanError(detail::str(w, ": IPOPT did not converge (", plan.status, " after ", plan.iterations,
+                                        " iterations; the constraints' residual reached ", viol,
+                                        ", asked ", po.tolerance, ")"),
+                            plan.status, viol);
+  plan.duration = x(0);
+  const detail::DetumbleSystem& sys = nlp->work0().sys;
+  const int n = stack.n(), ny = nlp->ny(), nu = nlp->nu();
+  for (int k = 0; k <= N; ++k) plan.nodes.push_back(sys.unpack(x.segment(nlp->oy(k), ny)));
+  for (int k = 0; k < N; ++k) {
+    const Eigen::VectorXd u = x.segment(nlp->ou(k), nu).cwiseProduct(nlp->scale());
+    plan.tau.push_back(u.head(n));
+    Vector6 b = Vector6::Zero();
+    if (nu - n == 6) b = u.tail(6);
+    if (nu - n == 3) b.tail<3>() = u.tail(3);
+    plan.base_wrench.push_back(b);
+  }
+  plan.solve_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
+  return plan;
+}
+
+}  // namespace ffsr
