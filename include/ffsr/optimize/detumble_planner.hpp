@@ -10,10 +10,11 @@
 // every interval's controls (scaled by their bounds, so the box is [-1, 1] and held exactly); its
 // constraints the continuity of the states (x_k+1 - Phi = 0), the gripper's force and moment in norm at
 // every substep's end of every interval (the load with the interval's controls), the wheels' momentum
-// per base axis at every node; the start node is fixed to the start, the end node at rest (joint rates
-// zero; with stop_stack_spin the base's angular velocity too, and with thrusters its linear velocity).
-// The objective is T (plus an optional effort term). IPOPT (interior point, MUMPS) with a limited-memory
-// Hessian; the constraints' Jacobian by forward differences over each interval's inputs (step
+// per base axis at every node; the start node is fixed to the start, the end node within the rest test
+// with a margin (kDetumblePlanRestMargin: each joint rate within margin rest / n; with stop_stack_spin
+// each component of the base's angular velocity, and with thrusters of its linear velocity, within
+// margin rest / sqrt(3)). The objective is T (plus an optional effort term). IPOPT (interior point,
+// MUMPS) with a limited-memory SR1 Hessian; the constraints' Jacobian by forward differences over each interval's inputs (step
 // sqrt(eps) max(1, |z|): about 1e-8 relative), computed interval by interval on a few threads; the
 // values themselves are exact (the solver's feasibility is the integrator's).
 //
@@ -80,7 +81,6 @@ class DetumblePlanNlp : public Ipopt::TNLP {
     if (wheels_) scale_.tail(3) = Vector3::Constant(limits.wheel_torque);
     n_grip_ = (std::isfinite(limits.gripper_force) ? 1 : 0) + (std::isfinite(limits.gripper_moment) ? 1 : 0);
     nz_ = ny_ + nu_ + 1;
-    n_term_ = 0;
     rest_ = kDetumblePlanRestMargin * options.rest_rate;
     nout_ = ny_ + (S_ + 1) * n_grip_;
     {
@@ -98,6 +98,7 @@ class DetumblePlanNlp : public Ipopt::TNLP {
   Index oy(int k) const { return 1 + k * ny_; }
   Index ou(int k) const { return 1 + (N_ + 1) * ny_ + k * nu_; }
   int ny() const { return ny_; }
+  const Model& stack() const { return stack_; }
   int nu() const { return nu_; }
   const Eigen::VectorXd& scale() const { return scale_; }
 
@@ -108,8 +109,8 @@ class DetumblePlanNlp : public Ipopt::TNLP {
 
   bool get_nlp_info(Index& n, Index& m, Index& nnz_jac, Index& nnz_h, IndexStyleEnum& style) override {
     n = num_vars();
-    m = N_ * nout_ + (wheels_ ? 3 * N_ : 0) + n_term_;
-    nnz_jac = N_ * (ny_ + nout_ * nz_) + (wheels_ ? 3 * N_ * ny_ : 0) + n_term_ * ny_;
+    m = N_ * nout_ + (wheels_ ? 3 * N_ : 0);
+    nnz_jac = N_ * (ny_ + nout_ * nz_) + (wheels_ ? 3 * N_ * ny_ : 0);
     nnz_h = 0;
     style = TNLP::C_STYLE;
     return true;
@@ -152,13 +153,8 @@ class DetumblePlanNlp : public Ipopt::TNLP {
         gu[r] = 1;
       }
     }
-    if (wheels_)
-      for (int i = 0; i < 3 * N_; ++i, ++r) {
-        gl[r] = -1;
-        gu[r] = 1;
-      }
-    for (; r < m; ++r) {  // the rest test's norms at the end, over rest^2
-      gl[r] = -inf;
+    for (; r < m; ++r) {  // the wheels' momentum per base axis over its bound
+      gl[r] = -1;
       gu[r] = 1;
     }
     return true;
@@ -206,42 +202,13 @@ class DetumblePlanNlp : public Ipopt::TNLP {
         const Vector3 w = wheel_rows(x + oy(k));
         for (int i = 0; i < 3; ++i) g[r++] = w(i);
       }
-    const Vector3 t = terminal_rows(x + oy(N_));
-    for (int i = 0; i < n_term_; ++i) g[r++] = t(i);
     (void)m;
     return true;
   }
 
   bool eval_jac_g(Index n, const Number* x, bool, Index, Index nele, Index* row, Index* col,
                   Number* val) override {
-    if (!x) {  // the structure
-      Index e = 0, r = 0;
-      for (int k = 0; k < N_; ++k) {
-        for (int i = 0; i < nout_; ++i, ++r) {
-          if (i < ny_) {
-            row[e] = r;
-            col[e++] = oy(k + 1) + i;
-          }
-          for (int j = 0; j < nz_; ++j) {
-            row[e] = r;
-            col[e++] = zcol(k, j);
-          }
-        }
-      }
-      if (wheels_)
-        for (int k = 1; k <= N_; ++k)
-          for (int i = 0; i < 3; ++i, ++r)
-            for (int j = 0; j < ny_; ++j) {
-              row[e] = r;
-              col[e++] = oy(k) + j;
-            }
-      for (int i = 0; i < n_term_; ++i, ++r)
-        for (int j = 0; j < ny_; ++j) {
-          row[e] = r;
-          col[e++] = oy(N_) + j;
-        }
-      return e == nele;
-    }
+    if (!x) return jacobian_structure(row, col) == nele;
     if (!evaluate(n, x, true)) return false;
     Index e = 0;
     for (int k = 0; k < N_; ++k) {
@@ -254,32 +221,10 @@ class DetumblePlanNlp : public Ipopt::TNLP {
     }
     if (wheels_)
       for (int k = 1; k <= N_; ++k) {
-        const Number* xk = x + oy(k);
-        Eigen::VectorXd yk = Eigen::Map<const Eigen::VectorXd>(xk, ny_);
-        Eigen::Matrix<double, 3, Eigen::Dynamic> W = Eigen::Matrix<double, 3, Eigen::Dynamic>::Zero(3, ny_);
-        const Vector3 w0 = wheel_rows(yk.data());
-        for (int j : {3, 4, 5, 6, ny_ - 3, ny_ - 2, ny_ - 1}) {
-          const double d = 1e-7 * std::max(1.0, std::abs(yk(j))), keep = yk(j);
-          yk(j) += d;
-          W.col(j) = (wheel_rows(yk.data()) - w0) / d;
-          yk(j) = keep;
-        }
+        const Eigen::Matrix<double, 3, Eigen::Dynamic> W = wheel_jacobian(x + oy(k));
         for (int i = 0; i < 3; ++i)
           for (int j = 0; j < ny_; ++j) val[e++] = W(i, j);
       }
-    {  // the rest rows: forward differences over the end node
-      Eigen::VectorXd yN = Eigen::Map<const Eigen::VectorXd>(x + oy(N_), ny_);
-      Eigen::MatrixXd D(3, ny_);
-      const Vector3 t0 = terminal_rows(yN.data());
-      for (int j = 0; j < ny_; ++j) {
-        const double d = 1.49e-8 * std::max(1.0, std::abs(yN(j))), keep = yN(j);
-        yN(j) += d;
-        D.col(j) = (terminal_rows(yN.data()) - t0) / d;
-        yN(j) = keep;
-      }
-      for (int i = 0; i < n_term_; ++i)
-        for (int j = 0; j < ny_; ++j) val[e++] = D(i, j);
-    }
     return e == nele;
   }
 
@@ -386,28 +331,44 @@ class DetumblePlanNlp : public Ipopt::TNLP {
   }
 
  private:
+  /// The Jacobian's entries in eval_jac_g's order; returns their count.
+  Index jacobian_structure(Index* row, Index* col) const {
+    Index e = 0, r = 0;
+    const auto entry = [&](Index c) {
+      row[e] = r;
+      col[e++] = c;
+    };
+    for (int k = 0; k < N_; ++k)
+      for (int i = 0; i < nout_; ++i, ++r) {
+        if (i < ny_) entry(oy(k + 1) + i);
+        for (int j = 0; j < nz_; ++j) entry(zcol(k, j));
+      }
+    if (wheels_)
+      for (int k = 1; k <= N_; ++k)
+        for (int i = 0; i < 3; ++i, ++r)
+          for (int j = 0; j < ny_; ++j) entry(oy(k) + j);
+    return e;
+  }
+
+  /// The wheel rows' derivatives at the node y (forward differences over the quaternion and the
+  /// wheels' momentum, the only entries they depend on).
+  Eigen::Matrix<double, 3, Eigen::Dynamic> wheel_jacobian(const Number* y) const {
+    Eigen::VectorXd yk = Eigen::Map<const Eigen::VectorXd>(y, ny_);
+    Eigen::Matrix<double, 3, Eigen::Dynamic> W = Eigen::Matrix<double, 3, Eigen::Dynamic>::Zero(3, ny_);
+    const Vector3 w0 = wheel_rows(yk.data());
+    for (int j : {3, 4, 5, 6, ny_ - 3, ny_ - 2, ny_ - 1}) {
+      const double d = 1e-7 * std::max(1.0, std::abs(yk(j))), keep = yk(j);
+      yk(j) += d;
+      W.col(j) = (wheel_rows(yk.data()) - w0) / d;
+      yk(j) = keep;
+    }
+    return W;
+  }
+
   Index zcol(int k, int j) const {
     if (j < ny_) return oy(k) + j;
     if (j < ny_ + nu_) return ou(k) + (j - ny_);
     return 0;
-  }
-
-  /// The rest test's norms at the state y over rest^2: the gripper's angular rate relative to the base;
-  /// with stop_stack_spin the base's angular velocity; with thrusters too its linear velocity.
-  Vector3 terminal_rows(const Number* y) {
-    const Eigen::Map<const Eigen::VectorXd> yy(y, ny_);
-    BasePose b;
-    b.position = yy.head<3>();
-    b.orientation = Quaternion(y[6], y[3], y[4], y[5]).normalized();
-    forward_kinematics(stack_, term_data_, b, yy.segment(7, n_));
-    frame_jacobian(stack_, term_data_, gripper_);
-    const auto v = yy.segment(7 + n_, 6 + n_);
-    const double r2 = rest_ * rest_;
-    Vector3 t = Vector3::Zero();
-    t(0) = (term_data_.J.bottomRows<3>().rightCols(n_) * v.tail(n_)).squaredNorm() / r2;
-    if (n_term_ > 1) t(1) = v.segment<3>(3).squaredNorm() / r2;
-    if (n_term_ > 2) t(2) = v.head<3>().squaredNorm() / r2;
-    return t;
   }
 
   Vector3 wheel_rows(const Number* y) const {
@@ -458,9 +419,8 @@ class DetumblePlanNlp : public Ipopt::TNLP {
   DetumbleOptions options_;
   DetumblePlanOptions po_;
   double horizon_;
-  int n_, N_, S_, ny_ = 0, nu_ = 0, nz_ = 0, nout_ = 0, n_grip_ = 0, n_term_ = 1;
+  int n_, N_, S_, ny_ = 0, nu_ = 0, nz_ = 0, nout_ = 0, n_grip_ = 0;
   double rest_ = 0;
-  Data term_data_{stack_};
   bool wheels_ = false, thrusters_ = false;
   Eigen::VectorXd scale_, y0_, guess_, x_, xc_;
   bool have_jac_ = false, ok_ = false;

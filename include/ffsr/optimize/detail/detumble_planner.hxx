@@ -111,6 +111,45 @@ inline void detumble_plan_guess(DetumblePlanNlp& nlp, const DetumblePlan& p, int
   }
 }
 
+/// IPOPT's settings for the plan (see the top of detumble_planner.hpp); `warm`: near the solution, a
+/// small barrier and the start kept near its bounds.
+inline void set_ipopt_options(Ipopt::OptionsList& opt, const DetumblePlanOptions& po, bool warm) {
+  opt.SetStringValue("sb", "yes");
+  opt.SetIntegerValue("print_level", po.print_level);
+  opt.SetStringValue("hessian_approximation", "limited-memory");
+  opt.SetNumericValue("tol", po.optimality);
+  opt.SetNumericValue("constr_viol_tol", po.tolerance);
+  opt.SetNumericValue("acceptable_constr_viol_tol", po.tolerance);
+  opt.SetNumericValue("bound_relax_factor", 0);
+  opt.SetIntegerValue("max_iter", po.max_iterations);
+  opt.SetStringValue("mu_strategy", po.adaptive_mu ? "adaptive" : "monotone");
+  opt.SetIntegerValue("limited_memory_max_history", po.history);
+  opt.SetStringValue("limited_memory_update_type", po.sr1 ? "sr1" : "bfgs");
+  opt.SetNumericValue("acceptable_tol", 100 * po.optimality);
+  opt.SetIntegerValue("acceptable_iter", 10);
+  if (warm) {
+    opt.SetNumericValue("mu_init", 1e-5);
+    opt.SetNumericValue("bound_push", 1e-6);
+    opt.SetNumericValue("bound_frac", 1e-6);
+  }
+}
+
+/// The plan of the NLP's solution x.
+inline void plan_from_solution(const DetumblePlanNlp& nlp, const Eigen::VectorXd& x, int n, int N, DetumblePlan& plan) {
+  plan.duration = x(0);
+  const DetumbleSystem sys(nlp.stack());
+  const int ny = nlp.ny(), nu = nlp.nu();
+  for (int k = 0; k <= N; ++k) plan.nodes.push_back(sys.unpack(x.segment(nlp.oy(k), ny)));
+  for (int k = 0; k < N; ++k) {
+    const Eigen::VectorXd u = x.segment(nlp.ou(k), nu).cwiseProduct(nlp.scale());
+    plan.tau.push_back(u.head(n));
+    Vector6 b = Vector6::Zero();
+    if (nu - n == 6) b = u.tail(6);
+    if (nu - n == 3) b.tail<3>() = u.tail(3);
+    plan.base_wrench.push_back(b);
+  }
+}
+
 }  // namespace detail
 
 inline DetumblePlan plan_detumble(const Model& stack, int gripper, const AttachedBody& body,
@@ -146,25 +185,7 @@ inline DetumblePlan plan_detumble(const Model& stack, int gripper, const Attache
   nlp->set_guess(x0);
 
   Ipopt::SmartPtr<Ipopt::IpoptApplication> app = IpoptApplicationFactory();
-  auto& opt = *app->Options();
-  opt.SetStringValue("sb", "yes");
-  opt.SetIntegerValue("print_level", po.print_level);
-  opt.SetStringValue("hessian_approximation", "limited-memory");
-  opt.SetNumericValue("tol", po.optimality);
-  opt.SetNumericValue("constr_viol_tol", po.tolerance);
-  opt.SetNumericValue("acceptable_constr_viol_tol", po.tolerance);
-  opt.SetNumericValue("bound_relax_factor", 0);
-  opt.SetIntegerValue("max_iter", po.max_iterations);
-  opt.SetStringValue("mu_strategy", po.adaptive_mu ? "adaptive" : "monotone");
-  opt.SetIntegerValue("limited_memory_max_history", po.history);
-  opt.SetStringValue("limited_memory_update_type", po.sr1 ? "sr1" : "bfgs");
-  opt.SetNumericValue("acceptable_tol", 100 * po.optimality);
-  opt.SetIntegerValue("acceptable_iter", 10);
-  if (warm) {  // near the solution: a small barrier, and the start kept near its bounds
-    opt.SetNumericValue("mu_init", 1e-5);
-    opt.SetNumericValue("bound_push", 1e-6);
-    opt.SetNumericValue("bound_frac", 1e-6);
-  }
+  detail::set_ipopt_options(*app->Options(), po, warm != nullptr);
   if (app->Initialize() != Ipopt::Solve_Succeeded)
     throw NumericalError(detail::str(w, ": IPOPT could not be initialised"));
   const Ipopt::ApplicationReturnStatus st = app->OptimizeTNLP(Ipopt::SmartPtr<Ipopt::TNLP>(GetRawPtr(nlp)));
@@ -179,18 +200,7 @@ inline DetumblePlan plan_detumble(const Model& stack, int gripper, const Attache
                                         " iterations; the constraints' residual reached ", viol,
                                         ", asked ", po.tolerance, ")"),
                             plan.status, viol);
-  plan.duration = x(0);
-  const detail::DetumbleSystem& sys = nlp->work0().sys;
-  const int n = stack.n(), ny = nlp->ny(), nu = nlp->nu();
-  for (int k = 0; k <= N; ++k) plan.nodes.push_back(sys.unpack(x.segment(nlp->oy(k), ny)));
-  for (int k = 0; k < N; ++k) {
-    const Eigen::VectorXd u = x.segment(nlp->ou(k), nu).cwiseProduct(nlp->scale());
-    plan.tau.push_back(u.head(n));
-    Vector6 b = Vector6::Zero();
-    if (nu - n == 6) b = u.tail(6);
-    if (nu - n == 3) b.tail<3>() = u.tail(3);
-    plan.base_wrench.push_back(b);
-  }
+  detail::plan_from_solution(*nlp, x, stack.n(), N, plan);
   plan.solve_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
   return plan;
 }
