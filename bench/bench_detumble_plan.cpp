@@ -1,4 +1,4 @@
-// Timings of the time-optimal post-capture plan (optimize/detumble_planner.hpp) on the published planar
+// Timings of the time-optimal post-capture plan (control/detumble_planner.hpp) on the published planar
 // problem (robots/vyas2022_planar.urdf; Vyas et al. 2022, published 4.095 s): the cold solve (from the
 // detumbling law's run, the law's run included) and the warm solve (from the previous plan), wall time
 // over `--repeat` solves each (median, min, max), on all cores (the Jacobian's intervals on threads) and on
@@ -6,7 +6,7 @@
 // Run (Release): build/bench/ffsr-bench-plan [robots/] [--repeat N]. Exit status 1 when a plan fails or
 // its re-run is not at rest within the bounds; no budget on time (the figures go to docs/performance.md).
 
-#include "ffsr/optimize/detumble_planner.hpp"
+#include "ffsr/control/detumble_planner.hpp"
 #include "ffsr/parsers/urdf.hpp"
 
 #include <algorithm>

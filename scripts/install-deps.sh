@@ -6,7 +6,7 @@ packages=(cmake ninja-build g++ pkg-config libeigen3-dev liburdfdom-dev libtinyx
           libtomlplusplus-dev
           libplplot-dev plplot-driver-cairo zlib1g-dev)  # figures (--plot; optional) and their test
 packages+=(libnlopt-cxx-dev)  # NLopt: the global capture search (optimize/global.hpp)
-packages+=(coinor-libipopt-dev)  # IPOPT: the time-optimal post-capture planner (optimize/detumble_planner.hpp; optional)
+packages+=(coinor-libipopt-dev)  # IPOPT: the time-optimal post-capture planner (control/detumble_planner.hpp; optional)
 packages+=(libfcl-dev)  # FCL: distances between the robot, the bus and the target (geometry/distance.hpp; optional)
 packages+=(chromium)  # the 3-D view's tests (python/tests/test_view.py): headless, WebGL through SwiftShader
 packages+=(debootstrap)  # the wheel's check in a minimal Debian 12 root (scripts/check-wheel.sh)

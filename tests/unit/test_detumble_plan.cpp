@@ -1,4 +1,4 @@
-// The time-optimal post-capture plan (optimize/detumble_planner.hpp): the published planar problem
+// The time-optimal post-capture plan (control/detumble_planner.hpp): the published planar problem
 // (Vyas et al. 2022) against its published time, the plan's controls re-run by CVODE (an integrator
 // other than the plan's RK4) to rest within every bound, the warm start; the paper's 7-DOF stack against
 // the detumbling law, with and without gripper limits; bad input.
@@ -8,7 +8,7 @@
 #include "support/dynamics_helpers.hpp"
 
 #include "ffsr/jobs/detumble.hpp"
-#include "ffsr/optimize/detumble_planner.hpp"
+#include "ffsr/control/detumble_planner.hpp"
 #include "ffsr/parsers/urdf.hpp"
 #include "ffsr/scenario/scenario.hpp"
 

@@ -1,5 +1,5 @@
 // ffsr/control/detumble_plan.hpp -- a post-capture plan (the time-optimal planner's result,
-// optimize/detumble_planner.hpp) and its independent check: the plan's controls, each held over its
+// control/detumble_planner.hpp) and its independent check: the plan's controls, each held over its
 // interval as planned, re-run by CVODE on the stack's full dynamics (ABA), then the detumbling
 // controller holding the stack for the dwell. Needs SUNDIALS only (the planner needs IPOPT).
 #pragma once

@@ -1,4 +1,4 @@
-// ffsr/optimize/detumble_planner.hpp -- the time-optimal post-capture plan: the shortest time in which
+// ffsr/control/detumble_planner.hpp -- the time-optimal post-capture plan: the shortest time in which
 // the stack (robot + grasped target, model/attach.hpp) can be brought to rest within the hardware's
 // bounds, by direct multiple shooting solved with IPOPT.
 //
@@ -475,4 +475,4 @@ inline DetumblePlan plan_detumble(const Model& stack, int gripper, const Attache
 
 }  // namespace ffsr
 
-#include "ffsr/optimize/detail/detumble_planner.hxx"
+#include "ffsr/control/detail/detumble_planner.hxx"

@@ -1,4 +1,4 @@
-// ffsr/optimize/detail/detumble_planner.hxx -- body of ffsr/optimize/detumble_planner.hpp.
+// ffsr/control/detail/detumble_planner.hxx -- body of ffsr/control/detumble_planner.hpp.
 #pragma once
 
 #include <algorithm>
