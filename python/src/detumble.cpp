@@ -206,30 +206,40 @@ void bind_detumble_job(nb::module_& m) {
       .def_prop_ro(
           "peak_joint", [](const DetumbleJobRun& r) { return r.result.front().peak_joint_name; },
           "The joint of that peak.")
+      .def_prop_ro(
+          "plan_time_to_rest",
+          [](const DetumbleJobRun& r) -> std::optional<double> {
+            const auto& p = r.result.front().plan;
+            return p ? std::optional<double>(p->plan.duration) : std::nullopt;
+          },
+          "The first start's time-optimal plan's time to rest, s (None without plan=True).")
       .def(
           "series_csv", [](const DetumbleJobRun& r) { return r.series_csv; },
           "The post-capture series as the command's --csv writes it (with the joint angles and the\n"
           "base's, the target's and every body's pose: ffsr.view.capture(..., detumble=this) animates it).");
   def_scenario_method(
       "detumble",
-      [](const Scenario& sc, std::optional<std::string> run) {
+      [](const Scenario& sc, std::optional<std::string> run, bool plan) {
         return run_job<DetumbleJobRun>([&](DetumbleJobRun& r) {
-          if (run) {
+          if (plan) require_detumble_planner();
+          if (run)
             r.result = detumble_runs(sc, *run);
-            r.json = detumble_runs_json(sc, r.result, FFSR_VERSION).dump();
-          } else {
+          else
             r.result.push_back(detumble(sc));
-            r.json = detumble_json(sc, r.result.front(), FFSR_VERSION).dump();
-          }
+          if (plan) detumble_plans(sc, r.result);
+          r.json = (run ? detumble_runs_json(sc, r.result, FFSR_VERSION)
+                        : detumble_json(sc, r.result.front(), FFSR_VERSION))
+                       .dump();
           r.series_csv = detumble_series_csv(sc, r.result);
         });
       },
-      "run"_a = nb::none(),
+      "run"_a = nb::none(), "plan"_a = false,
       "The job `detumble` (ffsr-optimize detumble --config FILE): the grasp at the end of the approach\n"
       "(or, with the key grasp_after = 'contact', after the Hertz contact run at its separation),\n"
       "then the stack brought to rest under the scenario's limits (joint-torque-limit, base-actuator,\n"
       "...). run: plain, optimized, global or all (as --run: from the main job's captures); default: the\n"
-      "scenario's configuration.");
+      "scenario's configuration. plan: also the time-optimal plan from each start and its re-run by CVODE\n"
+      "(as --plan: to_dict()['plan'], plan_time_to_rest, the plan's rows in series_csv()).");
 }
 
 void bind_detumble_controller(nb::module_& m) {

@@ -364,3 +364,58 @@ TEST_CASE("main job: an error of the post-capture phase names the key and the ru
   CHECK(std::regex_search(r.err, std::regex("spin\\.toml:\\d+: stop-stack-spin: .*conserved.*baseline run")));
   CHECK(ffsr::test::read_file(dir.str() + "/out.json") == old);
 }
+
+#if defined(FFSR_HAVE_PLAN)
+TEST_CASE("detumble --plan: the time-optimal plan beside the law, its re-run in the CSV within every limit",
+          "[cli]") {
+  ffsr::test::TempDir dir;
+  const auto r = cli({"detumble", "--config", kDetumbleToml, "--quiet", "--plan", "--json", "-", "--csv", "series.csv"},
+                     dir.str());
+  const json j = ffsr::test::parse_json(r);
+  const json& p = j.at("plan");
+  CHECK(p.at("solver_status") == "Solve_Succeeded");
+  const double T = p.at("time_to_rest").get<double>();
+  CHECK(T < j.at("time_to_rest").get<double>());  // the law's
+  CHECK(T <= 0.5 * 5.05);                         // the fixed-gain law of the earlier releases
+  CHECK(p.at("initial_guess_time_to_rest").get<double>() == Approx(j.at("time_to_rest").get<double>()).margin(0.02));
+  const json& rr = p.at("rerun");
+  CHECK(rr.at("at_rest").get<bool>());
+  CHECK(rr.at("dwell_at_rest").get<bool>());
+  CHECK(rr.at("worst_bound_excess").get<double>() <= 1e-9);
+  CHECK(rr.at("momentum_drift").get<double>() <= 1e-7);
+  const auto limits = j.at("parameters").at("joint_torque_limit").get<std::vector<double>>();
+  REQUIRE(p.at("controls").size() == size_t(p.at("intervals").get<int>()));
+  REQUIRE(p.at("nodes").size() == p.at("controls").size() + 1);
+  for (const json& c : p.at("controls")) {
+    const auto tau = c.at("tau").get<std::vector<double>>();
+    for (size_t k = 0; k < limits.size(); ++k) CHECK(std::abs(tau[k]) <= limits[k]);
+    CHECK(c.at("base_force").get<std::vector<double>>() == std::vector<double>{0, 0, 0});  // free-floating
+  }
+  CHECK(p.at("nodes").back().at("t").get<double>() == Approx(T).epsilon(1e-12));
+  // the CSV: the law's rows ("law") then the plan's re-run ("plan"), each torque within its limit
+  std::istringstream csv(ffsr::test::read_file(dir.str() + "/series.csv"));
+  std::string line;
+  std::getline(csv, line);
+  REQUIRE(line.rfind("run,t,", 0) == 0);
+  std::map<std::string, int> rows;
+  double last_plan_t = 0;
+  while (std::getline(csv, line)) {
+    std::vector<std::string> cells;
+    std::istringstream in(line);
+    for (std::string cell; std::getline(in, cell, ',');) cells.push_back(cell);
+    ++rows[cells.at(0)];
+    if (cells[0] == "plan") last_plan_t = std::stod(cells.at(1));
+  }
+  CHECK(rows.size() == 2);
+  CHECK(rows["law"] == j.at("ticks").get<long>() + 1);
+  CHECK(rows["plan"] > 0);
+  CHECK(last_plan_t == Approx(T + 5).margin(0.011));  // the plan, then the 5 s hold
+}
+#else
+TEST_CASE("detumble --plan without IPOPT: refused naming the flag and what to install", "[cli]") {
+  const auto r = cli({"detumble", "--config", kDetumbleToml, "--plan"});
+  CHECK(r.exit_code == 2);
+  CHECK(r.err.find("--plan") != std::string::npos);
+  CHECK(r.err.find("coinor-libipopt-dev") != std::string::npos);
+}
+#endif

@@ -16,6 +16,9 @@
 #include "ffsr/jobs/detail/post_capture.hpp"
 #include "ffsr/jobs/scenario_run.hpp"
 #include "ffsr/model/attach.hpp"
+#if defined(FFSR_HAVE_PLAN)
+#include "ffsr/control/detumble_planner.hpp"
+#endif
 
 #include <cmath>
 #include <iomanip>
@@ -80,6 +83,7 @@ inline DetumbleJobResult detumble(const Scenario& s, const BasePose& base, const
   } catch (const NumericalError& e) {
     throw NumericalError(str(e.what(), " (--target-mass, --target-inertia: the target it grasps)"));
   }
+  out.start = start;
   const Model stack = attach_body(model, model.frame(ee).name, out.grasp.body);
   const DetumbleSettings& settings = out.settings;
   try {  // an actuator that cannot stop the stack's spin: the key of the bound that is too small
@@ -164,6 +168,71 @@ inline std::vector<DetumbleJobResult> detumble_runs(const Scenario& sc, const st
   return detail::detumble_each_run(sc, runs);
 }
 
+/// Whether this build has the time-optimal planner (IPOPT found when ffsr was built: FFSR_HAVE_PLAN).
+inline constexpr bool kHaveDetumblePlan =
+#if defined(FFSR_HAVE_PLAN)
+    true;
+#else
+    false;
+#endif
+
+/// InputError naming --plan when this build has no time-optimal planner.
+inline void require_detumble_planner() {
+  if (!kHaveDetumblePlan)
+    throw InputError(
+        "--plan: this build of ffsr has no time-optimal planner (IPOPT was not found when it was built: "
+        "install Debian's coinor-libipopt-dev and build again)");
+}
+
+/// `detumble --plan`: for each result, the time-optimal plan from its start under its settings
+/// (plan_detumble: the horizon bounds T) and the plan's re-run (replay_detumble_plan, with the run's
+/// tick and dwell). InputError naming --plan when this build has no planner; the planner's errors
+/// (DetumblePlanError: IPOPT's status and the residual it reached) as they come.
+inline void detumble_plans(const Scenario& s, std::vector<DetumbleJobResult>& results) {
+#if defined(FFSR_HAVE_PLAN)
+  const Model& model = *s.model;
+  const int ee = s.problem.frame;
+  for (DetumbleJobResult& d : results) {
+    const Model stack = attach_body(model, model.frame(ee).name, d.grasp.body);
+    const DetumbleSettings& st = d.settings;
+    DetumblePlanJob job;
+    try {
+      job.plan = plan_detumble(stack, ee, d.grasp.body, d.start, st.limits, st.options, st.run.horizon);
+    } catch (const DetumblePlanError& e) {
+      throw DetumblePlanError(detail::str("--plan: ", e.what(), d.run.empty() ? "" : " (from the " + d.run + " run's capture)"),
+                              e.status, e.best_residual);
+    }
+    job.run = replay_detumble_plan(stack, ee, d.grasp.body, job.plan, st.limits, st.options, st.run);
+    d.plan = std::move(job);
+  }
+#else
+  (void)s;
+  (void)results;
+  require_detumble_planner();
+#endif
+}
+
+namespace detail {
+
+/// The results as the CSV and the figure show them: each run, then its plan's re-run (named "plan", or
+/// "<run>-plan"), the run named "law" when it has a plan and no name.
+inline std::vector<DetumbleJobResult> with_plan_runs(const std::vector<DetumbleJobResult>& results) {
+  std::vector<DetumbleJobResult> out;
+  for (const DetumbleJobResult& d : results) {
+    out.push_back(d);
+    if (!d.plan) continue;
+    if (out.back().run.empty()) out.back().run = "law";
+    DetumbleJobResult p = d;
+    p.run = d.run.empty() ? "plan" : d.run + "-plan";
+    p.result = d.plan->run;
+    p.plan.reset();
+    out.push_back(std::move(p));
+  }
+  return out;
+}
+
+}  // namespace detail
+
 /// detumble_json (jobs/detail/detumble_result.hpp) for the scenario's robot.
 inline nlohmann::json detumble_json(const Scenario& s, const DetumbleJobResult& d,
                                     const std::string& version) {
@@ -182,13 +251,15 @@ inline nlohmann::json detumble_runs_json(const Scenario& s, const std::vector<De
   return j;
 }
 
-/// The series as the CSV of `ffsr-optimize detumble --csv`: (with runs: the run's name first) time,
+/// The series as the CSV of `ffsr-optimize detumble --csv`: (with runs or a plan: the run's name first,
+/// a plan's re-run as its own run, detail::with_plan_runs) time,
 /// the rates, the gripper load (norms), the base's rotation, the wheels' momentum (norm), the energy,
 /// the law's decay rate and whether it was the passive one, the base wrench (force and moment about the
 /// base origin, inertial), the wheels' momentum per base axis, each joint's rate and torque; then each joint's angle (rad), the base's pose, the target's (the gripper frame's
 /// pose composed with the grasp's attachment) and every moving body's (its joint frame, numbered as the
 /// main job's body<i> columns). Poses: x, y, z, qw, qx, qy, qz in the inertial frame.
-inline std::string detumble_series_csv(const Scenario& s, const std::vector<DetumbleJobResult>& results) {
+inline std::string detumble_series_csv(const Scenario& s, const std::vector<DetumbleJobResult>& all) {
+  const std::vector<DetumbleJobResult> results = detail::with_plan_runs(all);
   const Model& model = *s.model;
   const int gripper = s.problem.frame;
   Data data(model);

@@ -22,6 +22,7 @@ struct DetumbleCommandOptions {
   SubjectOptions subject;
   OutputKeys out;   ///< --json, --csv, --plot, --plot-format, --quiet
   std::string run;  ///< --run: plain, optimized, global or all; empty: the scenario's configuration
+  bool plan = false;  ///< --plan: the time-optimal plan from each start too
 };
 
 void print_detumble_table(std::ostream& out, const DetumbleJobResult& d) {
@@ -53,6 +54,17 @@ void print_detumble_table(std::ostream& out, const DetumbleJobResult& d) {
       << "base attitude excursion  " << r.base_attitude_excursion * deg << " deg\n"
       << "peak wheel momentum      " << r.peak_wheel_momentum << " N m s\n"
       << "momentum drift           " << r.momentum_drift << " (relative)\n";
+  if (!d.plan) return;
+  const DetumblePlan& p = d.plan->plan;
+  const DetumblePlanRun& pr = d.plan->run;
+  out << "time-optimal plan        at rest in " << p.duration << " s (the law: " << r.time_to_rest << " s); "
+      << p.intervals() << " intervals, IPOPT " << p.status << " in " << p.iterations << " iterations, "
+      << p.solve_seconds << " s\n"
+      << "plan re-run (CVODE)      " << (pr.at_rest ? "at rest at T" : "NOT at rest at T") << ": largest joint rate "
+      << pr.end_joint_rate * deg << " deg/s, base " << pr.end_base_rate * deg << " deg/s and "
+      << pr.end_base_speed * 1e3 << " mm/s; bounds " << (pr.worst_bound_excess <= 1e-9 ? "held" : "EXCEEDED")
+      << " (largest excess " << pr.worst_bound_excess << "); held " << d.settings.run.dwell << " s"
+      << (pr.dwell_at_rest ? " at rest" : " NOT at rest") << "\n";
 }
 
 /// The contact law's flags act with grasp-after = contact only (the Hertz run before the grasp); the
@@ -81,8 +93,10 @@ plot::Figure detumble_figure(const Scenario& sc, const std::vector<DetumbleJobRe
     f.wheel_bound = settings.limits.wheel_momentum;
   for (const DetumbleJobResult& d : results) {
     figures::DetumbleSeries::Run r;
-    r.label = d.run == "baseline" ? "plain" : d.run.empty() ? "joints-deg" : d.run;
-    r.color = d.run == "optimized" ? 1 : d.run == "global" ? 2 : 0;  // the runs' colours of the main job
+    r.label = d.run == "baseline" ? "plain" : d.run.empty() ? "joints-deg" : d.run == "baseline-plan" ? "plain-plan" : d.run;
+    // the runs' colours of the main job; a plan's re-run in the next colour
+    const bool plan = d.run.size() >= 4 && d.run.compare(d.run.size() - 4, 4, "plan") == 0;
+    r.color = (d.run == "optimized" ? 1 : d.run == "global" ? 2 : 0) + (plan ? 3 : 0);
     for (const DetumbleSample& x : d.result.series) {
       r.t.push_back(x.t);
       r.joint_rate.push_back(x.command.joint_rate);
@@ -103,7 +117,7 @@ plot::Figure detumble_figure(const Scenario& sc, const std::vector<DetumbleJobRe
                           " s, peak joint torque ", first.result.peak_joint_torque, " N m (joint ",
                           first.peak_joint_name, ")");
   } else {
-    f.title = "After each run's capture: at rest in ";
+    f.title = first.run == "law" ? "After the capture: at rest in " : "After each run's capture: at rest in ";
     for (size_t i = 0; i < results.size(); ++i)
       f.title += detail::str(i ? ", " : "", std::setprecision(3), results[i].result.time_to_rest, " s (",
                              f.runs[i].label, ")");
@@ -117,18 +131,22 @@ int run_detumble_command(const DetumbleCommandOptions& o) {
   Scenario sc = load_subject(o.subject);  // the robot is loaded once: --run resolves the rest of it
   refuse_law_flags_without_contact(o, sc.keys);
   const plot::Format plot_format = plot::check_request(o.out.plot, o.out.plot_format);  // before the run
+  if (o.plan) require_detumble_planner();  // before the runs
   std::vector<DetumbleJobResult> results;
   if (o.run.empty()) {
     results.push_back(detumble(sc));
-    outputs.set("--json", detumble_json(sc, results.front(), FFSR_VERSION).dump(2) + "\n");
   } else {
     const EmbeddedUrdf embedded = builtin_urdf();
     resolve_run(sc, &embedded);
     results = detumble_runs(sc, o.run);
-    outputs.set("--json", detumble_runs_json(sc, results, FFSR_VERSION).dump(2) + "\n");
   }
+  if (o.plan) detumble_plans(sc, results);
+  outputs.set("--json", (o.run.empty() ? detumble_json(sc, results.front(), FFSR_VERSION)
+                                       : detumble_runs_json(sc, results, FFSR_VERSION))
+                                .dump(2) +
+                            "\n");
   if (!o.out.plot.empty())
-    outputs.stage(plot::draw({detumble_figure(sc, results)}, o.out.plot, plot_format));
+    outputs.stage(plot::draw({detumble_figure(sc, detail::with_plan_runs(results))}, o.out.plot, plot_format));
   if (!o.out.csv.empty()) outputs.set("--csv", detumble_series_csv(sc, results));
   outputs.write();
   for (size_t i = 0; i < results.size(); ++i) {
@@ -149,6 +167,9 @@ void register_detumble(CLI::App& app, Action& action) {
   sub->add_option("--run", o->run,
                   "Start from the capture the main job plans: plain, optimized, global or all (default: the "
                   "scenario's configuration, joints-deg)");
+  sub->add_flag("--plan", o->plan,
+               "Also plan the fastest detumble from each start (IPOPT): the plan, its controls and its re-run "
+               "by CVODE in the outputs beside the law's run");
   add_output_flags(
       *sub, o->out,
       {"Write the grasp and the post-capture run's summary as JSON to FILE",

@@ -20,6 +20,8 @@ inline void check_detumble_plan_options(const DetumblePlanOptions& po, double ho
     throw InputError(str(w, ": the tolerance must be positive and finite, got ", po.tolerance));
   if (!std::isfinite(po.optimality) || !(po.optimality > 0))
     throw InputError(str(w, ": the optimality tolerance must be positive and finite, got ", po.optimality));
+  if (std::isnan(po.max_joint_rate) || !(po.max_joint_rate > 0))
+    throw InputError(str(w, ": the largest joint rate must be positive (infinity: none), got ", po.max_joint_rate));
   if (po.max_iterations < 1) throw InputError(str(w, ": max_iterations must be >= 1, got ", po.max_iterations));
   if (!std::isfinite(horizon) || !(horizon > 0))
     throw InputError(str(w, ": the horizon must be positive and finite, got ", horizon));

@@ -3,6 +3,7 @@
 // one per run (the post_capture object), and neither job includes the other's header for it.
 #pragma once
 
+#include "ffsr/control/detumble_plan.hpp"
 #include "ffsr/control/detumble_run.hpp"
 #include "ffsr/jobs/detail/json_values.hpp"
 #include "ffsr/model/attach.hpp"
@@ -18,6 +19,13 @@
 
 namespace ffsr {
 
+/// The time-optimal plan from a run's start (`detumble --plan`: control/detumble_planner.hpp) and its
+/// re-run by CVODE under the plan's controls, then the law holding (replay_detumble_plan).
+struct DetumblePlanJob {
+  DetumblePlan plan;
+  DetumblePlanRun run;
+};
+
 /// The job's result: the grasp, the run's summary and series, the limits it ran under.
 struct DetumbleJobResult {
   std::string
@@ -30,7 +38,59 @@ struct DetumbleJobResult {
   DetumbleRunResult result;
   DetumbleSettings settings;  ///< what it ran under, as detumble_settings built them
   std::string peak_joint_name;  ///< the joint of the peak torque
+  DetumbleState start;          ///< the stack's state after the grasp, where the run starts
+  std::optional<DetumblePlanJob> plan;  ///< with `detumble --plan`
 };
+
+/// The plan's object of the detumble JSON: the solver's account, the re-run's check (its rest test at
+/// T, the largest excess over the bounds, the hold), the controls of each interval (joint torques; the
+/// actuator's force and moment in the base frame) and the states at the nodes.
+inline nlohmann::json detumble_plan_json(const DetumblePlanJob& p) {
+  using detail::vector_json;
+  const DetumblePlan& plan = p.plan;
+  const DetumblePlanRun& r = p.run;
+  nlohmann::json j{{"time_to_rest", plan.duration},
+                   {"intervals", plan.intervals()},
+                   {"solver_status", plan.status},
+                   {"iterations", plan.iterations},
+                   {"solve_seconds", plan.solve_seconds},
+                   {"constraint_violation", plan.constraint_violation},
+                   {"initial_guess_time_to_rest", plan.warm_start_duration}};
+  j["rerun"] = {{"at_rest", r.at_rest},
+                {"final_joint_rate", r.end_joint_rate},
+                {"final_relative_rate", r.end_relative_rate},
+                {"final_stack_rate", r.end_base_rate},
+                {"final_base_speed", r.end_base_speed},
+                {"worst_bound_excess", r.worst_bound_excess},
+                {"peak_joint_torque", r.peak_joint_torque},
+                {"peak_gripper_force", r.peak_gripper_force},
+                {"peak_gripper_moment", r.peak_gripper_moment},
+                {"momentum_drift", r.momentum_drift},
+                {"dwell_peak_rate", r.dwell_peak_rate},
+                {"dwell_at_rest", r.dwell_at_rest}};
+  nlohmann::json controls = nlohmann::json::array(), nodes = nlohmann::json::array();
+  const double h = plan.interval();
+  for (int k = 0; k < plan.intervals(); ++k) {
+    const auto i = static_cast<size_t>(k);
+    controls.push_back({{"t", k * h},
+                        {"tau", vector_json(plan.tau[i])},
+                        {"base_force", vector_json(Eigen::VectorXd(plan.base_wrench[i].head<3>()))},
+                        {"base_moment", vector_json(Eigen::VectorXd(plan.base_wrench[i].tail<3>()))}});
+  }
+  for (int k = 0; k <= plan.intervals(); ++k) {
+    const DetumbleState& x = plan.nodes[static_cast<size_t>(k)];
+    const Quaternion q = x.base.orientation;
+    nodes.push_back({{"t", k * h},
+                     {"theta", vector_json(x.theta)},
+                     {"v", vector_json(x.v)},
+                     {"base_position", vector_json(Eigen::VectorXd(x.base.position))},
+                     {"base_quaternion_wxyz", {q.w(), q.x(), q.y(), q.z()}},
+                     {"wheel_momentum", vector_json(Eigen::VectorXd(x.wheel_momentum))}});
+  }
+  j["controls"] = std::move(controls);
+  j["nodes"] = std::move(nodes);
+  return j;
+}
 
 /// The grasped target as attached at the gripper (grasp.attachment of the JSON): the gripper frame's
 /// name, the target's mass and inertia (its own axes), the pose of its centre-of-mass frame in the
@@ -110,6 +170,7 @@ inline nlohmann::json detumble_json(const Model& model, int gripper,
   j["dwell_peak_rate"] = r.dwell_peak_rate;
   j["dwell_at_rest"] = r.dwell_at_rest;
   j["ticks"] = r.ticks;
+  if (d.plan) j["plan"] = detumble_plan_json(*d.plan);
   return j;
 }
 
