@@ -77,6 +77,7 @@ void operator delete[](void* p, std::size_t) noexcept { operator delete(p); }
 
 #include "ffsr/control/capture_controller.hpp"
 #include "ffsr/control/detumble_controller.hpp"
+#include "ffsr/control/detumble_tracker.hpp"
 #include "ffsr/model/attach.hpp"
 #include "ffsr/parsers/urdf.hpp"
 #include "ffsr/scenario/scenario.hpp"
@@ -205,6 +206,48 @@ TEST_CASE("detumble controller: 1e5 ticks allocate nothing (7-DOF stack, each ac
   CHECK(g_news.load() - n0 == 0);
   CHECK(g_deletes.load() - d0 == 0);
   CHECK(sum > 0);
+}
+
+TEST_CASE("detumble plan tracker: 1e5 ticks allocate nothing (7-DOF stack, thrusters, gripper limits)") {
+  const Model robot = model_from_urdf_file(kRobots + "paper_7dof.urdf");
+  AttachedBody body;
+  body.mass = 200;
+  body.inertia = Vector3(100, 80, 120).asDiagonal();
+  body.pose.p = Vector3(0.3, -0.1, 0.2);
+  const Model stack = attach_body(robot, "ee", body);
+  DetumbleLimits lim;
+  lim.joint_torque = Eigen::VectorXd::Constant(7, 5.0);
+  lim.actuator = BaseActuator::Thrusters;
+  lim.thruster_force = 2;
+  lim.thruster_torque = 0.2;
+  lim.gripper_force = 20;
+  lim.gripper_moment = 10;
+  DetumbleOptions opt;
+  opt.stop_stack_spin = true;
+  // a plan of 20 intervals of 0.05 s through the state the ticks measure (tracked: within its band)
+  DetumbleState st{BasePose{}, Eigen::VectorXd::Constant(7, 0.4), Eigen::VectorXd::Constant(13, 0.05),
+                   Vector3::Zero()};
+  DetumblePlan plan;
+  plan.duration = 1.0;
+  plan.nodes.assign(21, st);
+  plan.tau.assign(20, Eigen::VectorXd::Constant(7, 0.5));
+  plan.base_wrench.assign(20, (Vector6() << 0.5, 0, 0, 0, 0.05, 0).finished());
+  DetumblePlanTracker tracker(stack, stack.frame_index("ee"), body, plan, lim, opt, 0.01);
+  DetumbleCommand cmd = tracker.make_command();
+  long faults = 0, tracking = 0;
+  const long n0 = g_news.load(), d0 = g_deletes.load();
+  for (long k = 0; k < 100000; ++k) {
+    for (Eigen::Index j = 0; j < 7; ++j) st.theta(j) = 0.4 + 0.05 * std::sin(1e-3 * static_cast<double>(k + j));
+    st.v(8) = (k % 1000 == 999) ? std::nan("") : 0.05;
+    tracker.step(st, 0.01 * static_cast<double>(k % 100), cmd);
+    faults += cmd.status == DetumbleStatus::Fault;
+    tracking += cmd.tracking;
+  }
+  CHECK(g_news.load() - n0 == 0);
+  CHECK(g_deletes.load() - d0 == 0);
+  CHECK(faults == 100);
+  CHECK(tracking > 50000);
+  CHECK(!tracker.fell_back());
 }
 
 TEST_CASE("controller: the counters see new and Eigen's allocations (control)") {

@@ -166,6 +166,7 @@ struct DetumbleCommand {
   double stack_rate = 0;                  ///< |angular velocity of the base|
   DetumbleStatus status = DetumbleStatus::Braking;
   DetumbleFault fault = DetumbleFault::None;
+  bool tracking = false;  ///< the plan's command acted (DetumblePlanTracker), not the law's
 };
 
 namespace detail {
@@ -263,7 +264,8 @@ class DetumbleController {
         hb_(6, stack.n()),
         hstar_(stack.n(), stack.n()),
         inv_(stack.n(), stack.n()),
-        llt_m_(stack.n()) {
+        llt_m_(stack.n()),
+        full_llt_(stack.nv()) {
     detail::check_detumble(stack, limits, options, "DetumbleController");
     if (!std::isfinite(tick) || !(tick > 0))
       throw InputError(detail::str("DetumbleController: the tick must be positive and finite, got ", tick));
@@ -288,6 +290,26 @@ class DetumbleController {
   /// The largest decay rate the law asks of the joint rates: max_decay, at most
   /// kDetumbleTickFraction / tick.
   double decay_cap() const noexcept { return decay_cap_; }
+
+  /// The stack's mass matrix H (6 + n) at the last step's state (CRBA; valid after a step without fault).
+  const Eigen::MatrixXd& mass_matrix() const noexcept { return data_.H; }
+
+  /// The gripper's load under the command c at the state s of the last step (its H and velocity terms):
+  /// the accelerations of H vd = [base wrench; tau] - C, then the attached body's Newton-Euler equation;
+  /// the force on the target (N) and the moment about the contact point (N m). Never allocates.
+  void gripper_load(const DetumbleState& s, const DetumbleCommand& c, Vector3& force, Vector3& moment) noexcept {
+    const int n = model_->n();
+    full_llt_.compute(data_.H);
+    vdt_.head<6>() = c.base_wrench - c_.head<6>();
+    vdt_.tail(n) = c.tau - c_.tail(n);
+    full_llt_.solveInPlace(vdt_);
+    const auto e = static_cast<size_t>(body_index_);
+    rnea(*model_, data_, s.base, s.theta, s.v, vdt_);
+    const Vector6 A = data_.A[e], V = data_.V[e];
+    const Vector6 w = target_ * A + cross_force(V, target_ * V);
+    force = w.head<3>();
+    moment = w.tail<3>() - r_gripper_.cross(force);
+  }
 
   /// A command sized for this controller (allocates: make it once).
   DetumbleCommand make_command() const {
@@ -511,6 +533,7 @@ class DetumbleController {
   Eigen::Matrix<double, 6, Eigen::Dynamic> hb_;
   Eigen::MatrixXd hstar_, inv_;
   Eigen::LLT<Eigen::MatrixXd> llt_m_;
+  Eigen::LLT<Eigen::MatrixXd> full_llt_;  ///< of H, for gripper_load
 };
 
 }  // namespace ffsr

@@ -60,7 +60,7 @@ struct DetumblePlanOptions {
 
 /// The plan ends within this fraction of the rest rate (every joint rate, and the rest test's norms):
 /// at rest by the rest test with room for the re-run's integration error.
-inline constexpr double kDetumblePlanRestMargin = 0.75;
+inline constexpr double kDetumblePlanRestMargin = 0.6;
 
 namespace detail {
 

@@ -67,17 +67,15 @@ inline DetumbleSample detumble_sample(DetumbleSystem& sys, const Eigen::VectorXd
 
 }  // namespace detail
 
-inline DetumbleRunResult run_detumble(const Model& stack, int gripper, const AttachedBody& body,
-                                      const DetumbleState& start, const DetumbleLimits& limits,
-                                      const DetumbleOptions& options, const DetumbleRunOptions& run) {
-  detail::check_detumble_run(stack, gripper, body, start, run);
-  const bool none = limits.actuator == BaseActuator::None;  // no actuator: say so before the limits' checks
-  if (none) check_detumble_feasible(stack, start, limits, options, run.horizon);
-  detail::check_detumble(stack, limits, options, "run_detumble");
-  if (!none) check_detumble_feasible(stack, start, limits, options, run.horizon);
-  check_detumble_tick(stack, gripper, start, run.tick);
-  DetumbleController ctrl(stack, gripper, body, limits, options, run.tick);
-  DetumbleCommand cmd = ctrl.make_command();
+namespace detail {
+
+/// The run of run_detumble with the command of `step(state, t, command)` at each tick (the law's, or
+/// a plan tracker's); `cmd` sized for the stack.
+template <class Step>
+DetumbleRunResult run_detumble_loop(const Model& stack, int gripper, const AttachedBody& body,
+                                    const DetumbleState& start, const DetumbleLimits& limits,
+                                    const DetumbleOptions& options, const DetumbleRunOptions& run,
+                                    DetumbleCommand cmd, Step&& step) {
   detail::DetumbleSystem sys(stack), probe(stack);
   const bool wheels = limits.actuator == BaseActuator::ReactionWheels && options.stop_stack_spin;
   const bool closed = limits.actuator == BaseActuator::None || !options.stop_stack_spin;
@@ -100,7 +98,7 @@ inline DetumbleRunResult run_detumble(const Model& stack, int gripper, const Att
   double T_prev = res.energy_start;
   for (long k = 0;; ++k) {
     const double t = static_cast<double>(k) * run.tick;
-    ctrl.step(sys.unpack(y), cmd);
+    step(sys.unpack(y), t, cmd);
     if (cmd.status == DetumbleStatus::Fault)
       throw NumericalError(
           detail::str("run_detumble: the controller faulted (", fault_name(cmd.fault), ") at t = ", t, " s"));
@@ -141,6 +139,22 @@ inline DetumbleRunResult run_detumble(const Model& stack, int gripper, const Att
     }
   }
   return res;
+}
+
+}  // namespace detail
+
+inline DetumbleRunResult run_detumble(const Model& stack, int gripper, const AttachedBody& body,
+                                      const DetumbleState& start, const DetumbleLimits& limits,
+                                      const DetumbleOptions& options, const DetumbleRunOptions& run) {
+  detail::check_detumble_run(stack, gripper, body, start, run);
+  const bool none = limits.actuator == BaseActuator::None;  // no actuator: say so before the limits' checks
+  if (none) check_detumble_feasible(stack, start, limits, options, run.horizon);
+  detail::check_detumble(stack, limits, options, "run_detumble");
+  if (!none) check_detumble_feasible(stack, start, limits, options, run.horizon);
+  check_detumble_tick(stack, gripper, start, run.tick);
+  DetumbleController ctrl(stack, gripper, body, limits, options, run.tick);
+  return detail::run_detumble_loop(stack, gripper, body, start, limits, options, run, ctrl.make_command(),
+                                   [&](const DetumbleState& s, double, DetumbleCommand& c) { ctrl.step(s, c); });
 }
 
 }  // namespace ffsr
