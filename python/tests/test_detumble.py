@@ -241,6 +241,26 @@ def test_detumble_series_equals_the_command(tmp_path):
     assert ffsr.Scenario.load(str(scenario)).detumble(run="optimized").series_csv() == out.read_text()
 
 
+def test_detumble_plan_equals_the_command(tmp_path):
+    """Scenario.detumble(plan=True) is `detumble --plan`: the plan's time, its re-run at rest within the
+    limits, and its rows in series_csv() beside the law's."""
+    scenario = ROBOTS / "paper_7dof_detumble.toml"
+    expected = command_json(tmp_path, scenario, "--plan", subcommand="detumble")
+    result = ffsr.Scenario.load(str(scenario)).detumble(plan=True)
+    plan = result.to_dict()["plan"]
+    assert result.plan_time_to_rest == pytest.approx(expected["plan"]["time_to_rest"], rel=1e-9)
+    assert result.plan_time_to_rest < result.time_to_rest
+    assert plan["solver_status"] == "Solve_Succeeded"
+    assert plan["rerun"]["at_rest"] and plan["rerun"]["dwell_at_rest"]
+    assert plan["rerun"]["worst_bound_excess"] <= 1e-9
+    limits = np.array(plan and result.to_dict()["parameters"]["joint_torque_limit"])
+    taus = np.array([c["tau"] for c in plan["controls"]])
+    assert np.all(np.abs(taus) <= limits)
+    runs = {line.split(",", 1)[0] for line in result.series_csv().splitlines()[1:]}
+    assert runs == {"law", "plan"}
+    assert ffsr.Scenario.load(str(scenario)).detumble().plan_time_to_rest is None
+
+
 def test_detumble_keys_from_python_name_the_bound_too_small():
     """Scenario.detumble with the Detumble keys as keywords: the key of the bound that is too small,
     numbers as written (0.05, not 0.050000000000000003), no NaN accepted; a value Scenario.load refuses

@@ -119,8 +119,8 @@ plot::Figure detumble_figure(const Scenario& sc, const std::vector<DetumbleJobRe
   } else {
     f.title = first.run == "law" ? "After the capture: at rest in " : "After each run's capture: at rest in ";
     for (size_t i = 0; i < results.size(); ++i)
-      f.title += detail::str(i ? ", " : "", std::setprecision(3), results[i].result.time_to_rest, " s (",
-                             f.runs[i].label, ")");
+      f.title += std::string(i ? ", " : "") + detail::str(std::setprecision(3), results[i].result.time_to_rest) +
+                 " s (" + f.runs[i].label + ")";
   }
   return figures::detumble(f);
 }
