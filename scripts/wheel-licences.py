@@ -13,7 +13,8 @@ import subprocess
 import sys
 import zipfile
 
-LIB_DIRS = ("/usr/lib/x86_64-linux-gnu", "/lib/x86_64-linux-gnu", "/usr/lib", "/lib")
+LIB_DIRS = ("/usr/lib/x86_64-linux-gnu", "/lib/x86_64-linux-gnu", "/usr/lib", "/lib",
+            "/usr/lib/x86_64-linux-gnu/openblas-pthread")  # OpenBLAS, the BLAS of IPOPT's MUMPS
 
 
 def fail(message: str) -> None:
@@ -21,10 +22,11 @@ def fail(message: str) -> None:
 
 
 def original_name(grafted: str) -> str:
-    """auditwheel names a copied library <stem>-<8 hex digits of its hash>.so...: the stem and suffix."""
-    m = re.fullmatch(r"(.+)-[0-9a-f]{8}(\.so.*)", grafted)
+    """auditwheel names a copied library <stem>-<8 hex digits of its hash><rest>, the stem the name up to
+    its first dot (libblas.so.3: libblas-<hash>.so.3; libdmumps_seq-5.5.0.so: libdmumps_seq-5-<hash>.5.0.so)."""
+    m = re.fullmatch(r"(.+)-[0-9a-f]{8}(\..*)", grafted)
     if not m:
-        fail(f"ffsr.libs/{grafted}: not a name auditwheel gives (<name>-<hash>.so...)")
+        fail(f"ffsr.libs/{grafted}: not a name auditwheel gives (<name>-<hash>.<rest>)")
     return m.group(1) + m.group(2)
 
 
