@@ -292,35 +292,30 @@ class DetumblePlanNlp : public Ipopt::TNLP {
       w.sys.rhs(y, w.cmd, wheels_, yd);
     };
     for (int j = 0; j < S_; ++j) {
-      f(w.y, w.k1);
-      w.tmp = w.y + 0.5 * dt * w.k1;
-      f(w.tmp, w.k2);
-      w.tmp = w.y + 0.5 * dt * w.k2;
-      f(w.tmp, w.k3);
-      w.tmp = w.y + dt * w.k3;
-      f(w.tmp, w.k4);
-      w.y += dt / 6 * (w.k1 + 2 * w.k2 + 2 * w.k3 + w.k4);
-      w.y.segment<4>(3).normalize();
+      rk4_step(w, dt, f);
       grip(w.y);
     }
     out.head(ny_) = w.y;
   }
 
+  /// One RK4 step of w.y over dt with the right-hand side f(y, ydot), the quaternion kept unit.
+  template <class Rhs>
+  static void rk4_step(Work& w, double dt, const Rhs& f) {
+    f(w.y, w.k1);
+    w.tmp = w.y + 0.5 * dt * w.k1;
+    f(w.tmp, w.k2);
+    w.tmp = w.y + 0.5 * dt * w.k2;
+    f(w.tmp, w.k3);
+    w.tmp = w.y + dt * w.k3;
+    f(w.tmp, w.k4);
+    w.y += dt / 6 * (w.k1 + 2 * w.k2 + 2 * w.k3 + w.k4);
+    w.y.segment<4>(3).normalize();
+  }
+
   /// One RK4 tick of the feedback law's command (held, inertial), for the initial guess.
   void step_held(Work& w, const DetumbleCommand& c, double dt, int substeps) const {
     const auto f = [&](const Eigen::VectorXd& y, Eigen::VectorXd& yd) { w.sys.rhs(y, c, wheels_, yd); };
-    const double d = dt / substeps;
-    for (int j = 0; j < substeps; ++j) {
-      f(w.y, w.k1);
-      w.tmp = w.y + 0.5 * d * w.k1;
-      f(w.tmp, w.k2);
-      w.tmp = w.y + 0.5 * d * w.k2;
-      f(w.tmp, w.k3);
-      w.tmp = w.y + d * w.k3;
-      f(w.tmp, w.k4);
-      w.y += d / 6 * (w.k1 + 2 * w.k2 + 2 * w.k3 + w.k4);
-      w.y.segment<4>(3).normalize();
-    }
+    for (int j = 0; j < substeps; ++j) rk4_step(w, dt / substeps, f);
   }
 
   Work& work0() { return work_.front(); }
