@@ -1,0 +1,95 @@
+// Proves the platform layer's checks fire, on every target: each mode does one forbidden thing and the
+// runner (scripts/onboard.sh) expects the matching exit status and message.
+//
+//   platform_test ok        allocate (malloc, new, std::vector) before the lock only  -> 0
+//   platform_test malloc    malloc after ffsr_heap_lock()                           -> 90
+//   platform_test new       std::vector growth (operator new) after the lock         -> 90
+//   platform_test stdio     first printf on a stream without a buffer, after the lock -> 90 (newlib, glibc
+//                           static); 0 where the C library's own calls are not seen (host, shared libc)
+//   platform_test throw     std::vector::at out of range (would throw)               -> 92 on the M7;
+//                           on Linux libstdc++ throws, and allocating the exception object trips the
+//                           heap guard (90; unlocked, it would end in std::terminate)
+//   platform_test fault     a faulting instruction                                   -> 91 on the M7; a
+//                           signal on Linux
+//   platform_test count     a loop of exactly 200000 instructions timed with ffsr_cycles() -> 0; on the
+//                           M7 the printed count must be 200000 to within SysTick's 40-instruction tick
+//                           (QEMU implements no DWT: its CYCCNT reads 0)
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <vector>
+
+#include "ffsr_platform.h"
+#include "heap_guard.h"
+
+namespace {
+
+// Opaque to the optimiser, so that allocations and out-of-range indices are not folded away.
+volatile std::size_t opaque_size = 64;
+
+int run(const char* mode) {
+  std::vector<double> before(opaque_size, 1.0);
+  void* block = std::malloc(opaque_size);
+  std::printf("mode %s: %lu allocations before the lock\n", mode, ffsr_heap_allocations());
+  std::fflush(stdout);
+  ffsr_heap_lock();
+
+  if (std::strcmp(mode, "ok") == 0) {
+    std::free(block);  // free stays allowed
+    return before.size() == opaque_size ? 0 : 1;
+  }
+  if (std::strcmp(mode, "malloc") == 0) {
+    void* late = std::malloc(opaque_size);
+    std::printf("not trapped: %p\n", late);
+    return 1;
+  }
+  if (std::strcmp(mode, "new") == 0) {
+    before.push_back(2.0);  // the vector is full: it reallocates through operator new
+    std::printf("not trapped: %zu\n", before.size());
+    return 1;
+  }
+  if (std::strcmp(mode, "stdio") == 0) {
+    // A stream never used before: its buffer is allocated on this first use.
+    static const char path[] = "platform_test_stdio.txt";
+    std::FILE* file = std::fopen(path, "w");
+    if (file == nullptr) return 1;
+    std::fprintf(file, "%d\n", 42);
+    std::fclose(file);
+    std::remove(path);
+    std::printf("not trapped (the C library's own allocations are not wrapped here)\n");
+    return 0;
+  }
+  if (std::strcmp(mode, "throw") == 0) {
+    const double value = before.at(opaque_size + 1);
+    std::printf("not trapped: %g\n", value);
+    return 1;
+  }
+  if (std::strcmp(mode, "count") == 0) {
+#if defined(__arm__) && defined(__thumb2__)
+    const std::uint64_t start = ffsr_cycles();
+    // 100000 iterations of two instructions (movw/movt set 100000 = 0x186a0).
+    __asm__ volatile("movw r0, #0x86a0\n movt r0, #1\n 1: subs r0, r0, #1\n bne 1b\n" ::: "r0", "cc");
+    const std::uint64_t spent = ffsr_cycles() - start;
+    std::printf("200000 instructions counted as %lu %s\n", static_cast<unsigned long>(spent), ffsr_cycles_unit());
+#else
+    std::printf("count: only meaningful on the Cortex-M7 (here %s)\n", ffsr_cycles_unit());
+#endif
+    return 0;
+  }
+  if (std::strcmp(mode, "fault") == 0) {
+    __builtin_trap();  // UDF on Arm (UsageFault, escalated to HardFault); SIGILL/SIGTRAP on Linux
+  }
+  std::fprintf(stderr, "platform_test: unknown mode %s\n", mode);
+  return 1;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 2) {
+    std::fprintf(stderr, "usage: platform_test ok|malloc|new|stdio|throw|fault|count\n");
+    return 1;
+  }
+  return run(argv[1]);
+}
