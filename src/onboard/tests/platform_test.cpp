@@ -14,6 +14,10 @@
 //   platform_test count     a loop of exactly 200000 instructions timed with ffsr_cycles() -> 0; on the
 //                           M7 the printed count must be 200000 to within SysTick's 40-instruction tick
 //                           (QEMU implements no DWT: its CYCCNT reads 0)
+//   platform_test libm FILE writes x, sin x, cos x, atan2(x, 0.7), sqrt|x|, exp(x/8) for 4096 x in
+//                           [-8, 8) to FILE (the example's format) -> 0; scripts/onboard-compare.py then
+//                           shows which functions of the C libraries (glibc, newlib) round differently
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -86,9 +90,29 @@ int run(const char* mode) {
 
 }  // namespace
 
+// The C library's functions on a grid, in the example's file format (onboard_example.c).
+int write_libm(const char* path) {
+  std::FILE* file = std::fopen(path, "wb");
+  if (file == nullptr) return 1;
+  constexpr std::uint32_t kPoints = 4096;
+  constexpr std::uint32_t kValues = 6;
+  const unsigned char header[16] = {'F', 'F', 'S', 'R', 'O', 'N', 'B', '1', kValues, 0, 0, 0,
+                                    kPoints & 0xFF, kPoints >> 8, 0, 0};
+  bool ok = std::fwrite(header, 1, sizeof header, file) == sizeof header;
+  for (std::uint32_t i = 0; i < kPoints && ok; ++i) {
+    // Not a multiple of a simple fraction: the arguments are not special cases of the algorithms.
+    const double x = -8.0 + 16.0 * (i + 0.318309886) / kPoints;
+    const double record[kValues] = {x, std::sin(x), std::cos(x), std::atan2(x, 0.7), std::sqrt(std::fabs(x)),
+                                    std::exp(x / 8.0)};
+    ok = std::fwrite(record, sizeof record, 1, file) == 1;
+  }
+  return (std::fclose(file) == 0 && ok) ? 0 : 1;
+}
+
 int main(int argc, char** argv) {
+  if (argc == 3 && std::strcmp(argv[1], "libm") == 0) return write_libm(argv[2]);
   if (argc < 2) {
-    std::fprintf(stderr, "usage: platform_test ok|malloc|new|stdio|throw|fault|count\n");
+    std::fprintf(stderr, "usage: platform_test ok|malloc|new|stdio|throw|fault|count | libm FILE\n");
     return 1;
   }
   return run(argv[1]);
