@@ -138,6 +138,7 @@ run_platform_tests() {
   if [ "$target" = m7 ]; then
     expect "$target" throw 92 "C++ error: out_of_range"
     expect "$target" fault 91 "ffsr: fault"
+    expect "$target" oom 93 "out of memory"
   else
     expect "$target" throw nonzero
     expect "$target" fault nonzero

@@ -33,8 +33,8 @@ set(CMAKE_EXE_LINKER_FLAGS_INIT "${FFSR_M7_ARCH_FLAGS} --specs=nano.specs --spec
 #                   -icount shift=0 -kernel <elf>
 # because a program's own arguments cannot follow -kernel <elf>: they go into the semihosting
 # configuration (arg=<program>,arg=<first>,...), where the startup code reads them back with
-# SYS_GET_CMDLINE. target=native: QEMU serves the requests itself (not a gdb). The wrapper also turns
-# a missing exit marker into a failure (see qemu-run.sh).
+# SYS_GET_CMDLINE. target=native: QEMU serves the requests itself (not a gdb). QEMU's exit status is the
+# program's (SYS_EXIT_EXTENDED). -icount shift=0 makes ffsr_cycles() count instructions.
 find_program(FFSR_QEMU_SYSTEM_ARM qemu-system-arm REQUIRED)
 set(CMAKE_CROSSCOMPILING_EMULATOR
     ${CMAKE_CURRENT_LIST_DIR}/../../src/onboard/platform/cortex_m7/qemu-run.sh)

@@ -14,6 +14,8 @@
 //   platform_test count     a loop of exactly 200000 instructions timed with ffsr_cycles() -> 0; on the
 //                           M7 the printed count must be 200000 to within SysTick's 40-instruction tick
 //                           (QEMU implements no DWT: its CYCCNT reads 0)
+//   platform_test oom       (M7) operator new until the fixed heap is exhausted          -> 93; Linux: 0,
+//                           not run (its heap has no fixed bound)
 //   platform_test libm FILE writes x, sin x, cos x, atan2(x, 0.7), sqrt|x|, exp(x/8) for 4096 x in
 //                           [-8, 8) to FILE (the example's format) -> 0; scripts/onboard-compare.py then
 //                           shows which functions of the C libraries (glibc, newlib) round differently
@@ -111,6 +113,20 @@ int write_libm(const char* path) {
 
 int main(int argc, char** argv) {
   if (argc == 3 && std::strcmp(argv[1], "libm") == 0) return write_libm(argv[2]);
+  if (argc == 2 && std::strcmp(argv[1], "oom") == 0) {
+#if defined(__arm__)
+    // 64 KiB blocks, never freed: _sbrk refuses to pass the linker script's heap, malloc returns null,
+    // operator new ends the program (no_throw.cpp) instead of throwing.
+    for (unsigned long blocks = 1;; ++blocks) {
+      volatile char* block = new char[65536];
+      block[0] = 1;
+      if (blocks % 4 == 0) std::printf("%lu KiB allocated\n", blocks * 64);
+    }
+#else
+    std::printf("oom: only run on the Cortex-M7\n");
+    return 0;
+#endif
+  }
   if (argc < 2) {
     std::fprintf(stderr, "usage: platform_test ok|malloc|new|stdio|throw|fault|count | libm FILE\n");
     return 1;

@@ -13,10 +13,13 @@ void ffsr_platform_fatal(const char *message, int status) {
   ffsr_semihost_exit(status);
 }
 
+/* The linker script's symbols are distinct objects to C: comparing or subtracting pointers to them is
+ * undefined, so the bounds are compared as integers. */
 size_t ffsr_stack_high_water(void) {
+  const uintptr_t top = (uintptr_t)__stack_top;
   const uint32_t *word = __stack_bottom;
-  while (word < __stack_top && *word == FFSR_M7_STACK_PAINT) ++word;
-  return (size_t)((const char *)__stack_top - (const char *)word);
+  while ((uintptr_t)word < top && *word == FFSR_M7_STACK_PAINT) ++word;
+  return (size_t)(top - (uintptr_t)word);
 }
 
 /* A leaf with no frame of its own at -O2: the painting stops at the caller's stack pointer. */
@@ -24,10 +27,10 @@ void ffsr_stack_paint(void) {
   uint32_t *word;
   uint32_t *stack_pointer;
   __asm__ volatile("mov %0, sp" : "=r"(stack_pointer));
-  for (word = __stack_bottom; word < stack_pointer; ++word) *word = FFSR_M7_STACK_PAINT;
+  for (word = __stack_bottom; (uintptr_t)word < (uintptr_t)stack_pointer; ++word) *word = FFSR_M7_STACK_PAINT;
 }
 
-size_t ffsr_stack_size(void) { return (size_t)((const char *)__stack_top - (const char *)__stack_bottom); }
+size_t ffsr_stack_size(void) { return (size_t)((uintptr_t)__stack_top - (uintptr_t)__stack_bottom); }
 
 /* SysTick (ARMv7-M system timer) and the SCB's interrupt control register. */
 #define SYST_CSR (*(volatile uint32_t *)0xE000E010u)

@@ -3,7 +3,8 @@
 #
 # The program's arguments travel in the semihosting configuration (arg=...; the startup code reads
 # them with SYS_GET_CMDLINE), its files are opened by QEMU relative to the current directory, and QEMU's
-# exit status is the program's (the startup code exits with SYS_EXIT_EXTENDED). -icount shift=0: one
+# exit status is the program's (the startup code exits with SYS_EXIT_EXTENDED, which QEMU 7.2 honours
+# on 32-bit Arm: checked with statuses 0, 1, 90, 91, 92, 94). -icount shift=0: one
 # virtual nanosecond per instruction, so that ffsr_cycles() counts instructions; it also makes the run
 # deterministic. Arguments cannot contain spaces or commas (QEMU's option syntax).
 # Set FFSR_QEMU_TIMEOUT (seconds, default 600) to bound a run that hangs.

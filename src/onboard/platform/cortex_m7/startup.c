@@ -98,10 +98,12 @@ void ffsr_start(void) {
    * this function's frame). Memory is written only below the stack pointer by pushes and frames, so a
    * word that no longer holds the pattern has been used. */
   __asm__ volatile("mov %0, sp" : "=r"(stack_pointer));
-  for (word = __stack_bottom; word < stack_pointer; ++word) *word = FFSR_M7_STACK_PAINT;
+  /* (The linker script's symbols are distinct objects to C: bounds are compared as integers.) */
+  for (word = __stack_bottom; (uintptr_t)word < (uintptr_t)stack_pointer; ++word) *word = FFSR_M7_STACK_PAINT;
 
-  for (word = __data_start, source = __data_load; word < __data_end; ++word, ++source) *word = *source;
-  for (word = __bss_start__; word < __bss_end__; ++word) *word = 0u;
+  for (word = __data_start, source = __data_load; (uintptr_t)word < (uintptr_t)__data_end; ++word, ++source)
+    *word = *source;
+  for (word = __bss_start__; (uintptr_t)word < (uintptr_t)__bss_end__; ++word) *word = 0u;
 
   ffsr_m7_counter_start();
   initialise_monitor_handles(); /* librdimon: stdin/stdout/stderr as semihosting handles */
@@ -118,6 +120,10 @@ void ffsr_start(void) {
 void _init(void) {}
 void _fini(void) {}
 
+/* The handle that C++ registers static destructors under (__cxa_atexit); crtbegin.o defines it and is
+ * left out with -nostartfiles. One image, no shared objects: any unique address does. */
+void *__dso_handle = &__dso_handle;
+
 /* The end of every exit path: QEMU's exit status is `status`. */
 void _exit(int status) { ffsr_semihost_exit(status); }
 
@@ -126,15 +132,17 @@ void abort(void) { ffsr_platform_fatal("abort() called", FFSR_EXIT_ABORT); }
 /* The heap is the linker script's fixed region [__heap_start, __heap_end): malloc fails cleanly (NULL,
  * ENOMEM) when it is exhausted instead of growing into the stack or past the end of the RAM. */
 void *_sbrk(ptrdiff_t increment) {
-  static char *program_break = __heap_start;
-  char *const previous = program_break;
-  if (increment < 0 ? program_break + increment < __heap_start
-                    : __heap_end - program_break < increment) {
+  static uintptr_t program_break;
+  const uintptr_t start = (uintptr_t)__heap_start, end = (uintptr_t)__heap_end;
+  uintptr_t previous;
+  if (program_break == 0u) program_break = start;
+  previous = program_break;
+  if (increment < 0 ? previous - start < (uintptr_t)-increment : end - previous < (uintptr_t)increment) {
     errno = ENOMEM;
     return (void *)-1;
   }
-  program_break += increment;
-  return previous;
+  program_break = previous + (uintptr_t)increment;
+  return (void *)previous;
 }
 
 /* Which stack the exception frame was pushed on (EXC_RETURN bit 2) tells where to read the faulting
