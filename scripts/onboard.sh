@@ -61,6 +61,23 @@ run_on() {
   )
 }
 
+# The tools a target needs (Debian 12: cmake ninja-build python3 qemu-user qemu-system-arm
+# g++-12-aarch64-linux-gnu gcc-arm-none-eabi libstdc++-arm-none-eabi-newlib libnewlib-arm-none-eabi
+# libeigen3-dev).
+check_tools() {
+  local tools=(cmake ninja python3 timeout) missing=()
+  case $1 in
+    host) tools+=(gcc g++) ;;
+    aarch64) tools+=(aarch64-linux-gnu-gcc-12 aarch64-linux-gnu-g++-12 qemu-aarch64) ;;
+    m7) tools+=(arm-none-eabi-gcc arm-none-eabi-g++ arm-none-eabi-nm arm-none-eabi-size qemu-system-arm) ;;
+  esac
+  for tool in "${tools[@]}"; do command -v "$tool" >/dev/null || missing+=("$tool"); done
+  if [ ${#missing[@]} -ne 0 ]; then
+    fail "$1: missing ${missing[*]}"
+    return 1
+  fi
+}
+
 build() {
   local target=$1 toolchain dir=$build_root/$1
   toolchain=$(toolchain_of "$target") || return 1
@@ -103,7 +120,7 @@ run_example() {
   status=$?
   end=$(date +%s.%N)
   sed 's/^/   /' "$dir/onboard_example.log"
-  printf '   run time (%s, 10^4 steps, wall): %.2f s\n' "$target" "$(echo "$end - $start" | bc)"
+  awk -v t="$target" -v s="$start" -v e="$end" 'BEGIN { printf "   run time (%s, 10^4 steps, wall): %.2f s\n", t, e - s }'
   if [ $status -ne 0 ]; then
     fail "$target: onboard_example exited with $status"
   elif [ ! -s "$dir/onboard_output.bin" ]; then
@@ -181,7 +198,7 @@ compare_outputs() {
 
 for target in "${targets[@]}"; do
   mkdir -p "$build_root"
-  if ! build "$target"; then continue; fi
+  if ! check_tools "$target" || ! build "$target"; then continue; fi
   check_include_paths "$target"
   run_example "$target"
   run_platform_tests "$target"
