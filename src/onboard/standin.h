@@ -9,6 +9,10 @@
 
 #ifdef __cplusplus
 extern "C" {
+/* The step's promise not to throw is part of its C++ declaration (and must match the definition). */
+#define FFSR_STANDIN_NOEXCEPT noexcept
+#else
+#define FFSR_STANDIN_NOEXCEPT
 #endif
 
 #define FFSR_STANDIN_OUTPUTS 16
@@ -23,7 +27,7 @@ typedef struct ffsr_standin_output {
 ffsr_standin *ffsr_standin_init(void);
 
 /* One tick; 0 on success. Allocation-free. */
-int ffsr_standin_step(ffsr_standin *handle, ffsr_standin_output *output);
+int ffsr_standin_step(ffsr_standin *handle, ffsr_standin_output *output) FFSR_STANDIN_NOEXCEPT;
 
 void ffsr_standin_free(ffsr_standin *handle);
 
