@@ -58,9 +58,17 @@ def ordered(bits):
     return bits if bits >= 0 else -(bits & 0x7FFFFFFFFFFFFFFF)
 
 
-def compare(reference, other, rel_tol, abs_tol):
+def record_scales(reference, skip):
+    """The largest |value| of each record of the reference, its first `skip` values (labels) left out."""
+    n = reference.doubles
+    return [max((abs(v) for v in reference.values[r * n + skip:(r + 1) * n]), default=0.0)
+            for r in range(reference.records)]
+
+
+def compare(reference, other, rel_tol, abs_tol, record_rel=0.0, skip=0):
     """Returns a dict of statistics of `other` against `reference`."""
-    stats = {"differing": 0, "first": None, "max_ulps": 0, "max_ulps_at": None, "max_abs": 0.0,
+    scales = record_scales(reference, skip) if record_rel > 0 else None
+    stats = {"max_record_rel": 0.0, "max_record_rel_at": None, "differing": 0, "first": None, "max_ulps": 0, "max_ulps_at": None, "max_abs": 0.0,
              "max_abs_at": None, "max_rel": 0.0, "max_rel_at": None, "beyond_tolerance": 0, "nan_mismatch": 0,
              "by_index": [0] * reference.doubles}
     n = reference.doubles
@@ -87,7 +95,13 @@ def compare(reference, other, rel_tol, abs_tol):
             stats["max_abs"], stats["max_abs_at"] = difference, at
         if relative > stats["max_rel"]:
             stats["max_rel"], stats["max_rel_at"] = relative, at
-        if not math.isclose(a, b, rel_tol=rel_tol, abs_tol=abs_tol):
+        record_bound = 0.0
+        if scales is not None and scales[at[0]] > 0:
+            record_relative = difference / scales[at[0]]
+            record_bound = record_rel * scales[at[0]]
+            if record_relative > stats["max_record_rel"]:
+                stats["max_record_rel"], stats["max_record_rel_at"] = record_relative, at
+        if not math.isclose(a, b, rel_tol=rel_tol, abs_tol=max(abs_tol, record_bound)):
             stats["beyond_tolerance"] += 1
     return stats
 
@@ -97,6 +111,11 @@ def main():
     parser.add_argument("files", nargs="+", metavar="NAME=FILE", help="the reference first")
     parser.add_argument("--rel-tol", type=float, default=0.0, help="relative tolerance (default 0)")
     parser.add_argument("--abs-tol", type=float, default=0.0, help="absolute tolerance (default 0)")
+    parser.add_argument("--record-rel", type=float, default=0.0,
+                        help="a value also passes within this fraction of the largest |value| of its record "
+                             "in the reference (a command vector's own scale; default 0: off)")
+    parser.add_argument("--skip", type=int, default=0,
+                        help="leading values of a record that label it (left out of its scale)")
     parser.add_argument("--exact", action="append", default=[], metavar="NAME",
                         help="this file must be bit-identical to the reference, whatever the tolerances")
     args = parser.parse_args()
@@ -120,7 +139,7 @@ def main():
             print(f"onboard-compare: {other.name}: {other.records} records of {other.doubles} doubles, "
                   f"{reference.name}: {reference.records} of {reference.doubles}", file=sys.stderr)
             return 2
-        stats = compare(reference, other, args.rel_tol, args.abs_tol)
+        stats = compare(reference, other, args.rel_tol, args.abs_tol, args.record_rel, args.skip)
         total = len(reference.values)
         if stats["differing"] == 0:
             print(f"{other.name} vs {reference.name}: bit-identical ({reference.records} records of "
@@ -133,9 +152,12 @@ def main():
               f"max {stats['max_ulps']} ulps at {stats['max_ulps_at']}, "
               f"max abs {stats['max_abs']:.3e} at {stats['max_abs_at']}, "
               f"max rel {stats['max_rel']:.3e} at {stats['max_rel_at']}"
+              + (f", max relative to its record's scale {stats['max_record_rel']:.3e} at "
+                 f"{stats['max_record_rel_at']}" if args.record_rel > 0 else "")
               + (f"; {stats['nan_mismatch']} NaN mismatches" if stats["nan_mismatch"] else "")
               + (" -> FAIL (must be bit-identical)" if exact else
-                 f" -> {'pass' if passed else 'FAIL'} (rel_tol {args.rel_tol:g}, abs_tol {args.abs_tol:g}"
+                 f" -> {'pass' if passed else 'FAIL'} (rel_tol {args.rel_tol:g}, abs_tol {args.abs_tol:g}, "
+                 f"record_rel {args.record_rel:g}"
                  + ("" if passed else f", {stats['beyond_tolerance']} values beyond") + ")"))
         print("  differing values by index in the record: "
               + ", ".join(f"[{i}] {count}" for i, count in enumerate(stats["by_index"]) if count))

@@ -13,7 +13,8 @@
 #   FFSR_ONBOARD_JOBS      parallel build jobs (default 2; builds run under nice -n 10)
 #   FFSR_ONBOARD_COMPARE   the comparison command; it is given NAME=FILE arguments, the host's first,
 #                          and fails with a non-zero status (default: compare_outputs below)
-#   FFSR_ONBOARD_STACK_ENTRY  entry function for the static stack analysis (default ffsr_standin_step)
+#   FFSR_ONBOARD_EXPORT    ffsr-onboard-export (default: build-ci's, then build's) that writes the
+#                          example's four blobs from the scenario files into build-onboard/blobs/
 #   FFSR_QEMU_TIMEOUT      seconds before an emulator run counts as hung (default 600)
 set -uo pipefail
 
@@ -21,7 +22,7 @@ root=$(cd "$(dirname "$0")/.." && pwd)
 build_root=$root/build-onboard
 jobs=${FFSR_ONBOARD_JOBS:-2}
 timeout_s=${FFSR_QEMU_TIMEOUT:-600}
-stack_entry=${FFSR_ONBOARD_STACK_ENTRY:-ffsr_standin_step}
+stack_entries=(--entry ffsr_capture_step --entry ffsr_detumble_step)
 m7_runner=$root/src/onboard/platform/cortex_m7/qemu-run.sh
 
 if [ $# -gt 0 ]; then targets=("$@"); else targets=(host aarch64 m7); fi
@@ -83,6 +84,7 @@ build() {
   toolchain=$(toolchain_of "$target") || return 1
   local args=(-G Ninja -S "$root/src/onboard" -B "$dir")
   [ -n "$toolchain" ] && args+=("-DCMAKE_TOOLCHAIN_FILE=$toolchain")
+  args+=("-DFFSR_ONBOARD_BLOB_DIR=$build_root/blobs")
   echo "== $target: configure and build"
   if ! nice -n 10 cmake "${args[@]}" >"$dir.configure.log" 2>&1; then
     cat "$dir.configure.log" >&2
@@ -184,22 +186,66 @@ check_m7_image() {
 report_stack() {
   local target=$1 dir=$build_root/$1
   echo "   static stack analysis (scripts/stack-usage.py):"
-  python3 "$root/scripts/stack-usage.py" "$dir/CMakeFiles/ffsr_onboard.dir" --entry "$stack_entry" |
+  python3 "$root/scripts/stack-usage.py" "$dir/CMakeFiles/ffsr_onboard.dir" "${stack_entries[@]}" |
     sed 's/^/     /' || fail "$target: stack analysis"
 }
 
-# The comparison across targets: the plug-in point. It receives NAME=FILE arguments, the host first.
-# For the stand-in: glibc and newlib round sin, cos and atan2 differently in the last place for some
-# arguments (platform_test libm shows which), so the M7 differs from the host by a few ulps growing
-# along the trajectory; the tolerance bounds that. The onboard core's comparison replaces this.
-compare_outputs() {
-  python3 "$root/scripts/onboard-compare.py" --rel-tol 1e-9 --abs-tol 1e-12 "$@"
+# The core's objects must hold no exception or RTTI machinery: no throw (__cxa_throw, the allocation of
+# an exception), no handler (__cxa_begin_catch, the personality routine), no typeid or dynamic_cast, no
+# type_info objects (_ZTI*, _ZTS*). nm lists the defined and the undefined symbols of every object.
+check_core_symbols() {
+  local target=$1 nm=nm
+  case $target in aarch64) nm=aarch64-linux-gnu-nm ;; m7) nm=arm-none-eabi-nm ;; esac
+  local symbols
+  symbols=$($nm "$build_root/$target/libffsr_onboard.a" |
+    grep -E ' (__cxa_throw|__cxa_allocate_exception|__cxa_begin_catch|__cxa_rethrow|__gxx_personality_v0|__cxa_bad_typeid|__cxa_bad_cast|__dynamic_cast|_ZTI[A-Za-z0-9_]*|_ZTS[A-Za-z0-9_]*)$')
+  if [ -n "$symbols" ]; then
+    echo "$symbols" | sort -u | head -20 >&2
+    fail "$target: exception or RTTI symbols in the core's objects"
+  else
+    echo "   core objects: no __cxa_throw, personality, typeid, dynamic_cast or type_info symbol"
+  fi
 }
 
+# The example's four blobs, written once from the scenario files by the host's ffsr-onboard-export.
+make_blobs() {
+  local export=${FFSR_ONBOARD_EXPORT:-}
+  if [ -z "$export" ]; then
+    for candidate in "$root/build-ci/ffsr-onboard-export" "$root/build/ffsr-onboard-export"; do
+      [ -x "$candidate" ] && { export=$candidate; break; }
+    done
+  fi
+  if [ -z "$export" ] || [ ! -x "$export" ]; then
+    fail "ffsr-onboard-export not found: build the project (scripts/run.sh or .ci/run) or set FFSR_ONBOARD_EXPORT"
+    return 1
+  fi
+  mkdir -p "$build_root/blobs"
+  local out=$build_root/blobs
+  echo "== blobs ($export)"
+  "$export" "$root/robots/paper_3dof.toml" capture ffsr_blob_capture_3dof "$out/capture_3dof.c" &&
+    "$export" "$root/robots/paper_7dof_position.toml" capture ffsr_blob_capture_7dof "$out/capture_7dof.c" &&
+    "$export" "$root/examples/onboard/paper_3dof_detumble.toml" detumble ffsr_blob_detumble_3dof \
+      "$out/detumble_3dof.c" &&
+    "$export" "$root/robots/paper_7dof_detumble.toml" detumble ffsr_blob_detumble_7dof "$out/detumble_7dof.c" ||
+    { fail "the example's blobs"; return 1; }
+}
+
+# The comparison across targets: every command of every tick against the host's. Values relative to the
+# largest value of their own command (a torque component near zero is compared at its vector's scale):
+# 1e-12. The compilers contract no multiply-add (-ffp-contract=off) and Eigen does not vectorize, so the
+# arithmetic is the same operations in the same order on every target; what differs is the C library's
+# sin, cos and atan2 (glibc and newlib round a few arguments differently in the last place; platform_test
+# libm shows which).
+compare_outputs() {
+  python3 "$root/scripts/onboard-compare.py" --record-rel 1e-12 --skip 2 "$@"
+}
+
+mkdir -p "$build_root"
+make_blobs || { printf '  %s\n' "${failures[@]}" >&2; exit 1; }
 for target in "${targets[@]}"; do
-  mkdir -p "$build_root"
   if ! check_tools "$target" || ! build "$target"; then continue; fi
   check_include_paths "$target"
+  check_core_symbols "$target"
   run_example "$target"
   run_platform_tests "$target"
   [ "$target" = m7 ] && check_m7_image

@@ -19,8 +19,53 @@
 //   NumericalError   -- a computation cannot give an answer (singular matrix, no convergence)
 //   IntegrationError -- SUNDIALS CVODE reported a failure (the message names the flag)
 // Messages name the function and the offending argument, what was expected and what came.
+//
+// The onboard core (the controllers and the headers they include: algorithm/, model/, spatial/,
+// contact/, the capture rate law of optimize/, control/'s controllers) also compiles without exceptions
+// (-fno-exceptions, flight software's rule). It throws through FFSR_THROW and catches through FFSR_TRY /
+// FFSR_CATCH; without exceptions a throw becomes a call of the failure handler (set_failure_handler: the
+// platform's fault reporting, e.g. a flight framework's FDIR hook) followed by std::abort(), and a
+// handler is never entered. Onboard, the checks that throw are the contract of direct C++ callers at
+// initialisation: the controllers' steps check their inputs first and report a bad one as a status, so
+// they never reach a throw; the C interface (onboard/ffsr_onboard.h) checks its inputs before it builds
+// anything. The rest of the library (parsers, scenarios, jobs, CVODE, the planner) needs exceptions.
+#if defined(__cpp_exceptions) || defined(__EXCEPTIONS)
+#define FFSR_THROW(...) throw __VA_ARGS__
+#define FFSR_RETHROW throw
+#define FFSR_TRY try
+#define FFSR_CATCH(...) catch (__VA_ARGS__)
+#else
+// the argument is not evaluated (an operand of sizeof: no code, and the names in the message count as
+// used): a message is built only where it can be thrown
+#define FFSR_THROW(...) \
+  (static_cast<void>(sizeof(__VA_ARGS__)), ::ffsr::detail::failed_check(__FILE__, __LINE__))
+#define FFSR_RETHROW ::ffsr::detail::failed_check(__FILE__, __LINE__)
+#define FFSR_TRY if (true)
+#define FFSR_CATCH(...) else if (false)
+#endif
 
 namespace ffsr {
+
+/// What the library calls, without exceptions, where it would throw: the source file and line of the
+/// check that failed. It may not return (std::abort() follows when it does).
+using FailureHandler = void (*)(const char* file, int line);
+
+namespace detail {
+inline FailureHandler failure_handler = nullptr;
+
+[[noreturn]] inline void failed_check(const char* file, int line) noexcept {
+  if (failure_handler != nullptr) failure_handler(file, line);
+  std::abort();
+}
+}  // namespace detail
+
+/// Sets the handler of a failed check in a build without exceptions (nullptr: std::abort() alone);
+/// returns the previous one. With exceptions the library throws and never calls it.
+inline FailureHandler set_failure_handler(FailureHandler h) noexcept {
+  const FailureHandler old = detail::failure_handler;
+  detail::failure_handler = h;
+  return old;
+}
 
 class Error : public std::runtime_error {
  public:
@@ -61,8 +106,8 @@ namespace detail {
 inline std::string number_with_digits(double x, int digits) {
   if (!std::isfinite(x)) return std::isnan(x) ? "nan" : x > 0 ? "inf" : "-inf";
   char e_form[40], out[400];
-  std::snprintf(e_form, sizeof e_form, "%.*e", digits - 1, x);
-  const int exponent = std::atoi(std::strchr(e_form, 'e') + 1);  // of x rounded to `digits`
+  (void)std::snprintf(e_form, sizeof e_form, "%.*e", digits - 1, x);
+  const int exponent = static_cast<int>(std::strtol(std::strchr(e_form, 'e') + 1, nullptr, 10));  // of x rounded
   if (exponent < -5 || exponent >= 16) {
     std::string t(e_form);  // drop the mantissa's trailing zeros: 1.50000e-07 -> 1.5e-07
     const size_t e = t.find('e'), dot = t.find('.');
@@ -72,7 +117,7 @@ inline std::string number_with_digits(double x, int digits) {
     if (end == dot + 1) --end;
     return t.substr(0, end) + t.substr(e);
   }
-  std::snprintf(out, sizeof out, "%.*f", std::max(digits - 1 - exponent, 0), x);
+  (void)std::snprintf(out, sizeof out, "%.*f", std::max(digits - 1 - exponent, 0), x);
   std::string t(out);
   if (t.find('.') != std::string::npos) {
     while (t.back() == '0') t.pop_back();
@@ -86,7 +131,7 @@ inline int shortest_digits(double x) {
   if (!std::isfinite(x) || x == 0) return 1;
   char buf[40];
   for (int p = 1; p < 17; ++p) {
-    std::snprintf(buf, sizeof buf, "%.*e", p - 1, x);
+    (void)std::snprintf(buf, sizeof buf, "%.*e", p - 1, x);
     if (std::strtod(buf, nullptr) == x) return p;
   }
   return 17;
@@ -122,7 +167,7 @@ std::string str(const Args&... args) {
 
 /// Throws InputError("<where>: <what> must be finite, got <value>") for NaN or infinity.
 inline void require_finite(double value, const char* where, const char* what) {
-  if (!std::isfinite(value)) throw InputError(str(where, ": ", what, " must be finite, got ", value));
+  if (!std::isfinite(value)) FFSR_THROW(InputError(str(where, ": ", what, " must be finite, got ", value)));
 }
 
 /// The error of require_finite_all, out of line: names the first entry of x[0..size) not finite.
@@ -130,7 +175,7 @@ inline void require_finite(double value, const char* where, const char* what) {
                                           const char* what) {
   Eigen::Index i = 0;
   while (i + 1 < size && std::isfinite(x[i])) ++i;
-  throw InputError(str(where, ": ", what, " must be finite, entry ", i, " is ", x[i]));
+  FFSR_THROW(InputError(str(where, ": ", what, " must be finite, entry ", i, " is ", x[i])));
 }
 
 /// Throws InputError unless every coefficient of an Eigen expression is finite (the test inline and
@@ -145,7 +190,7 @@ void require_finite_all(const Derived& m, const char* where, const char* what) {
 /// Throws InputError("<where>: <what> has <got> entries, expected <expected>").
 inline void require_size(long got, long expected, const char* where, const char* what) {
   if (got != expected)
-    throw InputError(str(where, ": ", what, " has ", got, " entries, expected ", expected));
+    FFSR_THROW(InputError(str(where, ": ", what, " has ", got, " entries, expected ", expected)));
 }
 
 }  // namespace detail

@@ -77,7 +77,7 @@ void operator delete[](void* p, std::size_t) noexcept { operator delete(p); }
 
 #include "ffsr/control/capture_controller.hpp"
 #include "ffsr/control/detumble_controller.hpp"
-#include "ffsr/control/detumble_tracker.hpp"
+#include "ffsr/control/detumble_replay.hpp"
 #include "ffsr/model/attach.hpp"
 #include "ffsr/parsers/urdf.hpp"
 #include "ffsr/scenario/scenario.hpp"

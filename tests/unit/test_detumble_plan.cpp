@@ -9,7 +9,7 @@
 
 #include "ffsr/jobs/detumble.hpp"
 #include "ffsr/control/detumble_planner.hpp"
-#include "ffsr/control/detumble_tracker.hpp"
+#include "ffsr/control/detumble_replay.hpp"
 #include "ffsr/parsers/urdf.hpp"
 #include "ffsr/scenario/scenario.hpp"
 

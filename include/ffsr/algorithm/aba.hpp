@@ -92,7 +92,7 @@ inline void aba_velocity_pass(const Model& model, Data& data, const BasePose& ba
     const Vector6 U = data.IA[ui] * S;
     const double D = dot6(S.data(), U.data());
     if (!(D > 0.0))
-      throw NumericalError(str("aba: the articulated inertia is not positive definite (joint ", i, ")"));
+      FFSR_THROW(NumericalError(str("aba: the articulated inertia is not positive definite (joint ", i, ")")));
     data.U[ui] = U;
     data.D(i - 1) = D;
     data.IA[static_cast<size_t>(model.body(i).parent)].add_projected(data.IA[ui], U, D);
@@ -132,7 +132,7 @@ inline void aba_acceleration_pass(const Model& model, Data& data, const Eigen::R
   Vector6 rhs;
   for (int j = 0; j < 6; ++j) rhs(j) = tau(j) - data.pA[0](j);
   if (!solve_spd6(data.IA[0].matrix(), rhs, data.A[0]))
-    throw NumericalError("aba: the articulated inertia of the base is not positive definite");
+    FFSR_THROW(NumericalError("aba: the articulated inertia of the base is not positive definite"));
   for (int i = 1; i < nb; ++i) {
     const auto ui = static_cast<size_t>(i);
     const Vector6& Ap = data.A[static_cast<size_t>(model.body(i).parent)];
@@ -171,7 +171,7 @@ inline void aba(const Model& model, Data& data, const BasePose& base, const Eige
                 const Eigen::Ref<const Eigen::VectorXd>& v, const Eigen::Ref<const Eigen::VectorXd>& tau,
                 Eigen::VectorXd& a) {
   if (model.nb() - 1 != model.n())
-    throw InputError("aba: the model has mimic joints; use forward_dynamics");
+    FFSR_THROW(InputError("aba: the model has mimic joints; use forward_dynamics"));
   detail::require_size(v.size(), model.nv(), "aba", "v");
   detail::require_size(tau.size(), model.nv(), "aba", "tau");
   detail::require_finite_all(v, "aba", "v");
@@ -179,7 +179,7 @@ inline void aba(const Model& model, Data& data, const BasePose& base, const Eige
   a.resize(model.nv());
   detail::aba_velocity_pass(model, data, base, theta, v);
   detail::aba_acceleration_pass(model, data, v, tau, a);
-  if (!a.allFinite()) throw NumericalError("aba: the accelerations overflow double precision");
+  if (!a.allFinite()) FFSR_THROW(NumericalError("aba: the accelerations overflow double precision"));
 }
 
 }  // namespace ffsr

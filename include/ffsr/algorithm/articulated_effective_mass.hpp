@@ -133,8 +133,8 @@ inline Vector6 unit_point_force(const Model& model, const Data& data, int frame,
   const auto b = static_cast<size_t>(fr.body);
   const Vector3 pe = data.p[b] + data.R[b] * fr.pose.p;  // frame_pose's position, without its rotation
   if (!pe.allFinite())
-    throw NumericalError(str("effective_mass: the position of frame '", model.frame(frame).name,
-                             "' overflows double precision"));
+    FFSR_THROW(NumericalError(str("effective_mass: the position of frame '", model.frame(frame).name,
+                             "' overflows double precision")));
   Vector6 f;
   f << u, (pe - data.p[0]).cross(u);
   return f;
@@ -167,8 +167,8 @@ inline void articulated_inertias(const Model& model, Data& data, const Eigen::Ve
     const Vector6 U = data.IA[ui] * S;
     const double D = S.dot(U) + (armature ? (*armature)(i - 1) : 0.0);
     if (!(D > 0.0))
-      throw NumericalError(
-          str("effective_mass: the articulated inertia is not positive definite (joint ", i, ")"));
+      FFSR_THROW(NumericalError(
+          str("effective_mass: the articulated inertia is not positive definite (joint ", i, ")")));
     data.U[ui] = U;
     data.D(i - 1) = D;
     if (df && model.subtree_last(i) == model.subtree_last(model.body(i).parent))
@@ -208,11 +208,11 @@ inline double articulated_solve(const Model& model, Data& data, int ee, const Ve
   if (!all) {
     double q0 = 0.0;
     if (!inverse_quadratic_articulated(data.IA[0], pA, q0))
-      throw NumericalError("effective_mass: the articulated inertia of the base is not positive definite");
+      FFSR_THROW(NumericalError("effective_mass: the articulated inertia of the base is not positive definite"));
     return q + q0;
   }
   if (!solve_spd6(data.IA[0].matrix(), -pA, data.A[0]))
-    throw NumericalError("effective_mass: the articulated inertia of the base is not positive definite");
+    FFSR_THROW(NumericalError("effective_mass: the articulated inertia of the base is not positive definite"));
   std::fill(data.on_path.begin(), data.on_path.end(), char(0));
   for (int k = 0; k < len; ++k) data.on_path[static_cast<size_t>(data.path[static_cast<size_t>(k)])] = 1;
   data.y.head<6>() = data.A[0];
@@ -231,7 +231,7 @@ inline double articulated_solve(const Model& model, Data& data, int ee, const Ve
 /// robot about p_0, in data.Ic[0]); writes y_b = Ic_0^-1 f.
 inline double locked_inverse_form_composite(const Data& data, const Vector6& f, Vector6& yb) {
   if (!solve_spd6(data.Ic[0].matrix(), f, yb))
-    throw NumericalError("effective_mass: the locked robot's inertia is not positive definite");
+    FFSR_THROW(NumericalError("effective_mass: the locked robot's inertia is not positive definite"));
   return f.dot(yb);
 }
 
@@ -265,8 +265,8 @@ inline double inverse_effective_mass_articulated(const Model& model, Data& data,
                                                  const Vector3& u) {
   const Vector6 f = detail::unit_point_force(model, data, frame, u);
   if (model.nb() - 1 != model.n())  // a mimic joint couples bodies through one coordinate: not a tree recursion
-    throw InputError(
-        "inverse_effective_mass_articulated: the model has mimic joints; use inverse_effective_mass");
+    FFSR_THROW(InputError(
+        "inverse_effective_mass_articulated: the model has mimic joints; use inverse_effective_mass"));
   detail::articulated_inertias(model, data, nullptr);
   return detail::articulated_solve(model, data, model.frame(frame).body, f, false);
 }
@@ -281,8 +281,8 @@ inline double inverse_effective_mass_articulated(const Model& model, Data& data,
                                                  const ContactJoints& joints) {
   const Vector6 f = detail::unit_point_force(model, data, frame, u);
   if (model.nb() - 1 != model.n())
-    throw InputError(
-        "inverse_effective_mass_articulated: the model has mimic joints; use inverse_effective_mass");
+    FFSR_THROW(InputError(
+        "inverse_effective_mass_articulated: the model has mimic joints; use inverse_effective_mass"));
   if (joints.model == JointModel::Locked) {
     detail::body_inertias(model, data);
     for (int i = model.nb() - 1; i > 0; --i)

@@ -104,8 +104,8 @@ inline BaseDisturbance base_disturbance(const Model& model, Data& data, const Ba
 
 inline double single_body_restitution(double f) {
   if (!std::isfinite(f) || f < 0.0)
-    throw InputError(
-        detail::str("single_body_restitution: the damping factor must be >= 0 and finite, got ", f));
+    FFSR_THROW(InputError(
+        detail::str("single_body_restitution: the damping factor must be >= 0 and finite, got ", f)));
   if (f == 0.0) return 1.0;
   // G is increasing in s on s < 0 (dG/ds = -s/(1 + f s)), positive at 0, <= 0 at -1 and -> -inf at
   // -1/f: the root lies in (max(-1, -1/f), 0).
@@ -138,7 +138,7 @@ inline Vector6 base_velocity_per_unit_impulse(const Model& model, Data& data, in
                                               const ContactJoints& joints, double& inverse_mass,
                                               const Vector3& rho) {
   if (joints.model == JointModel::Free) {
-    const Vector6 b = base_velocity_per_unit_impulse(model, data, frame, u, rho);
+    Vector6 b = base_velocity_per_unit_impulse(model, data, frame, u, rho);
     inverse_mass = data.w.dot(data.y);  // s^T J H^-1 J^T s
     return b;
   }
@@ -180,7 +180,7 @@ inline BaseDisturbance base_disturbance_at(const Model& model, Data& data, int f
   d.linear = -d.impulse * per_unit.head<3>();
   d.angular = -d.impulse * per_unit.tail<3>();
   if (!d.linear.allFinite() || !d.angular.allFinite() || !std::isfinite(d.M_ie))
-    throw NumericalError("base_disturbance: the configuration gives a non-finite impulse response");
+    FFSR_THROW(NumericalError("base_disturbance: the configuration gives a non-finite impulse response"));
   return d;
 }
 

@@ -114,10 +114,10 @@ inline const Eigen::MatrixXd& crba(const Model& model, Data& data, const BasePos
   const double sum_I0 = std::abs(I0.m) + I0.h.cwiseAbs().sum() + I0.Ibar.cwiseAbs().sum();
   const double sum_S = data.S.cwiseAbs().sum(), sum_F = data.Fc.cwiseAbs().sum();
   if (!(sum_I0 <= 1e300 && sum_S <= 1e300 && sum_F <= 1e300 && sum_S * sum_F <= 5e307))
-    throw NumericalError(
+    FFSR_THROW(NumericalError(
         detail::str("crba: the inertia matrix H is not finite: the model's lengths, masses or the "
                     "joint positions overflow double precision (",
-                    model.source, ")"));
+                    model.source, ")")));
   return H;
 }
 
@@ -131,7 +131,7 @@ inline void cholesky(const Eigen::MatrixXd& A, Eigen::MatrixXd& L, const char* w
     double d = A(j, j);
     for (Eigen::Index k = 0; k < j; ++k) d -= L(j, k) * L(j, k);
     if (!(d > 0.0))
-      throw NumericalError(str(where, ": the inertia matrix is not positive definite (pivot ", j, ")"));
+      FFSR_THROW(NumericalError(str(where, ": the inertia matrix is not positive definite (pivot ", j, ")")));
     const double ljj = std::sqrt(d);
     L(j, j) = ljj;
     for (Eigen::Index i = j + 1; i < n; ++i) {

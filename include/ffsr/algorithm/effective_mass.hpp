@@ -21,8 +21,8 @@ inline void jacobian_transpose_times(const Model& model, Data& data, int frame, 
                                      const Vector3& m) {
   const Vector3 pe = frame_pose(model, data, frame).p;
   if (!pe.allFinite())
-    throw NumericalError(str("effective_mass: the position of frame '", model.frame(frame).name,
-                             "' overflows double precision"));
+    FFSR_THROW(NumericalError(str("effective_mass: the position of frame '", model.frame(frame).name,
+                             "' overflows double precision")));
   data.w.setZero();
   data.w.head<3>() = f;
   data.w.segment<3>(3) = (pe - data.p[0]).cross(f) + m;
@@ -57,7 +57,7 @@ inline double locked_wrench_form(const Model& model, Data& data, int frame, cons
   const Vector6 sb = data.w.head<6>();
   const Matrix6 Hbb = data.H.topLeftCorner<6, 6>();
   if (!solve_spd6(Hbb, sb, yb))  // the recursion's fixed-size Cholesky (Eigen's LLT: +3 s to compile)
-    throw NumericalError("effective_mass: the locked robot's inertia is not positive definite");
+    FFSR_THROW(NumericalError("effective_mass: the locked robot's inertia is not positive definite"));
   return sb.dot(yb);
 }
 
@@ -131,11 +131,11 @@ inline double effective_mass(const Model& model, Data& data, const BasePose& bas
 /// NumericalError when the sum of the inverses overflows (a denormal m_e: M_ie would read 0).
 inline double integrated_effective_mass(double m_e, const Target& target) {
   if (!(m_e > 0) || !std::isfinite(m_e))
-    throw InputError(detail::str("integrated_effective_mass: m_e must be positive and finite, got ", m_e));
+    FFSR_THROW(InputError(detail::str("integrated_effective_mass: m_e must be positive and finite, got ", m_e)));
   const double inverse = 1.0 / m_e + target.inverse_mass_along_normal();
   if (!std::isfinite(inverse))
-    throw NumericalError(
-        detail::str("integrated_effective_mass: 1/m_e + 1/m_t overflows double precision, m_e = ", m_e));
+    FFSR_THROW(NumericalError(
+        detail::str("integrated_effective_mass: 1/m_e + 1/m_t overflows double precision, m_e = ", m_e)));
   return 1.0 / inverse;
 }
 
@@ -156,15 +156,15 @@ inline bool takes_recursion(const Model& model) {
 inline double integrated_from_inverse(double inverse, double target_inverse_mass) {
   const double M = 1.0 / (inverse + target_inverse_mass);
   if (!(M > 0.0) || !std::isfinite(M))
-    throw NumericalError(str("integrated_effective_mass: M_ie is not representable (1/m_e = ", inverse,
-                             ", target's inverse mass ", target_inverse_mass, ")"));
+    FFSR_THROW(NumericalError(str("integrated_effective_mass: M_ie is not representable (1/m_e = ", inverse,
+                             ", target's inverse mass ", target_inverse_mass, ")")));
   return M;
 }
 
 inline void check_target_inverse_mass(double target_inverse_mass) {
   if (!(target_inverse_mass >= 0.0) || !std::isfinite(target_inverse_mass))
-    throw InputError(str("integrated_effective_mass: the target's inverse mass along the normal must be ",
-                         "finite and >= 0, got ", target_inverse_mass));
+    FFSR_THROW(InputError(str("integrated_effective_mass: the target's inverse mass along the normal must be ",
+                         "finite and >= 0, got ", target_inverse_mass)));
 }
 }  // namespace detail
 

@@ -48,7 +48,7 @@ inline Matrix6 inverse_inertia_matrix(const Model& model, Data& data, int frame,
     const Matrix6 Hbb = data.H.topLeftCorner<6, 6>();
     const Eigen::LLT<Matrix6> llt(Hbb);
     if (llt.info() != Eigen::Success)
-      throw NumericalError("inverse_inertia_matrix: the locked robot's inertia is not positive definite");
+      FFSR_THROW(NumericalError("inverse_inertia_matrix: the locked robot's inertia is not positive definite"));
     Linv = X.transpose() * llt.solve(X);
   } else {
     detail::require_size(joints.armature.size(), model.n(), "inverse_inertia_matrix", "armature");
@@ -219,7 +219,7 @@ inline double integrated_effective_mass_gradient_at(const Model& model, Data& da
   detail::require_size(grad.size(), model.n(), "integrated_effective_mass_gradient", "grad");
   detail::check_unit_direction(u, "effective_mass");
   detail::check_frame(model, frame, "effective_mass");
-  double inv_me;
+  double inv_me = 0;
   if (joints.model == JointModel::Locked) {
     Vector6 yb;
     inv_me = detail::locked_inverse_form(model, data, frame, u, yb);
@@ -293,7 +293,7 @@ inline double integrated_effective_mass_gradient(const Model& model, Data& data,
   detail::require_size(grad.size(), model.n(), "integrated_effective_mass_gradient", "grad");
   forward_kinematics(model, data, base, theta);
   const Vector6 f = detail::unit_point_force(model, data, frame, u);
-  double inv_me;
+  double inv_me = 0;
   if (joints.model == JointModel::Locked) {
     detail::body_inertias(model, data);
     for (int i = model.nb() - 1; i > 0; --i)

@@ -92,7 +92,7 @@ inline GraspResult grasp(const Model& model, Data& data, const BasePose& base,
   const Matrix6 S = data.J * MinvJr - Jt * MinvJt;  // J M^-1 J^T
   const Vector6 rel = data.J * v - Jt * r.target_before;
   const Eigen::LLT<Matrix6> llt(S);
-  if (llt.info() != Eigen::Success) throw NumericalError("grasp: the lock's inverse inertia is singular");
+  if (llt.info() != Eigen::Success) FFSR_THROW(NumericalError("grasp: the lock's inverse inertia is singular"));
   r.impulse = -llt.solve(rel);
   r.v_after = v + MinvJr * r.impulse;
   r.target_after = r.target_before + MinvJt * r.impulse;

@@ -10,12 +10,12 @@ namespace ffsr {
 /// Reads the kinematics (call forward_kinematics or crba first). Writes data.J. Returns data.J.
 inline const Eigen::MatrixXd& frame_jacobian(const Model& model, Data& data, int frame) {
   if (frame < 0 || frame >= static_cast<int>(model.frames().size()))
-    throw InputError(detail::str("frame_jacobian: frame index ", frame, " out of range"));
+    FFSR_THROW(InputError(detail::str("frame_jacobian: frame index ", frame, " out of range")));
   Eigen::MatrixXd& J = data.J;
   const Vector3 pe = frame_pose(model, data, frame).p;
   if (!pe.allFinite())
-    throw NumericalError(detail::str("frame_jacobian: the position of frame '", model.frame(frame).name,
-                                     "' overflows double precision"));
+    FFSR_THROW(NumericalError(detail::str("frame_jacobian: the position of frame '", model.frame(frame).name,
+                                     "' overflows double precision")));
   const Vector3 d0 = pe - data.p[0];
   J.setZero();
   J.topLeftCorner<3, 3>().setIdentity();
@@ -43,7 +43,7 @@ inline const Eigen::MatrixXd& generalized_jacobian(const Model& model, Data& dat
   const int n = model.n();
   const Eigen::LLT<Matrix6> Hb(data.H.topLeftCorner<6, 6>());
   if (Hb.info() != Eigen::Success)
-    throw NumericalError("generalized_jacobian: the base inertia H_b is singular");
+    FFSR_THROW(NumericalError("generalized_jacobian: the base inertia H_b is singular"));
   data.HbInv_Hbm = data.H.topRightCorner(6, n);
   Hb.solveInPlace(data.HbInv_Hbm);
   data.Jf.noalias() = data.J.rightCols(n);

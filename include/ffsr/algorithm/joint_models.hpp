@@ -40,7 +40,7 @@ inline JointModel parse_joint_model(const std::string& name, const std::string& 
   if (name == "free") return JointModel::Free;
   if (name == "locked") return JointModel::Locked;
   if (name == "armature") return JointModel::Armature;
-  throw InputError(detail::str(where, ": unknown joint model '", name, "'; use free, locked or armature"));
+  FFSR_THROW(InputError(detail::str(where, ": unknown joint model '", name, "'; use free, locked or armature")));
 }
 
 /// One non-negative finite value per coordinate of `model` from `values`: empty gives zeros, one value
@@ -52,15 +52,15 @@ inline Eigen::VectorXd per_joint_values(const std::vector<double>& values, const
   if (!values.empty() && values.size() != 1 && int(values.size()) != n) {
     std::string list;
     for (const auto& name : model.joint_names()) list += (list.empty() ? "" : ", ") + name;
-    throw InputError(detail::str(where, ": ", values.size(), " values for ", n, " joints (", list,
-                                 "); give one value or one per joint"));
+    FFSR_THROW(InputError(detail::str(where, ": ", values.size(), " values for ", n, " joints (", list,
+                                 "); give one value or one per joint")));
   }
   Eigen::VectorXd v = Eigen::VectorXd::Zero(n);
   for (int k = 0; k < n; ++k) {
     if (!values.empty()) v(k) = values.size() == 1 ? values[0] : values[size_t(k)];
     if (!(v(k) >= 0) || !std::isfinite(v(k)))
-      throw InputError(detail::str(where, ": the value of joint '", model.joint(k).name,
-                                   "' must be finite and >= 0, got ", v(k)));
+      FFSR_THROW(InputError(detail::str(where, ": the value of joint '", model.joint(k).name,
+                                   "' must be finite and >= 0, got ", v(k))));
   }
   return v;
 }
@@ -83,13 +83,13 @@ namespace detail {
 
 inline void check_frame(const Model& model, int frame, const char* where) {
   if (frame < 0 || frame >= static_cast<int>(model.frames().size()))
-    throw InputError(str(where, ": frame index ", frame, " out of range"));
+    FFSR_THROW(InputError(str(where, ": frame index ", frame, " out of range")));
 }
 
 inline void check_unit_direction(const Vector3& u, const char* where) {
   require_finite_all(u, where, "direction u");
   if (std::abs(u.norm() - 1.0) > 1e-9)
-    throw InputError(str(where, ": direction u must be a unit vector, |u| = ", u.norm()));
+    FFSR_THROW(InputError(str(where, ": direction u must be a unit vector, |u| = ", u.norm())));
 }
 
 }  // namespace detail

@@ -15,7 +15,7 @@ inline double check_configuration(const Model& model, const BasePose& base,
   require_finite_all(base.position, where, "base position");
   require_finite_all(base.orientation.coeffs(), where, "base orientation");
   const double qn = base.orientation.norm();
-  if (qn < 1e-9) throw InputError(str(where, ": base orientation quaternion has zero norm"));
+  if (qn < 1e-9) FFSR_THROW(InputError(str(where, ": base orientation quaternion has zero norm")));
   return qn;
 }
 
@@ -32,7 +32,7 @@ struct SplitColumn {
   SplitColumn() : top(Eigen::Vector2d::Zero()) {}
   SplitColumn(const Eigen::Vector2d& t, double l) : top(t), last(l) {}
   /// Column c of M.
-  SplitColumn(const Matrix3& M, int c) : top(Eigen::Vector2d::Map(M.data() + 3 * c)), last(M(2, c)) {}
+  SplitColumn(const Matrix3& M, int c) : top(Eigen::Vector2d::Map(M.data() + 3 * std::ptrdiff_t{c})), last(M(2, c)) {}
   explicit SplitColumn(const Vector3& v) : top(Eigen::Vector2d::Map(v.data())), last(v(2)) {}
   SplitColumn operator*(double f) const { return {top * f, last * f}; }
   SplitColumn operator+(const SplitColumn& o) const { return {top + o.top, last + o.last}; }
@@ -40,7 +40,7 @@ struct SplitColumn {
   double entry(int r) const { return r == 2 ? last : top(r); }
   /// Into column c of M.
   void store(Matrix3& M, int c) const {
-    Eigen::Vector2d::Map(M.data() + 3 * c) = top;
+    Eigen::Vector2d::Map(M.data() + 3 * std::ptrdiff_t{c}) = top;
     M(2, c) = last;
   }
   void store(Vector3& v) const {

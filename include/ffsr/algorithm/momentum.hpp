@@ -51,7 +51,7 @@ inline Vector6 momentum(const Model& model, const Data& data, const Eigen::Ref<c
     h.tail<3>() += (c - data.p[0]).cross(in.mass * vc) + R * in.I * R.transpose() * w;
   });
   if (!h.allFinite() && v.allFinite())  // NaN in v propagates; finite v whose products overflow do not
-    throw NumericalError("momentum: the momentum overflows double precision");
+    FFSR_THROW(NumericalError("momentum: the momentum overflows double precision"));
   return h;
 }
 
@@ -110,7 +110,7 @@ inline double kinetic_energy(const Model& model, const Data& data,
     T += 0.5 * in.mass * vc.squaredNorm() + 0.5 * w.dot(R * in.I * R.transpose() * w);
   });
   if (!std::isfinite(T) && v.allFinite())
-    throw NumericalError("kinetic_energy: the energy overflows double precision");
+    FFSR_THROW(NumericalError("kinetic_energy: the energy overflows double precision"));
   return T;
 }
 
@@ -124,10 +124,10 @@ inline Vector6 base_velocity_from_momentum(const Model& model, const Data& data,
   detail::require_finite_all(theta_dot, "base_velocity_from_momentum", "theta_dot");
   detail::require_finite_all(h, "base_velocity_from_momentum", "momentum");
   const Eigen::LLT<Matrix6> Hb(data.H.topLeftCorner<6, 6>());
-  if (Hb.info() != Eigen::Success) throw NumericalError("base_velocity_from_momentum: H_b is singular");
-  const Vector6 xb = Hb.solve(h - data.H.topRightCorner(6, model.n()) * theta_dot);
+  if (Hb.info() != Eigen::Success) FFSR_THROW(NumericalError("base_velocity_from_momentum: H_b is singular"));
+  Vector6 xb = Hb.solve(h - data.H.topRightCorner(6, model.n()) * theta_dot);
   if (!xb.allFinite())
-    throw NumericalError("base_velocity_from_momentum: the base velocity overflows double precision");
+    FFSR_THROW(NumericalError("base_velocity_from_momentum: the base velocity overflows double precision"));
   return xb;
 }
 

@@ -81,7 +81,7 @@ inline const Eigen::VectorXd& rnea(const Model& model, Data& data, const BasePos
   data.tau.head<3>() = R0 * data.F[0].head<3>();
   data.tau.segment<3>(3) = R0 * data.F[0].tail<3>();
   if (!data.tau.allFinite())  // finite velocities whose products pass double precision
-    throw NumericalError("rnea: the generalized forces overflow double precision");
+    FFSR_THROW(NumericalError("rnea: the generalized forces overflow double precision"));
   return data.tau;
 }
 

@@ -268,7 +268,7 @@ inline PeakRate contact_peak(double f, double alpha) {
     x = next;
     if (done) return near_touch ? PeakRate{1.0 - x, x} : PeakRate{x, 1.0 - x};
   }
-  if (v(x) != 0.0) throw NumericalError(str("contact_peak: no convergence for f = ", f, ", alpha = ", alpha));
+  if (v(x) != 0.0) FFSR_THROW(NumericalError(str("contact_peak: no convergence for f = ", f, ", alpha = ", alpha)));
   return near_touch ? PeakRate{1.0 - x, x} : PeakRate{x, 1.0 - x};
 }
 
@@ -279,13 +279,13 @@ inline double contact_peak_rate(double f, double alpha) { return contact_peak(f,
 /// (it overflows double precision, e.g. M_ie = 1e300 kg).
 inline double require_finite_result(double x, std::string_view where, const char* what, double M_ie) {
   if (!std::isfinite(x))
-    throw NumericalError(str(where, ": ", what, " is not representable (", x, ") for M_ie = ", M_ie, " kg"));
+    FFSR_THROW(NumericalError(str(where, ": ", what, " is not representable (", x, ") for M_ie = ", M_ie, " kg")));
   return x;
 }
 
 inline void require_positive_mass(double M_ie, std::string_view where) {
   if (!(M_ie > 0.0) || !std::isfinite(M_ie))
-    throw InputError(str(where, ": integrated effective mass M_ie must be positive and finite, got ", M_ie));
+    FFSR_THROW(InputError(str(where, ": integrated effective mass M_ie must be positive and finite, got ", M_ie)));
 }
 
 template <std::size_t... I>
@@ -305,7 +305,7 @@ AnyContactLaw make_contact_law_impl(std::string_view name, const ContactParams& 
       if (!valid.empty()) valid += ", ";
       valid += n;
     }
-    throw InputError(str("make_contact_law: unknown contact law '", name, "'; valid names: ", valid));
+    FFSR_THROW(InputError(str("make_contact_law: unknown contact law '", name, "'; valid names: ", valid)));
   }
 }
 
@@ -313,12 +313,12 @@ AnyContactLaw make_contact_law_impl(std::string_view name, const ContactParams& 
 
 inline void validate(const ContactParams& p, const char* where) {
   if (!(p.K > 0.0) || !std::isfinite(p.K))
-    throw InputError(detail::str(where, ": stiffness K must be positive and finite, got ", p.K));
+    FFSR_THROW(InputError(detail::str(where, ": stiffness K must be positive and finite, got ", p.K)));
   if (!(p.alpha > 0.0) || !std::isfinite(p.alpha))
-    throw InputError(detail::str(where, ": exponent alpha must be positive and finite, got ", p.alpha));
+    FFSR_THROW(InputError(detail::str(where, ": exponent alpha must be positive and finite, got ", p.alpha)));
   if (!(p.c_r > 0.0 && p.c_r <= 1.0))
-    throw InputError(
-        detail::str(where, ": coefficient of restitution c_r must satisfy 0 < c_r <= 1, got ", p.c_r));
+    FFSR_THROW(InputError(
+        detail::str(where, ": coefficient of restitution c_r must satisfy 0 < c_r <= 1, got ", p.c_r)));
 }
 
 template <class Damping>
@@ -327,15 +327,15 @@ HertzDamped<Damping>::HertzDamped(const ContactParams& p, double approach_veloci
   const std::string where = str("contact law ", Damping::name);
   validate(p, where.c_str());
   if (!std::isfinite(approach_velocity))
-    throw InputError(str(where, ": approach velocity must be finite, got ", approach_velocity));
+    FFSR_THROW(InputError(str(where, ": approach velocity must be finite, got ", approach_velocity)));
   if (!(approach_velocity > 0.0))
-    throw InputError(
+    FFSR_THROW(InputError(
         str(where, ": approach velocity must be positive (the bodies approach), got ", approach_velocity,
-            approach_velocity < 0.0 ? ": the bodies are receding" : ": the bodies do not approach"));
+            approach_velocity < 0.0 ? ": the bodies are receding" : ": the bodies do not approach")));
   v0_ = approach_velocity;
   f_ = Damping::factor(p.c_r);
   if (!(f_ >= 0.0) || !std::isfinite(f_))  // a tiny c_r (1e-320) overflows f = 8 (1 - c_r) / (5 c_r)
-    throw NumericalError(str(where, ": damping factor f(c_r) = ", f_, " for c_r = ", p.c_r));
+    FFSR_THROW(NumericalError(str(where, ": damping factor f(c_r) = ", f_, " for c_r = ", p.c_r)));
   lambda_ = f_ * p.K / v0_;
   G0_ = detail::contact_G(f_, 0.0);
   // Eq. 25 written with G(0) = h(f)/f²: ζ = K^(1/(α+1)) ((α+1) δ̇⁻² G(0))^(α/(α+1)).
@@ -344,10 +344,10 @@ HertzDamped<Damping>::HertzDamped(const ContactParams& p, double approach_veloci
   // Finite inputs can still overflow the law's constants (an approach velocity of 1e200 m/s, or
   // K = 1e300 with a tiny approach velocity): an error, not a law that answers inf or NaN.
   if (!std::isfinite(lambda_) || !std::isfinite(zeta_))
-    throw NumericalError(
+    FFSR_THROW(NumericalError(
         str(where, ": the parameters overflow double precision (lambda = f K / approach velocity = ", lambda_,
             ", zeta = ", zeta_, " for K = ", p.K, ", alpha = ", p.alpha, ", approach velocity ",
-            approach_velocity, ")"));
+            approach_velocity, ")")));
 }
 
 template <class Damping>
@@ -358,8 +358,8 @@ double HertzDamped<Damping>::force(double delta, double delta_dot) const {
   const double P = std::pow(delta, p_.alpha);
   const double F = P == 0.0 ? 0.0 : P * g;  // δ^α underflowing to 0 times a huge g is 0, not NaN
   if (std::isinf(F) && std::isfinite(delta) && std::isfinite(delta_dot))
-    throw NumericalError(detail::str(name, ": the force overflows double precision at delta = ", delta,
-                                     " m, delta_dot = ", delta_dot, " m/s"));
+    FFSR_THROW(NumericalError(detail::str(name, ": the force overflows double precision at delta = ", delta,
+                                     " m, delta_dot = ", delta_dot, " m/s")));
   return F;
 }
 
@@ -375,8 +375,8 @@ double HertzDamped<Damping>::deformation(double M_ie, double delta_dot) const {
   const double s = delta_dot / v0_;
   const double G = (s >= -1.0 && s <= 1.0 && 1.0 + f_ * s > 0.0) ? detail::contact_G(f_, s) : -1.0;
   if (!(G >= 0.0))
-    throw InputError(detail::str(name, ": deformation: delta_dot = ", delta_dot,
-                                 " is not reached during a contact with approach velocity ", v0_));
+    FFSR_THROW(InputError(detail::str(name, ": deformation: delta_dot = ", delta_dot,
+                                 " is not reached during a contact with approach velocity ", v0_)));
   return detail::require_finite_result(delta_from_G(M_ie, G), name, "deformation", M_ie);
 }
 
@@ -409,9 +409,9 @@ ForcePeak HertzDamped<Damping>::exact_peak(double M_ie) const {
   pk.force = p_.K * std::pow(pk.deformation, p_.alpha) * (1.0 + f_ * s);
   // δ(t*) underflowing to 0 (a peak within ~1e-300 of first touch) would report F = 0: not an answer.
   if (!(pk.deformation > 0.0))
-    throw NumericalError(
+    FFSR_THROW(NumericalError(
         detail::str(name, ": the force peak is too close to first touch to be represented (f = ", f_,
-                    ", alpha = ", p_.alpha, ", M_ie = ", M_ie, " kg)"));
+                    ", alpha = ", p_.alpha, ", M_ie = ", M_ie, " kg)")));
   detail::require_finite_result(pk.deformation, name, "deformation at the force peak", M_ie);
   detail::require_finite_result(pk.force, name, "exact F_max", M_ie);
   return pk;
@@ -432,7 +432,7 @@ double HertzDamped<Damping>::relative_error() const {
   // + 0.0: at c_r = 1 (f = 0) the product is -0, which would print as "-0"; zero has no sign here
   const double xi = -100.0 * std::expm1(ln_ratio) + 0.0;
   if (!std::isfinite(xi))
-    throw NumericalError(detail::str(name, ": xi is not representable for f = ", f_, ", alpha = ", a));
+    FFSR_THROW(NumericalError(detail::str(name, ": xi is not representable for f = ", f_, ", alpha = ", a)));
   return xi;
 }
 
@@ -501,15 +501,15 @@ inline double approach_velocity(const Eigen::Vector3d& u, const Eigen::Vector3d&
   detail::require_finite_all(omega_t, where, "target angular velocity omega_t");
   detail::require_finite_all(r, where, "contact point offset r");
   if (std::abs(u.norm() - 1.0) > 1e-9)
-    throw InputError(detail::str(where, ": normal u must be a unit vector, |u| = ", u.norm()));
+    FFSR_THROW(InputError(detail::str(where, ": normal u must be a unit vector, |u| = ", u.norm())));
   const Eigen::Vector3d v_tp = v_t + omega_t.cross(r);  // Eq. 12
   const double v = u.dot(v_e - v_tp);
   // finite inputs whose products pass 1e308 (omega_t x r) give inf, or NaN from 0 * inf in the dot
   if (!std::isfinite(v)) {
     auto largest = [](const Eigen::Vector3d& x) { return x.cwiseAbs().maxCoeff(); };
-    throw NumericalError(detail::str(where, ": the relative velocity overflows double precision (largest ",
+    FFSR_THROW(NumericalError(detail::str(where, ": the relative velocity overflows double precision (largest ",
                                      "entries: v_e ", largest(v_e), ", v_t ", largest(v_t), ", omega_t ",
-                                     largest(omega_t), ", r ", largest(r), ")"));
+                                     largest(omega_t), ", r ", largest(r), ")")));
   }
   return v;
 }
@@ -517,11 +517,11 @@ inline double approach_velocity(const Eigen::Vector3d& u, const Eigen::Vector3d&
 inline double model_accuracy(double F_model, double F_exact) {
   detail::require_finite(F_model, "model_accuracy", "F_model");
   if (!(F_exact > 0.0) || !std::isfinite(F_exact))
-    throw InputError(detail::str("model_accuracy: F_exact must be positive and finite, got ", F_exact));
+    FFSR_THROW(InputError(detail::str("model_accuracy: F_exact must be positive and finite, got ", F_exact)));
   const double accuracy = (1.0 - std::abs(F_model - F_exact) / F_exact) * 100.0;  // Eq. 32
   if (!std::isfinite(accuracy))  // |F_model - F_exact| / F_exact overflows, e.g. F_exact = 1e-310 N
-    throw NumericalError(detail::str("model_accuracy: the accuracy is not representable for F_model = ",
-                                     F_model, ", F_exact = ", F_exact));
+    FFSR_THROW(NumericalError(detail::str("model_accuracy: the accuracy is not representable for F_model = ",
+                                     F_model, ", F_exact = ", F_exact)));
   return accuracy;
 }
 

@@ -239,9 +239,9 @@ class CaptureController {
       fault(out, f, bad);
       return;
     }
-    try {
+    FFSR_TRY {
       c.field(t, state.base, state.theta, out.theta_dot, out.base_velocity);
-    } catch (...) {
+    } FFSR_CATCH(...) {
       fault(out, ControlFault::Numerical, -1);
       return;
     }
@@ -279,7 +279,7 @@ class CaptureController {
     int bad = -1;
     const ControlFault f = detail::check_estimate(estimate, c.copt.quaternion_tolerance, bad);
     if (f != ControlFault::None) return f;
-    try {
+    FFSR_TRY {
       Target now = c.pb.target;
       now.position = estimate.position;
       now.attitude = estimate.attitude.normalized();
@@ -300,7 +300,7 @@ class CaptureController {
       s.line.a0 = ad;
       s.line.start = t;
       s.line.x_cap = s.capture.x_cap;
-    } catch (...) {
+    } FFSR_CATCH(...) {
       return ControlFault::Numerical;
     }
     return ControlFault::None;
@@ -346,10 +346,10 @@ class CaptureController {
           n(pb_.model->n()),
           field(pb, task, opt, setup, policy) {
       if (!(copt.quaternion_tolerance > 0 && copt.quaternion_tolerance < 1))
-        throw InputError("CaptureController: quaternion tolerance must be in (0, 1)");
+        FFSR_THROW(InputError("CaptureController: quaternion tolerance must be in (0, 1)"));
       if (copt.prediction_window < 1 || copt.prediction_window > 100000)
-        throw InputError(detail::str("CaptureController: prediction window must be in 1..100000, got ",
-                                     copt.prediction_window));
+        FFSR_THROW(InputError(detail::str("CaptureController: prediction window must be in 1..100000, got ",
+                                     copt.prediction_window)));
       points.assign(static_cast<size_t>(copt.prediction_window), Vector3::Zero());
       normals.assign(static_cast<size_t>(copt.prediction_window), Vector3::Zero());
       presize(policy, n);
@@ -363,10 +363,10 @@ class CaptureController {
     static void presize(GradientPolicy& p, int n) { p.grad = Eigen::VectorXd::Zero(n); }
     static void presize(ServoPolicy& p, int n) {
       if (p.theta_goal.size() != 0 && p.theta_goal.size() != n)
-        throw InputError(detail::str("CaptureController: the servo goal has ", p.theta_goal.size(),
-                                     " joints, the robot ", n));
+        FFSR_THROW(InputError(detail::str("CaptureController: the servo goal has ", p.theta_goal.size(),
+                                     " joints, the robot ", n)));
       if (p.theta_goal.size() != 0 && !p.theta_goal.allFinite())
-        throw InputError("CaptureController: the servo goal is not finite");
+        FFSR_THROW(InputError("CaptureController: the servo goal is not finite"));
       p.err = Eigen::VectorXd::Zero(n);
     }
   };

@@ -176,13 +176,13 @@ inline void check_detumble(const Model& stack, const DetumbleLimits& l, const De
                            const char* where) {
   auto positive = [&](double x, const char* what) {
     if (!detumble_bound_ok(x))
-      throw InputError(str(where, ": ", what, " must be positive and finite, got ", x));
+      FFSR_THROW(InputError(str(where, ": ", what, " must be positive and finite, got ", x)));
   };
   require_size(l.joint_torque.size(), stack.n(), where, "joint torque limits");
   for (int k = 0; k < stack.n(); ++k)
     if (!detumble_bound_ok(l.joint_torque(k)))
-      throw InputError(str(where, ": the torque limit of joint '", stack.joint(k).name,
-                           "' must be positive and finite, got ", l.joint_torque(k)));
+      FFSR_THROW(InputError(str(where, ": the torque limit of joint '", stack.joint(k).name,
+                           "' must be positive and finite, got ", l.joint_torque(k))));
   if (l.actuator == BaseActuator::ReactionWheels) {
     positive(l.wheel_torque, "the reaction wheels' torque");
     positive(l.wheel_momentum, "the reaction wheels' momentum");
@@ -192,7 +192,7 @@ inline void check_detumble(const Model& stack, const DetumbleLimits& l, const De
   }
   auto gripper = [&](double x, const char* what) {
     if (std::isnan(x) || !(x > 0))
-      throw InputError(str(where, ": ", what, " must be positive (infinity: not limited), got ", x));
+      FFSR_THROW(InputError(str(where, ": ", what, " must be positive (infinity: not limited), got ", x)));
   };
   gripper(l.gripper_force, "the gripper's force limit");
   gripper(l.gripper_moment, "the gripper's moment limit");
@@ -200,9 +200,9 @@ inline void check_detumble(const Model& stack, const DetumbleLimits& l, const De
   positive(o.max_base_decay, "the largest decay rate of the stack's momentum");
   positive(o.rest_rate, "the rest rate");
   if (o.stop_stack_spin && l.actuator == BaseActuator::None)
-    throw InputError(str(where,
+    FFSR_THROW(InputError(str(where,
                          ": the stack's spin cannot be stopped without a base actuator: its total "
-                         "angular momentum is conserved (name reaction wheels or thrusters)"));
+                         "angular momentum is conserved (name reaction wheels or thrusters)")));
 }
 
 /// Narrows [lo, hi] to the lambdas with |a + lambda b| <= L (lo > hi: none).
@@ -268,10 +268,10 @@ class DetumbleController {
         full_llt_(stack.nv()) {
     detail::check_detumble(stack, limits, options, "DetumbleController");
     if (!std::isfinite(tick) || !(tick > 0))
-      throw InputError(detail::str("DetumbleController: the tick must be positive and finite, got ", tick));
+      FFSR_THROW(InputError(detail::str("DetumbleController: the tick must be positive and finite, got ", tick)));
     if (gripper < 0 || gripper >= static_cast<int>(stack.frames().size()))
-      throw InputError(detail::str("DetumbleController: frame index ", gripper, " out of range"));
-    if (stack.nb() - 1 != stack.n()) throw InputError("DetumbleController: the model has mimic joints");
+      FFSR_THROW(InputError(detail::str("DetumbleController: frame index ", gripper, " out of range")));
+    if (stack.nb() - 1 != stack.n()) FFSR_THROW(InputError("DetumbleController: the model has mimic joints"));
     detail::check_attached_body(body);
     const Frame& f = stack.frame(gripper);
     body_index_ = f.body;
@@ -322,12 +322,12 @@ class DetumbleController {
   void step(const DetumbleState& s, DetumbleCommand& out) noexcept {
     const DetumbleFault f = check(s, out);
     if (f != DetumbleFault::None) return fault(out, f);
-    try {
+    FFSR_TRY {
       crba(*model_, data_, s.base, s.theta);
       base_wrench(s, out);
       const bool saturated = joint_torques(s, out);
       rates(s, saturated, out);
-    } catch (...) {
+    } FFSR_CATCH(...) {
       return fault(out, DetumbleFault::Numerical);
     }
     if (!out.tau.allFinite() || !out.base_wrench.allFinite()) return fault(out, DetumbleFault::Numerical);

@@ -1,11 +1,13 @@
 // ffsr/control/detumble_plan.hpp -- a post-capture plan (the time-optimal planner's result,
-// control/detumble_planner.hpp) and its independent check: the plan's controls, each held over its
-// interval as planned, re-run by CVODE on the stack's full dynamics (ABA), then the detumbling
-// controller holding the stack for the dwell. Needs SUNDIALS only (the planner needs IPOPT).
+// control/detumble_planner.hpp): its nodes and each interval's controls, the command of an interval,
+// and the check of a plan's shape. Part of the onboard core (Eigen only): the plan-tracking controller
+// (control/detumble_tracker.hpp) takes one; its re-run by CVODE is control/detumble_replay.hpp.
 #pragma once
 
-#include "ffsr/control/detumble_run.hpp"
+#include "ffsr/control/detumble_controller.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -46,43 +48,25 @@ inline void plan_command(const DetumblePlan& plan, int k, const Quaternion& base
   c.base_wrench << R * w.head<3>(), R * w.tail<3>();
 }
 
-/// The plan re-run (replay_detumble_plan): the series (one sample per tick, the plan's end, then the
-/// dwell under the detumbling controller) and its summary; at_rest and time_to_rest are the rest test
-/// at the plan's end T (every rate, and with stop_stack_spin the base's twist, at most rest_rate).
-struct DetumblePlanRun : DetumbleRunResult {
-  double end_joint_rate = 0;    ///< largest |qd| at T
-  double end_base_rate = 0;     ///< |angular velocity of the base| at T
-  double end_base_speed = 0;    ///< |velocity of the base origin| at T
-  double end_relative_rate = 0; ///< |angular velocity of the gripper relative to the base| at T
-  /// the largest excess over the bounds along the re-run's samples (joint torque, actuator per axis,
-  /// wheel momentum per axis, gripper force and moment): <= 0 when every bound holds
-  double worst_bound_excess = 0;
-};
-
 namespace detail {
 
-/// The rates of the state y (the command's joint_rate, relative_rate, stack_rate fields) and the rest
-/// test; the model's kinematics at y must be current in `d`.
-inline void plan_rates(const Model& stack, Data& d, int gripper, const Eigen::VectorXd& v,
-                       DetumbleCommand& c) {
-  const int n = stack.n();
-  frame_jacobian(stack, d, gripper);
-  c.joint_rate = n > 0 ? v.tail(n).cwiseAbs().maxCoeff() : 0.0;
-  c.relative_rate = (d.J.bottomRows<3>().rightCols(n) * v.tail(n)).norm();
-  c.stack_rate = v.segment<3>(3).norm();
+/// Throws InputError naming `w` unless the plan has N >= 1 intervals of a positive finite duration, N + 1
+/// nodes, N finite joint torques of the stack's size and N finite base wrenches.
+inline void check_detumble_plan(const Model& stack, const DetumblePlan& plan, const char* w) {
+  const int N = plan.intervals();
+  if (N < 1) FFSR_THROW(InputError(str(w, ": the plan has no interval")));
+  if (!std::isfinite(plan.duration) || !(plan.duration > 0))
+    FFSR_THROW(InputError(str(w, ": the plan's duration must be positive and finite, got ", plan.duration)));
+  if (plan.nodes.size() != static_cast<size_t>(N) + 1 || plan.base_wrench.size() != static_cast<size_t>(N))
+    FFSR_THROW(InputError(str(w, ": the plan needs N + 1 nodes and N base wrenches for its N = ", N,
+                         " intervals, got ", plan.nodes.size(), " and ", plan.base_wrench.size())));
+  for (int k = 0; k < N; ++k) {
+    require_size(plan.tau[static_cast<size_t>(k)].size(), stack.n(), w, "the plan's joint torques");
+    require_finite_all(plan.tau[static_cast<size_t>(k)], w, "the plan's joint torques");
+    require_finite_all(plan.base_wrench[static_cast<size_t>(k)], w, "the plan's base wrench");
+  }
 }
 
 }  // namespace detail
 
-/// Re-runs `plan` from its start node: CVODE on the stack's full dynamics (ABA) with each interval's
-/// controls held (the joint torques, the actuator's wrench in the base frame, plan_command), a sample
-/// every `run.tick` and at T; then, for `run.dwell`, the detumbling controller under `limits` and
-/// `options` holding the stack. The summary's bounds are measured on the samples. InputError for a bad
-/// plan or options; IntegrationError from CVODE.
-inline DetumblePlanRun replay_detumble_plan(const Model& stack, int gripper, const AttachedBody& body,
-                                            const DetumblePlan& plan, const DetumbleLimits& limits,
-                                            const DetumbleOptions& options, const DetumbleRunOptions& run);
-
 }  // namespace ffsr
-
-#include "ffsr/control/detail/detumble_plan.hxx"

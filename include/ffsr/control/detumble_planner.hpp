@@ -24,7 +24,7 @@
 // Component ffsr::plan (IPOPT, Debian coinor-libipopt-dev).
 #pragma once
 
-#include "ffsr/control/detumble_plan.hpp"
+#include "ffsr/control/detumble_replay.hpp"
 #include "ffsr/detail/parallel.hpp"
 
 #include <IpIpoptApplication.hpp>

@@ -8,7 +8,6 @@
 
 #include "ffsr/control/detumble_controller.hpp"
 #include "ffsr/control/detumble_plan.hpp"
-#include "ffsr/control/detumble_run.hpp"
 
 #include "ffsr/algorithm/aba.hpp"
 
@@ -42,12 +41,12 @@ class DetumblePlanTracker {
     detail::check_detumble_plan(stack, plan, "DetumblePlanTracker");
     for (const DetumbleState& x : plan.nodes)
       if (x.v.size() != stack.nv())
-        throw InputError("DetumblePlanTracker: the plan's states are not of this stack");
+        FFSR_THROW(InputError("DetumblePlanTracker: the plan's states are not of this stack"));
     if (plan.interval() < tick * (1 - 1e-9))
-      throw InputError(detail::str("DetumblePlanTracker: the plan's intervals (", plan.interval(),
+      FFSR_THROW(InputError(detail::str("DetumblePlanTracker: the plan's intervals (", plan.interval(),
                                    " s) are shorter than the tick (", tick,
                                    " s): a command held over a tick cannot follow them (plan with fewer "
-                                   "intervals, or tick faster)"));
+                                   "intervals, or tick faster)")));
     for (const DetumbleState& x : plan.nodes)
       peak_rate_ = std::max(peak_rate_, x.v.tail(stack.n()).cwiseAbs().maxCoeff());
     // each interval's accelerations at its ends under its controls (ABA), for the reference
@@ -153,21 +152,5 @@ class DetumblePlanTracker {
   double peak_rate_ = 0, band_ = 0;
   bool fell_back_ = false;
 };
-
-/// The post-capture run (run_detumble's: CVODE on the stack's ABA, the command held over each tick, the
-/// dwell after the first tick at rest) with DetumblePlanTracker following `plan` from `start` (the plan's
-/// start). Its errors are run_detumble's.
-inline DetumbleRunResult run_detumble_tracking(const Model& stack, int gripper, const AttachedBody& body,
-                                               const DetumbleState& start, const DetumblePlan& plan,
-                                               const DetumbleLimits& limits, const DetumbleOptions& options,
-                                               const DetumbleRunOptions& run) {
-  detail::check_detumble_run(stack, gripper, body, start, run);
-  detail::check_detumble(stack, limits, options, "run_detumble_tracking");
-  check_detumble_tick(stack, gripper, start, run.tick);
-  DetumblePlanTracker tracker(stack, gripper, body, plan, limits, options, run.tick);
-  return detail::run_detumble_loop(
-      stack, gripper, body, start, limits, options, run, tracker.make_command(),
-      [&](const DetumbleState& s, double t, DetumbleCommand& c) { tracker.step(s, t, c); });
-}
 
 }  // namespace ffsr

@@ -24,24 +24,24 @@ namespace detail {
 inline void check_attached_body(const AttachedBody& b) {
   const char* w = "attach_body";
   if (!std::isfinite(b.mass) || !(b.mass > 0))
-    throw InputError(str(w, ": the attached mass must be positive and finite, got ", b.mass));
+    FFSR_THROW(InputError(str(w, ": the attached mass must be positive and finite, got ", b.mass)));
   require_finite_all(b.inertia, w, "inertia");
   require_finite_all(b.pose.p, w, "pose position");
   require_finite_all(b.pose.R, w, "pose rotation");
   const double scale = b.inertia.cwiseAbs().maxCoeff();
   if ((b.inertia - b.inertia.transpose()).cwiseAbs().maxCoeff() > 1e-12 * scale)
-    throw InputError(str(w, ": the attached inertia must be symmetric"));
+    FFSR_THROW(InputError(str(w, ": the attached inertia must be symmetric")));
   Eigen::SelfAdjointEigenSolver<Matrix3> es(b.inertia, Eigen::EigenvaluesOnly);
-  const Vector3 e = es.eigenvalues();
+  const Vector3& e = es.eigenvalues();
   if (!(scale > 0) || !(e(0) > 1e-12 * scale))
-    throw InputError(str(w, ": the attached inertia must be positive definite, principal moments (", e(0),
-                         ", ", e(1), ", ", e(2), ")"));
+    FFSR_THROW(InputError(str(w, ": the attached inertia must be positive definite, principal moments (", e(0),
+                         ", ", e(1), ", ", e(2), ")")));
   if (e(2) > (e(0) + e(1)) * (1 + 1e-9))
-    throw InputError(str(w, ": the attached inertia's principal moments (", e(0), ", ", e(1), ", ", e(2),
-                         ") break the triangle inequality"));
+    FFSR_THROW(InputError(str(w, ": the attached inertia's principal moments (", e(0), ", ", e(1), ", ", e(2),
+                         ") break the triangle inequality")));
   if ((b.pose.R.transpose() * b.pose.R - Matrix3::Identity()).cwiseAbs().maxCoeff() > 1e-9 ||
       b.pose.R.determinant() < 0)
-    throw InputError(str(w, ": the pose rotation is not a proper rotation matrix"));
+    FFSR_THROW(InputError(str(w, ": the pose rotation is not a proper rotation matrix")));
 }
 
 }  // namespace detail
@@ -56,16 +56,18 @@ inline Model attach_body(const Model& model, const std::string& frame, const Att
   using detail::str;
   detail::check_attached_body(body);
   int fi = -1;
-  try {
-    fi = model.frame_index(frame);
-  } catch (const InputError& e) {
-    throw InputError(str("attach_body: ", e.what()));
+  for (size_t i = 0; i < model.frames().size() && fi < 0; ++i)
+    if (model.frames()[i].name == frame) fi = static_cast<int>(i);
+  if (fi < 0) {
+    std::string list;
+    for (const Frame& f : model.frames()) list += (list.empty() ? "" : ", ") + f.name;
+    FFSR_THROW(InputError(str("attach_body: unknown frame '", frame, "'; the model has: ", list)));
   }
   for (const Frame& f : model.frames())
     if (f.name == body.name)
-      throw InputError(str("attach_body: the model already has a frame '", body.name, "'"));
+      FFSR_THROW(InputError(str("attach_body: the model already has a frame '", body.name, "'")));
   Model m = model;
-  const Frame at = model.frame(fi);
+  const Frame& at = model.frame(fi);
   const Pose com = at.pose * body.pose;  // the body's centre-of-mass frame in the carrying body's frame
   const Inertia in{body.mass, com.p, com.R * body.inertia * com.R.transpose()};
   Inertia& carrier = m.bodies_[static_cast<size_t>(at.body)].inertia;

@@ -94,21 +94,21 @@ struct Frame {
 inline void validate_inertia(const Inertia& in, const std::string& what, bool require_positive_mass) {
   using detail::str;
   if (!std::isfinite(in.mass) || !in.com.allFinite() || !in.I.allFinite())
-    throw ModelError(str(what, ": inertial values must be finite"));
+    FFSR_THROW(ModelError(str(what, ": inertial values must be finite")));
   if (in.mass < 0 || (require_positive_mass && in.mass <= 0))
-    throw ModelError(str(what, ": mass must be positive, got ", in.mass));
+    FFSR_THROW(ModelError(str(what, ": mass must be positive, got ", in.mass)));
   const double scale = std::max(1.0, in.I.cwiseAbs().maxCoeff());
   if ((in.I - in.I.transpose()).cwiseAbs().maxCoeff() > 1e-12 * scale)
-    throw ModelError(str(what, ": inertia matrix is not symmetric"));
+    FFSR_THROW(ModelError(str(what, ": inertia matrix is not symmetric")));
   Eigen::SelfAdjointEigenSolver<Matrix3> es(in.I, Eigen::EigenvaluesOnly);
-  const Vector3 e = es.eigenvalues();
+  const Vector3& e = es.eigenvalues();
   const double tol = 1e-9 * scale;
   if (e.minCoeff() < -tol)
-    throw ModelError(str(what, ": inertia matrix is not positive semi-definite (smallest principal moment ",
-                         e.minCoeff(), ")"));
+    FFSR_THROW(ModelError(str(what, ": inertia matrix is not positive semi-definite (smallest principal moment ",
+                         e.minCoeff(), ")")));
   if (e(2) > e(0) + e(1) + tol)
-    throw ModelError(
-        str(what, ": principal moments (", e(0), ", ", e(1), ", ", e(2), ") break the triangle inequality"));
+    FFSR_THROW(ModelError(
+        str(what, ": principal moments (", e(0), ", ", e(1), ", ", e(2), ") break the triangle inequality")));
 }
 
 namespace detail {
@@ -205,7 +205,7 @@ class Model {
       if (frames_[i].name == name) return static_cast<int>(i);
     std::string list;
     for (const auto& f : frames_) list += (list.empty() ? "" : ", ") + f.name;
-    throw InputError(detail::str("unknown frame '", name, "'; the model has: ", list));
+    FFSR_THROW(InputError(detail::str("unknown frame '", name, "'; the model has: ", list)));
   }
   /// The default end-effector frame (the single leaf, or the one set by the builder).
   int end_effector() const { return end_effector_; }
@@ -265,12 +265,12 @@ class ModelBuilder {
     check_new_name(child, name);
     check_pose(origin, "joint '" + name + "' origin");
     if (!axis.allFinite() || axis.norm() < 1e-12)
-      throw ModelError(str("joint '", name, "': axis must be a finite non-zero vector"));
+      FFSR_THROW(ModelError(str("joint '", name, "': axis must be a finite non-zero vector")));
     if (std::isnan(lower) || std::isnan(upper) || lower > upper)
-      throw ModelError(
-          str("joint '", name, "': limits must satisfy lower <= upper, got [", lower, ", ", upper, "]"));
+      FFSR_THROW(ModelError(
+          str("joint '", name, "': limits must satisfy lower <= upper, got [", lower, ", ", upper, "]")));
     if (!(effort >= 0) || !std::isfinite(effort))
-      throw ModelError(str("joint '", name, "': effort must be finite and >= 0, got ", effort));
+      FFSR_THROW(ModelError(str("joint '", name, "': effort must be finite and >= 0, got ", effort)));
     validate_inertia(inertia, "link '" + child + "'", false);
     Body b;
     b.name = child;
@@ -310,7 +310,7 @@ class ModelBuilder {
   /// at a link origin): build() adds the frame "<end-effector>_contact" there, on the same body, and
   /// makes it the end-effector, so every quantity of the end-effector (J_f, m_e, M_ie) uses it.
   ModelBuilder& set_end_effector_offset(const Vector3& xyz) {
-    if (!xyz.allFinite()) throw InputError("end-effector-offset: expected 3 finite numbers");
+    if (!xyz.allFinite()) FFSR_THROW(InputError("end-effector-offset: expected 3 finite numbers"));
     ee_offset_ = xyz;
     has_ee_offset_ = true;
     return *this;
@@ -322,7 +322,7 @@ class ModelBuilder {
   ModelBuilder& set_mimic(const std::string& follower, const std::string& leader, double multiplier,
                           double offset) {
     if (!std::isfinite(multiplier) || !std::isfinite(offset))
-      throw ModelError(detail::str("mimic joint '", follower, "': multiplier and offset must be finite"));
+      FFSR_THROW(ModelError(detail::str("mimic joint '", follower, "': multiplier and offset must be finite")));
     mimic_.push_back({follower, leader, multiplier, offset});
     return *this;
   }
@@ -332,7 +332,7 @@ class ModelBuilder {
   Model build() const {
     using detail::str;
     Model m = model_;
-    if (m.nb() < 2) throw ModelError("the robot has no moving joint");
+    if (m.nb() < 2) FFSR_THROW(ModelError("the robot has no moving joint"));
     resolve_mimics(m);
     validate_inertia(m.bodies_[0].inertia, "base link '" + m.bodies_[0].name + "'", true);
     for (int i = 1; i <= m.n(); ++i)
@@ -344,8 +344,8 @@ class ModelBuilder {
       if (leaves.size() != 1) {
         std::string list;
         for (const auto& l : leaves) list += (list.empty() ? "" : ", ") + l;
-        throw InputError(str("the end-effector is ambiguous: the tree has ", leaves.size(), " leaf links (",
-                             list, "); name one"));
+        FFSR_THROW(InputError(str("the end-effector is ambiguous: the tree has ", leaves.size(), " leaf links (",
+                             list, "); name one")));
       }
       m.end_effector_ = m.frame_index(leaves.front());
     }
@@ -353,11 +353,28 @@ class ModelBuilder {
       const Frame ee = m.frames_[static_cast<size_t>(m.end_effector_)];
       const std::string name = ee.name + "_contact";
       for (const auto& f : m.frames_)
-        if (f.name == name) throw ModelError(str("end-effector-offset: a frame '", name, "' already exists"));
+        if (f.name == name) FFSR_THROW(ModelError(str("end-effector-offset: a frame '", name, "' already exists")));
       m.frames_.push_back({name, ee.body, ee.pose * Pose{ee_offset_, Matrix3::Identity()}});
       m.end_effector_ = static_cast<int>(m.frames_.size()) - 1;
     }
     m.kin_.clear();
+    for (const Body& b : m.bodies_) m.kin_.push_back(detail::joint_kinematics(b));
+    number_subtrees(m);
+    return m;
+  }
+
+  /// The model whose bodies(), frames(), end_effector() and gravity are these, as another Model held
+  /// them: the way back from a serialized model (control/onboard_blob.hpp), exact to the bit (nothing
+  /// is renormalized or merged again). The parts are taken as they are; their reader checks their
+  /// shape (each parent before its child, frames on existing bodies, leaders naming a joint).
+  static Model assemble(std::vector<Body> bodies, std::vector<Frame> frames, int end_effector,
+                        const Vector3& gravity) {
+    Model m;
+    m.bodies_ = std::move(bodies);
+    m.frames_ = std::move(frames);
+    m.end_effector_ = end_effector;
+    m.gravity = gravity;
+    number_coordinates(m);
     for (const Body& b : m.bodies_) m.kin_.push_back(detail::joint_kinematics(b));
     number_subtrees(m);
     return m;
@@ -369,7 +386,7 @@ class ModelBuilder {
     return *this;
   }
   ModelBuilder& set_gravity(const Vector3& g) {
-    if (!g.allFinite()) throw InputError("gravity must be finite");
+    if (!g.allFinite()) FFSR_THROW(InputError("gravity must be finite"));
     model_.gravity = g;
     return *this;
   }
@@ -393,16 +410,16 @@ class ModelBuilder {
   Frame find_parent(const std::string& parent, const std::string& joint) const {
     for (const auto& f : model_.frames_)
       if (f.name == parent) return f;
-    throw ModelError(detail::str("joint '", joint, "': unknown parent link '", parent, "'"));
+    FFSR_THROW(ModelError(detail::str("joint '", joint, "': unknown parent link '", parent, "'")));
   }
   void check_new_name(const std::string& child, const std::string& joint) const {
     for (const auto& f : model_.frames_)
       if (f.name == child)
-        throw ModelError(detail::str("joint '", joint, "': link '", child,
-                                     "' already has a parent (closed loop or duplicate link)"));
+        FFSR_THROW(ModelError(detail::str("joint '", joint, "': link '", child,
+                                     "' already has a parent (closed loop or duplicate link)")));
   }
   static void check_pose(const Pose& p, const std::string& what) {
-    if (!p.p.allFinite() || !p.R.allFinite()) throw ModelError(what + ": values must be finite");
+    if (!p.p.allFinite() || !p.R.allFinite()) FFSR_THROW(ModelError(what + ": values must be finite"));
   }
   std::vector<std::string> leaf_frames(const Model& m) const {
     // A leaf is a link frame that is no other link's parent (fixed children count as children).
@@ -446,15 +463,15 @@ class ModelBuilder {
     double mult = 1.0, off = 0.0;
     for (const MimicSpec* s = mimic_of(b.joint.name); s; s = mimic_of(chain.back())) {
       if (body_of_joint(m, s->leader) < 0)
-        throw ModelError(str("mimic joint '", s->follower, "': its leader '", s->leader,
-                             "' is not a moving joint of the model"));
+        FFSR_THROW(ModelError(str("mimic joint '", s->follower, "': its leader '", s->leader,
+                             "' is not a moving joint of the model")));
       off += mult * s->offset;  // q_f = mult * (m q_l + o) + off
       mult *= s->multiplier;
       for (const auto& c : chain)
         if (c == s->leader) {
           std::string loop;
           for (const auto& x : chain) loop += "'" + x + "' -> ";
-          throw ModelError(str("mimic joints form a loop: ", loop, "'", s->leader, "'"));
+          FFSR_THROW(ModelError(str("mimic joints form a loop: ", loop, "'", s->leader, "'")));
         }
       chain.push_back(s->leader);
     }
@@ -484,7 +501,7 @@ class ModelBuilder {
   void resolve_mimics(Model& m) const {
     for (const auto& s : mimic_)
       if (body_of_joint(m, s.follower) < 0)
-        throw ModelError(detail::str("mimic joint '", s.follower, "': not a moving joint of the model"));
+        FFSR_THROW(ModelError(detail::str("mimic joint '", s.follower, "': not a moving joint of the model")));
     for (int i = 1; i < m.nb(); ++i) resolve_mimic_chain(m, i);
     number_coordinates(m);
   }

@@ -15,7 +15,7 @@ namespace detail {
 /// passed double precision, or inputs that were not finite).
 inline Vector3 finite_result(const Vector3& v, const char* where) {
   if (!v.allFinite())
-    throw NumericalError(str(where, ": the result is not finite (", v.transpose(), ")"));
+    FFSR_THROW(NumericalError(str(where, ": the result is not finite (", v.transpose(), ")")));
   return v;
 }
 }  // namespace detail
@@ -36,7 +36,7 @@ struct Target {
   void validate(const char* where = "target") const {
     using detail::str;
     if (!std::isfinite(mass) || mass <= 0)
-      throw InputError(str(where, ": mass must be positive and finite, got ", mass));
+      FFSR_THROW(InputError(str(where, ": mass must be positive and finite, got ", mass)));
     detail::require_finite_all(inertia, where, "inertia");
     detail::require_finite_all(position, where, "position");
     detail::require_finite_all(attitude.coeffs(), where, "attitude");
@@ -44,25 +44,25 @@ struct Target {
     detail::require_finite_all(angular_velocity, where, "angular velocity");
     detail::require_finite_all(contact_offset, where, "contact offset");
     detail::require_finite_all(normal, where, "normal");
-    if (attitude.norm() < 1e-9) throw InputError(str(where, ": attitude quaternion has zero norm"));
-    if (normal.norm() < 1e-12) throw InputError(str(where, ": normal must be a non-zero vector"));
+    if (attitude.norm() < 1e-9) FFSR_THROW(InputError(str(where, ": attitude quaternion has zero norm")));
+    if (normal.norm() < 1e-12) FFSR_THROW(InputError(str(where, ": normal must be a non-zero vector")));
     const double scale = inertia.cwiseAbs().maxCoeff();
     if ((inertia - inertia.transpose()).cwiseAbs().maxCoeff() > 1e-12 * scale)
-      throw InputError(str(where, ": inertia must be symmetric"));
+      FFSR_THROW(InputError(str(where, ": inertia must be symmetric")));
     Eigen::SelfAdjointEigenSolver<Matrix3> es(inertia, Eigen::EigenvaluesOnly);
-    const Vector3 e = es.eigenvalues();
+    const Vector3& e = es.eigenvalues();
     if (!(e(0) > 1e-12 * scale) || !(scale > 0))
-      throw InputError(str(where, ": inertia must be positive definite, principal moments (", e(0), ", ",
-                           e(1), ", ", e(2), ")"));
+      FFSR_THROW(InputError(str(where, ": inertia must be positive definite, principal moments (", e(0), ", ",
+                           e(1), ", ", e(2), ")")));
     if (e(2) > (e(0) + e(1)) * (1 + 1e-9))
-      throw InputError(str(where, ": principal moments (", e(0), ", ", e(1), ", ", e(2),
-                           ") break the triangle inequality"));
+      FFSR_THROW(InputError(str(where, ": principal moments (", e(0), ", ", e(1), ", ", e(2),
+                           ") break the triangle inequality")));
     // A positive but denormal mass or inertia (1e-312 kg) has an inverse that overflows: Eq. 14 would
     // give M_ie = 0.
     const double inv = inverse_mass_along_normal();
     if (!std::isfinite(inv))
-      throw InputError(str(where, ": mass ", mass, " kg and inertia (smallest principal moment ", e(0),
-                           ") are too small: the inverse mass along the normal is ", inv));
+      FFSR_THROW(InputError(str(where, ": mass ", mass, " kg and inertia (smallest principal moment ", e(0),
+                           ") are too small: the inverse mass along the normal is ", inv)));
   }
   /// oR_t.
   Matrix3 rotation() const { return attitude.normalized().toRotationMatrix(); }
@@ -133,7 +133,7 @@ inline void euler_rate(const Matrix3& I, const Matrix3& Iinv, const double* w, d
 /// InputError for a t that is not finite or too long a span; NumericalError when the motion of
 /// finite values passes double precision.
 inline Target propagate_target(const Target& t0, double t) {
-  if (!std::isfinite(t)) throw InputError(detail::str("propagate_target: time must be finite, got ", t));
+  if (!std::isfinite(t)) FFSR_THROW(InputError(detail::str("propagate_target: time must be finite, got ", t)));
   Target t1 = t0;
   t1.position = detail::finite_result(Vector3(t0.position + t0.velocity * t), "propagate_target: position");
   const Matrix3 I = t0.inertia;
@@ -148,7 +148,7 @@ inline Target propagate_target(const Target& t0, double t) {
   }
   const Matrix3 Iinv = detail::inverse3(I);
   const double steps = std::ceil(std::abs(t) / 1e-3);
-  if (steps > 1e8) throw InputError("propagate_target: time span too long");
+  if (steps > 1e8) FFSR_THROW(InputError("propagate_target: time span too long"));
   const long nsteps = std::max<long>(1, static_cast<long>(steps));
   const double h = t / static_cast<double>(nsteps), hh = 0.5 * h, h6 = h / 6;
   Matrix3 R = t0.rotation();
@@ -168,8 +168,8 @@ inline Target propagate_target(const Target& t0, double t) {
     for (int i = 0; i < 3; ++i) w[i] = wn[i];
   }
   if (!R.allFinite() || !Vector3(w[0], w[1], w[2]).allFinite())  // a spin whose products overflow
-    throw NumericalError(detail::str("propagate_target: the rotation is not finite after ", t,
-                                     " s (angular velocity ", t0.angular_velocity.transpose(), " rad/s)"));
+    FFSR_THROW(NumericalError(detail::str("propagate_target: the rotation is not finite after ", t,
+                                     " s (angular velocity ", t0.angular_velocity.transpose(), " rad/s)")));
   t1.attitude = detail::quaternion_from_rotation(R);
   t1.angular_velocity = Vector3(w[0], w[1], w[2]);
   return t1;

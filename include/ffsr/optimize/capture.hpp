@@ -59,17 +59,17 @@ namespace detail {
 /// The errors of plan_capture on the problem, task and options (messages start with `where`).
 inline void check_capture_input(const CaptureProblem& pb, const CaptureTask& task, const CaptureOptions& opt,
                                 const char* where) {
-  if (!pb.model) throw InputError(str(where, ": no model"));
+  if (!pb.model) FFSR_THROW(InputError(str(where, ": no model")));
   const Model& model = *pb.model;
   const int n = model.n();
   detail::check_configuration(model, pb.base, pb.theta, where);
   if (pb.frame < 0 || pb.frame >= static_cast<int>(model.frames().size()))
-    throw InputError(str(where, ": end-effector frame out of range"));
+    FFSR_THROW(InputError(str(where, ": end-effector frame out of range")));
   pb.target.validate(str(where, ": target").c_str());
   validate(pb.contact, where);
   auto positive = [&](double x, const char* what) {
     if (!std::isfinite(x) || x <= 0)
-      throw InputError(str(where, ": ", what, " must be positive and finite, got ", x));
+      FFSR_THROW(InputError(str(where, ": ", what, " must be positive and finite, got ", x)));
   };
   positive(opt.duration, "duration");
   positive(opt.step, "step");
@@ -78,19 +78,19 @@ inline void check_capture_input(const CaptureProblem& pb, const CaptureTask& tas
   positive(opt.singular_value_threshold, "singular value threshold");
   detail::require_finite(opt.gain, where, "gain rho");
   detail::require_finite(opt.feedback, where, "feedback gain");
-  if (opt.feedback < 0) throw InputError(str(where, ": feedback gain must be >= 0"));
+  if (opt.feedback < 0) FFSR_THROW(InputError(str(where, ": feedback gain must be >= 0")));
   if (!std::isfinite(opt.max_joint_rate) || opt.max_joint_rate < 0)
-    throw JointRateLimitError(
-        str(where, ": max joint rate must be >= 0 (0: not limited), got ", opt.max_joint_rate));
+    FFSR_THROW(JointRateLimitError(
+        str(where, ": max joint rate must be >= 0 (0: not limited), got ", opt.max_joint_rate)));
   if (opt.duration / opt.step > 1e7)
-    throw InputError(
-        str(where, ": duration / step = ", opt.duration / opt.step, " steps is too many (at most 1e7)"));
-  if (opt.record_every < 1) throw InputError(str(where, ": record_every must be >= 1"));
+    FFSR_THROW(InputError(
+        str(where, ": duration / step = ", opt.duration / opt.step, " steps is too many (at most 1e7)")));
+  if (opt.record_every < 1) FFSR_THROW(InputError(str(where, ": record_every must be >= 1")));
   const int m = task.rows();
-  if (m < 1) throw InputError(str(where, ": the task constrains no axis"));
+  if (m < 1) FFSR_THROW(InputError(str(where, ": the task constrains no axis")));
   if (opt.gain != 0.0 && m >= n)
-    throw InputError(str(where, ": the task has ", m, " rows and the robot ", n,
-                         " joints: no null space to optimize in (use gain 0 or a smaller task)"));
+    FFSR_THROW(InputError(str(where, ": the task has ", m, " rows and the robot ", n,
+                         " joints: no null space to optimize in (use gain 0 or a smaller task)")));
 }
 
 }  // namespace detail
@@ -110,11 +110,11 @@ inline void prepare_base_attitude_hold(const CaptureProblem& pb, const CaptureOp
   s.held_freedom = held_freedom_shares(Jt, s.attitude_basis.transpose() * base_angular_rows(data));
   const int needed = joints_needed_to_hold(m, r, opt.gain != 0.0);
   if (needed > model.n())
-    throw InputError(str(where, ": holding the base attitude takes ", m, " task rows + ", r,
+    FFSR_THROW(InputError(str(where, ": holding the base attitude takes ", m, " task rows + ", r,
                          r == 1 ? " base-attitude row = " : " base-attitude rows = ", m + r,
                          " of the robot's ", model.n(), " joints",
                          opt.gain != 0.0 ? ": no freedom left for the objective" : "", " (it needs ", needed,
-                         " joints)"));
+                         " joints)")));
 }
 
 }  // namespace detail
@@ -140,9 +140,9 @@ inline CaptureSetup prepare_capture(const CaptureProblem& pb, const CaptureTask&
   c.v_in = approach_velocity(c.u_cap, Vector3(pb.approach_speed * c.u_cap), c.target.velocity,
                              c.target.angular_velocity_world(), c.target.offset_world());
   if (!(c.v_in > 0))
-    throw InputError(
+    FFSR_THROW(InputError(
         str(where, ": at the capture the end-effector does not approach the target (delta_dot^- = ", c.v_in,
-            " m/s); increase the approach speed"));
+            " m/s); increase the approach speed")));
   c.law = make_contact_law(pb.law, pb.contact, c.v_in);
 
   Data data(model);
@@ -271,13 +271,13 @@ inline void finish_capture(const Model& model, Data& data, const CaptureProblem&
   res.f_max_closed_form = objective.f_max_closed_form(res.M_ie);
   res.f_max_exact = objective.f_max_exact(res.M_ie);
   if (!std::isfinite(res.M_ie) || !std::isfinite(res.f_max_exact) || !std::isfinite(res.f_max_closed_form))
-    throw NumericalError(str(where, ": the capture configuration gives a non-finite M_ie or F_max"));
+    FFSR_THROW(NumericalError(str(where, ": the capture configuration gives a non-finite M_ie or F_max")));
   if (res.tracking_error > opt.tolerance)
-    throw NumericalError(str(where, ": the end-effector missed the capture point by ", res.tracking_error,
-                             " m (tolerance ", opt.tolerance, " m); the point may be out of reach"));
+    FFSR_THROW(NumericalError(str(where, ": the end-effector missed the capture point by ", res.tracking_error,
+                             " m (tolerance ", opt.tolerance, " m); the point may be out of reach")));
   if (task.kind == CaptureTask::Kind::Pose && res.orientation_error > opt.orientation_tolerance)
-    throw NumericalError(str(where, ": the end-effector orientation is off by ", res.orientation_error,
-                             " rad at the capture (tolerance ", opt.orientation_tolerance, " rad)"));
+    FFSR_THROW(NumericalError(str(where, ": the end-effector orientation is off by ", res.orientation_error,
+                             " rad at the capture (tolerance ", opt.orientation_tolerance, " rad)")));
 }
 
 /// The error of a held approach (hold_base_attitude) that loses the line at an algorithmic
@@ -352,13 +352,13 @@ CaptureResult integrate_capture(const CaptureProblem& pb, const CaptureTask& tas
     const double t = static_cast<double>(k) * h;
     rk4.begin(field, t, base, theta);  // data holds the kinematics of the current state
     monitors.check_motion(model, data, rk4.k_base[0], rk4.k_theta[0]);
-    try {
+    FFSR_TRY {
       monitors.check_tracking(setup.line.position(t) - frame_pose(model, data, pb.frame).p, setup.rows, t);
-    } catch (const NumericalError&) {
-      if (setup.held_freedom.size() == 0 || field.first_damped_time < 0) throw;
-      throw NumericalError(detail::held_singularity_message(model, opt, setup, where, field.first_damped_time,
+    } FFSR_CATCH(const NumericalError&) {
+      if (setup.held_freedom.size() == 0 || field.first_damped_time < 0) FFSR_RETHROW;
+      FFSR_THROW(NumericalError(detail::held_singularity_message(model, opt, setup, where, field.first_damped_time,
                                                             field.min_singular_value, t,
-                                                            monitors.max_tracking_error));
+                                                            monitors.max_tracking_error)));
     }
     monitors.check_quaternion(rk4.finish(field, t, h, base, theta));
     monitors.check_state(model, base, theta, t + h);

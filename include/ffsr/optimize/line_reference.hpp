@@ -74,7 +74,7 @@ struct LineReference {
   /// Desired position xd and velocity vd at time t (writes all four outputs); for a pose task also
   /// the orientation Rd and the angular velocity wd (inertial frame).
   void at(double t, Vector3& xd, Vector3& vd, Matrix3& Rd, Vector3& wd) const {
-    double s, sdot;
+    double s = 0, sdot = 0;
     detail::quintic(t / duration, s, sdot);
     sdot /= duration;
     Rd = rotation_from_vector(s * rot_total) * R0;
@@ -102,7 +102,7 @@ struct LineReference {
   }
   /// Desired position only (the same value as `at`).
   Vector3 position(double t) const {
-    double s, sdot;
+    double s = 0, sdot = 0;
     if (start != 0.0) {
       Vector3 xd, vd, wd;
       Matrix3 Rd;

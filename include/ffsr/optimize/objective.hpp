@@ -84,7 +84,7 @@ class CaptureEvaluator {
         kind_(kind),
         peak_(peak),
         robust_(robust) {
-    if (!model_) throw InputError("CaptureEvaluator: no model");
+    if (!model_) FFSR_THROW(InputError("CaptureEvaluator: no model"));
   }
 
   /// A contact with `target` as it is at the capture (its attitude gives u = R_t u_n) under `law`, for
@@ -100,8 +100,8 @@ class CaptureEvaluator {
         joints_(&joints),
         kind_(kind) {
     if (kind == GlobalObjective::MultibodyForce || kind == GlobalObjective::RobustForce)
-      throw InputError(detail::str("CaptureEvaluator: the ", objective_name(kind),
-                                   " objective needs the capture problem"));
+      FFSR_THROW(InputError(detail::str("CaptureEvaluator: the ", objective_name(kind),
+                                   " objective needs the capture problem")));
   }
 
   const Model& model() const { return *model_; }
@@ -109,7 +109,7 @@ class CaptureEvaluator {
   const ContactJoints& joints() const { return *joints_; }
   GlobalObjective kind() const { return kind_; }
   const AnyContactLaw& law() const {
-    if (!law_) throw InputError("CaptureEvaluator: no contact law given (M_ie only)");
+    if (!law_) FFSR_THROW(InputError("CaptureEvaluator: no contact law given (M_ie only)"));
     return *law_;
   }
   const Vector3& normal() const { return u_; }
@@ -157,8 +157,8 @@ class CaptureEvaluator {
   double of_mass(double M_ie) const {
     if (kind_ == GlobalObjective::Mass) return M_ie;
     if (kind_ == GlobalObjective::ExactForce) return f_max_exact(M_ie);
-    throw InputError(
-        detail::str("CaptureEvaluator: the ", objective_name(kind_), " objective is no function of M_ie"));
+    FFSR_THROW(InputError(
+        detail::str("CaptureEvaluator: the ", objective_name(kind_), " objective is no function of M_ie")));
   }
 
   /// The robot's 6x6 inverse inertia at the contact frame under the joint model (Lambda^-1 of
@@ -209,7 +209,7 @@ class CaptureEvaluator {
         p.objective = of_mass(p.M_ie);
         break;
       case GlobalObjective::MultibodyForce:
-        if (!peak_) throw InputError("CaptureEvaluator: the multibody-force objective needs its CVODE run");
+        if (!peak_) FFSR_THROW(InputError("CaptureEvaluator: the multibody-force objective needs its CVODE run"));
         p.objective = (*peak_)(base, theta);
         break;
       case GlobalObjective::RobustForce:
@@ -239,7 +239,7 @@ class CaptureEvaluator {
 
  private:
   RobustForceObjective& robust() const {
-    if (!robust_) throw InputError("CaptureEvaluator: the robust-force objective needs its sample set");
+    if (!robust_) FFSR_THROW(InputError("CaptureEvaluator: the robust-force objective needs its sample set"));
     return *robust_;
   }
 

@@ -62,10 +62,10 @@ struct RunMonitors {
     const double err = std::sqrt(err2);
     max_tracking_error = std::max(max_tracking_error, err);
     if (err > divergence)
-      throw NumericalError(detail::str(where,
+      FFSR_THROW(NumericalError(detail::str(where,
                                        ": the end-effector cannot follow the line to the capture point "
                                        "(tracking error ",
-                                       err, " m at t = ", t, " s); ", hint));
+                                       err, " m at t = ", t, " s); ", hint)));
     return err;
   }
 
@@ -78,12 +78,12 @@ struct RunMonitors {
   void check_state(const Model& model, const BasePose& base, const Eigen::VectorXd& theta, double t) const {
     using detail::str;
     if (!theta.allFinite() || !base.position.allFinite())
-      throw NumericalError(str(where, ": the state became non-finite at t = ", t, " s"));
+      FFSR_THROW(NumericalError(str(where, ": the state became non-finite at t = ", t, " s")));
     for (int j = 0; j < model.n(); ++j) {
       const Joint& jt = model.joint(j);
       if (theta(j) < jt.lower - 1e-9 || theta(j) > jt.upper + 1e-9)
-        throw JointLimitError(str(where, ": joint '", jt.name, "' left its limits [", jt.lower, ", ",
-                                  jt.upper, "] rad at t = ", t, " s (", theta(j), " rad)"));
+        FFSR_THROW(JointLimitError(str(where, ": joint '", jt.name, "' left its limits [", jt.lower, ", ",
+                                  jt.upper, "] rad at t = ", t, " s (", theta(j), " rad)")));
     }
   }
 

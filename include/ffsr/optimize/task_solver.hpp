@@ -97,8 +97,8 @@ class TaskSolver {
         N_(n, n),
         svd_(static_cast<Eigen::Index>(rows_.size()) + std::max(extra_rows, 0), n,
              Eigen::ComputeFullU | Eigen::ComputeFullV) {
-    if (n < 1 || rows_.empty()) throw InputError("TaskSolver: needs at least one joint and one task row");
-    if (extra_rows < 0) throw InputError("TaskSolver: the number of extra rows must be >= 0");
+    if (n < 1 || rows_.empty()) FFSR_THROW(InputError("TaskSolver: needs at least one joint and one task row"));
+    if (extra_rows < 0) FFSR_THROW(InputError("TaskSolver: the number of extra rows must be >= 0"));
     if (extra_rows > 0) {
       svd_extra_ =
           Eigen::JacobiSVD<Eigen::MatrixXd>(extra_rows, n, Eigen::ComputeFullU | Eigen::ComputeFullV);
@@ -108,7 +108,7 @@ class TaskSolver {
       JtN_.resize(static_cast<Eigen::Index>(rows_.size()), n);
     }
     for (int r : rows_)
-      if (r < 0 || r > 5) throw InputError(detail::str("TaskSolver: task row ", r, " is not in 0..5"));
+      if (r < 0 || r > 5) FFSR_THROW(InputError(detail::str("TaskSolver: task row ", r, " is not in 0..5")));
     out_.theta_dot.resize(n);
     N_.setIdentity();
   }
@@ -122,7 +122,7 @@ class TaskSolver {
   /// `with_projector` also the null-space projector N (projector()). Reads Jf, cmd. No allocation.
   const TaskRates& solve(const Eigen::Ref<const Eigen::MatrixXd>& Jf, const Vector6& cmd,
                          bool with_projector) {
-    if (extra_ > 0) throw InputError("TaskSolver: built with extra rows; pass them to solve()");
+    if (extra_ > 0) FFSR_THROW(InputError("TaskSolver: built with extra rows; pass them to solve()"));
     select_task_rows(Jf, cmd);
     return factorize(with_projector);
   }
@@ -135,8 +135,8 @@ class TaskSolver {
   const TaskRates& solve(const Eigen::Ref<const Eigen::MatrixXd>& Jf, const Vector6& cmd, bool with_projector,
                          const Eigen::Ref<const Eigen::MatrixXd>& A) {
     if (A.rows() != extra_ || A.cols() != Jt_.cols())
-      throw InputError(detail::str("TaskSolver: the extra rows are ", A.rows(), "x", A.cols(), ", expected ",
-                                   extra_, "x", Jt_.cols()));
+      FFSR_THROW(InputError(detail::str("TaskSolver: the extra rows are ", A.rows(), "x", A.cols(), ", expected ",
+                                   extra_, "x", Jt_.cols())));
     const int m = task_rows();
     select_task_rows(Jf, cmd);
     Jt_.bottomRows(extra_) = A;

@@ -79,7 +79,7 @@ inline void sin_cos(double x, double& s, double& c) {
   // the quadrant without a branch (random angles mispredict a switch): s = sr, cr, -sr, -cr and
   // c = cr, -sr, -cr, sr for k mod 4 = 0..3, by selecting and flipping sign bits
   const auto quadrant = static_cast<std::uint64_t>(static_cast<long long>(k));
-  std::uint64_t bs, bc;
+  std::uint64_t bs = 0, bc = 0;
   std::memcpy(&bs, &sr, sizeof bs);
   std::memcpy(&bc, &cr, sizeof bc);
   const std::uint64_t swap = std::uint64_t{0} - (quadrant & 1);  // all ones when odd
@@ -200,7 +200,7 @@ inline double stable_norm3(double x, double y, double z) {
 
 /// Rotation by `angle` about the unit vector `axis` (Rodrigues), without allocation.
 inline Matrix3 rotation_about(const Vector3& axis, double angle) {
-  double s, c;
+  double s = 0, c = 0;
   detail::sin_cos(angle, s, c);
   const double t = 1.0 - c;
   const double x = axis.x(), y = axis.y(), z = axis.z();
@@ -330,7 +330,7 @@ struct SpatialInertia {
     const double mc0 = mass * c0, mc1 = mass * c1, mc2 = mass * c2;
     s.h = Vector3(mc0, mc1, mc2);
     const double mcc = mc0 * c0 + mc1 * c1 + mc2 * c2;  // m |c|^2
-    double i00, i11, i22, i01, i02, i12;
+    double i00 = 0, i11 = 0, i22 = 0, i01 = 0, i02 = 0, i12 = 0;
     if (I_com(0, 1) == 0.0 && I_com(0, 2) == 0.0 && I_com(1, 2) == 0.0 && I_com(1, 0) == 0.0 &&
         I_com(2, 0) == 0.0 && I_com(2, 1) == 0.0) {
       // R diag(d) R^T = d2 1 + (d0 - d2) r0 r0^T + (d1 - d2) r1 r1^T (r_k the columns of R, R R^T = 1):

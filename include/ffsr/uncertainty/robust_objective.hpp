@@ -45,7 +45,7 @@ class RobustForceObjective {
   /// `law` names the damping law (Table 1). InputError for an empty sample set or a bad law.
   RobustForceObjective(std::vector<UncertainSample> samples, std::string law)
       : samples_(std::move(samples)), law_(std::move(law)) {
-    if (samples_.empty()) throw InputError("RobustForceObjective: no samples");
+    if (samples_.empty()) FFSR_THROW(InputError("RobustForceObjective: no samples"));
     c_.resize(samples_.size());
     p_.resize(samples_.size());
     for (std::size_t i = 0; i < samples_.size(); ++i) {
@@ -133,8 +133,8 @@ class RobustForceObjective {
       M_[i] = 1.0 / (s.dot(Linv * s) + samples_[i].target_inverse_mass);
       F_[i] = c_[i] * std::pow(M_[i], p_[i]);
       if (!std::isfinite(F_[i]) || !(M_[i] > 0))
-        throw NumericalError(detail::str("RobustForceObjective: sample ", samples_[i].index,
-                                         " has no finite force (M_ie = ", M_[i], " kg)"));
+        FFSR_THROW(NumericalError(detail::str("RobustForceObjective: sample ", samples_[i].index,
+                                         " has no finite force (M_ie = ", M_[i], " kg)")));
     }
   }
   /// order_[0..tail_) = the indices of the tail_ largest forces (ties by index, so deterministic).

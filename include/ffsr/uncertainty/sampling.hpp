@@ -182,7 +182,7 @@ class SampleStream {
   /// A uniformly distributed unit 3-vector.
   Vector3 unit_sphere() {
     const double z = 2.0 * uniform() - 1.0;
-    double c, s;
+    double c = 0, s = 0;
     unit_circle(c, s);
     const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
     return {r * c, r * s, z};

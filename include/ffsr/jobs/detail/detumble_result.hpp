@@ -3,7 +3,7 @@
 // one per run (the post_capture object), and neither job includes the other's header for it.
 #pragma once
 
-#include "ffsr/control/detumble_plan.hpp"
+#include "ffsr/control/detumble_replay.hpp"
 #include "ffsr/control/detumble_run.hpp"
 #include "ffsr/jobs/detail/json_values.hpp"
 #include "ffsr/model/attach.hpp"

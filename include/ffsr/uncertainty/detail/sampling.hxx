@@ -68,8 +68,8 @@ inline double draw_scalar(const Spread& sp, Quantity q, double x0, SampleStream&
     }
     ++redraws;
   }
-  throw NumericalError(str(quantity_key(q), ": no physical value within the bounds in ", kMaxRedraws,
-                           " draws (the law puts almost no probability there)"));
+  FFSR_THROW(NumericalError(str(quantity_key(q), ": no physical value within the bounds in ", kMaxRedraws,
+                           " draws (the law puts almost no probability there)")));
 }
 
 inline Vector3 draw_offset(const Spread& sp, SampleStream& rng, double& score) {
@@ -91,8 +91,8 @@ inline Matrix3 draw_inertia(const Spread& sp, const Matrix3& I0, SampleStream& r
   score = 0;
   if (sp.law == Spread::Law::Fixed) return I0;
   const Eigen::SelfAdjointEigenSolver<Matrix3> es(I0);
-  const Vector3 l0 = es.eigenvalues();
-  const Matrix3 V = es.eigenvectors();
+  const Vector3& l0 = es.eigenvalues();
+  const Matrix3& V = es.eigenvectors();
   for (int k = 0; k < kMaxRedraws; ++k) {
     Vector3 e;
     for (int i = 0; i < 3; ++i)
@@ -114,20 +114,20 @@ inline Matrix3 draw_inertia(const Spread& sp, const Matrix3& I0, SampleStream& r
     score = sp.scale > 0.0 ? e.cwiseAbs().maxCoeff() / sp.scale : 0.0;
     return I;
   }
-  throw NumericalError(str(quantity_key(Quantity::TargetInertia),
+  FFSR_THROW(NumericalError(str(quantity_key(Quantity::TargetInertia),
                            ": no principal moments satisfying the triangle inequality in ", kMaxRedraws,
-                           " draws (spread too large)"));
+                           " draws (spread too large)")));
 }
 
 inline Vector3 draw_normal(const Spread& sp, const Vector3& n0, SampleStream& rng, double& score) {
   score = 0;
-  const Vector3 n = n0.normalized();
+  Vector3 n = n0.normalized();
   if (sp.law == Spread::Law::Fixed || sp.scale == 0.0) return n;
   const Vector3 e1 = n.unitOrthogonal(), e2 = n.cross(e1);
   const double cos_a = std::cos(sp.scale);
   const double ct = 1.0 - rng.uniform() * (1.0 - cos_a);  // uniform on the cap
   const double st = std::sqrt(std::max(0.0, 1.0 - ct * ct));
-  double c, s;
+  double c = 0, s = 0;
   rng.unit_circle(c, s);
   score = std::acos(std::clamp(ct, -1.0, 1.0)) / sp.scale;
   return (ct * n + st * (c * e1 + s * e2)).normalized();
@@ -136,48 +136,48 @@ inline Vector3 draw_normal(const Spread& sp, const Vector3& n0, SampleStream& rn
 /// The checks every law of `key` passes: a finite non-negative scale, min <= max, a range's bounds finite.
 inline void validate_spread_scale(const Spread& sp, const std::string& key) {
   if (!std::isfinite(sp.scale) || sp.scale < 0)
-    throw InputError(
-        str(key, ": the spread must be a non-negative finite number, got ", short_number(sp.scale)));
+    FFSR_THROW(InputError(
+        str(key, ": the spread must be a non-negative finite number, got ", short_number(sp.scale))));
   if (std::isnan(sp.min) || std::isnan(sp.max) || sp.min > sp.max)
-    throw InputError(
-        str(key, ": min (", short_number(sp.min), ") is greater than max (", short_number(sp.max), ")"));
+    FFSR_THROW(InputError(
+        str(key, ": min (", short_number(sp.min), ") is greater than max (", short_number(sp.max), ")")));
   if (sp.has_range && (!std::isfinite(sp.min) || !std::isfinite(sp.max)))
-    throw InputError(str(key, ": a uniform law needs finite min and max"));
+    FFSR_THROW(InputError(str(key, ": a uniform law needs finite min and max")));
 }
 
 /// The normal: a cone of half-angle at most 90 deg.
 inline void validate_normal_spread(const Spread& sp, const std::string& key) {
   if (sp.law != Spread::Law::Cone)
-    throw InputError(str(key, ": the normal takes the law 'cone' (angle-deg)"));
+    FFSR_THROW(InputError(str(key, ": the normal takes the law 'cone' (angle-deg)")));
   if (sp.scale > M_PI / 2 * (1 + 1e-15))
-    throw InputError(str(key, ": the cone half-angle must be at most 90 deg, got ",
-                         short_number(sp.scale * 180 / M_PI), " deg"));
+    FFSR_THROW(InputError(str(key, ": the cone half-angle must be at most 90 deg, got ",
+                         short_number(sp.scale * 180 / M_PI), " deg")));
 }
 
 /// The inertia: a relative normal or uniform law that keeps the moments positive, axes in [0, 180] deg.
 inline void validate_inertia_spread(const Spread& sp, const std::string& key) {
   if (sp.law != Spread::Law::Normal && sp.law != Spread::Law::Uniform)
-    throw InputError(str(key, ": the inertia takes a 'normal' or 'uniform' law with a relative spread"));
+    FFSR_THROW(InputError(str(key, ": the inertia takes a 'normal' or 'uniform' law with a relative spread")));
   if (!(sp.axes >= 0 && sp.axes <= M_PI))
-    throw InputError(str(key, ": axes-deg must be in [0, 180], got ", short_number(sp.axes * 180 / M_PI)));
+    FFSR_THROW(InputError(str(key, ": axes-deg must be in [0, 180], got ", short_number(sp.axes * 180 / M_PI))));
   if (sp.scale >= 1.0 && sp.law == Spread::Law::Uniform)
-    throw InputError(str(key, ": a relative half-width of ", short_number(sp.scale),
-                         " allows non-positive moments (must be < 1)"));
+    FFSR_THROW(InputError(str(key, ": a relative half-width of ", short_number(sp.scale),
+                         " allows non-positive moments (must be < 1)")));
 }
 
 /// A vector quantity: a normal or uniform law with an absolute spread.
 inline void validate_vector_spread(const Spread& sp, const std::string& key) {
   if (sp.law == Spread::Law::LogNormal)
-    throw InputError(str(key, ": a vector takes a 'normal' or 'uniform' law"));
+    FFSR_THROW(InputError(str(key, ": a vector takes a 'normal' or 'uniform' law")));
   if (sp.relative || sp.has_range)
-    throw InputError(
-        str(key, ": a vector takes an absolute spread (std or half-width), not relative or min/max"));
+    FFSR_THROW(InputError(
+        str(key, ": a vector takes an absolute spread (std or half-width), not relative or min/max")));
 }
 
 }  // namespace detail
 
 inline void validate(const UncertaintySpec& spec) {
-  if (spec.samples < 1) throw InputError("uncertainty.samples: must be at least 1, got 0");
+  if (spec.samples < 1) FFSR_THROW(InputError("uncertainty.samples: must be at least 1, got 0"));
   for (std::size_t i = 0; i < kNumQuantities; ++i) {
     const Quantity q = static_cast<Quantity>(i);
     const Spread& sp = spec.spread[i];
@@ -189,7 +189,7 @@ inline void validate(const UncertaintySpec& spec) {
       continue;
     }
     if (sp.law == Spread::Law::Cone)
-      throw InputError(detail::str(key, ": the law 'cone' is for the normal only"));
+      FFSR_THROW(InputError(detail::str(key, ": the law 'cone' is for the normal only")));
     if (q == Quantity::TargetInertia)
       detail::validate_inertia_spread(sp, key);
     else if (detail::is_vector_quantity(q))
@@ -241,9 +241,9 @@ inline UncertainSample draw_sample(const UncertaintySpec& spec, const UncertainN
     }
     ++s.redraws;  // the bodies would not approach: redraw the whole sample
   }
-  throw NumericalError(
+  FFSR_THROW(NumericalError(
       detail::str("uncertainty: sample ", index, " has the bodies receding (delta_dot^- <= 0) in ",
-                  kMaxRedraws, " draws; increase the approach speed or narrow the spin/velocity spreads"));
+                  kMaxRedraws, " draws; increase the approach speed or narrow the spin/velocity spreads")));
 }
 
 inline Matrix3 robot_inverse_mass_matrix(const Model& model, Data& data, const BasePose& base,
@@ -274,24 +274,24 @@ inline SampleForce sample_force(const Matrix6& Linv, const UncertainSample& s, s
   else if (model == ForceModel::Exact)
     f.f_max = max_force_exact(l, f.M_ie);
   else
-    throw InputError("sample_force: the multibody force model is in ffsr/uncertainty/multibody.hpp");
+    FFSR_THROW(InputError("sample_force: the multibody force model is in ffsr/uncertainty/multibody.hpp"));
   return f;
 }
 
 inline double nearest_rank(const std::vector<double>& sorted, int percent) {
   const std::size_t n = sorted.size();
-  if (n == 0) throw InputError("nearest_rank: no values");
+  if (n == 0) FFSR_THROW(InputError("nearest_rank: no values"));
   if (percent < 1 || percent > 100)
-    throw InputError(detail::str("nearest_rank: percent must be in [1, 100], got ", percent));
+    FFSR_THROW(InputError(detail::str("nearest_rank: percent must be in [1, 100], got ", percent)));
   const std::size_t rank = (static_cast<std::size_t>(percent) * n + 99) / 100;  // ceil(p n / 100) >= 1
   return sorted[rank - 1];
 }
 
 inline QuantileRanks quantile_interval(std::size_t n, double q, double confidence) {
-  if (n == 0) throw InputError("quantile_interval: no values");
-  if (!(q > 0 && q < 1)) throw InputError(detail::str("quantile_interval: q must be in (0, 1), got ", q));
+  if (n == 0) FFSR_THROW(InputError("quantile_interval: no values"));
+  if (!(q > 0 && q < 1)) FFSR_THROW(InputError(detail::str("quantile_interval: q must be in (0, 1), got ", q)));
   if (!(confidence > 0 && confidence < 1))
-    throw InputError(detail::str("quantile_interval: confidence must be in (0, 1), got ", confidence));
+    FFSR_THROW(InputError(detail::str("quantile_interval: confidence must be in (0, 1), got ", confidence)));
   const double nd = static_cast<double>(n), sd = std::sqrt(nd * q * (1 - q));
   // the binomial mass outside [k0, k1] is below 1e-300: the CDF starts at 0 at k0
   const auto k0 = static_cast<std::size_t>(std::max(0.0, std::floor(nd * q - 40 * sd - 40)));
@@ -322,10 +322,10 @@ inline QuantileRanks quantile_interval(std::size_t n, double q, double confidenc
 inline ForceSummary summarize(const std::vector<double>& v) {
   ForceSummary s;
   s.n = v.size();
-  if (s.n == 0) throw InputError("summarize: no values");
+  if (s.n == 0) FFSR_THROW(InputError("summarize: no values"));
   double sum = 0;
   for (double x : v) {
-    if (!std::isfinite(x)) throw NumericalError(detail::str("summarize: a value is not finite (", x, ")"));
+    if (!std::isfinite(x)) FFSR_THROW(NumericalError(detail::str("summarize: a value is not finite (", x, ")")));
     sum += x;
   }
   s.mean = sum / static_cast<double>(s.n);
@@ -392,16 +392,16 @@ struct TruncatedLaw {
   double x0, L, U, cdf_L, Z;
   TruncatedLaw(const Spread& law, Quantity q, double nominal) : sp(law), x0(nominal) {
     if (!is_scalar_quantity(q))
-      throw InputError(str("scalar_law: ", quantity_key(q), " is not a scalar quantity"));
+      FFSR_THROW(InputError(str("scalar_law: ", quantity_key(q), " is not a scalar quantity")));
     if (!std::isfinite(x0) || !has_density(sp, x0))
-      throw InputError(
-          str("scalar_law: ", quantity_key(q), " has no law with a spread (fixed or zero spread)"));
+      FFSR_THROW(InputError(
+          str("scalar_law: ", quantity_key(q), " has no law with a spread (fixed or zero spread)")));
     L = std::max(sp.min, 0.0);
     U = q == Quantity::Restitution ? std::min(sp.max, 1.0) : sp.max;
     cdf_L = base_law(sp, x0, L).cdf;
     Z = base_law(sp, x0, U).cdf - cdf_L;
     if (!(Z > 0))
-      throw NumericalError(str("scalar_law: ", quantity_key(q), " puts no probability within its bounds"));
+      FFSR_THROW(NumericalError(str("scalar_law: ", quantity_key(q), " puts no probability within its bounds")));
   }
   LawPoint operator()(double x) const {
     if (x <= L) return {0.0, 0.0};
@@ -414,7 +414,7 @@ struct TruncatedLaw {
 }  // namespace detail
 
 inline LawPoint scalar_law(const Spread& sp, Quantity q, double x0, double x) {
-  if (std::isnan(x)) throw InputError("scalar_law: x is NaN");
+  if (std::isnan(x)) FFSR_THROW(InputError("scalar_law: x is NaN"));
   return detail::TruncatedLaw(sp, q, x0)(x);
 }
 
@@ -450,16 +450,18 @@ struct ConditionalCdf {
 /// then Newton steps kept inside it (bisection when a step leaves it or the slope vanishes).
 inline double conditional_quantile(const ConditionalCdf& C, double p, double t0) {
   double lo = t0 - 0.25, hi = t0 + 0.25, step = 0.25;
-  for (int k = 0; C(lo).first >= p; ++k, step *= 2) {
-    if (k > 200) throw NumericalError("summarize_stiffness_conditional: no lower bracket of the quantile");
+  for (int k = 0; C(lo).first >= p; ++k) {
+    if (k > 200) FFSR_THROW(NumericalError("summarize_stiffness_conditional: no lower bracket of the quantile"));
     hi = std::min(hi, lo);
     lo -= step;
+    step *= 2;
   }
   step = 0.25;
-  for (int k = 0; C(hi).first < p; ++k, step *= 2) {
-    if (k > 200) throw NumericalError("summarize_stiffness_conditional: no upper bracket of the quantile");
+  for (int k = 0; C(hi).first < p; ++k) {
+    if (k > 200) FFSR_THROW(NumericalError("summarize_stiffness_conditional: no upper bracket of the quantile"));
     lo = std::max(lo, hi);
     hi += step;
+    step *= 2;
   }
   double t = std::clamp(t0, lo, hi);
   for (int it = 0; it < 200; ++it) {
@@ -494,18 +496,18 @@ inline ForceSummary conditional_summary(const std::vector<double>& f, const std:
                                         ConditionalAtP95* at) {
   const std::size_t n = f.size();
   if (K.size() != n || alpha.size() != n)
-    throw InputError(detail::str("summarize_stiffness_conditional: ", n, " forces, ", K.size(),
-                                 " stiffnesses and ", alpha.size(), " exponents"));
+    FFSR_THROW(InputError(detail::str("summarize_stiffness_conditional: ", n, " forces, ", K.size(),
+                                 " stiffnesses and ", alpha.size(), " exponents")));
   if (!(K0 > 0) || !std::isfinite(K0))
-    throw InputError(
-        detail::str("summarize_stiffness_conditional: the nominal stiffness must be positive, got ", K0));
+    FFSR_THROW(InputError(
+        detail::str("summarize_stiffness_conditional: the nominal stiffness must be positive, got ", K0)));
   const TruncatedLaw law(stiffness, Quantity::Stiffness, K0);  // InputError for a law without spread
   ForceSummary s = summarize(f);  // mean, std, max and the order statistics; checks f finite
   std::vector<double> a(n), b(n);
   for (std::size_t i = 0; i < n; ++i) {
     if (!(f[i] > 0) || !(K[i] > 0) || !std::isfinite(K[i]) || !(alpha[i] > 0) || !std::isfinite(alpha[i]))
-      throw InputError(detail::str("summarize_stiffness_conditional: sample ", i, " has F_max ", f[i], ", K ",
-                                   K[i], ", alpha ", alpha[i], " (all must be positive and finite)"));
+      FFSR_THROW(InputError(detail::str("summarize_stiffness_conditional: sample ", i, " has F_max ", f[i], ", K ",
+                                   K[i], ", alpha ", alpha[i], " (all must be positive and finite)")));
     a[i] = alpha[i] + 1.0;
     b[i] = std::log(K[i]) - a[i] * std::log(f[i]);
   }
@@ -553,8 +555,8 @@ inline PercentileRatio compare_p95_stiffness_conditional(const std::vector<doubl
                                                          const Spread& stiffness, double K0) {
   const std::size_t n = f_a.size();
   if (f_b.size() != n)
-    throw InputError(detail::str("compare_p95_stiffness_conditional: ", n, " and ", f_b.size(),
-                                 " forces: the two configurations must share the samples"));
+    FFSR_THROW(InputError(detail::str("compare_p95_stiffness_conditional: ", n, " and ", f_b.size(),
+                                 " forces: the two configurations must share the samples")));
   detail::ConditionalAtP95 A, B;
   const double pa = detail::conditional_summary(f_a, K, alpha, stiffness, K0, &A).p95;
   const double pb = detail::conditional_summary(f_b, K, alpha, stiffness, K0, &B).p95;
@@ -578,7 +580,7 @@ inline PercentileRatio compare_p95_stiffness_conditional(const std::vector<doubl
 inline double robust_force_p95(const Model& model, Data& data, const BasePose& base,
                                const Eigen::Ref<const Eigen::VectorXd>& theta, int frame,
                                const std::vector<UncertainSample>& samples, std::string_view law) {
-  if (samples.empty()) throw InputError("robust_force_p95: no samples");
+  if (samples.empty()) FFSR_THROW(InputError("robust_force_p95: no samples"));
   const Matrix6 Linv = robot_inverse_inertia(model, data, base, theta, frame);
   std::vector<double> f(samples.size());
   for (std::size_t i = 0; i < samples.size(); ++i)

@@ -1,27 +1,13 @@
-// ffsr/control/detail/detumble_plan.hxx -- body of ffsr/control/detumble_plan.hpp.
+// ffsr/control/detail/detumble_replay.hxx -- body of ffsr/control/detumble_replay.hpp.
 #pragma once
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace ffsr {
 
 namespace detail {
-
-inline void check_detumble_plan(const Model& stack, const DetumblePlan& plan, const char* w) {
-  const int N = plan.intervals();
-  if (N < 1) throw InputError(str(w, ": the plan has no interval"));
-  if (!std::isfinite(plan.duration) || !(plan.duration > 0))
-    throw InputError(str(w, ": the plan's duration must be positive and finite, got ", plan.duration));
-  if (plan.nodes.size() != static_cast<size_t>(N) + 1 || plan.base_wrench.size() != static_cast<size_t>(N))
-    throw InputError(str(w, ": the plan needs N + 1 nodes and N base wrenches for its N = ", N,
-                         " intervals, got ", plan.nodes.size(), " and ", plan.base_wrench.size()));
-  for (int k = 0; k < N; ++k) {
-    require_size(plan.tau[static_cast<size_t>(k)].size(), stack.n(), w, "the plan's joint torques");
-    require_finite_all(plan.tau[static_cast<size_t>(k)], w, "the plan's joint torques");
-    require_finite_all(plan.base_wrench[static_cast<size_t>(k)], w, "the plan's base wrench");
-  }
-}
 
 /// How far the command c at the state y (base rotation R) exceeds the hardware's bounds (<= 0: within).
 inline double plan_bound_excess(const DetumbleLimits& l, const DetumbleCommand& c, const Matrix3& R,
