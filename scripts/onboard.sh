@@ -207,6 +207,35 @@ check_core_symbols() {
   fi
 }
 
+# clang-tidy (src/onboard/.clang-tidy: bugprone, cert, performance, a subset of the C++ Core Guidelines)
+# and cppcheck on the core: src/onboard/ffsr_onboard.cpp and every ffsr header it includes, with the
+# host build's flags (its compile_commands.json); any finding fails.
+lint_core() {
+  local dir=$build_root/host
+  echo "== lint: clang-tidy and cppcheck on the onboard core"
+  if ! command -v clang-tidy-14 >/dev/null || ! command -v cppcheck >/dev/null; then
+    fail "lint: clang-tidy-14 or cppcheck missing (Debian: clang-tidy-14 cppcheck)"
+    return 1
+  fi
+  if nice -n 10 clang-tidy-14 -p "$dir" --quiet "$root/src/onboard/ffsr_onboard.cpp" >"$dir/clang-tidy.log" 2>&1; then
+    echo "   clang-tidy: no finding"
+  else
+    grep -E "(warning|error):" "$dir/clang-tidy.log" | head -30 >&2
+    fail "lint: clang-tidy findings ($dir/clang-tidy.log)"
+  fi
+  if nice -n 10 cppcheck --quiet --enable=warning,performance,portability --std=c++17 --inline-suppr \
+       --error-exitcode=1 -I "$root/include" --language=c++ "$root/src/onboard/ffsr_onboard.cpp" \
+       >"$dir/cppcheck.log" 2>&1 &&
+     nice -n 10 cppcheck --quiet --enable=warning,performance,portability --std=c99 --inline-suppr \
+       --error-exitcode=1 -I "$root/include" -I "$root/src/onboard/platform" --language=c \
+       "$root/examples/onboard/onboard_example.c" >>"$dir/cppcheck.log" 2>&1; then
+    echo "   cppcheck: no finding"
+  else
+    head -30 "$dir/cppcheck.log" >&2
+    fail "lint: cppcheck findings ($dir/cppcheck.log)"
+  fi
+}
+
 # The example's four blobs, written once from the scenario files by the host's ffsr-onboard-export.
 make_blobs() {
   local export=${FFSR_ONBOARD_EXPORT:-}
@@ -249,6 +278,7 @@ for target in "${targets[@]}"; do
   run_example "$target"
   run_platform_tests "$target"
   [ "$target" = m7 ] && check_m7_image
+  [ "$target" = host ] && lint_core
   report_stack "$target"
 done
 

@@ -37,14 +37,16 @@
 #else
 // the argument is not evaluated (an operand of sizeof: no code, and the names in the message count as
 // used): a message is built only where it can be thrown
-#define FFSR_THROW(...) \
-  (static_cast<void>(sizeof(__VA_ARGS__)), ::ffsr::detail::failed_check(__FILE__, __LINE__))
+#define FFSR_THROW(...) ::ffsr::detail::failed_check(__FILE__, __LINE__, sizeof(__VA_ARGS__))
 #define FFSR_RETHROW ::ffsr::detail::failed_check(__FILE__, __LINE__)
 #define FFSR_TRY if (true)
 #define FFSR_CATCH(...) else if (false)
 #endif
 
 namespace ffsr {
+
+/// pi, for the headers that must compile in strict ISO C++ (M_PI is POSIX, not in newlib's strict mode).
+inline constexpr double kPi = 3.14159265358979323846;
 
 /// What the library calls, without exceptions, where it would throw: the source file and line of the
 /// check that failed. It may not return (std::abort() follows when it does).
@@ -53,7 +55,7 @@ using FailureHandler = void (*)(const char* file, int line);
 namespace detail {
 inline FailureHandler failure_handler = nullptr;
 
-[[noreturn]] inline void failed_check(const char* file, int line) noexcept {
+[[noreturn]] inline void failed_check(const char* file, int line, std::size_t /*exception's size*/ = 0) noexcept {
   if (failure_handler != nullptr) failure_handler(file, line);
   std::abort();
 }

@@ -53,6 +53,7 @@ inline bool inverse_quadratic_spd6(const Matrix6& A, const Vector6& x, double& q
     double v[6];  // L_jk D_k
     double d = A(j, j);
     for (int k = 0; k < j; ++k) {
+      // cppcheck-suppress uninitvar ; L[j][k] and D[k] for k < j were written at pivot k
       v[k] = L[j][k] * D[k];
       d -= L[j][k] * v[k];
     }
@@ -65,6 +66,7 @@ inline bool inverse_quadratic_spd6(const Matrix6& A, const Vector6& x, double& q
       L[i][j] = s * inv[j];
     }
     double yj = x(j);
+    // cppcheck-suppress uninitvar ; y[k] for k < j was written at pivot k
     for (int k = 0; k < j; ++k) yj -= L[j][k] * y[k];
     y[j] = yj;
     q += yj * yj * inv[j];

@@ -39,8 +39,9 @@ inline const char* joint_model_name(JointModel m) {
 inline JointModel parse_joint_model(const std::string& name, const std::string& where) {
   if (name == "free") return JointModel::Free;
   if (name == "locked") return JointModel::Locked;
-  if (name == "armature") return JointModel::Armature;
-  FFSR_THROW(InputError(detail::str(where, ": unknown joint model '", name, "'; use free, locked or armature")));
+  if (name != "armature")
+    FFSR_THROW(InputError(detail::str(where, ": unknown joint model '", name, "'; use free, locked or armature")));
+  return JointModel::Armature;
 }
 
 /// One non-negative finite value per coordinate of `model` from `values`: empty gives zeros, one value

@@ -324,7 +324,7 @@ inline void validate(const ContactParams& p, const char* where) {
 template <class Damping>
 HertzDamped<Damping>::HertzDamped(const ContactParams& p, double approach_velocity) : p_(p) {
   using detail::str;
-  const std::string where = str("contact law ", Damping::name);
+  const std::string where = "contact law " + std::string(Damping::name);  // no stream (onboard images)
   validate(p, where.c_str());
   if (!std::isfinite(approach_velocity))
     FFSR_THROW(InputError(str(where, ": approach velocity must be finite, got ", approach_velocity)));

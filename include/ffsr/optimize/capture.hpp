@@ -65,7 +65,7 @@ inline void check_capture_input(const CaptureProblem& pb, const CaptureTask& tas
   detail::check_configuration(model, pb.base, pb.theta, where);
   if (pb.frame < 0 || pb.frame >= static_cast<int>(model.frames().size()))
     FFSR_THROW(InputError(str(where, ": end-effector frame out of range")));
-  pb.target.validate(str(where, ": target").c_str());
+  pb.target.validate((std::string(where) + ": target").c_str());  // no stream: onboard images stay small
   validate(pb.contact, where);
   auto positive = [&](double x, const char* what) {
     if (!std::isfinite(x) || x <= 0)

@@ -46,7 +46,7 @@ inline void configuration_error(const Model& model, const Eigen::VectorXd& theta
   err = theta_goal - theta;
   for (int k = 0; k < model.n(); ++k) {
     const Joint& j = model.joint(k);
-    if (!std::isfinite(j.lower) && !std::isfinite(j.upper)) err(k) = std::remainder(err(k), 2 * M_PI);
+    if (!std::isfinite(j.lower) && !std::isfinite(j.upper)) err(k) = std::remainder(err(k), 2 * kPi);
   }
 }
 

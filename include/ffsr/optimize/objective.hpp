@@ -156,9 +156,10 @@ class CaptureEvaluator {
   /// (exact-force). InputError for the other kinds.
   double of_mass(double M_ie) const {
     if (kind_ == GlobalObjective::Mass) return M_ie;
-    if (kind_ == GlobalObjective::ExactForce) return f_max_exact(M_ie);
-    FFSR_THROW(InputError(
-        detail::str("CaptureEvaluator: the ", objective_name(kind_), " objective is no function of M_ie")));
+    if (kind_ != GlobalObjective::ExactForce)
+      FFSR_THROW(InputError(
+          detail::str("CaptureEvaluator: the ", objective_name(kind_), " objective is no function of M_ie")));
+    return f_max_exact(M_ie);
   }
 
   /// The robot's 6x6 inverse inertia at the contact frame under the joint model (Lambda^-1 of

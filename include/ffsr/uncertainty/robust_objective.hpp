@@ -140,6 +140,7 @@ class RobustForceObjective {
   /// order_[0..tail_) = the indices of the tail_ largest forces (ties by index, so deterministic).
   void select_tail() {
     for (std::size_t i = 0; i < order_.size(); ++i) order_[i] = i;
+    // cppcheck-suppress arrayIndexThenCheck ; a < b breaks ties between two valid indices, no bounds check
     auto larger = [&](std::size_t a, std::size_t b) { return F_[a] > F_[b] || (F_[a] == F_[b] && a < b); };
     std::nth_element(order_.begin(), order_.begin() + static_cast<std::ptrdiff_t>(tail_ - 1), order_.end(),
                      larger);

@@ -149,17 +149,17 @@ inline void validate_spread_scale(const Spread& sp, const std::string& key) {
 inline void validate_normal_spread(const Spread& sp, const std::string& key) {
   if (sp.law != Spread::Law::Cone)
     FFSR_THROW(InputError(str(key, ": the normal takes the law 'cone' (angle-deg)")));
-  if (sp.scale > M_PI / 2 * (1 + 1e-15))
+  if (sp.scale > kPi / 2 * (1 + 1e-15))
     FFSR_THROW(InputError(str(key, ": the cone half-angle must be at most 90 deg, got ",
-                         short_number(sp.scale * 180 / M_PI), " deg")));
+                         short_number(sp.scale * 180 / kPi), " deg")));
 }
 
 /// The inertia: a relative normal or uniform law that keeps the moments positive, axes in [0, 180] deg.
 inline void validate_inertia_spread(const Spread& sp, const std::string& key) {
   if (sp.law != Spread::Law::Normal && sp.law != Spread::Law::Uniform)
     FFSR_THROW(InputError(str(key, ": the inertia takes a 'normal' or 'uniform' law with a relative spread")));
-  if (!(sp.axes >= 0 && sp.axes <= M_PI))
-    FFSR_THROW(InputError(str(key, ": axes-deg must be in [0, 180], got ", short_number(sp.axes * 180 / M_PI))));
+  if (!(sp.axes >= 0 && sp.axes <= kPi))
+    FFSR_THROW(InputError(str(key, ": axes-deg must be in [0, 180], got ", short_number(sp.axes * 180 / kPi))));
   if (sp.scale >= 1.0 && sp.law == Spread::Law::Uniform)
     FFSR_THROW(InputError(str(key, ": a relative half-width of ", short_number(sp.scale),
                          " allows non-positive moments (must be < 1)")));
