@@ -9,7 +9,12 @@ packages+=(libnlopt-cxx-dev)  # NLopt: the global capture search (optimize/globa
 packages+=(coinor-libipopt-dev)  # IPOPT: the time-optimal post-capture planner (control/detumble_planner.hpp; optional)
 packages+=(libfcl-dev)  # FCL: distances between the robot, the bus and the target (geometry/distance.hpp; optional)
 packages+=(chromium)  # the 3-D view's tests (python/tests/test_view.py): headless, WebGL through SwiftShader
+packages+=(ccache)  # .ci/run: compiles cached between runs on one machine
 packages+=(debootstrap)  # the wheel's check in a minimal Debian 12 root (scripts/check-wheel.sh)
+# the onboard core on the flight targets (scripts/onboard.sh, docs/onboard.md): the cross compilers, their
+# emulators, and the core's static analysis
+packages+=(g++-12-aarch64-linux-gnu qemu-user gcc-arm-none-eabi libstdc++-arm-none-eabi-newlib
+           libnewlib-arm-none-eabi qemu-system-arm clang-tidy-14 cppcheck)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -217,7 +217,11 @@ lint_core() {
     fail "lint: clang-tidy-14 or cppcheck missing (Debian: clang-tidy-14 cppcheck)"
     return 1
   fi
-  if nice -n 10 clang-tidy-14 -p "$dir" --quiet "$root/src/onboard/ffsr_onboard.cpp" >"$dir/clang-tidy.log" 2>&1; then
+  # the core's flags (src/onboard/CMakeLists.txt) but GCC's stack-usage options, which clang does not know
+  if nice -n 10 clang-tidy-14 --quiet "$root/src/onboard/ffsr_onboard.cpp" "$root/src/onboard/core_check.cpp" \
+       -- -std=c++17 -fno-exceptions \
+       -fno-rtti "-I$root/include" -isystem /usr/include/eigen3 -DEIGEN_DONT_VECTORIZE -DEIGEN_NO_DEBUG \
+       -DEIGEN_ALLOCA=__builtin_alloca -DEIGEN_STACK_ALLOCATION_LIMIT=4096 >"$dir/clang-tidy.log" 2>&1; then
     echo "   clang-tidy: no finding"
   else
     grep -E "(warning|error):" "$dir/clang-tidy.log" | head -30 >&2
@@ -225,6 +229,7 @@ lint_core() {
   fi
   if nice -n 10 cppcheck --quiet --enable=warning,performance,portability --std=c++17 --inline-suppr \
        --error-exitcode=1 -I "$root/include" --language=c++ "$root/src/onboard/ffsr_onboard.cpp" \
+       "$root/src/onboard/core_check.cpp" \
        >"$dir/cppcheck.log" 2>&1 &&
      nice -n 10 cppcheck --quiet --enable=warning,performance,portability --std=c99 --inline-suppr \
        --error-exitcode=1 -I "$root/include" -I "$root/src/onboard/platform" --language=c \

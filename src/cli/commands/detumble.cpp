@@ -113,13 +113,15 @@ plot::Figure detumble_figure(const Scenario& sc, const std::vector<DetumbleJobRe
     f.runs.push_back(std::move(r));
   }
   if (first.run.empty()) {
-    f.title = detail::str("After the capture: at rest in ", std::setprecision(3), first.result.time_to_rest,
-                          " s, peak joint torque ", first.result.peak_joint_torque, " N m (joint ",
+    // three significant digits (str gives a computed number six, a short one all of them)
+    f.title = detail::str("After the capture: at rest in ",
+                          detail::number_with_digits(first.result.time_to_rest, 3), " s, peak joint torque ",
+                          detail::number_with_digits(first.result.peak_joint_torque, 3), " N m (joint ",
                           first.peak_joint_name, ")");
   } else {
     f.title = first.run == "law" ? "After the capture: at rest in " : "After each run's capture: at rest in ";
     for (size_t i = 0; i < results.size(); ++i)
-      f.title += std::string(i ? ", " : "") + detail::str(std::setprecision(3), results[i].result.time_to_rest) +
+      f.title += std::string(i ? ", " : "") + detail::number_with_digits(results[i].result.time_to_rest, 3) +
                  " s (" + f.runs[i].label + ")";
   }
   return figures::detumble(f);
