@@ -17,6 +17,9 @@
 #                          example's four blobs from the scenario files into build-onboard/blobs/
 #   FFSR_QEMU_TIMEOUT      seconds before an emulator run counts as hung (default 600)
 set -uo pipefail
+# No compiler cache here (.ci/run sets ccache for its other stages): on a hit ccache restores the object
+# and the .su file but not GCC's call-graph file (.ci), which the stack analysis reads.
+unset CMAKE_C_COMPILER_LAUNCHER CMAKE_CXX_COMPILER_LAUNCHER
 
 root=$(cd "$(dirname "$0")/.." && pwd)
 build_root=$root/build-onboard
