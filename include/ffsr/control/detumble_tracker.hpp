@@ -55,7 +55,7 @@ class DetumblePlanTracker {
     Eigen::VectorXd u(stack.nv()), acc(stack.nv());
     for (int k = 0; k < plan.intervals(); ++k)
       for (int end = 0; end < 2; ++end) {
-        const DetumbleState& x = plan.nodes[static_cast<size_t>(k + end)];
+        const DetumbleState& x = plan.nodes[static_cast<size_t>(k) + static_cast<size_t>(end)];
         plan_command(plan, k, x.base.orientation, c);
         u << c.base_wrench, c.tau;
         aba(stack, d, x.base, x.theta, x.v, u, acc);
