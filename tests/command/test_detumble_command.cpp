@@ -373,8 +373,14 @@ TEST_CASE("detumble --plan: the time-optimal plan beside the law, its re-run in 
                      dir.str());
   const json j = ffsr::test::parse_json(r);
   const json& p = j.at("plan");
-  CHECK(p.at("solver_status") == "Solve_Succeeded");
+  // the free plan's intervals are shorter than the 0.01 s tick: solved again on the tick's grid, whose
+  // least-effort solve may end at IPOPT's acceptable level (its constraints still within 1e-8)
+  CHECK((p.at("solver_status") == "Solve_Succeeded" || p.at("solver_status") == "Solved_To_Acceptable_Level"));
+  CHECK(p.at("constraint_violation").get<double>() <= 1e-8);
   const double T = p.at("time_to_rest").get<double>();
+  const double tick = j.at("parameters").at("tick").get<double>();
+  CHECK(p.at("free_intervals_time_to_rest").get<double>() <= T);
+  CHECK(T / p.at("intervals").get<int>() == Approx(tick).epsilon(1e-12));
   CHECK(T < j.at("time_to_rest").get<double>());  // the law's
   CHECK(T <= 0.5 * 5.05);                         // the fixed-gain law of the earlier releases
   CHECK(p.at("initial_guess_time_to_rest").get<double>() == Approx(j.at("time_to_rest").get<double>()).margin(0.02));
@@ -382,7 +388,7 @@ TEST_CASE("detumble --plan: the time-optimal plan beside the law, its re-run in 
   CHECK(rr.at("at_rest").get<bool>());
   CHECK(rr.at("dwell_at_rest").get<bool>());
   CHECK(rr.at("worst_bound_excess").get<double>() <= 1e-9);
-  CHECK(rr.at("momentum_drift").get<double>() <= 1e-7);
+  CHECK(rr.at("momentum_drift").get<double>() <= 1e-8);  // free-floating: the plan on the 0.01 s grid
   const auto limits = j.at("parameters").at("joint_torque_limit").get<std::vector<double>>();
   REQUIRE(p.at("controls").size() == size_t(p.at("intervals").get<int>()));
   REQUIRE(p.at("nodes").size() == p.at("controls").size() + 1);

@@ -471,14 +471,16 @@ TEST_CASE("detumble on the published planar problem (Vyas et al. 2022): the law 
   const DetumbleRunResult r = run_detumble(stack, stack.frame_index("ee"), body, s, lim, opt, run);
   INFO("time to rest " << r.time_to_rest << " s");
   REQUIRE(r.at_rest);
-  CHECK(r.time_to_rest <= 1.2 * 4.095);
+  CHECK(r.time_to_rest <= 1.05 * 4.095);  // 4.13 s: the thrusters brake the base while joint 1 brakes the arm
   CHECK(r.dwell_at_rest);
   check_torques_within_limits(r, lim.joint_torque);
   const double mass = 100 + 10 + 8 + 4 + 0.1 + 50;
   for (const DetumbleSample& x : r.series) {
+    const Matrix3 R = x.base.orientation.toRotationMatrix();  // the bounds are per base axis
+    const Vector3 f = R.transpose() * x.command.base_wrench.head<3>(), m = R.transpose() * x.command.base_wrench.tail<3>();
     for (int k = 0; k < 3; ++k) {
-      REQUIRE(std::abs(x.command.base_wrench(k)) <= 2 * (1 + 1e-12));
-      REQUIRE(std::abs(x.command.base_wrench(3 + k)) <= 2.5 * (1 + 1e-12));
+      REQUIRE(std::abs(f(k)) <= 2 * (1 + 1e-12));
+      REQUIRE(std::abs(m(k)) <= 2.5 * (1 + 1e-12));
     }
     if (x.t >= r.time_to_rest) {  // the base's twist too: its spin, and its speed (P / m at relative rest)
       REQUIRE(x.command.stack_rate <= 1e-3);

@@ -3,7 +3,7 @@
 // Each tick the joint torques brake the joint rates as hard as the joint torque limits and the gripper's
 // force and moment limits allow (the largest uniform decay that fits, a passive fallback when none does),
 // and hold the stack at rest once there; a base actuator (reaction wheels or thrusters), where there is
-// one, removes the stack's momentum as fast as its bounds allow. The law and its cost are in
+// one, brakes the base's own motion as hard as its bounds allow. The law and its cost are in
 // docs/detumble.md.
 #pragma once
 
@@ -84,9 +84,9 @@ struct DetumbleOptions {
   /// lambda_max (1/s): the fastest decay the joint rates are asked (qdd = -lambda qd, lambda the largest
   /// that fits the limits, at most this and kDetumbleTickFraction / tick): the law's bandwidth
   double max_decay = 20;
-  /// k_max (1/s): the fastest decay of the stack's momentum the actuator is asked (dL/dt = -k L, and
-  /// dP/dt = -k P with thrusters; k the largest within the actuator's bounds, at most this and
-  /// kDetumbleTickFraction / tick)
+  /// k_max (1/s): the fastest decay of the base's momentum with the arm held the actuator is asked
+  /// (the moment -k L_b, and the force -k P_b with thrusters, [P_b; L_b] = H_bb v_b; k the largest within
+  /// the actuator's bounds, at most this and kDetumbleTickFraction / tick)
   double max_base_decay = 2;
   double rest_rate = 1e-3;       ///< rad/s (m/s prismatic): at rest below it
   bool stop_stack_spin = false;  ///< also stop the stack's spin (needs an actuator)
@@ -364,21 +364,23 @@ class DetumbleController {
     return k;
   }
 
-  /// The actuator's wrench from the stack's centroidal momentum (centroidal_momentum, from the base rows
-  /// of H): the moment -k L_c, L_c the angular momentum about the stack's centre of mass, and for
-  /// thrusters the force -k_f P, with the largest k (k_f) up to base_cap_ that keeps every base-axis
-  /// component within the actuator's bound (the direction kept); a wheel's torque is cut so that its
-  /// stored momentum stays within its bound over the tick. Reads data_.H. Writes out.base_wrench,
-  /// out.base_decay.
+  /// The actuator's wrench that brakes the base's own motion: from the base's momentum with the arm
+  /// held, [P_b; L_b] = H_bb v_b (H_bb the stack's composite inertia about the base origin, v_b the
+  /// base's twist; inertial axes), the moment -k L_b, and for thrusters the force -k_f P_b, with the
+  /// largest k (k_f) up to base_cap_ that keeps every base-axis component within the actuator's bound
+  /// (the direction kept); a wheel's torque is cut so that its stored momentum stays within its bound
+  /// over the tick. Braking the base rather than the stack's centroidal momentum keeps the actuator at
+  /// work while the arm's motion spins the base (the momentum goes out as the whole stack stops).
+  /// Reads data_.H. Writes out.base_wrench, out.base_decay.
   void base_wrench(const DetumbleState& s, DetumbleCommand& out) const {
     out.base_wrench.setZero();
     out.base_decay = 0;
     if (!opt_.stop_stack_spin || limits_.actuator == BaseActuator::None) return;
-    const CentroidalMomentum h = centroidal_momentum(*model_, data_, s.v);
+    const Vector6 pb = data_.H.topLeftCorner<6, 6>() * s.v.head<6>();
     const Matrix3 R = s.base.orientation.normalized().toRotationMatrix();
-    const Vector3 Lb = R.transpose() * h.angular;
+    const Vector3 Lb = R.transpose() * pb.tail<3>();
     if (limits_.actuator == BaseActuator::Thrusters) {
-      const Vector3 Pb = R.transpose() * h.linear;
+      const Vector3 Pb = R.transpose() * pb.head<3>();
       out.base_wrench.head<3>() = R * (-base_fit(Pb, limits_.thruster_force) * Pb);
       out.base_decay = base_fit(Lb, limits_.thruster_torque);
       out.base_wrench.tail<3>() = R * (-out.base_decay * Lb);

@@ -28,6 +28,10 @@ struct DetumblePlan {
   double constraint_violation = 0;  ///< the largest residual of the dynamics and path constraints
   double solve_seconds = 0;         ///< wall time of the solve (the warm start's run included)
   double warm_start_duration = 0;   ///< T of the initial guess (the feedback law's time to rest)
+  /// T of the plan with free intervals when this one was solved again on the controller's tick's grid
+  /// (DetumblePlanOptions::tick), 0 when not; its iterations are counted in `iterations`
+  double free_duration = 0;
+  int substeps = 0;  ///< the planner's RK4 steps per interval (more than asked when a re-run missed rest)
   int intervals() const { return static_cast<int>(tau.size()); }
   double interval() const { return intervals() > 0 ? duration / intervals() : 0.0; }
   /// the interval holding time t (the last one from T on)

@@ -43,7 +43,10 @@ namespace ffsr {
 /// The transcription's and the solver's settings.
 struct DetumblePlanOptions {
   int intervals = 40;          ///< N
-  int substeps = 2;            ///< RK4 steps per interval
+  /// RK4 steps per interval at first: a plan whose controls, re-run by CVODE, do not bring the stack to
+  /// rest is solved again from itself with twice the steps (three times at most). Long plans of a spinning
+  /// stack (T of 8-24 s on 40 intervals) need 4-8: at 2 the re-run of 14 of 20 start spins missed rest
+  int substeps = 2;
   double effort_weight = 0;    ///< w: objective T + w h sum_k |u_k / bound|^2 (0: time only)
   double tolerance = 1e-8;     ///< the largest residual of the constraints (IPOPT constr_viol_tol)
   double optimality = 1e-5;    ///< IPOPT tol (the scaled optimality error)
@@ -56,6 +59,12 @@ struct DetumblePlanOptions {
   /// the largest joint rate at every node, rad/s (m/s prismatic; infinity: none). Time-optimal plans
   /// drive the joints hard: on the paper's 7-DOF stack to 60 deg/s for 0.13 s
   double max_joint_rate = std::numeric_limits<double>::infinity();
+  /// The onboard controller's tick, s (0: none). A plan whose intervals come out shorter than the tick
+  /// cannot be followed by a command held over a tick (DetumblePlanTracker refuses it): it is solved
+  /// again on the tick's grid, every interval one tick long and T the smallest multiple of the tick for
+  /// which the bounds hold (tried from the free plan's T up), with the controls of least effort (the
+  /// effort weight, 1 when zero) and the free plan as the initial guess.
+  double tick = 0;
 };
 
 /// The plan ends within this fraction of the rest rate (every joint rate, and the rest test's norms):
@@ -86,17 +95,26 @@ class DetumblePlanNlp : public Ipopt::TNLP {
     n_grip_ = (std::isfinite(limits.gripper_force) ? 1 : 0) + (std::isfinite(limits.gripper_moment) ? 1 : 0);
     nz_ = ny_ + nu_ + 1;
     rest_ = kDetumblePlanRestMargin * options.rest_rate;
-    nout_ = ny_ + (S_ + 1) * n_grip_;
     {
       DetumbleSystem sys(stack);
       y0_ = sys.pack(start);
     }
     threads_ = po.threads > 0 ? po.threads : std::max(1u, std::thread::hardware_concurrency());
     threads_ = std::min<unsigned>(threads_, static_cast<unsigned>(N_));
-    for (unsigned t = 0; t < threads_; ++t) work_.emplace_back(stack, ny_, nz_, nout_);
+    set_substeps(S_);
+  }
+
+  /// S RK4 steps per interval (the gripper's rows follow: one per substep's end).
+  void set_substeps(int S) {
+    S_ = S;
+    nout_ = ny_ + (S_ + 1) * n_grip_;
+    work_.clear();
+    for (unsigned t = 0; t < threads_; ++t) work_.emplace_back(stack_, ny_, nz_, nout_);
     out_.assign(static_cast<size_t>(N_), Eigen::VectorXd(nout_));
     jac_.assign(static_cast<size_t>(N_), Eigen::MatrixXd(nout_, nz_));
+    xc_.resize(0);
   }
+  int substeps() const { return S_; }
 
   Index num_vars() const { return 1 + (N_ + 1) * ny_ + N_ * nu_; }
   Index oy(int k) const { return 1 + k * ny_; }
@@ -108,6 +126,8 @@ class DetumblePlanNlp : public Ipopt::TNLP {
 
   /// The initial guess (x of num_vars()).
   void set_guess(const Eigen::VectorXd& x) { guess_ = x; }
+  /// T fixed to `T` (a plan on a tick's grid) instead of free within the horizon.
+  void fix_duration(double T) { fixed_duration_ = T; }
   const Eigen::VectorXd& solution() const { return x_; }
   Ipopt::SolverReturn status() const { return status_; }
 
@@ -126,8 +146,8 @@ class DetumblePlanNlp : public Ipopt::TNLP {
       xl[i] = -inf;
       xu[i] = inf;
     }
-    xl[0] = 1e-3;
-    xu[0] = horizon_;
+    xl[0] = fixed_duration_ > 0 ? fixed_duration_ : 1e-3;
+    xu[0] = fixed_duration_ > 0 ? fixed_duration_ : horizon_;
     for (Index i = 0; i < ny_; ++i) xl[oy(0) + i] = xu[oy(0) + i] = y0_(i);
     const Index e = oy(N_);
     // the end at rest by the rest test: each joint rate within rest / n (so that the gripper's rate
@@ -425,7 +445,7 @@ class DetumblePlanNlp : public Ipopt::TNLP {
   DetumblePlanOptions po_;
   double horizon_;
   int n_, N_, S_, ny_ = 0, nu_ = 0, nz_ = 0, nout_ = 0, n_grip_ = 0;
-  double rest_ = 0;
+  double rest_ = 0, fixed_duration_ = 0;
   bool wheels_ = false, thrusters_ = false;
   Eigen::VectorXd scale_, y0_, guess_, x_, xc_;
   bool have_jac_ = false, ok_ = false;

@@ -196,8 +196,10 @@ inline void detumble_plans(const Scenario& s, std::vector<DetumbleJobResult>& re
     const Model stack = attach_body(model, model.frame(ee).name, d.grasp.body);
     const DetumbleSettings& st = d.settings;
     DetumblePlanJob job;
+    DetumblePlanOptions po;
+    po.tick = st.run.tick;  // a plan the onboard tracker can follow at the run's tick
     try {
-      job.plan = plan_detumble(stack, ee, d.grasp.body, d.start, st.limits, st.options, st.run.horizon);
+      job.plan = plan_detumble(stack, ee, d.grasp.body, d.start, st.limits, st.options, st.run.horizon, po);
     } catch (const DetumblePlanError& e) {
       throw DetumblePlanError(detail::str("--plan: ", e.what(), d.run.empty() ? "" : " (from the " + d.run + " run's capture)"),
                               e.status, e.best_residual);

@@ -26,6 +26,8 @@ inline void check_detumble_plan_options(const DetumblePlanOptions& po, double ho
   if (std::isnan(po.max_joint_rate) || !(po.max_joint_rate > 0))
     throw InputError(str(w, ": the largest joint rate must be positive (infinity: none), got ", po.max_joint_rate));
   if (po.max_iterations < 1) throw InputError(str(w, ": max_iterations must be >= 1, got ", po.max_iterations));
+  if (!std::isfinite(po.tick) || po.tick < 0)
+    throw InputError(str(w, ": the tick must be >= 0 and finite (0: none), got ", po.tick));
   if (!std::isfinite(horizon) || !(horizon > 0))
     throw InputError(str(w, ": the horizon must be positive and finite, got ", horizon));
 }
@@ -183,6 +185,86 @@ inline void plan_from_solution(const DetumblePlanNlp& nlp, const Eigen::VectorXd
   }
 }
 
+/// Solves `nlp` from the guess x0: the plan, or DetumblePlanError naming `w` with IPOPT's status and
+/// the residual it reached.
+inline DetumblePlan solve_detumble_plan(const Ipopt::SmartPtr<DetumblePlanNlp>& nlp, const Eigen::VectorXd& x0,
+                                        const DetumblePlanOptions& po, bool warm, int n, const char* w) {
+  nlp->set_guess(x0);
+  Ipopt::SmartPtr<Ipopt::IpoptApplication> app = IpoptApplicationFactory();
+  set_ipopt_options(*app->Options(), po, warm);
+  if (app->Initialize() != Ipopt::Solve_Succeeded) throw NumericalError(str(w, ": IPOPT could not be initialised"));
+  Ipopt::ApplicationReturnStatus st;
+  {
+    const OneBlasThread one;
+    st = app->OptimizeTNLP(Ipopt::SmartPtr<Ipopt::TNLP>(GetRawPtr(nlp)));
+  }
+  DetumblePlan plan;
+  plan.status = ipopt_status_name(st);
+  plan.iterations = IsValid(app->Statistics()) ? app->Statistics()->IterationCount() : 0;
+  const Eigen::VectorXd& x = nlp->solution();
+  const double viol = x.size() == nlp->num_vars() ? nlp->violation(x) : std::numeric_limits<double>::infinity();
+  plan.constraint_violation = viol;
+  const bool ok = (st == Ipopt::Solve_Succeeded || st == Ipopt::Solved_To_Acceptable_Level) && viol <= po.tolerance;
+  if (!ok)
+    throw DetumblePlanError(str(w, ": IPOPT did not converge (", plan.status, " after ", plan.iterations,
+                                " iterations; the constraints' residual reached ", viol, ", asked ", po.tolerance, ")"),
+                            plan.status, viol);
+  plan_from_solution(*nlp, x, n, po.intervals, plan);
+  plan.substeps = nlp->substeps();
+  return plan;
+}
+
+/// Whether the plan's controls, held as planned and re-run by CVODE (replay_detumble_plan, without the
+/// dwell), bring the stack to rest at T: the plan is the dynamics', not the integrator's.
+inline bool plan_rests(const Model& stack, int gripper, const AttachedBody& body, const DetumblePlan& plan,
+                       const DetumbleLimits& limits, const DetumbleOptions& options) {
+  DetumbleRunOptions r;
+  r.tick = plan.interval();
+  r.horizon = 2 * plan.duration;
+  r.dwell = 0;
+  r.record_every = 0;
+  return replay_detumble_plan(stack, gripper, body, plan, limits, options, r).at_rest;
+}
+
+/// The plan `free` solved again on the grid of `po.tick` (DetumblePlanOptions::tick): T = N tick for
+/// N from ceil(free T / tick) up, the first that IPOPT solves; its controls of least effort.
+inline DetumblePlan plan_on_tick_grid(const Model& stack, int gripper, const AttachedBody& body,
+                                      const DetumbleState& start, const DetumbleLimits& limits,
+                                      const DetumbleOptions& options, double horizon, const DetumblePlanOptions& po,
+                                      const DetumblePlan& free) {
+  constexpr const char* w = "plan_detumble";
+  DetumblePlanOptions g = po;
+  if (!(g.effort_weight > 0)) g.effort_weight = 1;
+  const int first = std::max(2, static_cast<int>(std::ceil(free.duration / po.tick - 1e-9)));
+  const int last = std::min(2000, first + std::max(3, first / 4));  // up to a quarter longer
+  std::string why;
+  double residual = std::numeric_limits<double>::infinity();
+  const int iterations = free.iterations;
+  for (int N = first; N <= last && N * po.tick <= horizon; ++N) {
+    g.intervals = N;
+    Ipopt::SmartPtr<DetumblePlanNlp> nlp = new DetumblePlanNlp(stack, gripper, body, start, limits, options, horizon, g);
+    nlp->fix_duration(N * po.tick);
+    Eigen::VectorXd x0;
+    detumble_plan_guess(*nlp, free, N, x0);
+    x0(0) = N * po.tick;
+    try {
+      DetumblePlan p = solve_detumble_plan(nlp, x0, g, false, stack.n(), w);
+      p.iterations += iterations;
+      p.warm_start_duration = free.warm_start_duration;
+      p.free_duration = free.duration;
+      return p;
+    } catch (const DetumblePlanError& e) {
+      why = e.status;
+      residual = std::min(residual, e.best_residual);
+    }
+  }
+  throw DetumblePlanError(str(w, ": no plan on the tick's grid: the free plan rests at ", free.duration,
+                              " s on intervals of ", free.interval(), " s, shorter than the tick (", po.tick,
+                              " s), and IPOPT found none of ", first, " to ", last, " ticks within the horizon (",
+                              horizon, " s; last status ", why.empty() ? "none tried" : why, ")"),
+                          why, residual);
+}
+
 }  // namespace detail
 
 inline DetumblePlan plan_detumble(const Model& stack, int gripper, const AttachedBody& body,
@@ -207,37 +289,29 @@ inline DetumblePlan plan_detumble(const Model& stack, int gripper, const Attache
   Ipopt::SmartPtr<detail::DetumblePlanNlp> nlp =
       new detail::DetumblePlanNlp(stack, gripper, body, start, limits, options, horizon, po);
   Eigen::VectorXd x0;
-  DetumblePlan plan;
+  double guess_duration = 0;
   if (warm) {
     detail::detumble_plan_guess(*nlp, *warm, N, x0);
-    plan.warm_start_duration = warm->duration;
+    guess_duration = warm->duration;
   } else {
-    plan.warm_start_duration =
-        detail::detumble_law_guess(*nlp, stack, gripper, body, start, limits, options, horizon, N, x0);
+    guess_duration = detail::detumble_law_guess(*nlp, stack, gripper, body, start, limits, options, horizon, N, x0);
   }
-  nlp->set_guess(x0);
-
-  Ipopt::SmartPtr<Ipopt::IpoptApplication> app = IpoptApplicationFactory();
-  detail::set_ipopt_options(*app->Options(), po, warm != nullptr);
-  if (app->Initialize() != Ipopt::Solve_Succeeded)
-    throw NumericalError(detail::str(w, ": IPOPT could not be initialised"));
-  Ipopt::ApplicationReturnStatus st;
-  {
-    const detail::OneBlasThread one;
-    st = app->OptimizeTNLP(Ipopt::SmartPtr<Ipopt::TNLP>(GetRawPtr(nlp)));
+  DetumblePlan plan = detail::solve_detumble_plan(nlp, x0, po, warm != nullptr, stack.n(), w);
+  // a plan whose re-run misses rest is the integrator's: solved again from it with twice the substeps
+  for (int again = 0; again < 3 && nlp->substeps() < 50 &&
+                      !detail::plan_rests(stack, gripper, body, plan, limits, options);
+       ++again) {
+    DetumblePlanOptions finer = po;
+    finer.substeps = std::min(50, 2 * nlp->substeps());
+    const int iterations = plan.iterations;
+    nlp = new detail::DetumblePlanNlp(stack, gripper, body, start, limits, options, horizon, finer);
+    detail::detumble_plan_guess(*nlp, plan, N, x0);
+    plan = detail::solve_detumble_plan(nlp, x0, finer, true, stack.n(), w);
+    plan.iterations += iterations;
   }
-  plan.status = detail::ipopt_status_name(st);
-  plan.iterations = IsValid(app->Statistics()) ? app->Statistics()->IterationCount() : 0;
-  const Eigen::VectorXd& x = nlp->solution();
-  const double viol = x.size() == nlp->num_vars() ? nlp->violation(x) : std::numeric_limits<double>::infinity();
-  plan.constraint_violation = viol;
-  const bool ok = (st == Ipopt::Solve_Succeeded || st == Ipopt::Solved_To_Acceptable_Level) && viol <= po.tolerance;
-  if (!ok)
-    throw DetumblePlanError(detail::str(w, ": IPOPT did not converge (", plan.status, " after ", plan.iterations,
-                                        " iterations; the constraints' residual reached ", viol,
-                                        ", asked ", po.tolerance, ")"),
-                            plan.status, viol);
-  detail::plan_from_solution(*nlp, x, stack.n(), N, plan);
+  plan.warm_start_duration = guess_duration;
+  if (po.tick > 0 && plan.interval() < po.tick * (1 - 1e-9))
+    plan = detail::plan_on_tick_grid(stack, gripper, body, start, limits, options, horizon, po, plan);
   plan.solve_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
   return plan;
 }

@@ -51,11 +51,14 @@ inline nlohmann::json detumble_plan_json(const DetumblePlanJob& p) {
   const DetumblePlanRun& r = p.run;
   nlohmann::json j{{"time_to_rest", plan.duration},
                    {"intervals", plan.intervals()},
+                   {"substeps", plan.substeps},
                    {"solver_status", plan.status},
                    {"iterations", plan.iterations},
                    {"solve_seconds", plan.solve_seconds},
                    {"constraint_violation", plan.constraint_violation},
-                   {"initial_guess_time_to_rest", plan.warm_start_duration}};
+                   {"initial_guess_time_to_rest", plan.warm_start_duration},
+                   {"free_intervals_time_to_rest", plan.free_duration > 0 ? nlohmann::json(plan.free_duration)
+                                                                          : nlohmann::json(nullptr)}};
   j["rerun"] = {{"at_rest", r.at_rest},
                 {"final_joint_rate", r.end_joint_rate},
                 {"final_relative_rate", r.end_relative_rate},
