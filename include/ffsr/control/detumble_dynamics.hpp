@@ -96,19 +96,25 @@ struct StackRk4 {
   explicit StackRk4(Eigen::Index size) : k1(size), k2(size), k3(size), k4(size), tmp(size) {}
 };
 
-/// One classical Runge-Kutta step of the stack's state y over dt with the command c held; the
-/// quaternion renormalized after the step.
-inline void rk4_stack_step(DetumbleSystem& sys, StackRk4& w, Eigen::VectorXd& y, const DetumbleCommand& c,
-                           bool wheels, double dt) {
-  sys.rhs(y, c, wheels, w.k1);
+/// One classical Runge-Kutta step of the stack's state y over dt with the right-hand side f(y, ydot)
+/// (the stack's ODE under a command, which may depend on y); the quaternion renormalized after the step.
+template <class Rhs>
+inline void rk4_stack_step(StackRk4& w, Eigen::VectorXd& y, double dt, const Rhs& f) {
+  f(y, w.k1);
   w.tmp = y + 0.5 * dt * w.k1;
-  sys.rhs(w.tmp, c, wheels, w.k2);
+  f(w.tmp, w.k2);
   w.tmp = y + 0.5 * dt * w.k2;
-  sys.rhs(w.tmp, c, wheels, w.k3);
+  f(w.tmp, w.k3);
   w.tmp = y + dt * w.k3;
-  sys.rhs(w.tmp, c, wheels, w.k4);
+  f(w.tmp, w.k4);
   y += dt / 6 * (w.k1 + 2 * w.k2 + 2 * w.k3 + w.k4);
   y.segment<4>(3).normalize();
+}
+
+/// One classical Runge-Kutta step of the stack's state y over dt with the command c held.
+inline void rk4_stack_step(DetumbleSystem& sys, StackRk4& w, Eigen::VectorXd& y, const DetumbleCommand& c,
+                           bool wheels, double dt) {
+  rk4_stack_step(w, y, dt, [&](const Eigen::VectorXd& x, Eigen::VectorXd& xd) { sys.rhs(x, c, wheels, xd); });
 }
 
 }  // namespace detail

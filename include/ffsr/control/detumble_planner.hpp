@@ -269,10 +269,10 @@ class DetumblePlanNlp : public Ipopt::TNLP {
   /// gripper rows (|f|^2 / F^2, |m|^2 / M^2) at the start and every substep's end into `out`.
   struct Work {
     DetumbleSystem sys;
-    Eigen::VectorXd k1, k2, k3, k4, tmp, y, z, base, pert;
+    detail::StackRk4 rk;  ///< the stages of detail::rk4_stack_step
+    Eigen::VectorXd y, z, base, pert;
     DetumbleCommand cmd;
-    Work(const Model& m, int ny, int nz, int nout)
-        : sys(m), k1(ny), k2(ny), k3(ny), k4(ny), tmp(ny), y(ny), z(nz), base(nout), pert(nout) {
+    Work(const Model& m, int ny, int nz, int nout) : sys(m), rk(ny), y(ny), z(nz), base(nout), pert(nout) {
       cmd.tau = Eigen::VectorXd::Zero(m.n());
     }
   };
@@ -312,30 +312,16 @@ class DetumblePlanNlp : public Ipopt::TNLP {
       w.sys.rhs(y, w.cmd, wheels_, yd);
     };
     for (int j = 0; j < S_; ++j) {
-      rk4_step(w, dt, f);
+      detail::rk4_stack_step(w.rk, w.y, dt, f);
       grip(w.y);
     }
     out.head(ny_) = w.y;
   }
 
-  /// One RK4 step of w.y over dt with the right-hand side f(y, ydot), the quaternion kept unit.
-  template <class Rhs>
-  static void rk4_step(Work& w, double dt, const Rhs& f) {
-    f(w.y, w.k1);
-    w.tmp = w.y + 0.5 * dt * w.k1;
-    f(w.tmp, w.k2);
-    w.tmp = w.y + 0.5 * dt * w.k2;
-    f(w.tmp, w.k3);
-    w.tmp = w.y + dt * w.k3;
-    f(w.tmp, w.k4);
-    w.y += dt / 6 * (w.k1 + 2 * w.k2 + 2 * w.k3 + w.k4);
-    w.y.segment<4>(3).normalize();
-  }
-
   /// One RK4 tick of the feedback law's command (held, inertial), for the initial guess.
   void step_held(Work& w, const DetumbleCommand& c, double dt, int substeps) const {
     const auto f = [&](const Eigen::VectorXd& y, Eigen::VectorXd& yd) { w.sys.rhs(y, c, wheels_, yd); };
-    for (int j = 0; j < substeps; ++j) rk4_step(w, dt / substeps, f);
+    for (int j = 0; j < substeps; ++j) detail::rk4_stack_step(w.rk, w.y, dt / substeps, f);
   }
 
   Work& work0() { return work_.front(); }
