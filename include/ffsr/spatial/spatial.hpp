@@ -59,7 +59,10 @@ inline void sin_cos(double x, double& s, double& c) {
   }
   constexpr double kTwoOverPi = 0.6366197723675814;
   constexpr double kP1 = 0x1.921fb544p+0, kP2 = 0x1.0b4611a6p-34, kP3 = 0x1.3198a2e037073p-69;  // pi/2 = sum
-  const double k = std::nearbyint(x * kTwoOverPi);
+  // k = nearbyint(x 2/pi), rounded by adding and subtracting 1.5 2^52 (|x 2/pi| < 2^51: the same
+  // round-to-nearest-even as nearbyint, which without SSE4.1 is a call into libm)
+  constexpr double kRound = 0x1.8p52;
+  const double k = (x * kTwoOverPi + kRound) - kRound;
   const double r = ((x - k * kP1) - k * kP2) - k * kP3;
   const double z = r * r;
   // sin r = r + r z (-1/3! + z (1/5! - ...)), cos r = 1 - z/2 + z^2 (1/4! - z (1/6! - ...)): the two
