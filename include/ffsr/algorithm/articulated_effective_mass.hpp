@@ -195,7 +195,7 @@ inline bool inverse_form_composite(const Model& model, Data& data, int ee, const
   double g[6];
   q = I0.solve(f.data(), g);
   for (int j = 0; j < n; ++j) {
-    const Vector6 F = data.Ic[static_cast<size_t>(j + 1)] * Vector6(data.S.col(j));
+    const Vector6 F = data.Ic[static_cast<size_t>(j) + 1] * Vector6(data.S.col(j));
     double* Fj = data.Fc.col(j).data();
     for (int e = 0; e < 6; ++e) Fj[e] = F(e);
     I0.solve(Fj, L + j * ld);
