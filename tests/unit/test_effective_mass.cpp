@@ -164,6 +164,44 @@ TEST_CASE("inverse effective mass: the articulated-body recursion equals the den
   }
 }
 
+TEST_CASE("inverse effective mass: the composite route equals the dense Cholesky path", "[dynamics][fast]") {
+  // the Schur complement of the floating base over the composite inertias (inverse_form_composite,
+  // the route of integrated_effective_mass up to kCompositeMaxJoints joints) against crba + Cholesky,
+  // free and with armature, at frames on and off the path of every body
+  Rng rng(37);
+  std::vector<NamedModel> models = models_of_every_kind();
+  for (int n = 1; n <= kCompositeMaxJoints + 2; ++n)
+    models.push_back({"chain", random_chain(n, 100u + unsigned(n))});
+  int checked = 0;
+  for (const auto& [name, model] : models) {
+    if (!model.depth_first()) continue;  // the route needs contiguous subtrees (mimics: the dense route)
+    Data d(model), e(model);
+    for (const ContactJoints& joints : joint_models(model)) {
+      if (joints.model == JointModel::Locked) continue;
+      const Eigen::VectorXd* a = joints.model == JointModel::Armature ? &joints.armature : nullptr;
+      for (int k = 0; k < 3; ++k) {
+        const Config q = random_config(model, rng);
+        const Vector3 u = rng.unit();
+        for (int frame = 0; frame < static_cast<int>(model.frames().size()); ++frame) {
+          INFO(name << " n " << model.n() << " config " << k << " frame " << model.frame(frame).name << " "
+                    << joint_model_name(joints.model));
+          crba(model, d, q.base, q.theta);
+          const double dense = inverse_effective_mass(model, d, frame, u, joints);
+          forward_kinematics(model, e, q.base, q.theta);
+          const Vector6 f = detail::unit_point_force(model, e, frame, u);
+          double composite = -1.0;
+          REQUIRE(detail::inverse_form_composite(model, e, model.frame(frame).body, f, a, composite));
+          CHECK(std::abs(composite - dense) <= 1e-12 * dense);
+          // it leaves the composite inertias as crba does
+          CHECK((e.Ic[0].matrix() - d.Ic[0].matrix()).cwiseAbs().maxCoeff() == 0.0);
+          ++checked;
+        }
+      }
+    }
+  }
+  CHECK(checked > 100);
+}
+
 TEST_CASE("inverse_quadratic_spd6: x^T A^-1 x against Eigen's LLT solve, refuses indefinite matrices",
           "[dynamics]") {
   std::mt19937 gen(17);

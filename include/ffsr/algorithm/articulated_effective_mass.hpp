@@ -1,6 +1,7 @@
 // ffsr/algorithm/articulated_effective_mass.hpp -- the inverse effective mass (Eq. 4) in O(n) by
 // articulated-body inertias, without forming H: the recursion behind integrated_effective_mass
-// (effective_mass.hpp) and its gradient (effective_mass_gradient.hpp).
+// (effective_mass.hpp) and its gradient (effective_mass_gradient.hpp); and, for few joints, the
+// composite route (the floating base's Schur complement over the composite inertias).
 #pragma once
 
 #include "ffsr/algorithm/joint_models.hpp"
@@ -124,6 +125,118 @@ inline bool inverse_quadratic_articulated(const ArticulatedInertia& A, const Vec
     if (q >= 0.0 && q <= std::numeric_limits<double>::max()) return true;
   }
   return inverse_quadratic_spd6(A.matrix(), x, q);
+}
+
+/// The inverse of a rigid body's spatial inertia I = [m 1, -[h]x; [h]x, Ibar] (linear first, about a
+/// reference point), by its centre of mass: with K = Ibar - (|h|^2 1 - h h^T) / m (the rotational
+/// inertia about the centre of mass), I [v; w] = [a; b] gives w = K^-1 (b - h x a / m) and
+/// v = (a + h x w) / m. K^-1 is its adjugate over its determinant. `ok` is false unless m and K are
+/// positive definite with m, 1/m and |K| in the normal range of doubles.
+struct RigidInverse {
+  double im = 0.0, h0 = 0.0, h1 = 0.0, h2 = 0.0;
+  double k[6] = {};  ///< K^-1, upper triangle k00 k01 k02 k11 k12 k22
+  bool ok = false;
+  explicit RigidInverse(const SpatialInertia& I) : h0(I.h(0)), h1(I.h(1)), h2(I.h(2)) {
+    constexpr double lo = std::numeric_limits<double>::min(), hi = std::numeric_limits<double>::max();
+    if (!(I.m >= lo && I.m <= hi)) return;
+    im = 1.0 / I.m;
+    const Matrix3& B = I.Ibar;
+    bool pd = im <= hi;
+    double a[6];
+    const double det = adjugate_sym3(B(0, 0) - (h1 * h1 + h2 * h2) * im, B(0, 1) + h0 * h1 * im,
+                                     B(0, 2) + h0 * h2 * im, B(1, 1) - (h0 * h0 + h2 * h2) * im,
+                                     B(1, 2) + h1 * h2 * im, B(2, 2) - (h0 * h0 + h1 * h1) * im, a, pd);
+    if (!pd || !(det >= lo && det <= hi)) return;
+    const double id = 1.0 / det;
+    for (int e = 0; e < 6; ++e) k[e] = a[e] * id;
+    ok = true;
+  }
+  /// out = I^-1 x (6 entries each); returns x^T I^-1 x.
+  double solve(const double* x, double* out) const {
+    const double a0 = x[0], a1 = x[1], a2 = x[2];
+    const double c0 = x[3] - (h1 * a2 - h2 * a1) * im, c1 = x[4] - (h2 * a0 - h0 * a2) * im,
+                 c2 = x[5] - (h0 * a1 - h1 * a0) * im;
+    const double w0 = (k[0] * c0 + k[1] * c1) + k[2] * c2, w1 = (k[1] * c0 + k[3] * c1) + k[4] * c2,
+                 w2 = (k[2] * c0 + k[4] * c1) + k[5] * c2;
+    const double v0 = (a0 + (h1 * w2 - h2 * w1)) * im, v1 = (a1 + (h2 * w0 - h0 * w2)) * im,
+                 v2 = (a2 + (h0 * w1 - h1 * w0)) * im;
+    out[0] = v0, out[1] = v1, out[2] = v2, out[3] = w0, out[4] = w1, out[5] = w2;
+    return ((a0 * v0 + a1 * v1) + a2 * v2) + ((x[3] * w0 + x[4] * w1) + x[5] * w2);
+  }
+};
+
+/// a . b for 6-vectors, summed in pairs (three independent chains)
+inline double dot6_paired(const double* a, const double* b) {
+  return ((a[0] * b[0] + a[1] * b[1]) + (a[2] * b[2] + a[3] * b[3])) + (a[4] * b[4] + a[5] * b[5]);
+}
+
+/// w^T (H + diag(0, a))^-1 w for the generalized force w = J^T f of the spatial force f (about p_0,
+/// inertial axes) on body `ee`, by the composite inertias and the floating base's Schur complement:
+/// with H = [Ic_0 F; F^T H_m] (Ic_0 the composite inertia of the whole robot, a rigid body's, F_i =
+/// Ic_i S_i) and w = [f; w_m] (w_m,i = S_i . f for the joints that support ee),
+///   w^T H^-1 w = f^T Ic_0^-1 f + r^T M^-1 r,  M = H_m + diag(a) - F^T Ic_0^-1 F,  r = w_m - F^T Ic_0^-1 f,
+/// M (n x n, the inertia of the joints with the base free) by an LDL^T with one division per pivot:
+/// r^T M^-1 r = sum_j y_j^2 / D_j for L y = r. O(n^2) entries and an O(n^3) factorization, without
+/// the recursion's 6x6 rank-one update per body: the faster route for few joints (see
+/// kCompositeMaxJoints). Requires a depth-first model with one body per coordinate. Reads the
+/// kinematics. Writes data.Ic (composite), data.Fc, data.L (Ic_0^-1 F in its top rows, M's upper
+/// triangle and its factor below), data.w and data.y. False when Ic_0 or M is not positive definite
+/// or the result is not a finite non-negative number (q is then unspecified): the articulated route
+/// decides those cases.
+inline bool inverse_form_composite(const Model& model, Data& data, int ee, const Vector6& f,
+                                   const Eigen::VectorXd* armature, double& q) {
+  composite_inertias(model, data);
+  const RigidInverse I0(data.Ic[0]);
+  if (!I0.ok) return false;
+  const int n = model.nb() - 1;
+  const Eigen::Index ld = data.L.rows();
+  double* const L = data.L.data() + 6 * ld;  // column j of the joints: G_j = Ic_0^-1 F_j, then M's column j
+  double* const r = data.y.data() + 6;
+  double g[6];
+  q = I0.solve(f.data(), g);
+  for (int j = 0; j < n; ++j) {
+    const Vector6 F = data.Ic[static_cast<size_t>(j) + 1] * Vector6(data.S.col(j));
+    double* Fj = data.Fc.col(j).data();
+    for (int e = 0; e < 6; ++e) Fj[e] = F(e);
+    I0.solve(Fj, L + j * ld);
+  }
+  // M's upper triangle (M_ij, i <= j, in column j) and r: with T_i = S_i - G_i (G_i = Ic_0^-1 F_i),
+  // M_ij = F_j . T_i for j in the subtree of i (the contiguous range i..last; S_i . F_j is H_m's entry)
+  // and -F_j . G_i for the others; r_i = T_i . f for the joints that support ee (F_i . g = G_i . f) and
+  // -G_i . f for the others
+  for (int i = 0; i < n; ++i) {
+    const double* Si = data.S.col(i).data();
+    const double* Gi = L + i * ld;
+    const double T[6] = {Si[0] - Gi[0], Si[1] - Gi[1], Si[2] - Gi[2],
+                         Si[3] - Gi[3], Si[4] - Gi[4], Si[5] - Gi[5]};
+    const int last = model.subtree_last(i + 1) - 1;
+    for (int j = i; j <= last; ++j) L[j * ld + 6 + i] = dot6_paired(data.Fc.col(j).data(), T);
+    for (int j = last + 1; j < n; ++j) L[j * ld + 6 + i] = -dot6_paired(data.Fc.col(j).data(), Gi);
+    if (armature) L[i * ld + 6 + i] += (*armature)(i);
+    r[i] = i + 1 <= ee && ee <= last + 1 ? dot6_paired(T, f.data()) : -dot6_paired(Gi, f.data());
+  }
+  // LDL^T in place, row by row (L_ji over M_ij for i < j, 1 / D_j on the diagonal; each sum runs over
+  // contiguous entries), and L y = r over r: r^T M^-1 r = sum_j y_j^2 / D_j
+  double* const w = data.w.data() + 6;  // L_jk D_k of the current row j
+  for (int j = 0; j < n; ++j) {
+    double* Mj = L + j * ld + 6;
+    double d = Mj[j], yj = r[j];
+    for (int i = 0; i < j; ++i) {
+      const double* Mi = L + i * ld + 6;
+      double s = Mj[i];
+      for (int k = 0; k < i; ++k) s -= w[k] * Mi[k];
+      w[i] = s;
+      Mj[i] = s * Mi[i];
+      d -= s * Mj[i];
+      yj -= Mj[i] * r[i];
+    }
+    if (!(d > 0.0)) return false;
+    const double inv = 1.0 / d;
+    Mj[j] = inv;
+    r[j] = yj;
+    q += yj * yj * inv;
+  }
+  return q >= 0.0 && q <= std::numeric_limits<double>::max();
 }
 
 /// The unit force u at the origin of `frame` as a spatial force about the base origin p_0 (inertial

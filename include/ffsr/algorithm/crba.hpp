@@ -18,8 +18,16 @@ inline void body_inertias(const Model& model, Data& data) {
   for (int i = 0; i < nb; ++i) {
     const auto ui = static_cast<size_t>(i);
     const Inertia& in = model.body(i).inertia;
-    data.Ic[ui] = SpatialInertia::from_body(in.mass, in.com, in.I, data.R[ui], data.p[ui] - p0);
+    data.Ic[ui].set_body(in.mass, in.com, in.I, model.inertia_diagonal(i), data.R[ui], data.p[ui] - p0);
   }
+}
+
+/// The composite inertia of every body's subtree (body_inertias, then each body added into its
+/// parent's from the leaves). Reads the kinematics. Writes data.Ic.
+inline void composite_inertias(const Model& model, Data& data) {
+  body_inertias(model, data);
+  for (int i = model.nb() - 1; i > 0; --i)  // the children of i come after it: Ic_i is complete here
+    data.Ic[static_cast<size_t>(model.body(i).parent)] += data.Ic[static_cast<size_t>(i)];
 }
 
 }  // namespace detail
@@ -44,10 +52,8 @@ inline void body_inertias(const Model& model, Data& data) {
 inline const Eigen::MatrixXd& crba(const Model& model, Data& data, const BasePose& base,
                                    const Eigen::Ref<const Eigen::VectorXd>& theta) {
   forward_kinematics(model, data, base, theta);
-  detail::body_inertias(model, data);
+  detail::composite_inertias(model, data);
   const int nb = model.nb();
-  for (int i = nb - 1; i > 0; --i)  // the children of i come after it: Ic_i is complete here
-    data.Ic[static_cast<size_t>(model.body(i).parent)] += data.Ic[static_cast<size_t>(i)];
 
   Eigen::MatrixXd& H = data.H;
   const Eigen::Index ld = H.rows();

@@ -1,6 +1,7 @@
 // ffsr/algorithm/effective_mass.hpp -- the effective mass m_e (Eq. 4) and the integrated effective
 // mass M_ie (Eq. 14), every overload: integrated_effective_mass takes the O(n) articulated-body
-// recursion under each joint model (mimic joints: crba and the dense solve);
+// recursion under each joint model, or for few joints the composite route (mimic joints: crba and the
+// dense solve);
 // integrated_effective_mass_dense is the dense evaluation (crba, Cholesky), for cross-checks.
 // Their gradients: effective_mass_gradient.hpp.
 #pragma once
@@ -139,9 +140,16 @@ inline double integrated_effective_mass(double m_e, const Target& target) {
   return 1.0 / inverse;
 }
 
-/// Kept for callers that chose the route by size: the articulated-body recursion is the faster route
-/// at every size (ffsr-bench-pinocchio), so integrated_effective_mass takes it from one joint on.
+/// Kept for callers that chose the route by size: integrated_effective_mass never takes the dense
+/// route (crba and a Cholesky factorization of H) for a tree, from one joint on.
 inline constexpr int kArticulatedMinJoints = 1;
+
+/// Up to this many joints integrated_effective_mass takes the composite route
+/// (detail::inverse_form_composite: the composite inertias and the floating base's Schur complement,
+/// O(n^2) entries and an n x n factorization), above it the O(n) recursion. The rule is the size at
+/// which the two cost the same on ffsr-bench-pinocchio's chains (between 10 and 12 joints, with
+/// random axes; the composite route is 10-20 % faster at 3 and 7 joints), set below it.
+inline constexpr int kCompositeMaxJoints = 8;
 
 namespace detail {
 /// True when integrated_effective_mass takes the articulated-body recursion: at least
@@ -159,6 +167,26 @@ inline double integrated_from_inverse(double inverse, double target_inverse_mass
     FFSR_THROW(NumericalError(str("integrated_effective_mass: M_ie is not representable (1/m_e = ", inverse,
                              ", target's inverse mass ", target_inverse_mass, ")")));
   return M;
+}
+
+/// True when integrated_effective_mass tries the composite route (detail::inverse_form_composite)
+/// before the recursion: a depth-first model with one body per coordinate and at most
+/// kCompositeMaxJoints joints, under the Free or Armature joint model.
+inline bool takes_composite(const Model& model, const ContactJoints& joints) {
+  return joints.model != JointModel::Locked && model.depth_first() && model.nb() - 1 == model.n() &&
+         model.n() <= kCompositeMaxJoints;
+}
+
+/// The inverse effective mass by the route integrated_effective_mass takes (after the kinematics).
+inline double inverse_effective_mass_routed(const Model& model, Data& data, int frame, const Vector3& u,
+                                            const ContactJoints& joints) {
+  if (takes_composite(model, joints)) {
+    const Vector6 f = unit_point_force(model, data, frame, u);
+    double q = 0.0;
+    if (inverse_form_composite(model, data, model.frame(frame).body, f, armature_of(model, joints), q))
+      return q;
+  }
+  return inverse_effective_mass_articulated(model, data, frame, u, joints);
 }
 
 inline void check_target_inverse_mass(double target_inverse_mass) {
@@ -199,10 +227,13 @@ inline double integrated_effective_mass_dense(const Model& model, Data& data, co
 /// and the target's inverse mass along it, target_inverse_mass = Target::inverse_mass_along_normal:
 /// M_ie = 1 / (1/m_e + target_inverse_mass). In O(n) by the articulated-body recursion
 /// (inverse_effective_mass_articulated: Free, Armature with its a_i, Locked from the composite
-/// inertia of the whole robot), without forming H; a model with mimic joints takes the dense route
-/// (integrated_effective_mass_dense). The two routes agree to rounding (tested to 1e-12 relative).
-/// Writes the kinematics and the recursion's fields (data.H, data.L, data.w, data.y for mimics): do
-/// not rely on data.H afterwards. Errors as integrated_effective_mass_dense.
+/// inertia of the whole robot), without forming H; up to kCompositeMaxJoints joints (Free and
+/// Armature, depth-first models) by the composite route, which hands the cases it cannot decide (an
+/// inertia that is not positive definite, an overflow) to the recursion; a model with mimic joints
+/// takes the dense route (integrated_effective_mass_dense). The routes agree to rounding (tested to
+/// 1e-12 relative). Writes the kinematics and the routes' fields (data.Ic, data.Fc, data.L, data.w,
+/// data.y and the recursion's; data.H for mimics): do not rely on data.H afterwards. Errors as
+/// integrated_effective_mass_dense.
 inline double integrated_effective_mass(const Model& model, Data& data, const BasePose& base,
                                         const Eigen::Ref<const Eigen::VectorXd>& theta, int frame,
                                         const Vector3& u, double target_inverse_mass,
@@ -211,7 +242,7 @@ inline double integrated_effective_mass(const Model& model, Data& data, const Ba
     return integrated_effective_mass_dense(model, data, base, theta, frame, u, target_inverse_mass, joints);
   detail::check_target_inverse_mass(target_inverse_mass);
   forward_kinematics(model, data, base, theta);
-  return detail::integrated_from_inverse(inverse_effective_mass_articulated(model, data, frame, u, joints),
+  return detail::integrated_from_inverse(detail::inverse_effective_mass_routed(model, data, frame, u, joints),
                                          target_inverse_mass);
 }
 

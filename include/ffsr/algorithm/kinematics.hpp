@@ -108,7 +108,7 @@ inline void forward_kinematics(const Model& model, Data& data, const BasePose& b
       const double c = data.cos_q[ui];
       if (a >= 0) {  // about +-x, +-y or +-z: a plane rotation of two columns (12 products)
         s *= b.joint.axis(a);
-        const int c1 = (a + 1) % 3, c2 = (a + 2) % 3;
+        const int c1 = jk.next1, c2 = jk.next2;
         J[a].store(R, a);
         (J[c1] * c + J[c2] * s).store(R, c1);
         (J[c2] * c - J[c1] * s).store(R, c2);

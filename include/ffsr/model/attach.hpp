@@ -72,6 +72,7 @@ inline Model attach_body(const Model& model, const std::string& frame, const Att
   const Inertia in{body.mass, com.p, com.R * body.inertia * com.R.transpose()};
   Inertia& carrier = m.bodies_[static_cast<size_t>(at.body)].inertia;
   carrier = detail::merged_inertia(carrier, in);
+  m.inertia_diagonal_[static_cast<size_t>(at.body)] = SpatialInertia::is_diagonal(carrier.I) ? 1 : 0;
   m.frames_.push_back({body.name, at.body, com});
   return m;
 }

@@ -142,6 +142,7 @@ inline Inertia merged_inertia(const Inertia& a, const Inertia& b) {
 struct JointKinematics {
   bool tree_identity = true;  ///< tree.R is exactly the identity (rpy 0 0 0, most URDF joints)
   int axis = -1;              ///< 0, 1 or 2: the axis is exactly +-x, +-y or +-z; -1 otherwise
+  int next1 = 0, next2 = 0;   ///< (axis + 1) % 3 and (axis + 2) % 3: the columns a plane rotation turns
   Matrix3 B = Matrix3::Zero(), D = Matrix3::Zero();  ///< tree.R [k]x and tree.R (k k^T - 1)
   Vector3 z = Vector3::UnitZ();  ///< tree.R k: the joint axis in the parent body's axes
 };
@@ -160,6 +161,8 @@ inline JointKinematics joint_kinematics(const Body& b) {
   const Vector3& ax = b.joint.axis;
   k.tree_identity = b.tree.R == Matrix3::Identity();
   k.axis = coordinate_axis(ax);
+  k.next1 = (k.axis + 1) % 3;
+  k.next2 = (k.axis + 2) % 3;
   k.B = b.tree.R * skew(ax);
   k.z = b.tree.R * ax;
   k.D = k.z * ax.transpose() - b.tree.R;
@@ -193,6 +196,9 @@ class Model {
   const Frame& frame(int i) const { return frames_[static_cast<size_t>(i)]; }
   /// The constants of body i's joint that forward_kinematics reads (derived from body(i) by build()).
   const detail::JointKinematics& joint_kinematics(int i) const { return kin_[static_cast<size_t>(i)]; }
+  /// True when body i's inertia about its centre of mass is diagonal (URDF principal axes): the
+  /// shortcut of SpatialInertia::from_body, decided once (build()).
+  bool inertia_diagonal(int i) const { return inertia_diagonal_[static_cast<size_t>(i)] != 0; }
   /// The largest body index in the subtree of body i (i itself for a leaf).
   int subtree_last(int i) const { return subtree_last_[static_cast<size_t>(i)]; }
   /// True when every subtree is the contiguous range of bodies [i, subtree_last(i)] (the depth-first
@@ -233,6 +239,7 @@ class Model {
   std::vector<int> coord_body_;
   std::vector<detail::JointKinematics> kin_;  ///< one per body, from the bodies (build())
   std::vector<int> subtree_last_;             ///< per body (build())
+  std::vector<char> inertia_diagonal_;        ///< per body (build())
   bool depth_first_ = false;                  ///< (build())
   int end_effector_ = -1;
 };
@@ -397,7 +404,11 @@ class ModelBuilder {
     const auto nb = static_cast<size_t>(m.nb());
     std::vector<int> size(nb, 1);
     m.subtree_last_.resize(nb);
-    for (size_t i = 0; i < nb; ++i) m.subtree_last_[i] = static_cast<int>(i);
+    m.inertia_diagonal_.resize(nb);
+    for (size_t i = 0; i < nb; ++i) {
+      m.subtree_last_[i] = static_cast<int>(i);
+      m.inertia_diagonal_[i] = SpatialInertia::is_diagonal(m.bodies_[i].inertia.I) ? 1 : 0;
+    }
     for (size_t i = nb - 1; i > 0; --i) {
       const auto up = static_cast<size_t>(m.bodies_[i].parent);
       m.subtree_last_[up] = std::max(m.subtree_last_[up], m.subtree_last_[i]);

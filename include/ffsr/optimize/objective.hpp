@@ -127,9 +127,9 @@ class CaptureEvaluator {
     return mass_at(data);
   }
 
-  /// M_ie at (base, theta) by the faster path for many evaluations (maps): the articulated-body
-  /// recursion of the joint model (integrated_effective_mass; the same M_ie as mass to rounding).
-  /// Writes the kinematics and the recursion's fields.
+  /// M_ie at (base, theta) by the faster path for many evaluations (maps): integrated_effective_mass
+  /// under the joint model (the articulated-body recursion, or the composite route for few joints;
+  /// the same M_ie as mass to rounding). Writes the kinematics and the routes' fields.
   double mass_fast(Data& data, const BasePose& base, const Eigen::Ref<const Eigen::VectorXd>& theta) const {
     return integrated_effective_mass(*model_, data, base, theta, frame_, u_, b_, *joints_);
   }

@@ -59,7 +59,10 @@ inline void sin_cos(double x, double& s, double& c) {
   }
   constexpr double kTwoOverPi = 0.6366197723675814;
   constexpr double kP1 = 0x1.921fb544p+0, kP2 = 0x1.0b4611a6p-34, kP3 = 0x1.3198a2e037073p-69;  // pi/2 = sum
-  const double k = std::nearbyint(x * kTwoOverPi);
+  // k = nearbyint(x 2/pi), rounded by adding and subtracting 1.5 2^52 (|x 2/pi| < 2^51: the same
+  // round-to-nearest-even as nearbyint, which without SSE4.1 is a call into libm)
+  constexpr double kRound = 0x1.8p52;
+  const double k = (x * kTwoOverPi + kRound) - kRound;
   const double r = ((x - k * kP1) - k * kP2) - k * kP3;
   const double z = r * r;
   // sin r = r + r z (-1/3! + z (1/5! - ...)), cos r = 1 - z/2 + z^2 (1/4! - z (1/6! - ...)): the two
@@ -323,6 +326,19 @@ struct SpatialInertia {
   static SpatialInertia from_body(double mass, const Vector3& com, const Matrix3& I_com, const Matrix3& R,
                                   const Vector3& r) {
     SpatialInertia s;
+    s.set_body(mass, com, I_com, is_diagonal(I_com), R, r);
+    return s;
+  }
+  /// True when the off-diagonal entries of I are zero (from_body's shortcut applies).
+  static bool is_diagonal(const Matrix3& I) {
+    return I(0, 1) == 0.0 && I(0, 2) == 0.0 && I(1, 2) == 0.0 && I(1, 0) == 0.0 && I(2, 0) == 0.0 &&
+           I(2, 1) == 0.0;
+  }
+  /// This = from_body(mass, com, I_com, R, r), written in place, `diagonal` being is_diagonal(I_com)
+  /// (fixed with the model: Model::inertia_diagonal).
+  void set_body(double mass, const Vector3& com, const Matrix3& I_com, bool diagonal, const Matrix3& R,
+                const Vector3& r) {
+    SpatialInertia& s = *this;
     s.m = mass;
     const double c0 = r(0) + (R(0, 0) * com(0) + R(0, 1) * com(1) + R(0, 2) * com(2));
     const double c1 = r(1) + (R(1, 0) * com(0) + R(1, 1) * com(1) + R(1, 2) * com(2));
@@ -331,8 +347,7 @@ struct SpatialInertia {
     s.h = Vector3(mc0, mc1, mc2);
     const double mcc = mc0 * c0 + mc1 * c1 + mc2 * c2;  // m |c|^2
     double i00 = 0, i11 = 0, i22 = 0, i01 = 0, i02 = 0, i12 = 0;
-    if (I_com(0, 1) == 0.0 && I_com(0, 2) == 0.0 && I_com(1, 2) == 0.0 && I_com(1, 0) == 0.0 &&
-        I_com(2, 0) == 0.0 && I_com(2, 1) == 0.0) {
+    if (diagonal) {
       // R diag(d) R^T = d2 1 + (d0 - d2) r0 r0^T + (d1 - d2) r1 r1^T (r_k the columns of R, R R^T = 1):
       // two rank-one terms instead of a rotation (24 products per body instead of 33 with m c c^T)
       const double d2 = I_com(2, 2), e0 = I_com(0, 0) - d2, e1 = I_com(1, 1) - d2, dd = d2 + mcc;
@@ -360,7 +375,6 @@ struct SpatialInertia {
     I[0] = i00, I[1] = i01, I[2] = i02;
     I[3] = i01, I[4] = i11, I[5] = i12;
     I[6] = i02, I[7] = i12, I[8] = i22;
-    return s;
   }
 };
 
