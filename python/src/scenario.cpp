@@ -170,7 +170,12 @@ void bind_scenario(nb::module_& m) {
                 if (!find_scenario_key(key)) throw InputError(str("--", key, ": not a scenario key"));
                 override_scenario_key(keys, key, flag_text(v, key));
               }
-              return std::make_unique<Scenario>(build_scenario(std::move(keys)));
+              // a stack that holds its target needs none of the main job's keys: built as `detumble`
+              // builds it when it has none of them (require_capture_scenario refuses the other jobs)
+              bool capture = !holds_target(keys);
+              for (const std::string& key : required_scenario_keys()) capture = capture || keys.given.count(key);
+              return std::make_unique<Scenario>(build_scenario(
+                  std::move(keys), nullptr, capture ? ScenarioScope::Run : ScenarioScope::Configuration));
             });
           },
           "path"_a, "overrides"_a,
@@ -192,6 +197,7 @@ void bind_scenario(nb::module_& m) {
       .def(
           "run",
           [](const Scenario& sc) {
+            require_capture_scenario(sc);
             return run_job<RunResult>([&sc](RunResult& r) {
               ScenarioRunOptions o;
               o.keep_going = true;     // as the command: a failed plain or paper's-method row is reported

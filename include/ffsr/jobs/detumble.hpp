@@ -67,8 +67,8 @@ namespace detail {
 /// at the start configuration), moving with it, so the "grasp" takes no impulse: the result's grasp
 /// holds the attachment, the robot's velocity `v` before and after, the target's twist as the gripper
 /// carries it, the momentum and the kinetic energy of robot and target (equal before and after).
-inline GraspResult held_grasp(const Model& model, int frame, const BasePose& base, const Eigen::VectorXd& theta,
-                              const Eigen::VectorXd& v, const Target& target) {
+inline GraspResult held_grasp(const Model& model, int frame, const BasePose& base,
+                              const Eigen::VectorXd& theta, const Eigen::VectorXd& v, const Target& target) {
   Data data(model);
   forward_kinematics(model, data, base, theta);
   frame_jacobian(model, data, frame);

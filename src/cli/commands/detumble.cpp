@@ -143,8 +143,9 @@ plot::Figure detumble_figure(const Scenario& sc, const std::vector<DetumbleJobRe
 int run_detumble_command(const DetumbleCommandOptions& o) {
   set_quiet(o.out.quiet);
   Outputs outputs = o.out.outputs();  // an output on standard output: the table goes to standard error
+  // before the scenario is built: with held a capture flag would ask for the capture's other keys
+  refuse_capture_flags(o, command_scenario_keys(o.subject.config, o.subject.flags));
   Scenario sc = load_subject(o.subject, true);  // the robot is loaded once: --run resolves the rest of it
-  refuse_capture_flags(o, sc.keys);
   const plot::Format plot_format = plot::check_request(o.out.plot, o.out.plot_format);  // before the run
   if (o.plan) require_detumble_planner();  // before the runs
   std::vector<DetumbleJobResult> results;

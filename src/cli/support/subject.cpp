@@ -64,8 +64,8 @@ Scenario load_subject(const SubjectOptions& o, bool held) {
                             "exponent", "restitution", "approach-speed"})
       if (!keys.given.count(key))
         throw InputError(detail::str(keys.where, ": missing key '", key,
-                                     "' (grasp-after = held describes a stack that holds its target, and this "
-                                     "subcommand evaluates a capture)"));
+                                     "' (grasp-after = held describes a stack that holds its target, and "
+                                     "this subcommand evaluates a capture)"));
   return build_scenario(std::move(keys), &embedded, ScenarioScope::Configuration, warn_repairs);
 }
 

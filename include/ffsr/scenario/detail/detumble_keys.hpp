@@ -83,11 +83,24 @@ inline void add_detumble_keys(std::vector<ScenarioKey>& keys) {
         "gripper-moment-limit", &K::gripper_moment_limit);
 }
 
-/// A start rate of the held stack: finite values, `size` of them (0: any count; the conversion,
+/// Where a start rate of the held stack acts: with grasp-after = held only.
+inline std::string on_the_held_stack(const ScenarioKeys& k) {
+  if (k.grasp_after == "held") return "";
+  return str("acts with grasp-after = held only (the stack's rates at the start), and this scenario has "
+             "grasp-after = ",
+             k.grasp_after);
+}
+
+/// A start rate of the held stack: given with grasp-after = held only (it serves no other job, so a
+/// file's is refused too), finite values, `size` of them (0: any count; the conversion,
 /// held_start_state, checks one per joint against the robot).
-inline void check_start_rates(const ScenarioKeys& k, const char* name, const std::vector<double>& v, size_t size) {
+inline void check_start_rates(const ScenarioKeys& k, const char* name, const std::vector<double>& v,
+                              size_t size) {
   if (!k.given.count(name)) return;
-  if (size != 0 && v.size() != size) throw InputError(str("--", name, ": expected ", size, " numbers, got ", v.size()));
+  const std::string why = on_the_held_stack(k);
+  if (!why.empty()) throw InputError(str("--", name, ": ", why));
+  if (size != 0 && v.size() != size)
+    throw InputError(str("--", name, ": expected ", size, " numbers, got ", v.size()));
   for (double x : v)
     if (!std::isfinite(x)) throw InputError(str("--", name, ": values must be finite, got ", x));
 }
@@ -96,21 +109,18 @@ inline void check_start_rates(const ScenarioKeys& k, const char* name, const std
 /// only.
 inline void add_held_start_keys(std::vector<ScenarioKey>& keys) {
   using K = ScenarioKeys;
-  const auto held_key = [&keys](ScenarioKey key, const char* name, std::vector<double> K::*member, size_t size) {
+  const auto held_key = [&keys](ScenarioKey key, const char* name, std::vector<double> K::*member,
+                                size_t size) {
     keys.push_back(key.in(KeyGroup::Detumble)
-                       .checked([name, member, size](const K& k) { check_start_rates(k, name, k.*member, size); })
+                       .checked([name, member, size](const K& k) {
+                         check_start_rates(k, name, k.*member, size);
+                       })
                        .echoed(echo_given(name, member))
-                       .acting([](const K& k) -> std::string {
-                         return k.grasp_after == "held"
-                                    ? ""
-                                    : str("acts with grasp-after = held only (the stack's rates at the start), "
-                                          "and this run has grasp-after = ",
-                                          k.grasp_after);
-                       }));
+                       .acting(on_the_held_stack));
   };
   held_key(FFSR_KEY("start-joint-rates-deg", start_joint_rates_deg,
-                    "Detumble, grasp-after = held: the joint rates at the start, deg/s (one per joint; default "
-                    "0)"),
+                    "Detumble, grasp-after = held: the joint rates at the start, deg/s (one per joint; "
+                    "default 0)"),
            "start-joint-rates-deg", &K::start_joint_rates_deg, 0);
   held_key(FFSR_KEY("start-base-velocity", start_base_velocity,
                     "Detumble, grasp-after = held: the velocity of the base frame's origin at the start, m/s "

@@ -167,7 +167,8 @@ inline DetumbleState held_start_state(const ScenarioKeys& k, const Model& model,
   if (k.given.count("start-base-velocity"))
     s.v.head<3>() = detail::vec3_or_zero(k.start_base_velocity, "--start-base-velocity");
   if (k.given.count("start-base-angular-velocity-deg"))
-    s.v.segment<3>(3) = detail::vec3_or_zero(k.start_base_angular_velocity_deg, "--start-base-angular-velocity-deg") * rad;
+    s.v.segment<3>(3) =
+        detail::vec3_or_zero(k.start_base_angular_velocity_deg, "--start-base-angular-velocity-deg") * rad;
   if (!k.given.count("start-joint-rates-deg")) return s;
   const std::vector<double>& rates = k.start_joint_rates_deg;
   if (rates.size() != static_cast<size_t>(model.n())) {
@@ -442,7 +443,8 @@ inline Scenario build_scenario(ScenarioKeys k, const EmbeddedUrdf* embedded, Sce
       for (const ScenarioKey& key : scenario_keys())  // every key read is checked, those of other jobs too
         if (key.check) key.check(k);
       build_robot(sc, k, embedded, on_load);
-      if (!holds_target(k) || k.given.count("model") || k.given.count("stiffness")) configuration_contact_of(k, sc.problem);
+      if (!holds_target(k) || k.given.count("model") || k.given.count("stiffness"))  // held: no capture
+        configuration_contact_of(k, sc.problem);
     } else {
       build_robot(sc, k, embedded, nullptr);
       build_run(sc, k);
