@@ -171,11 +171,12 @@ void bind_scenario(nb::module_& m) {
                 override_scenario_key(keys, key, flag_text(v, key));
               }
               // a stack that holds its target needs none of the main job's keys: built as `detumble`
-              // builds it when it has none of them (require_capture_scenario refuses the other jobs)
-              bool capture = !holds_target(keys);
-              for (const std::string& key : required_scenario_keys()) capture = capture || keys.given.count(key);
+              // builds it when it lacks one (require_capture_scenario refuses the other jobs)
+              bool run = true;
+              for (const std::string& key : required_scenario_keys()) run = run && keys.given.count(key);
+              const bool held = holds_target(keys) && !run;
               return std::make_unique<Scenario>(build_scenario(
-                  std::move(keys), nullptr, capture ? ScenarioScope::Run : ScenarioScope::Configuration));
+                  std::move(keys), nullptr, held ? ScenarioScope::Configuration : ScenarioScope::Run));
             });
           },
           "path"_a, "overrides"_a,

@@ -244,7 +244,7 @@ def test_held_stack_equals_the_command(tmp_path):
     assert differences(got, expected) == []
     assert got["grasp"]["start"] == "held"
     assert abs(result.time_to_rest - 4.67) < 1e-9
-    with pytest.raises(ffsr.InputError, match=r"missing key 'task' \(grasp-after = held"):
+    with pytest.raises(ffsr.InputError, match=r"missing key 'target-angular-velocity-deg' \(grasp-after = held"):
         sc.run()
     with pytest.raises(ffsr.InputError, match=r"missing key '.*' \(grasp-after = held"):
         sc.inspect()
