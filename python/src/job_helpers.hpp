@@ -62,6 +62,18 @@ void def_scenario_method(const char* name, Fn&& fn, const Extra&... extra) {
                        nb::is_method(), nb::name(name), nb::scope(scenario), extra...);
 }
 
+/// A stack that holds its target (grasp-after = held) with none of the main job's keys is built as the
+/// command's `detumble` builds it (Scenario.load: scope Configuration, no capture): detumble() runs on
+/// it, and every other job refuses it, naming the first key it lacks.
+inline void require_capture_scenario(const Scenario& sc) {
+  if (sc.scope == ScenarioScope::Run) return;
+  for (const std::string& key : required_scenario_keys())
+    if (!sc.keys.given.count(key))
+      throw InputError(detail::str(sc.where, ": missing key '", key,
+                                   "' (grasp-after = held describes a stack that holds its target, on which "
+                                   "Scenario.detumble() runs; this job evaluates a capture)"));
+}
+
 /// (key, value) given to a job as the command's flags; no value: the scenario's.
 using KeyOverrides = std::vector<std::pair<const char*, std::optional<std::string>>>;
 

@@ -106,6 +106,7 @@ void bind_inspect(nb::module_& m) {
   def_scenario_method(
       "inspect",
       [](const Scenario& sc) {
+        require_capture_scenario(sc);
         return run_job<InspectRun>([&sc](InspectRun& r) {
           r.result.emplace(inspect(sc));
           r.json = inspect_json(sc, *r.result, FFSR_VERSION).dump();
@@ -162,6 +163,7 @@ void bind_contact_job(nb::module_& m) {
       "contact",
       [](const Scenario& sc, std::optional<std::string> model, std::optional<std::string> contact_joints,
          bool series) {
+        require_capture_scenario(sc);
         return run_job<ContactRun>([&](ContactRun& r) {
           std::optional<Scenario> variant;
           const Scenario& s =
@@ -217,6 +219,7 @@ void bind_closed_loop(nb::module_& m) {
          double control_rate, double estimate_rate, double position_noise, double attitude_noise_deg,
          double velocity_noise, double spin_noise_deg, int prediction_window, std::uint64_t noise_seed,
          double rate_loop_bandwidth, double torque_limit, double record_every) {
+        require_capture_scenario(sc);
         const ClosedLoopJobOptions o =
             closed_loop_options(plan, std::move(goal_joints_deg), control_rate, estimate_rate, position_noise,
                                 attitude_noise_deg, velocity_noise, spin_noise_deg, prediction_window,

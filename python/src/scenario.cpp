@@ -170,7 +170,13 @@ void bind_scenario(nb::module_& m) {
                 if (!find_scenario_key(key)) throw InputError(str("--", key, ": not a scenario key"));
                 override_scenario_key(keys, key, flag_text(v, key));
               }
-              return std::make_unique<Scenario>(build_scenario(std::move(keys)));
+              // a stack that holds its target needs none of the main job's keys: built as `detumble`
+              // builds it when it lacks one (require_capture_scenario refuses the other jobs)
+              bool run = true;
+              for (const std::string& key : required_scenario_keys()) run = run && keys.given.count(key);
+              const bool held = holds_target(keys) && !run;
+              return std::make_unique<Scenario>(build_scenario(
+                  std::move(keys), nullptr, held ? ScenarioScope::Configuration : ScenarioScope::Run));
             });
           },
           "path"_a, "overrides"_a,
@@ -192,6 +198,7 @@ void bind_scenario(nb::module_& m) {
       .def(
           "run",
           [](const Scenario& sc) {
+            require_capture_scenario(sc);
             return run_job<RunResult>([&sc](RunResult& r) {
               ScenarioRunOptions o;
               o.keep_going = true;     // as the command: a failed plain or paper's-method row is reported

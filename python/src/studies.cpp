@@ -113,6 +113,7 @@ void bind_map(nb::module_& m) {
       [](const Scenario& sc, std::vector<int> vary, std::vector<double> range_deg,
          std::vector<double> step_deg, std::uint64_t shard_k, std::uint64_t shard_n, unsigned threads,
          std::uint64_t max_points) {
+        require_capture_scenario(sc);
         MapJobOptions o;
         o.vary = std::move(vary);
         o.range_deg = std::move(range_deg);
@@ -177,6 +178,7 @@ void bind_robust(nb::module_& m) {
          std::optional<std::uint64_t> seed, std::uint64_t shard_k, std::uint64_t shard_n, int threads,
          std::optional<std::vector<double>> capture_joints_deg, std::vector<double> capture_base_position,
          std::vector<double> capture_base_rpy_deg) {
+        require_capture_scenario(sc);
         return run_job<RobustRunResult>([&](RobustRunResult& r) {
           // as the command: the table with the samples and seed given, the job's options, the scenario
           // (global runs with seed 1), checked before anything is planned
@@ -278,6 +280,7 @@ void bind_pareto(nb::module_& m) {
   def_scenario_method(
       "pareto",
       [](const Scenario& sc, int levels, int starts, const std::string& axis) {
+        require_capture_scenario(sc);
         ParetoJobOptions o;
         o.levels = levels;
         o.starts = starts;

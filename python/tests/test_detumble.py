@@ -232,6 +232,33 @@ def test_detumble_job_equals_the_command(tmp_path, run, grasp_after):
         ffsr.Scenario.load(str(scenario)).detumble(run="best")
 
 
+def test_held_stack_equals_the_command(tmp_path):
+    """robots/vyas2022_planar.toml: a stack that holds its target (grasp_after = 'held', no capture keys)
+    loads and runs detumble() as the command does; the jobs that evaluate a capture refuse it; the start
+    rates are keywords like the other keys."""
+    scenario = ROBOTS / "vyas2022_planar.toml"
+    expected = command_json(tmp_path, scenario, subcommand="detumble")
+    sc = ffsr.Scenario.load(str(scenario))
+    result = sc.detumble()
+    got = result.to_dict()
+    assert differences(got, expected) == []
+    assert got["grasp"]["start"] == "held"
+    assert abs(result.time_to_rest - 4.67) < 1e-9
+    with pytest.raises(ffsr.InputError, match=r"missing key 'target-angular-velocity-deg' \(grasp-after = held"):
+        sc.run()
+    with pytest.raises(ffsr.InputError, match=r"missing key '.*' \(grasp-after = held"):
+        sc.inspect()
+    # the keyword is the flag: the joints at rest at the start, only the chaser moving
+    still = ffsr.Scenario.load(str(scenario), start_joint_rates_deg=[0, 0, 0]).detumble().to_dict()
+    assert differences(still, command_json(tmp_path, scenario, "--start-joint-rates-deg", "0,0,0",
+                                           subcommand="detumble")) == []
+    assert still["time_to_rest"] != got["time_to_rest"]
+    with pytest.raises(ffsr.InputError, match=r"start.joint.rates.deg: got 2 rates, the robot has 3 joints"):
+        ffsr.Scenario.load(str(scenario), start_joint_rates_deg=[1, 2]).detumble()
+    with pytest.raises(ffsr.InputError, match=r"start.base.velocity: acts with grasp-after = held only"):
+        ffsr.Scenario.load(str(ROBOTS / "paper_7dof_detumble.toml"), start_base_velocity=[0, 0, 0.1])
+
+
 def test_detumble_series_equals_the_command(tmp_path):
     """series_csv() is the command's --csv (the poses the 3-D view animates after the capture)."""
     scenario = ROBOTS / "paper_7dof_detumble.toml"

@@ -144,6 +144,7 @@ const std::map<std::string, KeyCase>& key_cases() {
                        "--stop-stack-spin",    "true", "--target-velocity", "0.001,0,0"};
   const Args wheels_kept{"--joint-torque-limit", "20",  "--base-actuator",  "reaction-wheels",
                          "--wheel-torque",       "0.2", "--wheel-momentum", "25"};
+  const Args held{"--joint-torque-limit", "20", "--grasp-after", "held"};
   Args post_capture{"--config", files().post_capture_toml};
   post_capture.insert(post_capture.end(), global.begin(), global.end());
   static const std::map<std::string, KeyCase> cases = {
@@ -246,6 +247,11 @@ const std::map<std::string, KeyCase>& key_cases() {
       {"stop-stack-spin", {{"--stop-stack-spin", "true"}, wheels_kept}},
       // the grasp after the Hertz contact run: another lock impulse and start state
       {"grasp-after", {{"--grasp-after", "contact"}, torque}},
+      // the stack that holds its target from the start (the built-in target welded where it is): its
+      // start rates
+      {"start-joint-rates-deg", {{"--start-joint-rates-deg", "1,-2,3"}, held}},
+      {"start-base-velocity", {{"--start-base-velocity", "0.01,0,0"}, held}},
+      {"start-base-angular-velocity-deg", {{"--start-base-angular-velocity-deg", "0,0,0.5"}, held}},
       // the global search's post-capture constraints (20 N m joints): the impact-best capture needs
       // 3.59 N m and 1.57 N (another capture is chosen); no candidate rests within 3.3 s or holds the
       // gripper's moment within 1 N m (refused, naming the key, with the least each candidate reached)
@@ -374,7 +380,9 @@ TEST_CASE("the main job takes every key of the post-capture phase (the walk belo
     CHECK(flags.count("--" + key.name) == 1);
     ++keys;
   }
-  CHECK(keys == 16);  // grasp-after with the fifteen of the limits, the actuator, the law and the run
+  // grasp-after and the held stack's three start rates with the fifteen of the limits, the actuator,
+  // the law and the run
+  CHECK(keys == 19);
 }
 
 TEST_CASE("each key a subcommand accepts changes its result, or the subcommand refuses it",

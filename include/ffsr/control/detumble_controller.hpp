@@ -58,7 +58,7 @@ inline std::string base_actuator_names(const char* last = " or ") {
 }
 
 /// Whether `x` can be a bound of the hardware or a setting of the law: positive and finite. The one
-/// test of a limit: check_detumble's, and the Detumble keys' checks (scenario/detail/keys.hpp).
+/// test of a limit: check_detumble's, and the Detumble keys' checks (scenario/detail/detumble_keys.hpp).
 inline bool detumble_bound_ok(double x) { return std::isfinite(x) && x > 0; }
 
 /// The hardware's bounds. Per base axis: a component in the base frame.

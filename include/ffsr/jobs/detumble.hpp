@@ -61,12 +61,58 @@ inline DetumbleState detumble_start(const Scenario& s, const BasePose& base, con
   return {out.contact->end.base, out.contact->end.theta, out.grasp.v_after, Vector3::Zero()};
 }
 
-/// The job: the grasp of detumble_start at (base, theta) (grasp_at_capture: the contact point moving at
-/// the approach speed along the target's normal; or after the Hertz contact run), the stack,
-/// run_detumble under the scenario's detumble_settings. InputError for bad keys, an actuator too small
-/// for the horizon (run_detumble's check_detumble_feasible), or a stack not at rest at the horizon.
-inline DetumbleJobResult detumble(const Scenario& s, const BasePose& base, const Eigen::VectorXd& theta,
-                                  const Target& target) {
+namespace detail {
+
+/// grasp-after = held: the target welded to the gripper frame where it is at the start (`target`'s pose
+/// at the start configuration), moving with it, so the "grasp" takes no impulse: the result's grasp
+/// holds the attachment, the robot's velocity `v` before and after, the target's twist as the gripper
+/// carries it, the momentum and the kinetic energy of robot and target (equal before and after).
+inline GraspResult held_grasp(const Model& model, int frame, const BasePose& base,
+                              const Eigen::VectorXd& theta, const Eigen::VectorXd& v, const Target& target) {
+  Data data(model);
+  forward_kinematics(model, data, base, theta);
+  frame_jacobian(model, data, frame);
+  const Pose pf = frame_pose(model, data, frame);
+  const Vector6 twist = data.J * v;  // the gripper frame's [v; w] at its origin, inertial
+  const Matrix3 Rt = target.rotation();
+  GraspResult g;
+  g.contact_point = pf.p;
+  g.v_before = g.v_after = v;
+  g.target_before.head<3>() = twist.head<3>() + twist.tail<3>().cross(target.position - pf.p);
+  g.target_before.tail<3>() = twist.tail<3>();
+  g.target_after = g.target_before;
+  g.momentum_before = g.momentum_after =
+      robot_momentum_about_origin(model, data, v) + target_momentum(target, g.target_before);
+  const Vector3 w = g.target_before.tail<3>();
+  g.energy_before = g.energy_after = kinetic_energy(model, data, v) +
+                                     0.5 * target.mass * g.target_before.head<3>().squaredNorm() +
+                                     0.5 * w.dot(Rt * target.inertia * Rt.transpose() * w);
+  g.body.mass = target.mass;
+  g.body.inertia = target.inertia;
+  g.body.pose = Pose{pf.R.transpose() * (target.position - pf.p), pf.R.transpose() * Rt};
+  return g;
+}
+
+/// grasp-after = held: the stack's start state at (base, theta) with the start keys' rates
+/// (held_start_state) and the target welded where it is (held_grasp, into out.grasp; out.held).
+/// InputError naming the key, located in the file.
+inline DetumbleState held_start(const Scenario& s, const BasePose& base, const Eigen::VectorXd& theta,
+                                const Target& target, DetumbleJobResult& out) {
+  DetumbleState start;
+  try {
+    start = held_start_state(s.keys, *s.model, base, theta);
+  } catch (const InputError& e) {
+    throw InputError(located_key_message(s.keys, e.what()));
+  }
+  out.held = true;
+  out.grasp = held_grasp(*s.model, s.problem.frame, base, theta, start.v, target);
+  return start;
+}
+
+/// detumble's body: the grasp of grasp-after at (base, theta) with `target` (held: the target welded
+/// there, the start keys' rates), the stack, the run.
+inline DetumbleJobResult detumble_from(const Scenario& s, const BasePose& base, const Eigen::VectorXd& theta,
+                                       const Target& target) {
   using detail::str;
   DetumbleJobResult out;
   out.theta = theta;
@@ -79,7 +125,8 @@ inline DetumbleJobResult detumble(const Scenario& s, const BasePose& base, const
   const int ee = s.problem.frame;
   DetumbleState start;
   try {  // a degenerate pair of bodies (a target inertia near zero): name the keys that set it
-    start = detumble_start(s, base, theta, target, out);
+    start = holds_target(s.keys) ? held_start(s, base, theta, target, out)
+                                 : detumble_start(s, base, theta, target, out);
   } catch (const NumericalError& e) {
     throw NumericalError(str(e.what(), " (--target-mass, --target-inertia: the target it grasps)"));
   }
@@ -113,9 +160,23 @@ inline DetumbleJobResult detumble(const Scenario& s, const BasePose& base, const
   return out;
 }
 
-/// At the scenario's start configuration (its start state, the target at t = 0).
+}  // namespace detail
+
+/// The job: the grasp of detumble_start at (base, theta) (grasp_at_capture: the contact point moving at
+/// the approach speed along the target's normal; or after the Hertz contact run), the stack,
+/// run_detumble under the scenario's detumble_settings. InputError for bad keys, an actuator too small
+/// for the horizon (run_detumble's check_detumble_feasible), or a stack not at rest at the horizon;
+/// InputError naming grasp-after when the scenario's stack holds its target (held: detumble(s) starts it).
+inline DetumbleJobResult detumble(const Scenario& s, const BasePose& base, const Eigen::VectorXd& theta,
+                                  const Target& target) {
+  detail::refuse_held(s, "a run from a capture configuration");
+  return detail::detumble_from(s, base, theta, target);
+}
+
+/// At the scenario's start configuration (its start state, the target at t = 0): the grasp of
+/// grasp-after there, or (held) the stack as it holds its target, from the start keys' rates.
 inline DetumbleJobResult detumble(const Scenario& s) {
-  return detumble(s, s.problem.base, s.problem.theta, s.problem.target);
+  return detail::detumble_from(s, s.problem.base, s.problem.theta, s.problem.target);
 }
 
 namespace detail {
@@ -143,9 +204,10 @@ inline std::vector<DetumbleJobResult> detumble_each_run(
 /// From the capture of the main job's runs (jobs/scenario_run.hpp) of the scenario `sc` (scope Run:
 /// resolve_run completes a Configuration): `which` is plain, optimized, global or all (every run the
 /// scenario has); each run's capture configuration and base pose at T, the target at T. InputError
-/// naming --run.
+/// naming --run, or grasp-after when the scenario's stack holds its target.
 inline std::vector<DetumbleJobResult> detumble_runs(const Scenario& sc, const std::string& which) {
   using detail::str;
+  detail::refuse_held(sc, "--run");
   if (which != "plain" && which != "optimized" && which != "global" && which != "all")
     throw InputError(str("--run: expected plain, optimized, global or all, got '", which, "'"));
   if (which == "global" && !sc.keys.global)

@@ -28,8 +28,10 @@ inline std::vector<DetumbleJobResult> post_capture_runs(const Scenario& sc, cons
 /// The command's main job and Scenario.run: run_scenario, then with a Detumble key given
 /// (scenario_has_post_capture) each run's post-capture phase into ScenarioResult::post_capture (an
 /// error of that phase, an actuator too small or not at rest by the horizon, is an InputError naming
-/// the key and the run). Without one the runs stop at the impact.
+/// the key and the run; grasp-after = held is refused before the runs: it starts from no capture).
+/// Without one the runs stop at the impact.
 inline ScenarioResult run_whole_capture(const Scenario& sc, const ScenarioRunOptions& options = {}) {
+  if (scenario_has_post_capture(sc.keys)) detail::refuse_held(sc, "the main job's post-capture phase");
   ScenarioResult r = run_scenario(sc, options);
   if (scenario_has_post_capture(sc.keys)) r.post_capture = post_capture_runs(sc, r);
   return r;

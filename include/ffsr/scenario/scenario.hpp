@@ -94,7 +94,12 @@ struct ScenarioKeys {
   double rest_rate_deg = 0.05, detumble_horizon = 120, detumble_tick = 0.01, detumble_dwell = 5;
   double detumble_max_decay = 20, detumble_max_base_decay = 2;  ///< 1/s (DetumbleOptions)
   bool stop_stack_spin = false;
-  std::string grasp_after = "approach";  ///< the grasp's start: approach, or contact (the Hertz run first)
+  /// the grasp's start: approach, contact (the Hertz run first), or held (the stack holds its target
+  /// from the start state: no capture)
+  std::string grasp_after = "approach";
+  /// grasp-after = held: the stack's rates at the start (joints deg/s; the base origin's velocity m/s
+  /// and the base's angular velocity deg/s, inertial axes); empty: zero
+  std::vector<double> start_joint_rates_deg, start_base_velocity, start_base_angular_velocity_deg;
   // the global search's post-capture constraints (jobs/detail/post_capture.hpp); 0: not set
   double max_time_to_rest = 0, max_peak_joint_torque = 0, max_gripper_force = 0, max_gripper_moment = 0;
 };
@@ -106,6 +111,19 @@ struct ScenarioKeys {
 /// too), rest-rate-deg, stop-stack-spin, detumble-tick, detumble-horizon. Each key's value is checked
 /// once, by the key table (ScenarioKey::check, when the scenario is built). InputError naming the key.
 DetumbleSettings detumble_settings(const ScenarioKeys& keys, const Model& model);
+
+/// grasp-after = held: the stack holds its target from the start, and no capture is made (the keys of
+/// the capture, the target's motion, contact point and normal, the contact law and the approach speed,
+/// are not needed then: a file may give them for its other jobs).
+bool holds_target(const ScenarioKeys& keys);
+
+/// The held stack's start state (grasp-after = held), the one conversion of the start keys: the base
+/// pose and joint angles `base`, `theta` (the scenario's start configuration), the generalized velocity
+/// [v0; w0; theta_dot] of start-base-velocity (m/s), start-base-angular-velocity-deg and
+/// start-joint-rates-deg (one per joint of `model`; each zero when not given), no wheel momentum.
+/// InputError naming the key.
+DetumbleState held_start_state(const ScenarioKeys& keys, const Model& model, const BasePose& base,
+                               const Eigen::VectorXd& theta);
 
 /// The kind of a key's value: one parser each, from a TOML node and from text.
 enum class KeyKind { Text, Texts, Number, Numbers, Integer, Boolean };

@@ -31,19 +31,24 @@ void print_detumble_table(std::ostream& out, const DetumbleJobResult& d) {
   constexpr double deg = 180.0 / M_PI;
   if (!d.run.empty()) out << "-- " << d.run << " run's capture\n";
   out << std::setprecision(4);
-  if (d.contact)  // the Hertz phase before the lock
-    out << "contact before the grasp " << d.contact->model << ": peak " << d.contact->f_max << " N, "
-        << d.contact->contact_duration * 1e3 << " ms, impulse " << d.contact_impulse.norm()
-        << " N s; the grasp locks at the separation\n";
-  else
-    out << "grasp start              the end of the approach (no contact phase)\n";
-  out << "grasp impulse            " << g.impulse.head<3>().norm() << " N s, " << g.impulse.tail<3>().norm()
-      << " N m s\n"
-      << "base velocity jump       " << g.base_velocity_jump.head<3>().norm() * 1e3 << " mm/s, "
-      << g.base_velocity_jump.tail<3>().norm() * deg << " deg/s\n"
-      << "kinetic energy           " << g.energy_before << " J before the grasp, " << g.energy_after
-      << " J after\n"
-      << "base actuator            " << actuator_name(d.settings.limits.actuator)
+  if (d.held) {  // no grasp: the stack holds its target from the start
+    out << "grasp start              held: the target welded to the gripper from the start (no grasp)\n"
+        << "kinetic energy           " << g.energy_after << " J at the start\n";
+  } else {
+    if (d.contact)  // the Hertz phase before the lock
+      out << "contact before the grasp " << d.contact->model << ": peak " << d.contact->f_max << " N, "
+          << d.contact->contact_duration * 1e3 << " ms, impulse " << d.contact_impulse.norm()
+          << " N s; the grasp locks at the separation\n";
+    else
+      out << "grasp start              the end of the approach (no contact phase)\n";
+    out << "grasp impulse            " << g.impulse.head<3>().norm() << " N s, " << g.impulse.tail<3>().norm()
+        << " N m s\n"
+        << "base velocity jump       " << g.base_velocity_jump.head<3>().norm() * 1e3 << " mm/s, "
+        << g.base_velocity_jump.tail<3>().norm() * deg << " deg/s\n"
+        << "kinetic energy           " << g.energy_before << " J before the grasp, " << g.energy_after
+        << " J after\n";
+  }
+  out << "base actuator            " << actuator_name(d.settings.limits.actuator)
       << (d.settings.options.stop_stack_spin ? " (stops the stack's spin)" : "") << "\n"
       << "time to rest             " << r.time_to_rest << " s ("
       << std::lround(r.time_to_rest / d.settings.run.tick) << " ticks)\n"
@@ -67,16 +72,24 @@ void print_detumble_table(std::ostream& out, const DetumbleJobResult& d) {
       << (pr.dwell_at_rest ? " at rest" : " NOT at rest") << "\n";
 }
 
-/// The contact law's flags act with grasp-after = contact only (the Hertz run before the grasp); the
-/// file's keys of the law are the scenario's and stay.
-void refuse_law_flags_without_contact(const DetumbleCommandOptions& o, const ScenarioKeys& keys) {
-  if (keys.grasp_after == "contact") return;
-  for (const char* name : {"model", "stiffness", "exponent", "restitution"})
+/// The contact law's flags act with grasp-after = contact only (the Hertz run before the grasp); with
+/// held no capture is made, and the flags of the capture (the target's motion, the contact point and
+/// normal, the approach speed) act on nothing. The file's keys stay: the scenario serves other jobs.
+void refuse_capture_flags(const DetumbleCommandOptions& o, const ScenarioKeys& keys) {
+  if (keys.grasp_after != "contact")
+    for (const char* name : {"model", "stiffness", "exponent", "restitution"})
+      if (o.subject.flags.given(name))
+        throw InputError(detail::str("--", name,
+                                     ": acts on detumble only with grasp-after = contact (the Hertz contact "
+                                     "run before the grasp), and this run has grasp-after = ",
+                                     keys.grasp_after));
+  if (!holds_target(keys)) return;
+  for (const char* name :
+       {"target-angular-velocity-deg", "target-velocity", "contact-offset", "normal", "approach-speed"})
     if (o.subject.flags.given(name))
       throw InputError(detail::str("--", name,
-                                   ": acts on detumble only with grasp-after = contact (the Hertz contact "
-                                   "run before the grasp), and this run has grasp-after = ",
-                                   keys.grasp_after));
+                                   ": acts on the capture, and with grasp-after = held the stack holds its "
+                                   "target from the start (its motion is the start-* keys')"));
 }
 
 /// The figure of the runs: their series as recorded, the limits and the rest threshold they ran under.
@@ -130,14 +143,16 @@ plot::Figure detumble_figure(const Scenario& sc, const std::vector<DetumbleJobRe
 int run_detumble_command(const DetumbleCommandOptions& o) {
   set_quiet(o.out.quiet);
   Outputs outputs = o.out.outputs();  // an output on standard output: the table goes to standard error
-  Scenario sc = load_subject(o.subject);  // the robot is loaded once: --run resolves the rest of it
-  refuse_law_flags_without_contact(o, sc.keys);
+  // before the scenario is built: with held a capture flag would ask for the capture's other keys
+  refuse_capture_flags(o, command_scenario_keys(o.subject.config, o.subject.flags));
+  Scenario sc = load_subject(o.subject, true);  // the robot is loaded once: --run resolves the rest of it
   const plot::Format plot_format = plot::check_request(o.out.plot, o.out.plot_format);  // before the run
   if (o.plan) require_detumble_planner();  // before the runs
   std::vector<DetumbleJobResult> results;
   if (o.run.empty()) {
     results.push_back(detumble(sc));
   } else {
+    detail::refuse_held(sc, "--run");  // before the main job's keys are asked for
     const EmbeddedUrdf embedded = builtin_urdf();
     resolve_run(sc, &embedded);
     results = detumble_runs(sc, o.run);
@@ -164,7 +179,8 @@ void register_detumble(CLI::App& app, Action& action) {
   auto o = std::make_shared<DetumbleCommandOptions>();
   CLI::App* sub = app.add_subcommand(
       "detumble", "After the capture: the grasp, then robot and target brought to rest within the limits");
-  // the contact law acts with grasp-after = contact only (refuse_law_flags_without_contact)
+  // the contact law acts with grasp-after = contact only, the capture's keys not with held
+  // (refuse_capture_flags)
   o->subject.add_to(*sub, scenario_key_names({KeyGroup::Detumble}));
   sub->add_option("--run", o->run,
                   "Start from the capture the main job plans: plain, optimized, global or all (default: the "

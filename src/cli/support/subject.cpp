@@ -56,10 +56,17 @@ void SubjectOptions::add_to(CLI::App& app, const std::set<std::string>& also, co
   });
 }
 
-Scenario load_subject(const SubjectOptions& o) {
+Scenario load_subject(const SubjectOptions& o, bool held) {
   const EmbeddedUrdf embedded = builtin_urdf();
-  return build_scenario(command_scenario_keys(o.config, o.flags), &embedded, ScenarioScope::Configuration,
-                        warn_repairs);
+  ScenarioKeys keys = command_scenario_keys(o.config, o.flags);
+  if (!held && holds_target(keys))  // the library needs no capture then: this subcommand evaluates one
+    for (const char* key : {"target-angular-velocity-deg", "contact-offset", "normal", "model", "stiffness",
+                            "exponent", "restitution", "approach-speed"})
+      if (!keys.given.count(key))
+        throw InputError(detail::str(keys.where, ": missing key '", key,
+                                     "' (grasp-after = held describes a stack that holds its target, and "
+                                     "this subcommand evaluates a capture)"));
+  return build_scenario(std::move(keys), &embedded, ScenarioScope::Configuration, warn_repairs);
 }
 
 }  // namespace ffsr::cli

@@ -39,7 +39,10 @@ struct SubjectOptions {
 
 /// Builds the scenario of the options' keys, scope Configuration (scenario/scenario.hpp: the robot at its
 /// start configuration, the target, the contact law); warns about every repair of the model as soon as
-/// it is loaded. InputError naming the key or the file, ModelError from the loader.
-Scenario load_subject(const SubjectOptions& options);
+/// it is loaded. `held`: the subcommand takes a stack that holds its target (grasp-after = held, with
+/// no capture keys); else such a scenario must give the capture's keys (the target's spin, the contact
+/// point and normal, the contact law, the approach speed). InputError naming the key or the file,
+/// ModelError from the loader.
+Scenario load_subject(const SubjectOptions& options, bool held = false);
 
 }  // namespace ffsr::cli

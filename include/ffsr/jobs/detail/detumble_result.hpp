@@ -35,6 +35,9 @@ struct DetumbleJobResult {
   /// grasp-after = contact: the Hertz contact run before the lock and its impulse on the gripper (N s)
   std::optional<MultibodyContactResult> contact;
   Vector3 contact_impulse = Vector3::Zero();
+  /// grasp-after = held: no grasp, the stack holds its target from the start (grasp: held_grasp's, no
+  /// impulse)
+  bool held = false;
   DetumbleRunResult result;
   DetumbleSettings settings;  ///< what it ran under, as detumble_settings built them
   std::string peak_joint_name;  ///< the joint of the peak torque
@@ -128,7 +131,7 @@ inline nlohmann::json detumble_json(const Model& model, int gripper,
                 {"base_angular_velocity_jump", vector_json(Eigen::VectorXd(g.base_velocity_jump.tail<3>()))},
                 {"energy_before", g.energy_before},
                 {"energy_after", g.energy_after},
-                {"start", d.contact ? "contact" : "approach"},
+                {"start", d.held ? "held" : d.contact ? "contact" : "approach"},
                 {"attachment", attachment_json(model, gripper, g.body)}};
   if (d.contact) {  // the Hertz phase before the lock
     const MultibodyContactResult& c = *d.contact;

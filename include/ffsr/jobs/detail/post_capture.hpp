@@ -80,6 +80,20 @@ inline PostCaptureFigures post_capture_figures(const Model& model, int frame, De
   return f;
 }
 
+namespace detail {
+
+/// InputError naming grasp-after (located in the file) when the scenario's stack holds its target
+/// (grasp-after = held) and `what` starts from a capture instead.
+inline void refuse_held(const Scenario& s, const std::string& what) {
+  if (holds_target(s.keys))
+    throw InputError(located_key_message(
+        s.keys, str("--grasp-after: held starts from the scenario's start state (joints-deg, base-position, "
+                    "base-rpy-deg and the start-* rates), and ",
+                    what, " starts from a capture")));
+}
+
+}  // namespace detail
+
 /// The post-capture constraints of a scenario as the global search's candidate constraint
 /// (GlobalCaptureOptions::admit): each batch of candidates run in parallel (post_capture_figures),
 /// the least value of each figure over every candidate kept for the message when none meets them.
@@ -95,6 +109,7 @@ class PostCaptureScreen {
         speed_(sc.problem.approach_speed),
         constraints_(post_capture_constraints(sc.keys)) {
     using detail::str;
+    detail::refuse_held(sc, "the global search's post-capture constraints");
     const std::string first =
         who.empty() ? constraints_.flags().substr(0, constraints_.flags().find('/')) : std::move(who);
     try {

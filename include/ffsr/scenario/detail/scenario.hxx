@@ -156,6 +156,31 @@ inline DetumbleSettings detumble_settings(const ScenarioKeys& k, const Model& mo
   return s;
 }
 
+inline bool holds_target(const ScenarioKeys& k) { return k.grasp_after == "held"; }
+
+inline DetumbleState held_start_state(const ScenarioKeys& k, const Model& model, const BasePose& base,
+                                      const Eigen::VectorXd& theta) {
+  using detail::str;
+  // each value is checked by its key (finite; three for the base's): the joints' count needs the robot
+  DetumbleState s{base, theta, Eigen::VectorXd::Zero(model.nv()), Vector3::Zero()};
+  constexpr double rad = M_PI / 180.0;
+  if (k.given.count("start-base-velocity"))
+    s.v.head<3>() = detail::vec3_or_zero(k.start_base_velocity, "--start-base-velocity");
+  if (k.given.count("start-base-angular-velocity-deg"))
+    s.v.segment<3>(3) =
+        detail::vec3_or_zero(k.start_base_angular_velocity_deg, "--start-base-angular-velocity-deg") * rad;
+  if (!k.given.count("start-joint-rates-deg")) return s;
+  const std::vector<double>& rates = k.start_joint_rates_deg;
+  if (rates.size() != static_cast<size_t>(model.n())) {
+    std::string names;
+    for (const auto& name : model.joint_names()) names += (names.empty() ? "" : ", ") + name;
+    throw InputError(str("--start-joint-rates-deg: got ", rates.size(), " rates, the robot has ", model.n(),
+                         " joints (", names, ")"));
+  }
+  s.v.tail(model.n()) = Eigen::Map<const Eigen::VectorXd>(rates.data(), model.n()) * rad;
+  return s;
+}
+
 // --- validation ------------------------------------------------------------------------------------------
 
 namespace detail {
@@ -232,6 +257,15 @@ inline Target target_of(const ScenarioKeys& k) {
   t.inertia = inertia_from_components(I);
   t.position = vec3(k.target_position, "target-position");
   t.attitude = Quaternion(rpy_deg(k.target_rpy_deg, "target-rpy-deg"));
+  if (holds_target(k) && !k.given.count("target-angular-velocity-deg") && !k.given.count("contact-offset") &&
+      !k.given.count("normal")) {  // no capture: the target moves with the gripper, touches nowhere
+    try {
+      t.validate("target");
+    } catch (const InputError& e) {
+      throw InputError(str("--target-mass/--target-inertia: ", e.what()));
+    }
+    return t;
+  }
   t.angular_velocity = vec3(k.target_angular_velocity_deg, "target-angular-velocity-deg") * (M_PI / 180.0);
   t.velocity = vec3(k.target_velocity, "target-velocity");
   t.contact_offset = vec3(k.contact_offset, "contact-offset");
@@ -409,7 +443,8 @@ inline Scenario build_scenario(ScenarioKeys k, const EmbeddedUrdf* embedded, Sce
       for (const ScenarioKey& key : scenario_keys())  // every key read is checked, those of other jobs too
         if (key.check) key.check(k);
       build_robot(sc, k, embedded, on_load);
-      configuration_contact_of(k, sc.problem);
+      if (!holds_target(k) || k.given.count("model") || k.given.count("stiffness"))  // held: no capture
+        configuration_contact_of(k, sc.problem);
     } else {
       build_robot(sc, k, embedded, nullptr);
       build_run(sc, k);
