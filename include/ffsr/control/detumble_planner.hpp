@@ -61,9 +61,9 @@ struct DetumblePlanOptions {
   double max_joint_rate = std::numeric_limits<double>::infinity();
   /// The onboard controller's tick, s (0: none). A plan whose intervals come out shorter than the tick
   /// cannot be followed by a command held over a tick (DetumblePlanTracker refuses it): it is solved
-  /// again on the tick's grid, every interval one tick long and T the smallest multiple of the tick for
-  /// which the bounds hold (tried from the free plan's T up), with the controls of least effort (the
-  /// effort weight, 1 when zero) and the free plan as the initial guess.
+  /// again from itself on N = ceil(T / tick) intervals with T >= N tick (the shortest time on them: T at
+  /// that bound is the tick's grid, N + 1 intervals tried when N fails). When neither solves, the free
+  /// plan is returned (free_duration 0, its intervals shorter than the tick).
   double tick = 0;
 };
 
@@ -126,8 +126,10 @@ class DetumblePlanNlp : public Ipopt::TNLP {
 
   /// The initial guess (x of num_vars()).
   void set_guess(const Eigen::VectorXd& x) { guess_ = x; }
-  /// T fixed to `T` (a plan on a tick's grid) instead of free within the horizon.
-  void fix_duration(double T) { fixed_duration_ = T; }
+  /// T at least `T` (a plan on a tick's grid: N intervals no shorter than the tick) instead of 1 ms.
+  void set_min_duration(double T) { min_duration_ = T; }
+  /// T fixed to `T` (the tick's grid, from a plan on its intervals near it).
+  void set_fixed_duration(double T) { min_duration_ = max_duration_ = T; }
   const Eigen::VectorXd& solution() const { return x_; }
   Ipopt::SolverReturn status() const { return status_; }
 
@@ -146,8 +148,8 @@ class DetumblePlanNlp : public Ipopt::TNLP {
       xl[i] = -inf;
       xu[i] = inf;
     }
-    xl[0] = fixed_duration_ > 0 ? fixed_duration_ : 1e-3;
-    xu[0] = fixed_duration_ > 0 ? fixed_duration_ : horizon_;
+    xl[0] = min_duration_ > 0 ? min_duration_ : 1e-3;
+    xu[0] = max_duration_ > 0 ? max_duration_ : horizon_;
     for (Index i = 0; i < ny_; ++i) xl[oy(0) + i] = xu[oy(0) + i] = y0_(i);
     const Index e = oy(N_);
     // the end at rest by the rest test: each joint rate within rest / n (so that the gripper's rate
@@ -431,7 +433,7 @@ class DetumblePlanNlp : public Ipopt::TNLP {
   DetumblePlanOptions po_;
   double horizon_;
   int n_, N_, S_, ny_ = 0, nu_ = 0, nz_ = 0, nout_ = 0, n_grip_ = 0;
-  double rest_ = 0, fixed_duration_ = 0;
+  double rest_ = 0, min_duration_ = 0, max_duration_ = 0;
   bool wheels_ = false, thrusters_ = false;
   Eigen::VectorXd scale_, y0_, guess_, x_, xc_;
   bool have_jac_ = false, ok_ = false;

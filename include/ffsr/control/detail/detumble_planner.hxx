@@ -32,6 +32,9 @@ inline void check_detumble_plan_options(const DetumblePlanOptions& po, double ho
     throw InputError(str(w, ": the horizon must be positive and finite, got ", horizon));
 }
 
+/// The fraction of the gripper's limits the initial guess's law keeps within.
+inline constexpr double kDetumbleGuessGripperFraction = 0.9;
+
 /// The initial guess from the detumbling law's run on the planner's own integrator (RK4 over each
 /// tick, the command held in the inertial frame as the onboard law holds it), sampled at the nodes:
 /// the states interpolated, each interval's controls the mean of the law's commands over it (base frame,
@@ -41,7 +44,12 @@ inline double detumble_law_guess(DetumblePlanNlp& nlp, const Model& stack, int g
                                  const DetumbleOptions& options, double horizon, int N, Eigen::VectorXd& x) {
   const int n = stack.n(), ny = nlp.ny(), nu = nlp.nu();
   const double tick = std::min(0.01, 0.5 * detumble_longest_tick(stack, gripper, start));
-  DetumbleController ctrl(stack, gripper, body, limits, options, tick);
+  // the law within nine tenths of the gripper's limits: a guess strictly inside the gripper's rows (the
+  // law's run sits on a limit that binds, where the interior point starts badly)
+  DetumbleLimits inside = limits;
+  inside.gripper_force *= kDetumbleGuessGripperFraction;
+  inside.gripper_moment *= kDetumbleGuessGripperFraction;
+  DetumbleController ctrl(stack, gripper, body, inside, options, tick);
   DetumbleCommand cmd = ctrl.make_command();
   auto& w = nlp.work0();
   w.y = nlp.start();
@@ -226,43 +234,53 @@ inline bool plan_rests(const Model& stack, int gripper, const AttachedBody& body
   return replay_detumble_plan(stack, gripper, body, plan, limits, options, r).at_rest;
 }
 
-/// The plan `free` solved again on the grid of `po.tick` (DetumblePlanOptions::tick): T = N tick for
-/// N from ceil(free T / tick) up, the first that IPOPT solves; its controls of least effort.
+/// The plan `free` solved again on intervals no shorter than `po.tick` (DetumblePlanOptions::tick):
+/// N = ceil(free T / tick) intervals and T >= N tick, from `free` resampled; N + 1 when N fails. T
+/// within 1e-3 of N tick (the bound active, but for the barrier's margin) is then fixed to it, from that
+/// solution, with the controls of least effort: the tick's grid (that plan kept if this solve fails).
+/// The free plan when neither N solves.
 inline DetumblePlan plan_on_tick_grid(const Model& stack, int gripper, const AttachedBody& body,
                                       const DetumbleState& start, const DetumbleLimits& limits,
                                       const DetumbleOptions& options, double horizon, const DetumblePlanOptions& po,
                                       const DetumblePlan& free) {
   constexpr const char* w = "plan_detumble";
   DetumblePlanOptions g = po;
-  if (!(g.effort_weight > 0)) g.effort_weight = 1;
+  g.substeps = std::max(po.substeps, free.substeps);
+  g.max_iterations = std::min(po.max_iterations, 500);  // from the free plan: a few tens when it solves
   const int first = std::max(2, static_cast<int>(std::ceil(free.duration / po.tick - 1e-9)));
-  const int last = std::min(2000, first + std::max(3, first / 4));  // up to a quarter longer
-  std::string why;
-  double residual = std::numeric_limits<double>::infinity();
-  const int iterations = free.iterations;
-  for (int N = first; N <= last && N * po.tick <= horizon; ++N) {
+  for (int N = first; N <= std::min(2000, first + 1) && N * po.tick <= horizon; ++N) {
     g.intervals = N;
     Ipopt::SmartPtr<DetumblePlanNlp> nlp = new DetumblePlanNlp(stack, gripper, body, start, limits, options, horizon, g);
-    nlp->fix_duration(N * po.tick);
+    nlp->set_min_duration(N * po.tick);
     Eigen::VectorXd x0;
     detumble_plan_guess(*nlp, free, N, x0);
     x0(0) = N * po.tick;
     try {
-      DetumblePlan p = solve_detumble_plan(nlp, x0, g, false, stack.n(), w);
-      p.iterations += iterations;
+      DetumblePlan p = solve_detumble_plan(nlp, x0, g, true, stack.n(), w);
+      if (p.duration <= N * po.tick * (1 + 1e-3)) {  // the bound active, to the barrier's margin: T fixed on it
+        DetumblePlanOptions e = g;  // with T fixed, the controls of least effort (the weight 1 when zero)
+        if (!(e.effort_weight > 0)) e.effort_weight = 1;
+        nlp = new DetumblePlanNlp(stack, gripper, body, start, limits, options, horizon, e);
+        nlp->set_fixed_duration(N * po.tick);
+        detumble_plan_guess(*nlp, p, N, x0);
+        x0(0) = N * po.tick;
+        try {
+          const int it = p.iterations;
+          p = solve_detumble_plan(nlp, x0, e, true, stack.n(), w);
+          p.iterations += it;
+        } catch (const DetumblePlanError&) {
+          // keep the plan on intervals a little longer than the tick (the tracker follows it)
+        }
+      }
+      p.iterations += free.iterations;
       p.warm_start_duration = free.warm_start_duration;
       p.free_duration = free.duration;
       return p;
-    } catch (const DetumblePlanError& e) {
-      why = e.status;
-      residual = std::min(residual, e.best_residual);
+    } catch (const DetumblePlanError&) {
+      // the next N, then the free plan
     }
   }
-  throw DetumblePlanError(str(w, ": no plan on the tick's grid: the free plan rests at ", free.duration,
-                              " s on intervals of ", free.interval(), " s, shorter than the tick (", po.tick,
-                              " s), and IPOPT found none of ", first, " to ", last, " ticks within the horizon (",
-                              horizon, " s; last status ", why.empty() ? "none tried" : why, ")"),
-                          why, residual);
+  return free;
 }
 
 }  // namespace detail
