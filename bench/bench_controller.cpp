@@ -5,6 +5,7 @@
 
 #include "ffsr/control/capture_controller.hpp"
 #include "ffsr/control/detumble_run.hpp"
+#include "ffsr/control/detumble_tracker.hpp"
 #include "ffsr/scenario/scenario.hpp"
 
 #include <sched.h>
@@ -95,7 +96,9 @@ Timing time_reference(long calls) {
 
 /// DetumbleController::step on the 7-DOF stack of robots/paper_7dof_detumble.toml (the grasp at its
 /// configuration): the states of a run, replayed; `mode` 0 the law with the joint limits, 1 with the
-/// gripper's limits too, 2 the passive law, 3 thrusters stopping the stack's spin.
+/// gripper's limits too, 2 the passive law, 3 thrusters stopping the stack's spin; 4
+/// DetumblePlanTracker::step following that run as a plan (its states the nodes, its commands the
+/// controls, one interval per tick: the work of a tick does not depend on how the plan was made).
 Timing time_detumble(const Scenario& sc, int mode, long calls) {
   const Model& m = *sc.model;
   const int ee = sc.problem.frame;
@@ -131,13 +134,26 @@ Timing time_detumble(const Scenario& sc, int mode, long calls) {
     v << Vector6::Zero(), x.theta_dot;
     states.push_back({x.base, x.theta, v, x.wheel_momentum});
   }
+  DetumblePlan plan;
+  for (size_t i = 0; i + 1 < r.series.size(); ++i) {
+    plan.tau.push_back(r.series[i].command.tau);
+    plan.base_wrench.push_back(Vector6::Zero());
+  }
+  plan.nodes.assign(states.begin(), states.begin() + static_cast<std::ptrdiff_t>(plan.tau.size()) + 1);
+  plan.duration = run.tick * static_cast<double>(plan.tau.size());
   DetumbleController ctrl(stack, ee, g.body, lim, opt, run.tick);
+  DetumblePlanTracker tracker(stack, ee, g.body, plan, lim, opt, run.tick);
   DetumbleCommand cmd = ctrl.make_command();
   std::vector<double> us(static_cast<size_t>(calls));
+  const size_t ticks = mode == 4 ? plan.tau.size() : states.size();
   for (long k = 0; k < calls; ++k) {
-    const DetumbleState& st = states[static_cast<size_t>(k) % states.size()];
+    const size_t i = static_cast<size_t>(k) % ticks;
+    const DetumbleState& st = states[i];
     const auto a = Clock::now();
-    ctrl.step(st, cmd);
+    if (mode == 4)
+      tracker.step(st, run.tick * static_cast<double>(i), cmd);
+    else
+      ctrl.step(st, cmd);
     const auto b = Clock::now();
     if (cmd.status == DetumbleStatus::Fault) {
       std::fprintf(stderr, "bench_controller: unexpected detumble fault (%s)\n", fault_name(cmd.fault));
@@ -211,8 +227,8 @@ int main(int argc, char** argv) {
   {  // the detumbling controller on the 7-DOF stack
     const Scenario sc = load_scenario(robots + "paper_7dof_detumble.toml");
     const char* names[] = {"detumble 7-DOF joint limits", "detumble 7-DOF + gripper limits",
-                           "detumble 7-DOF passive law", "detumble 7-DOF thrusters"};
-    for (int mode = 0; mode < 4; ++mode) ok = report(names[mode], time_detumble(sc, mode, calls), 20.0) && ok;
+                           "detumble 7-DOF passive law", "detumble 7-DOF thrusters", "detumble 7-DOF plan tracker"};
+    for (int mode = 0; mode < 5; ++mode) ok = report(names[mode], time_detumble(sc, mode, calls), 20.0) && ok;
   }
   return ok ? 0 : 1;
 }

@@ -208,7 +208,7 @@ TEST_CASE("detumble controller: 1e5 ticks allocate nothing (7-DOF stack, each ac
   CHECK(sum > 0);
 }
 
-TEST_CASE("detumble plan tracker: 1e5 ticks allocate nothing (7-DOF stack, thrusters, gripper limits)") {
+TEST_CASE("detumble plan tracker: 1e5 ticks allocate nothing (7-DOF stack, thrusters or free-floating, gripper limits)") {
   const Model robot = model_from_urdf_file(kRobots + "paper_7dof.urdf");
   AttachedBody body;
   body.mass = 200;
@@ -224,6 +224,12 @@ TEST_CASE("detumble plan tracker: 1e5 ticks allocate nothing (7-DOF stack, thrus
   lim.gripper_moment = 10;
   DetumbleOptions opt;
   opt.stop_stack_spin = true;
+  // the feedback through H with thrusters, through H* (the base free) without an actuator
+  const bool free_floating = GENERATE(false, true);
+  if (free_floating) {
+    lim.actuator = BaseActuator::None;
+    opt.stop_stack_spin = false;
+  }
   // a plan of 20 intervals of 0.05 s through the state the ticks measure (tracked: within its band)
   DetumbleState st{BasePose{}, Eigen::VectorXd::Constant(7, 0.4), Eigen::VectorXd::Constant(13, 0.05),
                    Vector3::Zero()};
