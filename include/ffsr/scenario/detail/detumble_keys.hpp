@@ -8,10 +8,6 @@
 namespace ffsr {
 namespace detail {
 
-#define FFSR_KEY(name, member, ...) \
-  make_key(                         \
-      name, +[](ScenarioKeys& k) -> decltype(k.member)& { return k.member; }, __VA_ARGS__)
-
 /// A Detumble key of a positive number, checked and echoed when given; returns it for more settings.
 inline ScenarioKey& add_positive_detumble_key(std::vector<ScenarioKey>& keys, ScenarioKey key, const char* name,
                                               double ScenarioKeys::*member) {
@@ -226,8 +222,6 @@ inline void add_post_capture_keys(std::vector<ScenarioKey>& keys) {
                  "constraint; > 0)"),
         "max-gripper-moment", &K::max_gripper_moment);
 }
-
-#undef FFSR_KEY
 
 }  // namespace detail
 }  // namespace ffsr

@@ -9,6 +9,12 @@
 #include <nlohmann/json.hpp>
 #include <toml++/toml.h>
 
+/// An entry of the key table bound to its ScenarioKeys member (keys.hpp, detumble_keys.hpp; #undef at
+/// the end of keys.hpp).
+#define FFSR_KEY(name, member, ...) \
+  make_key(                         \
+      name, +[](ScenarioKeys& k) -> decltype(k.member)& { return k.member; }, __VA_ARGS__)
+
 namespace ffsr {
 namespace detail {
 

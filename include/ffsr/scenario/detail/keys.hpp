@@ -18,10 +18,6 @@ namespace detail {
 
 // --- the keys ------------------------------------------------------------------------------------
 
-#define FFSR_KEY(name, member, ...) \
-  make_key(                         \
-      name, +[](ScenarioKeys& k) -> decltype(k.member)& { return k.member; }, __VA_ARGS__)
-
 /// The robot: its URDF, the bus it is mounted on, the loader's repairs and the contact point.
 inline void add_robot_keys(std::vector<ScenarioKey>& keys) {
   using G = KeyGroup;
@@ -298,9 +294,7 @@ inline void add_joint_and_shape_keys(std::vector<ScenarioKey>& keys) {
           .echoed(echo_shape("contact-exemption", &K::contact_exemption)));
 }
 
-#undef FFSR_KEY
-
-#undef FFSR_KEY
+#undef FFSR_KEY  // defined in key_entry.hpp for this table and detumble_keys.hpp
 
 /// The table, in the order a command lists the keys (the flags of `ffsr-optimize --help`).
 inline std::vector<ScenarioKey> build_scenario_keys() {
