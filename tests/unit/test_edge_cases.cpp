@@ -4,6 +4,7 @@
 
 #include "support/paper.hpp"
 
+#include "ffsr/algorithm/aba.hpp"
 #include "ffsr/ffsr.hpp"
 #include "ffsr/parsers/urdf.hpp"
 #include "ffsr/optimize/capture.hpp"
