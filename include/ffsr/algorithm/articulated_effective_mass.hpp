@@ -287,10 +287,9 @@ inline void articulated_inertias(const Model& model, Data& data, const Eigen::Ve
     data.U[ui] = U;
     data.D(i - 1) = D;
     if (df && model.subtree_last(i) == model.subtree_last(model.body(i).parent))
-      data.IA[up].set_projected(data.Ic[up], data.IA[ui], U, D);  // data.Ic[up] is still the body alone
+      data.IA[up].set_projected(data.Ic[up], data.IA[ui], U, D);
     else
       data.IA[up].add_projected(data.IA[ui], U, D);
-    data.Ic[up] += data.Ic[ui];
   }
 }
 
