@@ -314,7 +314,7 @@ inline double articulated_solve(const Model& model, Data& data, int ee, const Ve
   for (int k = 0; k < len; ++k) {  // from ee towards the base
     const int i = data.path[static_cast<size_t>(k)];
     const double ui = -data.S.col(i - 1).dot(pA);
-    const double si = ui / data.D(i - 1);
+    const double si = ui * (1.0 / data.D(i - 1));  // the division off the chain from pA to pA
     data.u(i - 1) = ui;
     q += ui * si;
     pA.noalias() += data.U[static_cast<size_t>(i)] * si;
