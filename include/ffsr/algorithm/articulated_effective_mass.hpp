@@ -311,13 +311,21 @@ inline double articulated_solve(const Model& model, Data& data, int ee, const Ve
   for (int i = ee; i > 0; i = model.body(i).parent) data.path[static_cast<size_t>(len++)] = i;
   Vector6 pA = -f;
   double q = 0.0;
-  for (int k = 0; k < len; ++k) {  // from ee towards the base
+  // from ee towards the base; the next body's innovation ahead of pA's update, u_next = -S_next . pA -
+  // (S_next . U_i) s_i, so that from one s_i to the next the chain of dependent operations is a product
+  // and a subtraction (each 1 / D_i and the dot products wait for nothing on it)
+  double ui = len > 0 ? -data.S.col(data.path[0] - 1).dot(pA) : 0.0;
+  for (int k = 0; k < len; ++k) {
     const int i = data.path[static_cast<size_t>(k)];
-    const double ui = -data.S.col(i - 1).dot(pA);
-    const double si = ui * (1.0 / data.D(i - 1));  // the division off the chain from pA to pA
+    const Vector6& Ui = data.U[static_cast<size_t>(i)];
+    const double si = ui * (1.0 / data.D(i - 1));
     data.u(i - 1) = ui;
     q += ui * si;
-    pA.noalias() += data.U[static_cast<size_t>(i)] * si;
+    if (k + 1 < len) {
+      const auto Sn = data.S.col(data.path[static_cast<size_t>(k) + 1] - 1);
+      ui = -Sn.dot(pA) - Sn.dot(Ui) * si;
+    }
+    pA.noalias() += Ui * si;
   }
   if (!all) {
     double q0 = 0.0;
