@@ -215,26 +215,24 @@ inline bool inverse_form_composite(const Model& model, Data& data, int ee, const
     if (armature) L[i * ld + 6 + i] += (*armature)(i);
     r[i] = i + 1 <= ee && ee <= last + 1 ? dot6_paired(T, f.data()) : -dot6_paired(Gi, f.data());
   }
-  // LDL^T in place, row by row (L_ji over M_ij for i < j, 1 / D_j on the diagonal; each sum runs over
-  // contiguous entries), and L y = r over r: r^T M^-1 r = sum_j y_j^2 / D_j
-  double* const w = data.w.data() + 6;  // L_jk D_k of the current row j
-  for (int j = 0; j < n; ++j) {
-    double* Mj = L + j * ld + 6;
-    double d = Mj[j], yj = r[j];
-    for (int i = 0; i < j; ++i) {
-      const double* Mi = L + i * ld + 6;
-      double s = Mj[i];
-      for (int k = 0; k < i; ++k) s -= w[k] * Mi[k];
-      w[i] = s;
-      Mj[i] = s * Mi[i];
-      d -= s * Mj[i];
-      yj -= Mj[i] * r[i];
-    }
+  // LDL^T by eliminating one pivot after the other (the Schur complement of each in the trailing
+  // upper triangle, in place), r eliminated with them: r^T M^-1 r = sum_k r_k^2 / D_k, r_k and D_k as
+  // pivot k is reached. The updates after a pivot are independent of each other, so that the chain
+  // of dependent operations from one pivot to the next is a division, two products and a subtraction
+  // (the row-by-row order waited on each entry of a row before the next).
+  double* const t = data.w.data() + 6;  // M_kj / D_k of the current pivot k
+  for (int k = 0; k < n; ++k) {
+    const double d = L[k * ld + 6 + k];
     if (!(d > 0.0)) return false;
-    const double inv = 1.0 / d;
-    Mj[j] = inv;
-    r[j] = yj;
-    q += yj * yj * inv;
+    const double inv = 1.0 / d, rk = r[k];
+    q += rk * rk * inv;
+    for (int j = k + 1; j < n; ++j) t[j] = L[j * ld + 6 + k] * inv;
+    for (int j = k + 1; j < n; ++j) {
+      double* Mj = L + j * ld + 6;
+      const double a = Mj[k];
+      for (int i = k + 1; i <= j; ++i) Mj[i] -= t[i] * a;
+      r[j] -= t[j] * rk;
+    }
   }
   return q >= 0.0 && q <= std::numeric_limits<double>::max();
 }
