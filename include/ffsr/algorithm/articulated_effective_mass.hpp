@@ -220,18 +220,16 @@ inline bool inverse_form_composite(const Model& model, Data& data, int ee, const
   // pivot k is reached. The updates after a pivot are independent of each other, so that the chain
   // of dependent operations from one pivot to the next is a division, two products and a subtraction
   // (the row-by-row order waited on each entry of a row before the next).
-  double* const t = data.w.data() + 6;  // M_kj / D_k of the current pivot k
+  double* const M = L + 6;  // M's column j at M + j ld
   for (int k = 0; k < n; ++k) {
-    const double d = L[k * ld + 6 + k];
+    const double d = M[k * ld + k];
     if (!(d > 0.0)) return false;
     const double inv = 1.0 / d, rk = r[k];
     q += rk * rk * inv;
-    for (int j = k + 1; j < n; ++j) t[j] = L[j * ld + 6 + k] * inv;
-    for (int j = k + 1; j < n; ++j) {
-      double* Mj = L + j * ld + 6;
-      const double a = Mj[k];
-      for (int i = k + 1; i <= j; ++i) Mj[i] -= t[i] * a;
-      r[j] -= t[j] * rk;
+    for (int i = k + 1; i < n; ++i) {  // row i of the trailing triangle: M_ij -= (M_ki / D_k) M_kj
+      const double ti = M[i * ld + k] * inv;
+      r[i] -= ti * rk;
+      for (int j = i; j < n; ++j) M[j * ld + i] -= ti * M[j * ld + k];
     }
   }
   return q >= 0.0 && q <= std::numeric_limits<double>::max();
