@@ -262,18 +262,28 @@ inline Vector6 unit_point_force(const Model& model, const Data& data, int frame,
 /// Reads the kinematics. Writes data.Ic, data.IA, data.U, data.D. Throws NumericalError when a
 /// D_i is not positive.
 inline void articulated_inertias(const Model& model, Data& data, const Eigen::VectorXd* armature) {
-  body_inertias(model, data);
   const int nb = model.nb();
   // On a depth-first model a body's articulated inertia starts at its first child reached (the last
   // child, whose subtree ends the body's): set_projected, without setting it first; leaves start
-  // as their rigid inertia. Other trees set every body first.
+  // as their rigid inertia. Each body's own inertia is formed at that step (or a leaf's at its
+  // own), where its independent operations fill the gaps of the recursion's chain. Other trees set
+  // every body first.
   const bool df = model.depth_first();
-  for (int i = 0; i < nb; ++i)
-    if (!df || model.subtree_last(i) == i)
-      data.IA[static_cast<size_t>(i)].set(data.Ic[static_cast<size_t>(i)]);
+  if (!df) {
+    body_inertias(model, data);
+    for (int i = 0; i < nb; ++i) data.IA[static_cast<size_t>(i)].set(data.Ic[static_cast<size_t>(i)]);
+  } else if (nb == 1) {
+    body_inertia(model, data, 0);
+    data.IA[0].set(data.Ic[0]);
+  }
   for (int i = nb - 1; i > 0; --i) {
     const auto ui = static_cast<size_t>(i);
-    const auto up = static_cast<size_t>(model.body(i).parent);
+    const int p = model.body(i).parent;
+    const auto up = static_cast<size_t>(p);
+    if (df && model.subtree_last(i) == i) {
+      body_inertia(model, data, i);
+      data.IA[ui].set(data.Ic[ui]);
+    }
     const Vector6 S = data.S.col(i - 1);
     const Vector6 U = data.IA[ui] * S;
     const double D = S.dot(U) + (armature ? (*armature)(i - 1) : 0.0);
@@ -282,13 +292,14 @@ inline void articulated_inertias(const Model& model, Data& data, const Eigen::Ve
           str("effective_mass: the articulated inertia is not positive definite (joint ", i, ")")));
     data.U[ui] = U;
     data.D(i - 1) = D;
-    if (df && model.subtree_last(i) == model.subtree_last(model.body(i).parent))
+    if (df && model.subtree_last(i) == model.subtree_last(p)) {
+      body_inertia(model, data, p);
       data.IA[up].set_projected(data.Ic[up], data.IA[ui], U, D);
-    else
+    } else {
       data.IA[up].add_projected(data.IA[ui], U, D);
+    }
   }
 }
-
 /// The rest of the articulated-body algorithm for the spatial force f on body `ee` and no joint
 /// torque, after articulated_inertias: the bias forces along the path from `ee` to the base,
 ///   pA = -f on ee;  u_i = -S_i^T pA_i,  pA_parent = pA_i + U_i u_i / D_i  (only the path carries one).
