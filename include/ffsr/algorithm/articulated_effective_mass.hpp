@@ -170,6 +170,25 @@ inline double dot6_paired(const double* a, const double* b) {
   return ((a[0] * b[0] + a[1] * b[1]) + (a[2] * b[2] + a[3] * b[3])) + (a[4] * b[4] + a[5] * b[5]);
 }
 
+/// composite_inertias on a depth-first model, and F_i = Ic_i S_i into data.Fc as each Ic_i is
+/// complete: each body's own inertia is formed at the step of its first child reached (a leaf's at
+/// its own), where its independent operations fill the gaps of the chain of sums from the leaves.
+/// Reads the kinematics. Writes data.Ic (composite) and data.Fc.
+inline void composite_inertias_and_forces(const Model& model, Data& data) {
+  const int nb = model.nb();
+  if (nb == 1) body_inertia(model, data, 0);
+  for (int i = nb - 1; i > 0; --i) {
+    const auto ui = static_cast<size_t>(i);
+    const int p = model.body(i).parent;
+    if (model.subtree_last(i) == i) body_inertia(model, data, i);
+    const Vector6 F = data.Ic[ui] * Vector6(data.S.col(i - 1));
+    double* Fi = data.Fc.col(i - 1).data();
+    for (int e = 0; e < 6; ++e) Fi[e] = F(e);
+    if (model.subtree_last(i) == model.subtree_last(p)) body_inertia(model, data, p);
+    data.Ic[static_cast<size_t>(p)] += data.Ic[ui];
+  }
+}
+
 /// w^T (H + diag(0, a))^-1 w for the generalized force w = J^T f of the spatial force f (about p_0,
 /// inertial axes) on body `ee`, by the composite inertias and the floating base's Schur complement:
 /// with H = [Ic_0 F; F^T H_m] (Ic_0 the composite inertia of the whole robot, a rigid body's, F_i =
@@ -185,7 +204,7 @@ inline double dot6_paired(const double* a, const double* b) {
 /// decides those cases.
 inline bool inverse_form_composite(const Model& model, Data& data, int ee, const Vector6& f,
                                    const Eigen::VectorXd* armature, double& q) {
-  composite_inertias(model, data);
+  composite_inertias_and_forces(model, data);
   const RigidInverse I0(data.Ic[0]);
   if (!I0.ok) return false;
   const int n = model.nb() - 1;
@@ -194,12 +213,7 @@ inline bool inverse_form_composite(const Model& model, Data& data, int ee, const
   double* const r = data.y.data() + 6;
   double g[6];
   q = I0.solve(f.data(), g);
-  for (int j = 0; j < n; ++j) {
-    const Vector6 F = data.Ic[static_cast<size_t>(j) + 1] * Vector6(data.S.col(j));
-    double* Fj = data.Fc.col(j).data();
-    for (int e = 0; e < 6; ++e) Fj[e] = F(e);
-    I0.solve(Fj, L + j * ld);
-  }
+  for (int j = 0; j < n; ++j) I0.solve(data.Fc.col(j).data(), L + j * ld);
   // M's upper triangle (M_ij, i <= j, in column j) and r: with T_i = S_i - G_i (G_i = Ic_0^-1 F_i),
   // M_ij = F_j . T_i for j in the subtree of i (the contiguous range i..last; S_i . F_j is H_m's entry)
   // and -F_j . G_i for the others; r_i = T_i . f for the joints that support ee (F_i . g = G_i . f) and
