@@ -199,9 +199,9 @@ inline void composite_inertias_and_forces(const Model& model, Data& data) {
 /// the recursion's 6x6 rank-one update per body: the faster route for few joints (see
 /// kCompositeMaxJoints). Requires a depth-first model with one body per coordinate. Reads the
 /// kinematics. Writes data.Ic (composite), data.Fc, data.L (Ic_0^-1 F in its top rows, M's upper
-/// triangle and its factor below), data.w and data.y. False when Ic_0 or M is not positive definite
-/// or the result is not a finite non-negative number (q is then unspecified): the articulated route
-/// decides those cases.
+/// triangle below, reduced in place by the elimination) and data.y. False when Ic_0 or M is not
+/// positive definite or the result is not a finite non-negative number (q is then unspecified): the
+/// articulated route decides those cases.
 inline bool inverse_form_composite(const Model& model, Data& data, int ee, const Vector6& f,
                                    const Eigen::VectorXd* armature, double& q) {
   composite_inertias_and_forces(model, data);
@@ -271,10 +271,9 @@ inline Vector6 unit_point_force(const Model& model, const Data& data, int frame,
 ///   i = n..1:  U_i = IA_i S_i,  D_i = S_i^T U_i + a_i,  IA_parent += IA_i - U_i U_i^T / D_i,
 /// where a_i is the armature of joint i (a reflected rotor inertia on H's diagonal; `armature` null
 /// for none). A joint whose armature is infinite would pass IA_i unchanged: that is the Locked
-/// model, which needs the composite inertia only (written too: data.Ic[i] ends as the composite
-/// inertia of the subtree of i, as crba leaves it). Requires one body per coordinate (no mimics).
-/// Reads the kinematics. Writes data.Ic, data.IA, data.U, data.D. Throws NumericalError when a
-/// D_i is not positive.
+/// model, which needs the composite inertia only (its callers sum it apart). Requires one body per
+/// coordinate (no mimics). Reads the kinematics. Writes data.Ic (the bodies alone), data.IA, data.U,
+/// data.D. Throws NumericalError when a D_i is not positive.
 inline void articulated_inertias(const Model& model, Data& data, const Eigen::VectorXd* armature) {
   const int nb = model.nb();
   // On a depth-first model a body's articulated inertia starts at its first child reached (the last
@@ -401,7 +400,7 @@ inline const Eigen::VectorXd* armature_of(const Model& model, const ContactJoint
 /// (detail::articulated_inertias, detail::articulated_solve): one symmetric rank-one update of a 6x6
 /// articulated inertia (kept as 3x3 blocks) per body, bias forces only along the path from the
 /// frame's body to the base, one 6x6 LDL^T factorization at the base, no n x n matrix.
-/// Reads the kinematics (data.R, data.p, data.S). Writes data.Ic (composite), data.IA, data.U,
+/// Reads the kinematics (data.R, data.p, data.S). Writes data.Ic (the bodies alone), data.IA, data.U,
 /// data.D, data.u, data.path. Allocation-free. Throws InputError for a model with mimic joints
 /// (use inverse_effective_mass), NumericalError when an articulated inertia is not positive definite.
 inline double inverse_effective_mass_articulated(const Model& model, Data& data, int frame,
@@ -418,8 +417,8 @@ inline double inverse_effective_mass_articulated(const Model& model, Data& data,
 /// Free as above; Armature with the armature a_i added to each D_i (the recursion's form of
 /// H + diag(0, a)); Locked from the composite inertia of the whole robot, f^T Ic_0^-1 f (the 6x6
 /// H_bb, without the joint rows of H). Equal to inverse_effective_mass(model, data, frame, u, joints)
-/// after crba to rounding. Reads the kinematics. Writes data.Ic (composite) and, unless Locked, the
-/// fields of the recursion as above.
+/// after crba to rounding. Reads the kinematics. Writes data.Ic (composite when Locked, else the bodies
+/// alone) and, unless Locked, the fields of the recursion as above.
 inline double inverse_effective_mass_articulated(const Model& model, Data& data, int frame, const Vector3& u,
                                                  const ContactJoints& joints) {
   const Vector6 f = detail::unit_point_force(model, data, frame, u);
