@@ -334,16 +334,16 @@ inline double articulated_solve(const Model& model, Data& data, int ee, const Ve
   // from ee towards the base; the next body's innovation ahead of pA's update, u_next = -S_next . pA -
   // (S_next . U_i) s_i, so that from one s_i to the next the chain of dependent operations is a product
   // and a subtraction (each 1 / D_i and the dot products wait for nothing on it)
-  double ui = len > 0 ? -data.S.col(data.path[0] - 1).dot(pA) : 0.0;
+  double u_k = len > 0 ? -data.S.col(data.path[0] - 1).dot(pA) : 0.0;
   for (int k = 0; k < len; ++k) {
     const int i = data.path[static_cast<size_t>(k)];
     const Vector6& Ui = data.U[static_cast<size_t>(i)];
-    const double si = ui * (1.0 / data.D(i - 1));
-    data.u(i - 1) = ui;
-    q += ui * si;
+    const double si = u_k * (1.0 / data.D(i - 1));
+    data.u(i - 1) = u_k;
+    q += u_k * si;
     if (k + 1 < len) {
       const auto Sn = data.S.col(data.path[static_cast<size_t>(k) + 1] - 1);
-      ui = -Sn.dot(pA) - Sn.dot(Ui) * si;
+      u_k = -Sn.dot(pA) - Sn.dot(Ui) * si;
     }
     pA.noalias() += Ui * si;
   }
