@@ -232,8 +232,9 @@ inline bool inverse_form_composite(const Model& model, Data& data, int ee, const
   // LDL^T by eliminating one pivot after the other (the Schur complement of each in the trailing
   // upper triangle, in place), r eliminated with them: r^T M^-1 r = sum_k r_k^2 / D_k, r_k and D_k as
   // pivot k is reached. The updates after a pivot are independent of each other, so that the chain
-  // of dependent operations from one pivot to the next is a division, two products and a subtraction
-  // (the row-by-row order waited on each entry of a row before the next).
+  // of dependent operations from one pivot to the next is a division, a product and a subtraction
+  // (each diagonal entry as M_ii - M_ki^2 / D_k, M_ki^2 formed before the division; the row-by-row
+  // order waited on each entry of a row before the next).
   double* const M = L + 6;  // M's column j at M + j ld
   for (int k = 0; k < n; ++k) {
     const double d = M[k * ld + k];
@@ -241,9 +242,10 @@ inline bool inverse_form_composite(const Model& model, Data& data, int ee, const
     const double inv = 1.0 / d, rk = r[k];
     q += rk * rk * inv;
     for (int i = k + 1; i < n; ++i) {  // row i of the trailing triangle: M_ij -= (M_ki / D_k) M_kj
-      const double ti = M[i * ld + k] * inv;
+      const double mki = M[i * ld + k], ti = mki * inv;
       r[i] -= ti * rk;
-      for (int j = i; j < n; ++j) M[j * ld + i] -= ti * M[j * ld + k];
+      M[i * ld + i] -= (mki * mki) * inv;
+      for (int j = i + 1; j < n; ++j) M[j * ld + i] -= ti * M[j * ld + k];
     }
   }
   return q >= 0.0 && q <= std::numeric_limits<double>::max();
