@@ -315,6 +315,7 @@ inline void articulated_inertias(const Model& model, Data& data, const Eigen::Ve
     }
   }
 }
+
 /// The rest of the articulated-body algorithm for the spatial force f on body `ee` and no joint
 /// torque, after articulated_inertias: the bias forces along the path from `ee` to the base,
 ///   pA = -f on ee;  u_i = -S_i^T pA_i,  pA_parent = pA_i + U_i u_i / D_i  (only the path carries one).
