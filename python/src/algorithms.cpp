@@ -256,7 +256,7 @@ void bind_integrated_effective_mass(nb::module_& m) {
                    "(Eq. 14), kg, of the robot at (base, theta) with the end-effector frame (None: the\n"
                    "model's) touching `target` (None: the paper's); u = R_t u_n. In O(n) by the\n"
                    "articulated-body recursion (RBDA 7.3) with the joint model's contact inertia (locked:\n"
-                   "the composite inertia of the whole robot), up to 8 joints (free, armature) by the\n"
+                   "the composite inertia of the whole robot), up to 7 joints (free, armature) by the\n"
                    "composite route (the floating base's Schur complement over the composite inertias); a\n"
                    "model with mimic joints takes crba and the dense solve. Writes the kinematics and the\n"
                    "routes' fields: do not rely on Data.H afterwards (integrated_effective_mass_dense\n"

@@ -170,6 +170,25 @@ inline double dot6_paired(const double* a, const double* b) {
   return ((a[0] * b[0] + a[1] * b[1]) + (a[2] * b[2] + a[3] * b[3])) + (a[4] * b[4] + a[5] * b[5]);
 }
 
+/// composite_inertias on a depth-first model, and F_i = Ic_i S_i into data.Fc as each Ic_i is
+/// complete: each body's own inertia is formed at the step of its first child reached (a leaf's at
+/// its own), where its independent operations fill the gaps of the chain of sums from the leaves.
+/// Reads the kinematics. Writes data.Ic (composite) and data.Fc.
+inline void composite_inertias_and_forces(const Model& model, Data& data) {
+  const int nb = model.nb();
+  if (nb == 1) body_inertia(model, data, 0);
+  for (int i = nb - 1; i > 0; --i) {
+    const auto ui = static_cast<size_t>(i);
+    const int p = model.body(i).parent;
+    if (model.subtree_last(i) == i) body_inertia(model, data, i);
+    const Vector6 F = data.Ic[ui] * Vector6(data.S.col(i - 1));
+    double* Fi = data.Fc.col(i - 1).data();
+    for (int e = 0; e < 6; ++e) Fi[e] = F(e);
+    if (model.subtree_last(i) == model.subtree_last(p)) body_inertia(model, data, p);
+    data.Ic[static_cast<size_t>(p)] += data.Ic[ui];
+  }
+}
+
 /// w^T (H + diag(0, a))^-1 w for the generalized force w = J^T f of the spatial force f (about p_0,
 /// inertial axes) on body `ee`, by the composite inertias and the floating base's Schur complement:
 /// with H = [Ic_0 F; F^T H_m] (Ic_0 the composite inertia of the whole robot, a rigid body's, F_i =
@@ -180,12 +199,12 @@ inline double dot6_paired(const double* a, const double* b) {
 /// the recursion's 6x6 rank-one update per body: the faster route for few joints (see
 /// kCompositeMaxJoints). Requires a depth-first model with one body per coordinate. Reads the
 /// kinematics. Writes data.Ic (composite), data.Fc, data.L (Ic_0^-1 F in its top rows, M's upper
-/// triangle and its factor below), data.w and data.y. False when Ic_0 or M is not positive definite
-/// or the result is not a finite non-negative number (q is then unspecified): the articulated route
-/// decides those cases.
+/// triangle below, reduced in place by the elimination) and data.y. False when Ic_0 or M is not
+/// positive definite or the result is not a finite non-negative number (q is then unspecified): the
+/// articulated route decides those cases.
 inline bool inverse_form_composite(const Model& model, Data& data, int ee, const Vector6& f,
                                    const Eigen::VectorXd* armature, double& q) {
-  composite_inertias(model, data);
+  composite_inertias_and_forces(model, data);
   const RigidInverse I0(data.Ic[0]);
   if (!I0.ok) return false;
   const int n = model.nb() - 1;
@@ -194,12 +213,7 @@ inline bool inverse_form_composite(const Model& model, Data& data, int ee, const
   double* const r = data.y.data() + 6;
   double g[6];
   q = I0.solve(f.data(), g);
-  for (int j = 0; j < n; ++j) {
-    const Vector6 F = data.Ic[static_cast<size_t>(j) + 1] * Vector6(data.S.col(j));
-    double* Fj = data.Fc.col(j).data();
-    for (int e = 0; e < 6; ++e) Fj[e] = F(e);
-    I0.solve(Fj, L + j * ld);
-  }
+  for (int j = 0; j < n; ++j) I0.solve(data.Fc.col(j).data(), L + j * ld);
   // M's upper triangle (M_ij, i <= j, in column j) and r: with T_i = S_i - G_i (G_i = Ic_0^-1 F_i),
   // M_ij = F_j . T_i for j in the subtree of i (the contiguous range i..last; S_i . F_j is H_m's entry)
   // and -F_j . G_i for the others; r_i = T_i . f for the joints that support ee (F_i . g = G_i . f) and
@@ -215,26 +229,24 @@ inline bool inverse_form_composite(const Model& model, Data& data, int ee, const
     if (armature) L[i * ld + 6 + i] += (*armature)(i);
     r[i] = i + 1 <= ee && ee <= last + 1 ? dot6_paired(T, f.data()) : -dot6_paired(Gi, f.data());
   }
-  // LDL^T in place, row by row (L_ji over M_ij for i < j, 1 / D_j on the diagonal; each sum runs over
-  // contiguous entries), and L y = r over r: r^T M^-1 r = sum_j y_j^2 / D_j
-  double* const w = data.w.data() + 6;  // L_jk D_k of the current row j
-  for (int j = 0; j < n; ++j) {
-    double* Mj = L + j * ld + 6;
-    double d = Mj[j], yj = r[j];
-    for (int i = 0; i < j; ++i) {
-      const double* Mi = L + i * ld + 6;
-      double s = Mj[i];
-      for (int k = 0; k < i; ++k) s -= w[k] * Mi[k];
-      w[i] = s;
-      Mj[i] = s * Mi[i];
-      d -= s * Mj[i];
-      yj -= Mj[i] * r[i];
-    }
+  // LDL^T by eliminating one pivot after the other (the Schur complement of each in the trailing
+  // upper triangle, in place), r eliminated with them: r^T M^-1 r = sum_k r_k^2 / D_k, r_k and D_k as
+  // pivot k is reached. The updates after a pivot are independent of each other, so that the chain
+  // of dependent operations from one pivot to the next is a division, a product and a subtraction
+  // (each diagonal entry as M_ii - M_ki^2 / D_k, M_ki^2 formed before the division; the row-by-row
+  // order waited on each entry of a row before the next).
+  double* const M = L + 6;  // M's column j at M + j ld
+  for (int k = 0; k < n; ++k) {
+    const double d = M[k * ld + k];
     if (!(d > 0.0)) return false;
-    const double inv = 1.0 / d;
-    Mj[j] = inv;
-    r[j] = yj;
-    q += yj * yj * inv;
+    const double inv = 1.0 / d, rk = r[k];
+    q += rk * rk * inv;
+    for (int i = k + 1; i < n; ++i) {  // row i of the trailing triangle: M_ij -= (M_ki / D_k) M_kj
+      const double mki = M[i * ld + k], ti = mki * inv;
+      r[i] -= ti * rk;
+      M[i * ld + i] -= (mki * mki) * inv;
+      for (int j = i + 1; j < n; ++j) M[j * ld + i] -= ti * M[j * ld + k];
+    }
   }
   return q >= 0.0 && q <= std::numeric_limits<double>::max();
 }
@@ -261,23 +273,32 @@ inline Vector6 unit_point_force(const Model& model, const Data& data, int frame,
 ///   i = n..1:  U_i = IA_i S_i,  D_i = S_i^T U_i + a_i,  IA_parent += IA_i - U_i U_i^T / D_i,
 /// where a_i is the armature of joint i (a reflected rotor inertia on H's diagonal; `armature` null
 /// for none). A joint whose armature is infinite would pass IA_i unchanged: that is the Locked
-/// model, which needs the composite inertia only (written too: data.Ic[i] ends as the composite
-/// inertia of the subtree of i, as crba leaves it). Requires one body per coordinate (no mimics).
-/// Reads the kinematics. Writes data.Ic, data.IA, data.U, data.D. Throws NumericalError when a
-/// D_i is not positive.
+/// model, which needs the composite inertia only (its callers sum it apart). Requires one body per
+/// coordinate (no mimics). Reads the kinematics. Writes data.Ic (the bodies alone), data.IA, data.U,
+/// data.D. Throws NumericalError when a D_i is not positive.
 inline void articulated_inertias(const Model& model, Data& data, const Eigen::VectorXd* armature) {
-  body_inertias(model, data);
   const int nb = model.nb();
   // On a depth-first model a body's articulated inertia starts at its first child reached (the last
   // child, whose subtree ends the body's): set_projected, without setting it first; leaves start
-  // as their rigid inertia. Other trees set every body first.
+  // as their rigid inertia. Each body's own inertia is formed at that step (or a leaf's at its
+  // own), where its independent operations fill the gaps of the recursion's chain. Other trees set
+  // every body first.
   const bool df = model.depth_first();
-  for (int i = 0; i < nb; ++i)
-    if (!df || model.subtree_last(i) == i)
-      data.IA[static_cast<size_t>(i)].set(data.Ic[static_cast<size_t>(i)]);
+  if (!df) {
+    body_inertias(model, data);
+    for (int i = 0; i < nb; ++i) data.IA[static_cast<size_t>(i)].set(data.Ic[static_cast<size_t>(i)]);
+  } else if (nb == 1) {
+    body_inertia(model, data, 0);
+    data.IA[0].set(data.Ic[0]);
+  }
   for (int i = nb - 1; i > 0; --i) {
     const auto ui = static_cast<size_t>(i);
-    const auto up = static_cast<size_t>(model.body(i).parent);
+    const int p = model.body(i).parent;
+    const auto up = static_cast<size_t>(p);
+    if (df && model.subtree_last(i) == i) {
+      body_inertia(model, data, i);
+      data.IA[ui].set(data.Ic[ui]);
+    }
     const Vector6 S = data.S.col(i - 1);
     const Vector6 U = data.IA[ui] * S;
     const double D = S.dot(U) + (armature ? (*armature)(i - 1) : 0.0);
@@ -286,11 +307,12 @@ inline void articulated_inertias(const Model& model, Data& data, const Eigen::Ve
           str("effective_mass: the articulated inertia is not positive definite (joint ", i, ")")));
     data.U[ui] = U;
     data.D(i - 1) = D;
-    if (df && model.subtree_last(i) == model.subtree_last(model.body(i).parent))
-      data.IA[up].set_projected(data.Ic[up], data.IA[ui], U, D);  // data.Ic[up] is still the body alone
-    else
+    if (df && model.subtree_last(i) == model.subtree_last(p)) {
+      body_inertia(model, data, p);
+      data.IA[up].set_projected(data.Ic[up], data.IA[ui], U, D);
+    } else {
       data.IA[up].add_projected(data.IA[ui], U, D);
-    data.Ic[up] += data.Ic[ui];
+    }
   }
 }
 
@@ -312,13 +334,21 @@ inline double articulated_solve(const Model& model, Data& data, int ee, const Ve
   for (int i = ee; i > 0; i = model.body(i).parent) data.path[static_cast<size_t>(len++)] = i;
   Vector6 pA = -f;
   double q = 0.0;
-  for (int k = 0; k < len; ++k) {  // from ee towards the base
+  // from ee towards the base; the next body's innovation ahead of pA's update, u_next = -S_next . pA -
+  // (S_next . U_i) s_i, so that from one s_i to the next the chain of dependent operations is a product
+  // and a subtraction (each 1 / D_i and the dot products wait for nothing on it)
+  double u_k = len > 0 ? -data.S.col(data.path[0] - 1).dot(pA) : 0.0;
+  for (int k = 0; k < len; ++k) {
     const int i = data.path[static_cast<size_t>(k)];
-    const double ui = -data.S.col(i - 1).dot(pA);
-    const double si = ui / data.D(i - 1);
-    data.u(i - 1) = ui;
-    q += ui * si;
-    pA.noalias() += data.U[static_cast<size_t>(i)] * si;
+    const Vector6& Ui = data.U[static_cast<size_t>(i)];
+    const double si = u_k * (1.0 / data.D(i - 1));
+    data.u(i - 1) = u_k;
+    q += u_k * si;
+    if (k + 1 < len) {
+      const auto Sn = data.S.col(data.path[static_cast<size_t>(k) + 1] - 1);
+      u_k = -Sn.dot(pA) - Sn.dot(Ui) * si;
+    }
+    pA.noalias() += Ui * si;
   }
   if (!all) {
     double q0 = 0.0;
@@ -373,7 +403,7 @@ inline const Eigen::VectorXd* armature_of(const Model& model, const ContactJoint
 /// (detail::articulated_inertias, detail::articulated_solve): one symmetric rank-one update of a 6x6
 /// articulated inertia (kept as 3x3 blocks) per body, bias forces only along the path from the
 /// frame's body to the base, one 6x6 LDL^T factorization at the base, no n x n matrix.
-/// Reads the kinematics (data.R, data.p, data.S). Writes data.Ic (composite), data.IA, data.U,
+/// Reads the kinematics (data.R, data.p, data.S). Writes data.Ic (the bodies alone), data.IA, data.U,
 /// data.D, data.u, data.path. Allocation-free. Throws InputError for a model with mimic joints
 /// (use inverse_effective_mass), NumericalError when an articulated inertia is not positive definite.
 inline double inverse_effective_mass_articulated(const Model& model, Data& data, int frame,
@@ -390,8 +420,8 @@ inline double inverse_effective_mass_articulated(const Model& model, Data& data,
 /// Free as above; Armature with the armature a_i added to each D_i (the recursion's form of
 /// H + diag(0, a)); Locked from the composite inertia of the whole robot, f^T Ic_0^-1 f (the 6x6
 /// H_bb, without the joint rows of H). Equal to inverse_effective_mass(model, data, frame, u, joints)
-/// after crba to rounding. Reads the kinematics. Writes data.Ic (composite) and, unless Locked, the
-/// fields of the recursion as above.
+/// after crba to rounding. Reads the kinematics. Writes data.Ic (composite when Locked, else the bodies
+/// alone) and, unless Locked, the fields of the recursion as above.
 inline double inverse_effective_mass_articulated(const Model& model, Data& data, int frame, const Vector3& u,
                                                  const ContactJoints& joints) {
   const Vector6 f = detail::unit_point_force(model, data, frame, u);

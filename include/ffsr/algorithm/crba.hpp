@@ -22,6 +22,13 @@ inline void body_inertias(const Model& model, Data& data) {
   }
 }
 
+/// body_inertias for body i alone.
+inline void body_inertia(const Model& model, Data& data, int i) {
+  const auto ui = static_cast<size_t>(i);
+  const Inertia& in = model.body(i).inertia;
+  data.Ic[ui].set_body(in.mass, in.com, in.I, model.inertia_diagonal(i), data.R[ui], data.p[ui] - data.p[0]);
+}
+
 /// The composite inertia of every body's subtree (body_inertias, then each body added into its
 /// parent's from the leaves). Reads the kinematics. Writes data.Ic.
 inline void composite_inertias(const Model& model, Data& data) {

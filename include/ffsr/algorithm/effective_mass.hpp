@@ -147,9 +147,10 @@ inline constexpr int kArticulatedMinJoints = 1;
 /// Up to this many joints integrated_effective_mass takes the composite route
 /// (detail::inverse_form_composite: the composite inertias and the floating base's Schur complement,
 /// O(n^2) entries and an n x n factorization), above it the O(n) recursion. The rule is the size at
-/// which the two cost the same on ffsr-bench-pinocchio's chains (between 10 and 12 joints, with
-/// random axes; the composite route is 10-20 % faster at 3 and 7 joints), set below it.
-inline constexpr int kCompositeMaxJoints = 8;
+/// which the two cost the same on ffsr-bench-pinocchio's chains (7 to 8 joints with random axes: the
+/// composite route 2-5 % faster at 7, the recursion 1-2 % faster at 8, 10-15 % at 10-12; the
+/// composite route is 10-15 % faster at 3 joints).
+inline constexpr int kCompositeMaxJoints = 7;
 
 namespace detail {
 /// True when integrated_effective_mass takes the articulated-body recursion: at least

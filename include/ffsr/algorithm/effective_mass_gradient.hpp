@@ -281,7 +281,7 @@ inline double integrated_effective_mass_gradient_dense(const Model& model, Data&
 /// force (detail::articulated_solve with every body) instead of a dense Cholesky solve; Locked: the
 /// composite inertias and detail::locked_inverse_form_gradient. dM_ie = -M_ie^2 d(1/m_e). Mimic joints:
 /// integrated_effective_mass_gradient_dense. Runs forward_kinematics. Writes the recursion's fields,
-/// data.Ic (composite), data.y, data.V, data.F and grad (size n); not data.H. Returns M_ie.
+/// data.Ic (composite when Locked), data.y, data.V, data.F and grad (size n); not data.H. Returns M_ie.
 inline double integrated_effective_mass_gradient(const Model& model, Data& data, const BasePose& base,
                                                  const Eigen::Ref<const Eigen::VectorXd>& theta, int frame,
                                                  const Vector3& u, double target_inverse_mass,
