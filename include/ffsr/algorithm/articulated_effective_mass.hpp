@@ -429,9 +429,7 @@ inline double inverse_effective_mass_articulated(const Model& model, Data& data,
     FFSR_THROW(InputError(
         "inverse_effective_mass_articulated: the model has mimic joints; use inverse_effective_mass"));
   if (joints.model == JointModel::Locked) {
-    detail::body_inertias(model, data);
-    for (int i = model.nb() - 1; i > 0; --i)
-      data.Ic[static_cast<size_t>(model.body(i).parent)] += data.Ic[static_cast<size_t>(i)];
+    detail::composite_inertias(model, data);
     Vector6 yb;
     return detail::locked_inverse_form_composite(data, f, yb);
   }

@@ -9,24 +9,17 @@ namespace ffsr {
 
 namespace detail {
 
-/// The inertia of every body in inertial axes about the base frame origin p_0 (10 parameters each,
-/// SpatialInertia::from_body). Reads the kinematics. Writes data.Ic (the bodies alone, not yet
-/// composite).
-inline void body_inertias(const Model& model, Data& data) {
-  const int nb = model.nb();
-  const Vector3& p0 = data.p[0];
-  for (int i = 0; i < nb; ++i) {
-    const auto ui = static_cast<size_t>(i);
-    const Inertia& in = model.body(i).inertia;
-    data.Ic[ui].set_body(in.mass, in.com, in.I, model.inertia_diagonal(i), data.R[ui], data.p[ui] - p0);
-  }
-}
-
-/// body_inertias for body i alone.
+/// The inertia of body i in inertial axes about the base frame origin p_0 (10 parameters,
+/// SpatialInertia::from_body). Reads the kinematics. Writes data.Ic[i] (the body alone).
 inline void body_inertia(const Model& model, Data& data, int i) {
   const auto ui = static_cast<size_t>(i);
   const Inertia& in = model.body(i).inertia;
   data.Ic[ui].set_body(in.mass, in.com, in.I, model.inertia_diagonal(i), data.R[ui], data.p[ui] - data.p[0]);
+}
+
+/// body_inertia of every body. Writes data.Ic (the bodies alone, not yet composite).
+inline void body_inertias(const Model& model, Data& data) {
+  for (int i = 0; i < model.nb(); ++i) body_inertia(model, data, i);
 }
 
 /// The composite inertia of every body's subtree (body_inertias, then each body added into its

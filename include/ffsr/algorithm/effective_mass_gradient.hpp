@@ -295,9 +295,7 @@ inline double integrated_effective_mass_gradient(const Model& model, Data& data,
   const Vector6 f = detail::unit_point_force(model, data, frame, u);
   double inv_me = 0;
   if (joints.model == JointModel::Locked) {
-    detail::body_inertias(model, data);
-    for (int i = model.nb() - 1; i > 0; --i)
-      data.Ic[static_cast<size_t>(model.body(i).parent)] += data.Ic[static_cast<size_t>(i)];
+    detail::composite_inertias(model, data);
     Vector6 yb;
     inv_me = detail::locked_inverse_form_composite(data, f, yb);
     detail::locked_inverse_form_gradient(model, data, frame, u, yb, grad);
